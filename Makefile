@@ -1,0 +1,31 @@
+# Two entry points (see README): `make optimize` and `make test`.
+VENV ?= .venv
+PY := $(VENV)/bin/python
+STAMP := $(VENV)/.installed
+CONFIG ?= configs/g1_arms.yaml
+
+.PHONY: install optimize test smoke bench clean
+
+install: $(STAMP)
+
+$(STAMP): pyproject.toml
+	python3 -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet -e ".[test]"
+	touch $(STAMP)
+
+optimize: $(STAMP)
+	$(VENV)/bin/excite optimize $(CONFIG)
+
+test: $(STAMP)
+	$(PY) -m pytest -q
+
+smoke: $(STAMP)
+	$(VENV)/bin/excite optimize configs/smoke.yaml --output results/smoke.h5
+	$(VENV)/bin/excite verify-gradient configs/smoke.yaml
+
+bench: $(STAMP)
+	$(PY) bench/bench_g1_arms.py
+
+clean:
+	rm -rf $(VENV) results

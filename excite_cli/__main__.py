@@ -1,0 +1,3 @@
+from excite_cli.cli import app
+
+app()

@@ -1,0 +1,141 @@
+"""Problem configuration: the YAML file, validated once at load (pydantic).
+
+Sections follow the pipeline: robot, trajectory, limits, optimizer, sequence, output.
+Every field is documented in README.md ("Config reference") with its unit and default.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Literal, Optional, Union
+
+import yaml
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+from excite_cli.errors import ExciteError
+
+PerJoint = Union[float, dict[str, float]]
+
+
+class _Section(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+
+class RobotConfig(_Section):
+    urdf: str = Field(description="URDF path (relative to the config file) or a path inside example-robot-data")
+    source: Literal["file", "example-robot-data"] = "file"
+    floating_base: bool = False
+    active_joints: list[str] = Field(min_length=1)
+    locked_joints: dict[str, float] = Field(default_factory=dict)
+    base_wrench_rows: bool = False
+
+
+class TrajectoryConfig(_Section):
+    harmonics: int = Field(10, ge=1)
+    base_frequency: float = Field(math.pi / 4, gt=0.0)
+    cost_samples: int = Field(40, ge=1)
+    cost_period: float = Field(0.2, gt=0.0)
+    constraint_period: float = Field(0.02, gt=0.0)
+
+    @property
+    def duration(self) -> float:
+        """Length of the trajectory [s]: cost_samples × cost_period."""
+        return self.cost_samples * self.cost_period
+
+
+class LimitsConfig(_Section):
+    position_margin: float = Field(0.0, ge=0.0)
+    velocity: Optional[PerJoint] = None
+    acceleration: PerJoint
+    check_refinement: int = Field(10, ge=10)
+
+
+class OptimizerConfig(_Section):
+    method: Literal["SLSQP"] = "SLSQP"
+    objective: Literal["log_cond", "cond"] = "log_cond"
+    max_iterations: int = Field(200, ge=1)
+    tolerance: float = Field(1e-6, gt=0.0)
+    seed: int = 0
+    restarts: int = Field(3, ge=1)
+
+
+class SequenceConfig(_Section):
+    iterations: int = Field(3, ge=1)
+    prior: Optional[str] = None
+
+
+class Problem(_Section):
+    robot: RobotConfig
+    trajectory: TrajectoryConfig = TrajectoryConfig()
+    limits: LimitsConfig
+    optimizer: OptimizerConfig = OptimizerConfig()
+    sequence: SequenceConfig = SequenceConfig()
+    output: str = "results/excite.h5"
+
+    source_path: Optional[Path] = Field(None, exclude=True)
+    source_text: str = Field("", exclude=True)
+
+    @model_validator(mode="after")
+    def _grid_fits(self) -> "Problem":
+        if self.trajectory.constraint_period > self.trajectory.duration:
+            raise ValueError(
+                "trajectory.constraint_period must not exceed the trajectory duration "
+                f"cost_samples × cost_period = {self.trajectory.duration:g} s"
+            )
+        return self
+
+    def resolve(self, path: str) -> Path:
+        """A path from the config, relative to the config file's folder (absolute paths kept)."""
+        p = Path(path).expanduser()
+        if p.is_absolute() or self.source_path is None:
+            return p
+        return self.source_path.parent / p
+
+
+def _format_validation_error(path: Path, error: ValidationError) -> str:
+    first = error.errors()[0]
+    field = ".".join(str(part) for part in first["loc"]) or "(top level)"
+    message = first["msg"]
+    if first["type"] == "missing":
+        message = "is required but missing"
+    elif first["type"] == "extra_forbidden":
+        message = "is not a known field (check its spelling; see README 'Config reference')"
+    else:
+        message = f"{message} (got {first.get('input')!r})"
+    more = len(error.errors()) - 1
+    suffix = f" (+{more} more problem{'s' if more > 1 else ''})" if more else ""
+    return f"{path}: {field}: {message}{suffix}"
+
+
+def load_problem(path: str | Path) -> Problem:
+    """Read and validate a problem YAML file.
+
+    Args:
+        path: the YAML file.
+
+    Returns:
+        The validated :class:`Problem`, with ``source_path`` and ``source_text`` set.
+
+    Raises:
+        ExciteError: missing file, malformed YAML or an invalid field; the message names the field.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise ExciteError(f"config file not found: {path}")
+    text = path.read_text()
+    try:
+        raw = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        raise ExciteError(f"{path}: malformed YAML{where}: {getattr(exc, 'problem', exc)}") from None
+    if not isinstance(raw, dict):
+        raise ExciteError(f"{path}: expected a mapping with sections robot, trajectory, limits, ...")
+    try:
+        problem = Problem.model_validate(raw)
+    except ValidationError as exc:
+        raise ExciteError(_format_validation_error(path, exc)) from None
+    problem.source_path = path.resolve()
+    problem.source_text = text
+    return problem

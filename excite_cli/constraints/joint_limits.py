@@ -1,0 +1,141 @@
+"""Joint position, velocity and acceleration limits x_min ≤ x(t) ≤ x_max (Eq. 51).
+
+Sampled on the paper's 0.02 s grid these are T × n × 3 × 2 linear inequalities (tens of thousands),
+which makes SLSQP crawl. Each (order, side, joint) is aggregated instead into one smooth inequality:
+with s_t = (x_t − x_max)/h (or (x_min − x_t)/h), h the half-width of the allowed range,
+
+    g = (1/β) log Σ_t exp(β s_t) + δ ≤ 0,
+
+a log-sum-exp that over-estimates max_t s_t by at most log(T)/β, so it is conservative. Points with
+g ≤ δ/2 are accepted (``slack``): their samples stay δ/2 inside the bounds, which covers the overshoot
+between grid instants. The final trajectory is re-checked exactly on a finer grid.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.special import logsumexp, softmax
+
+from excite_cli.config import LimitsConfig, PerJoint
+from excite_cli.constraints.constraint import Constraint, FineCheck
+from excite_cli.errors import ExciteError
+from excite_cli.robot import Robot
+from excite_cli.trajectory import FourierBasis
+
+#: β of the log-sum-exp, in units of the half-range.
+SHARPNESS = 300.0
+#: δ: margin as a fraction of the half-range; half of it is the accepted slack of SQP iterates.
+GRID_MARGIN = 0.01
+ORDERS = ("position_rad", "velocity_rad_s", "acceleration_rad_s2")
+
+
+class JointLimits(Constraint):
+    """Eq. 51 on the constraint grid, 6n aggregated inequalities.
+
+    Args:
+        lower, upper: (3, n) bounds of q [rad], q̇ [rad/s], q̈ [rad/s²].
+        basis: Fourier basis on the constraint grid.
+
+    Raises:
+        ValueError: a lower bound is not below its upper bound.
+    """
+
+    name = "joint_limits"
+    slack = GRID_MARGIN / 2.0
+
+    def __init__(self, lower: np.ndarray, upper: np.ndarray, basis: FourierBasis):
+        self.lower = np.asarray(lower, dtype=float)
+        self.upper = np.asarray(upper, dtype=float)
+        if np.any(self.upper <= self.lower):
+            raise ValueError("joint limits: an upper bound is not above its lower bound")
+        self.half = (self.upper - self.lower) / 2.0
+        self.centre = (self.upper + self.lower) / 2.0
+        self.basis = basis
+        self._orders = (basis.q, basis.qd, basis.qdd)
+
+    def _normalized(self, alpha: np.ndarray, orders: tuple[np.ndarray, ...]) -> np.ndarray:
+        """(3, T, n) samples scaled so that ±1 is a bound and 0 the centre."""
+        return np.stack([(B @ alpha.T - self.centre[d]) / self.half[d] for d, B in enumerate(orders)])
+
+    def evaluate(self, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        n, m = alpha.shape
+        z = self._normalized(alpha, self._orders)
+        s = np.concatenate([z - 1.0, -z - 1.0])  # (6, T, n): upper sides, then lower sides
+        g = logsumexp(SHARPNESS * s, axis=1) / SHARPNESS + GRID_MARGIN  # (6, n)
+        w = softmax(SHARPNESS * s, axis=1)
+        J = np.zeros((6, n, n, m))
+        idx = np.arange(n)
+        for k in range(6):
+            d, sign = k % 3, (1.0 if k < 3 else -1.0)
+            J[k, idx, idx, :] = sign * (w[k].T @ self._orders[d]) / self.half[d][:, None]
+        return g.ravel(), J.reshape(6 * n, n * m)
+
+    def check(self, alpha: np.ndarray, basis: FourierBasis) -> FineCheck:
+        z = self._normalized(alpha, (basis.q, basis.qd, basis.qdd))
+        normalized = np.abs(z).max(axis=1) - 1.0  # (3, n)
+        details = {}
+        for d, order in enumerate(ORDERS):
+            x = z[d] * self.half[d] + self.centre[d]
+            details[f"max_violation_{order}"] = float(np.max(np.maximum(x - self.upper[d], self.lower[d] - x)))
+        return FineCheck(max_violation=float(normalized.max()), details=details)
+
+    def random_start(self, coefficients: int, rng: np.random.Generator, fill: float) -> np.ndarray:
+        """Random α (n, coefficients) centred in the position range, scaled so that the largest of its
+        normalized |q − centre|, |q̇|, |q̈| on the grid equals ``fill`` (< 1: strictly feasible).
+
+        Raises:
+            ValueError: ``fill`` not in (0, 1).
+        """
+        if not 0.0 < fill < 1.0:
+            raise ValueError("fill must be in (0, 1)")
+        n = self.lower.shape[1]
+        harmonics = (coefficients - 1) // 2
+        decay = 1.0 / np.tile(np.arange(1, harmonics + 1), 2)
+        alpha = np.zeros((n, coefficients))
+        alpha[:, 1:] = rng.standard_normal((n, coefficients - 1)) * decay
+        alpha[:, 0] = self.centre[0]
+        shifted = alpha.copy()
+        shifted[:, 0] = 0.0
+        peak = np.stack([np.abs(B @ shifted.T).max(axis=0) / self.half[d] for d, B in enumerate(self._orders)])
+        alpha[:, 1:] *= (fill / peak.max(axis=0))[:, None]
+        return alpha
+
+
+def _per_joint(field: str, value: PerJoint | None, default: np.ndarray, robot: Robot) -> np.ndarray:
+    """(n,) positive limits from a scalar, a {joint: value} map (others from ``default``) or None."""
+    out = default.astype(float).copy()
+    if isinstance(value, dict):
+        for name, v in value.items():
+            if name not in robot.joint_names:
+                raise ExciteError(f"{field}: '{name}' is not an active joint")
+            out[robot.joint_names.index(name)] = v
+    elif value is not None:
+        out[:] = value
+    for name, v in zip(robot.joint_names, out):
+        if not np.isfinite(v) or v <= 0:
+            source = "the URDF has none" if value is None else f"got {v:g}"
+            raise ExciteError(f"{field}: joint '{name}' needs a positive finite limit ({source})")
+    return out
+
+
+def joint_limit_bounds(cfg: LimitsConfig, robot: Robot) -> tuple[np.ndarray, np.ndarray]:
+    """Bounds (lower, upper), each (3, n), of q [rad], q̇ [rad/s], q̈ [rad/s²] for Eq. 51.
+
+    Position: the URDF limits tightened by ``position_margin``. Velocity: the config, else the URDF.
+    Acceleration: the config (URDFs have none).
+
+    Raises:
+        ExciteError: a missing or non-positive limit, an unknown joint, or a margin that leaves no range.
+    """
+    lower = robot.lower + cfg.position_margin
+    upper = robot.upper - cfg.position_margin
+    for name, lo, hi in zip(robot.joint_names, lower, upper):
+        if not (np.isfinite(lo) and np.isfinite(hi)):
+            raise ExciteError(f"limits: joint '{name}' has no finite position limits in the URDF")
+        if hi <= lo:
+            raise ExciteError(
+                f"limits.position_margin: {cfg.position_margin:g} rad leaves no range for joint '{name}'"
+            )
+    velocity = _per_joint("limits.velocity", cfg.velocity, robot.velocity_limit, robot)
+    acceleration = _per_joint("limits.acceleration", cfg.acceleration, np.full(robot.n_joints, np.nan), robot)
+    return np.stack([lower, -velocity, -acceleration]), np.stack([upper, velocity, acceleration])

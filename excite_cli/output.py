@@ -1,0 +1,162 @@
+"""HDF5 result files (h5py), readable without excite. Schema in README.md ("Output").
+
+The file is rewritten whole after every finished iteration into a temporary file that then replaces
+the target (``os.replace`` is atomic), so an interrupted run leaves a valid file with the finished
+iterations and never a half-written one.
+"""
+
+from __future__ import annotations
+
+import os
+from datetime import datetime, timezone
+from importlib import metadata
+from pathlib import Path
+from typing import Sequence
+
+import h5py
+import numpy as np
+
+from excite_cli.base_parameters import BaseParameters
+from excite_cli.errors import ExciteError
+from excite_cli.excitation import Excitation
+from excite_cli.sequence import IterationResult
+
+UNITS = {"alpha": "rad", "time": "s", "q": "rad", "qd": "rad/s", "qdd": "rad/s^2", "regressor": "SI (N·m per parameter unit)"}
+VERSIONED_PACKAGES = ("excite", "pin", "coal", "numpy", "scipy", "h5py", "example-robot-data")
+
+
+def package_versions() -> dict[str, str]:
+    """Installed versions of the packages a result depends on."""
+    versions = {}
+    for name in VERSIONED_PACKAGES:
+        try:
+            versions[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            versions[name] = "not installed"
+    return versions
+
+
+def _strings(group: h5py.Group, name: str, values: Sequence[str]) -> None:
+    group.create_dataset(name, data=np.array(values, dtype=h5py.string_dtype()))
+
+
+def _table(results: Sequence[IterationResult]) -> np.ndarray:
+    table = np.zeros(len(results), dtype=[("iteration", "i4"), ("cond_own", "f8"), ("cond_stacked", "f8")])
+    for row, r in zip(table, results):
+        row["iteration"], row["cond_own"], row["cond_stacked"] = r.index, r.cond_own, r.cond_stacked
+    return table
+
+
+def write_result(path: Path, excitation: Excitation, results: Sequence[IterationResult], seed: int) -> None:
+    """Write (or replace atomically) the result file of a sequential generation.
+
+    Args:
+        path: target ``.h5`` file; its folder is created.
+        excitation: the problem (robot names, composition matrix, config text).
+        results: finished iterations, in order.
+        seed: the seed the run used.
+
+    Raises:
+        ExciteError: the file cannot be written.
+    """
+    path = Path(path)
+    tmp = path.with_name(path.name + ".partial")
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with h5py.File(tmp, "w") as f:
+            f.attrs["config"] = excitation.problem.source_text
+            f.attrs["config_path"] = str(excitation.problem.source_path or "")
+            f.attrs["seed"] = seed
+            f.attrs["objective"] = excitation.problem.optimizer.objective
+            f.attrs["created"] = datetime.now(timezone.utc).isoformat(timespec="seconds")
+            for name, version in package_versions().items():
+                f.attrs[f"version_{name}"] = version
+            _write_robot(f.create_group("robot"), excitation)
+            iterations = f.create_group("iterations")
+            for r in results:
+                _write_iteration(iterations.create_group(str(r.index)), r)
+            table = f.create_dataset("table", data=_table(results))
+            table.attrs["description"] = "Table I: cond of each iteration's regressor and of the stacked regressor"
+        os.replace(tmp, path)
+    except OSError as exc:
+        tmp.unlink(missing_ok=True)
+        raise ExciteError(f"output: cannot write {path}: {exc}") from None
+
+
+def _write_robot(group: h5py.Group, excitation: Excitation) -> None:
+    robot, base = excitation.robot, excitation.base
+    _strings(group, "joint_names", robot.joint_names)
+    _strings(group, "parameter_names", robot.parameter_names)
+    _strings(group, "base_parameter_names", base.names)
+    group.create_dataset("composition_matrix", data=base.composition_matrix).attrs["description"] = "X (p x b): Y_B = Y X (Eq. 2)"
+    group.create_dataset("regrouping_matrix", data=base.regrouping).attrs["description"] = "K (b x p): phi_B = K phi"
+    group.create_dataset("urdf_base_parameters", data=base.from_standard(robot.urdf_parameters()))
+    group.attrs["urdf"] = excitation.problem.robot.urdf
+    group.attrs["floating_base"] = excitation.problem.robot.floating_base
+    group.attrs["regressor_rows_per_instant"] = robot.n_rows
+
+
+def _write_iteration(group: h5py.Group, r: IterationResult) -> None:
+    for name in ("alpha", "time", "q", "qd", "qdd", "regressor"):
+        group.create_dataset(name, data=getattr(r, name)).attrs["unit"] = UNITS[name]
+    group["alpha"].attrs["layout"] = "row j: [q0_j, a_j1..a_jN, b_j1..b_jN] (Eq. 50)"
+    group.attrs["cond_own"] = r.cond_own
+    group.attrs["cond_stacked"] = r.cond_stacked
+    group.attrs["max_violation"] = r.max_violation
+    group.attrs["wall_time_s"] = r.wall_time_s
+    group.attrs["sqp_iterations"] = r.sqp_iterations
+    group.attrs["optimizer_message"] = r.message
+    for key, value in r.checks.items():
+        group.attrs[key] = value
+
+
+def read_prior(path: Path, base: BaseParameters) -> np.ndarray:
+    """Prior data C₀ (m, b) for Eq. 41 from an excite result (all iterations' regressors stacked) or
+    an HDF5 file with a dataset ``regressor`` of base-regressor rows.
+
+    Raises:
+        ExciteError: missing or unreadable file, no regressor inside, or base parameters that differ.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise ExciteError(f"sequence.prior: file not found: {path}")
+    try:
+        with h5py.File(path, "r") as f:
+            if "iterations" in f:
+                keys = sorted(f["iterations"].keys(), key=int)
+                blocks = [f["iterations"][k]["regressor"][()] for k in keys]
+                prior = np.vstack(blocks) if blocks else np.zeros((0, base.count))
+            elif "regressor" in f:
+                prior = np.asarray(f["regressor"][()], dtype=float)
+            else:
+                raise ExciteError(f"sequence.prior: {path} has neither /iterations nor /regressor")
+            names = [n.decode() if isinstance(n, bytes) else n for n in f["robot/base_parameter_names"][()]] if "robot/base_parameter_names" in f else None
+    except OSError as exc:
+        raise ExciteError(f"sequence.prior: cannot read {path} as HDF5: {exc}") from None
+    if prior.ndim != 2 or prior.shape[1] != base.count or (names is not None and names != base.names):
+        raise ExciteError(
+            f"sequence.prior: {path} was made for other base parameters "
+            f"({prior.shape[-1]} columns, the problem has {base.count})"
+        )
+    if not np.all(np.isfinite(prior)):
+        raise ExciteError(f"sequence.prior: {path} contains NaN or infinite values")
+    return prior
+
+
+def read_last_alpha(path: Path) -> tuple[int, np.ndarray]:
+    """Index k and Fourier coefficients α (n, 2N+1) of the last iteration of an excite result.
+
+    Raises:
+        ExciteError: missing or unreadable file, or no finished iteration in it.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise ExciteError(f"result file not found: {path}")
+    try:
+        with h5py.File(path, "r") as f:
+            keys = sorted(f["iterations"].keys(), key=int) if "iterations" in f else []
+            if not keys:
+                raise ExciteError(f"{path} has no finished iteration")
+            return int(keys[-1]), f["iterations"][keys[-1]]["alpha"][()]
+    except OSError as exc:
+        raise ExciteError(f"cannot read {path} as HDF5: {exc}") from None

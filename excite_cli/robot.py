@@ -1,0 +1,219 @@
+"""The robot: a pinocchio model reduced to the joints that move, and its torque regressor (Eq. 1).
+
+A floating-base robot (humanoid) keeps its free-flyer joint, held fixed at the identity pose: its
+base velocity and acceleration are zero, and the 6 base-wrench rows of the regressor can be used
+when the robot has foot force sensors. Every joint that is not active is locked at its configured
+value (default 0) and its body is merged into its parent (``pinocchio.buildReducedModel``), as the
+paper does with HRP-4's legs and waist (Section IV-B).
+"""
+
+from __future__ import annotations
+
+import difflib
+from dataclasses import dataclass, field
+from importlib import metadata
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from excite_cli.config import Problem, RobotConfig
+from excite_cli.errors import ExciteError
+
+#: Order of pinocchio's 10 dynamic parameters of one body (``Inertia.toDynamicParameters``).
+PARAMETER_SYMBOLS = ("m", "mx", "my", "mz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz")
+
+
+def example_robot_data_root() -> Path:
+    """Folder ``share`` of the installed example-robot-data package (holds ``example-robot-data/robots``).
+
+    Raises:
+        ExciteError: the package is not installed.
+    """
+    try:
+        dist = metadata.distribution("example-robot-data")
+    except metadata.PackageNotFoundError:
+        raise ExciteError("robot.source: example-robot-data is not installed (run `make install`)") from None
+    return Path(dist.locate_file("cmeel.prefix/share")).resolve()
+
+
+def resolve_urdf(problem: Problem) -> tuple[Path, list[str]]:
+    """The URDF file named by ``robot.urdf`` and the package folders its meshes are found in.
+
+    Raises:
+        ExciteError: the file does not exist.
+    """
+    cfg = problem.robot
+    if cfg.source == "example-robot-data":
+        share = example_robot_data_root()
+        path = share / "example-robot-data" / "robots" / cfg.urdf
+        dirs = [str(share)]
+    else:
+        path = problem.resolve(cfg.urdf)
+        dirs = [str(path.parent), str(path.parent.parent)]
+    if not path.is_file():
+        raise ExciteError(f"robot.urdf: no URDF file at {path}")
+    return path, dirs
+
+
+def _unknown_joint(field_name: str, name: str, known: list[str]) -> ExciteError:
+    close = difflib.get_close_matches(name, known, n=1)
+    hint = f"; did you mean '{close[0]}'?" if close else ""
+    return ExciteError(f"{field_name}: '{name}' is not a joint of the robot{hint}")
+
+
+@dataclass
+class Robot:
+    """Reduced pinocchio model with the active joints' indices and limits.
+
+    Attributes:
+        model: reduced pinocchio model (locked joints removed).
+        joint_names: the n active joints, in config order.
+        q_idx, v_idx: (n,) indices of the active joints in the model's q and v.
+        row_idx: (n_rows,) indices in v of the regressor rows: the base wrench (6) if requested, then
+            the active joints.
+        q_reference: (model.nq,) configuration with the base at identity and locked joints set.
+        lower, upper: (n,) URDF position limits [rad].
+        velocity_limit: (n,) URDF velocity limits [rad/s] (0 or inf where the URDF has none).
+        body_names: (model.njoints - 1,) the link carried by each joint, for parameter names.
+    """
+
+    model: pin.Model
+    joint_names: list[str]
+    q_idx: np.ndarray
+    v_idx: np.ndarray
+    row_idx: np.ndarray
+    q_reference: np.ndarray
+    lower: np.ndarray
+    upper: np.ndarray
+    velocity_limit: np.ndarray
+    body_names: list[str]
+    data: pin.Data = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        self.data = self.model.createData()
+
+    @property
+    def n_joints(self) -> int:
+        return len(self.joint_names)
+
+    @property
+    def n_rows(self) -> int:
+        """Regressor rows per time instant."""
+        return len(self.row_idx)
+
+    @property
+    def n_parameters(self) -> int:
+        """Number p of standard inertial parameters (10 per body of the reduced model)."""
+        return 10 * (self.model.njoints - 1)
+
+    @property
+    def parameter_names(self) -> list[str]:
+        """(p,) names such as ``Izz_left_elbow_link``."""
+        return [f"{s}_{body}" for body in self.body_names for s in PARAMETER_SYMBOLS]
+
+    def urdf_parameters(self) -> np.ndarray:
+        """(p,) a-priori standard parameters φ from the URDF [kg, kg·m, kg·m²]."""
+        return np.concatenate([self.model.inertias[j].toDynamicParameters() for j in range(1, self.model.njoints)])
+
+    def state(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Full model (q, v, a) from the active joints' (n,) values; base and locked joints at rest."""
+        qf = self.q_reference.copy()
+        vf = np.zeros(self.model.nv)
+        af = np.zeros(self.model.nv)
+        qf[self.q_idx] = q
+        vf[self.v_idx] = qd
+        af[self.v_idx] = qdd
+        return qf, vf, af
+
+    def regressor(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
+        """Torque regressor Y(q, q̇, q̈) of Eq. 1, rows ``row_idx``: (n_rows, p).
+
+        Args:
+            q, qd, qdd: (n,) active joints' position [rad], velocity [rad/s], acceleration [rad/s²].
+        """
+        Y = pin.computeJointTorqueRegressor(self.model, self.data, *self.state(q, qd, qdd))
+        return Y[self.row_idx]
+
+    def regressor_stack(self, Q: np.ndarray, QD: np.ndarray, QDD: np.ndarray) -> np.ndarray:
+        """Regressors at T instants stacked as in Eq. 3: (T·n_rows, p) from (T, n) arrays."""
+        return np.vstack([self.regressor(Q[t], QD[t], QDD[t]) for t in range(Q.shape[0])])
+
+    def torques(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
+        """Inverse dynamics τ (RNEA) of the URDF model, rows ``row_idx``: (n_rows,) [Nm, N]."""
+        return pin.rnea(self.model, self.data, *self.state(q, qd, qdd))[self.row_idx].copy()
+
+    def random_states(self, count: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(count, n) random positions within the limits, and standard-normal velocities and accelerations."""
+        lo = np.where(np.isfinite(self.lower), self.lower, -np.pi)
+        hi = np.where(np.isfinite(self.upper), self.upper, np.pi)
+        Q = rng.uniform(lo, hi, size=(count, self.n_joints))
+        return Q, rng.standard_normal(Q.shape), rng.standard_normal(Q.shape)
+
+
+def _body_name(model: pin.Model, joint_id: int) -> str:
+    for frame in model.frames:
+        if frame.parentJoint == joint_id and frame.type == pin.FrameType.BODY:
+            return frame.name
+    return model.names[joint_id]
+
+
+def load_robot(problem: Problem) -> Robot:
+    """Build the :class:`Robot` of a problem: load the URDF, lock the non-active joints.
+
+    Raises:
+        ExciteError: missing URDF, unknown joint name, a joint that is not 1-DoF, a locked value
+            outside the joint's limits.
+    """
+    cfg: RobotConfig = problem.robot
+    path, _ = resolve_urdf(problem)
+    try:
+        if cfg.floating_base:
+            full = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
+        else:
+            full = pin.buildModelFromUrdf(str(path))
+    except (RuntimeError, ValueError) as exc:
+        raise ExciteError(f"robot.urdf: cannot read {path}: {exc}") from None
+
+    movable = [n for j, n in enumerate(full.names) if j > 0 and full.joints[j].shortname() != "JointModelFreeFlyer"]
+    for name in cfg.active_joints:
+        if name not in movable:
+            raise _unknown_joint("robot.active_joints", name, movable)
+        if full.joints[full.getJointId(name)].nq != 1:
+            raise ExciteError(f"robot.active_joints: '{name}' is not a 1-DoF revolute or prismatic joint")
+    if len(set(cfg.active_joints)) != len(cfg.active_joints):
+        raise ExciteError("robot.active_joints: a joint is listed twice")
+    for name, value in cfg.locked_joints.items():
+        if name not in movable:
+            raise _unknown_joint("robot.locked_joints", name, movable)
+        if name in cfg.active_joints:
+            raise ExciteError(f"robot.locked_joints: '{name}' is also an active joint")
+        j = full.getJointId(name)
+        lo, hi = full.lowerPositionLimit[full.idx_qs[j]], full.upperPositionLimit[full.idx_qs[j]]
+        if full.joints[j].nq == 1 and not lo <= value <= hi:
+            raise ExciteError(f"robot.locked_joints.{name}: {value} rad is outside the joint limits [{lo:g}, {hi:g}]")
+
+    q_full = pin.neutral(full)
+    for name, value in cfg.locked_joints.items():
+        q_full[full.idx_qs[full.getJointId(name)]] = value
+    lock_ids = [full.getJointId(n) for n in movable if n not in cfg.active_joints]
+    model = pin.buildReducedModel(full, lock_ids, q_full) if lock_ids else full
+
+    ids = [model.getJointId(n) for n in cfg.active_joints]
+    q_idx = np.array([model.idx_qs[j] for j in ids])
+    v_idx = np.array([model.idx_vs[j] for j in ids])
+    base_rows = np.arange(6) if (cfg.floating_base and cfg.base_wrench_rows) else np.arange(0)
+    if cfg.base_wrench_rows and not cfg.floating_base:
+        raise ExciteError("robot.base_wrench_rows: needs robot.floating_base: true")
+    return Robot(
+        model=model,
+        joint_names=list(cfg.active_joints),
+        q_idx=q_idx,
+        v_idx=v_idx,
+        row_idx=np.concatenate([base_rows, v_idx]).astype(int),
+        q_reference=pin.neutral(model),
+        lower=model.lowerPositionLimit[q_idx].copy(),
+        upper=model.upperPositionLimit[q_idx].copy(),
+        velocity_limit=model.velocityLimit[v_idx].copy(),
+        body_names=[_body_name(model, j) for j in range(1, model.njoints)],
+    )
