@@ -71,8 +71,6 @@ def optimize_trajectory(
     shape = (n, criterion.basis.q.shape[1])
     cache: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
 
-    slack = np.concatenate([np.full(c.evaluate(np.zeros(shape))[0].size, c.slack) for c in constraints])
-
     def constraint_values(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         key = x.tobytes()
         if key not in cache:
@@ -86,7 +84,7 @@ def optimize_trajectory(
     def objective(x: np.ndarray) -> tuple[float, np.ndarray]:
         value, grad = criterion.value_and_gradient(x.reshape(shape))
         last_value[0] = value
-        if np.all(constraint_values(x)[0] <= slack) and value < best_feasible.get("value", np.inf):
+        if value < best_feasible.get("value", np.inf) and all(c.accepts(x.reshape(shape)) for c in constraints):
             best_feasible.update(value=value, x=x.copy())
         return value, grad.ravel()
 
@@ -117,7 +115,12 @@ def optimize_trajectory(
             callback=callback,
         )
         total_iterations += int(result.nit)
-        # SQP iterates need not be feasible: keep the best feasible point evaluated (x0 is one).
+        # SQP iterates approach the boundary from outside: repair the last one where the
+        # constraints can, then keep the best feasible point evaluated (x0 always is one).
+        repaired = result.x.reshape(shape)
+        for c in constraints:
+            repaired = c.restore(repaired)
+        objective(repaired.ravel())
         candidate = (float(best_feasible["value"]), np.asarray(best_feasible["x"]).reshape(shape), str(result.message))
         if best is None or candidate[0] < best[0]:
             best = candidate

@@ -28,13 +28,14 @@ class Constraint(ABC):
 
     Attributes:
         name: short identifier.
-        slack: largest value of g at which the constraint still holds on the grid (g carries a
-            margin). SQP iterates approach the boundary from outside; points with g ≤ slack are
-            accepted as feasible.
+        basis: Fourier basis on the constraint grid.
+        grid_margin: normalized margin the exact grid samples must keep for α to be accepted; it
+            covers the overshoot between grid instants.
     """
 
     name: str
-    slack: float = 0.0
+    basis: FourierBasis
+    grid_margin: float = 0.0
 
     @abstractmethod
     def evaluate(self, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -43,3 +44,11 @@ class Constraint(ABC):
     @abstractmethod
     def check(self, alpha: np.ndarray, basis: FourierBasis) -> FineCheck:
         """Exact (not aggregated) re-check of α on the instants of ``basis``."""
+
+    def accepts(self, alpha: np.ndarray) -> bool:
+        """Whether α satisfies the constraint on the grid, exactly, with ``grid_margin`` to spare."""
+        return self.check(alpha, self.basis).max_violation <= -self.grid_margin
+
+    def restore(self, alpha: np.ndarray) -> np.ndarray:
+        """A nearby α that satisfies this constraint, where a cheap exact repair exists (default: α)."""
+        return alpha

@@ -6,9 +6,10 @@ with s_t = (x_t − x_max)/h (or (x_min − x_t)/h), h the half-width of the all
 
     g = (1/β) log Σ_t exp(β s_t) + δ ≤ 0,
 
-a log-sum-exp that over-estimates max_t s_t by at most log(T)/β, so it is conservative. Points with
-g ≤ δ/2 are accepted (``slack``): their samples stay δ/2 inside the bounds, which covers the overshoot
-between grid instants. The final trajectory is re-checked exactly on a finer grid.
+a log-sum-exp that over-estimates max_t s_t by at most log(T)/β, so it is conservative. SQP iterates
+approach g = 0 from outside, so a point is accepted when its exact grid samples stay δ/2 inside the
+bounds (``grid_margin``), which covers the overshoot between grid instants. The final trajectory is
+re-checked exactly on a finer grid.
 """
 
 from __future__ import annotations
@@ -24,7 +25,7 @@ from excite_cli.trajectory import FourierBasis
 
 #: β of the log-sum-exp, in units of the half-range.
 SHARPNESS = 300.0
-#: δ: margin as a fraction of the half-range; half of it is the accepted slack of SQP iterates.
+#: δ: margin as a fraction of the half-range; half of it must remain on the grid for acceptance.
 GRID_MARGIN = 0.01
 ORDERS = ("position_rad", "velocity_rad_s", "acceleration_rad_s2")
 
@@ -41,7 +42,7 @@ class JointLimits(Constraint):
     """
 
     name = "joint_limits"
-    slack = GRID_MARGIN / 2.0
+    grid_margin = GRID_MARGIN / 2.0
 
     def __init__(self, lower: np.ndarray, upper: np.ndarray, basis: FourierBasis):
         self.lower = np.asarray(lower, dtype=float)
@@ -78,6 +79,26 @@ class JointLimits(Constraint):
             x = z[d] * self.half[d] + self.centre[d]
             details[f"max_violation_{order}"] = float(np.max(np.maximum(x - self.upper[d], self.lower[d] - x)))
         return FineCheck(max_violation=float(normalized.max()), details=details)
+
+    def restore(self, alpha: np.ndarray) -> np.ndarray:
+        """Scale each joint's oscillation about its offset q0 (clamped into the range) so that its
+        samples stay 1 − δ inside every bound on the grid: the smallest change of shape that makes a
+        slightly violating SQP iterate feasible. α (n, 2N+1) in, same shape out."""
+        inner = 1.0 - GRID_MARGIN
+        out = alpha.copy()
+        out[:, 0] = np.clip(out[:, 0], self.centre[0] - inner * self.half[0], self.centre[0] + inner * self.half[0])
+        offset = (out[:, 0] - self.centre[0]) / self.half[0]  # (n,)
+        wave = out.copy()
+        wave[:, 0] = 0.0
+        scale = np.ones(out.shape[0])
+        for d, B in enumerate(self._orders):
+            o = (B @ wave.T) / self.half[d]  # (T, n) normalized oscillation
+            z0 = offset if d == 0 else np.zeros_like(offset)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                room = np.where(o > 0, (inner - z0) / o, np.where(o < 0, (inner + z0) / -o, np.inf))
+            scale = np.minimum(scale, room.min(axis=0))
+        out[:, 1:] *= np.clip(scale, 0.0, 1.0)[:, None]
+        return out
 
     def random_start(self, coefficients: int, rng: np.random.Generator, fill: float) -> np.ndarray:
         """Random α (n, coefficients) centred in the position range, scaled so that the largest of its

@@ -1,0 +1,64 @@
+"""Analytic gradient of cond / log cond (Eqs. 17, 45-49) against central finite differences."""
+
+import numpy as np
+import pytest
+
+from conftest import small
+from excite_cli.criterion import ConditionNumber, condition_number
+from excite_cli.excitation import build_excitation
+from excite_cli.verify import check_gradient, finite_difference_gradient
+
+
+def _feasible_alpha(excitation, seed=0):
+    return excitation.limits.random_start(excitation.trajectory.n_coefficients, np.random.default_rng(seed), 0.7)
+
+
+@pytest.mark.parametrize("name", ["g1_problem", "panda_problem", "ur5_problem"])
+@pytest.mark.parametrize("objective", ["cond", "log_cond"])
+def test_gradient_matches_finite_differences(name, objective, request):
+    problem = small(request.getfixturevalue(name))
+    problem.optimizer.objective = objective
+    excitation = build_excitation(problem)
+    criterion = excitation.criterion()
+    alpha = _feasible_alpha(excitation)
+    _, analytic = criterion.value_and_gradient(alpha)
+    fd = finite_difference_gradient(criterion, alpha, step=1e-6, central=True)
+    assert np.linalg.norm(analytic - fd) / np.linalg.norm(fd) < 1e-6
+
+
+def test_gradient_with_prior_rows_and_base_wrench_rows(g1_problem):
+    problem = small(g1_problem, harmonics=3, samples=15)
+    problem.robot.base_wrench_rows = True
+    excitation = build_excitation(problem)
+    assert excitation.robot.n_rows == 6 + 14
+    prior = excitation.criterion().regressor(_feasible_alpha(excitation, seed=5))
+    criterion = excitation.criterion(prior)
+    check = check_gradient(criterion, _feasible_alpha(excitation, seed=6), repeats=1)
+    assert check.error_central < 1e-6
+
+
+def test_value_is_the_condition_number_of_the_stacked_regressor(panda_problem):
+    excitation = build_excitation(small(panda_problem))
+    a, b = _feasible_alpha(excitation, 1), _feasible_alpha(excitation, 2)
+    prior = excitation.criterion().regressor(a)
+    criterion = ConditionNumber(excitation.robot, excitation.base, excitation.cost_basis, prior=prior, log=False)
+    stacked = np.vstack([prior, criterion.regressor(b)])
+    s = np.linalg.svd(stacked, compute_uv=False)
+    assert criterion.value(b) == pytest.approx(s[0] / s[-1], rel=1e-12)
+
+
+def test_rank_loss_gives_finite_values():
+    C = np.zeros((5, 3))
+    C[:, 0] = 1.0
+    assert condition_number(C) == float("inf")
+    assert condition_number(np.ones((2, 3))) == float("inf")
+
+
+def test_motionless_trajectory_gives_finite_value_and_gradient(panda_problem):
+    # q constant: only gravity is excited, C loses rank, yet nothing is NaN.
+    excitation = build_excitation(small(panda_problem))
+    alpha = np.zeros((7, excitation.trajectory.n_coefficients))
+    alpha[:, 0] = excitation.limits.centre[0]
+    value, grad = excitation.criterion().value_and_gradient(alpha)
+    assert np.isfinite(value) and value > np.log(1e8)
+    assert np.all(np.isfinite(grad))

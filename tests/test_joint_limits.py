@@ -1,0 +1,72 @@
+"""Joint limits (Eq. 51): aggregated values, their Jacobian, conservativeness and the fine re-check."""
+
+import numpy as np
+import pytest
+
+from conftest import small
+from excite_cli.constraints.joint_limits import GRID_MARGIN, JointLimits
+from excite_cli.excitation import build_excitation
+
+
+@pytest.fixture
+def panda(panda_problem):
+    return build_excitation(small(panda_problem))
+
+
+def test_jacobian_matches_finite_differences(panda):
+    limits = panda.limits
+    alpha = limits.random_start(panda.trajectory.n_coefficients, np.random.default_rng(0), 0.95)
+    g, J = limits.evaluate(alpha)
+    fd = np.zeros_like(J)
+    for k in range(alpha.size):
+        e = np.zeros(alpha.size)
+        e[k] = 1e-7
+        fd[:, k] = (limits.evaluate(alpha + e.reshape(alpha.shape))[0] - limits.evaluate(alpha - e.reshape(alpha.shape))[0]) / 2e-7
+    assert np.linalg.norm(J - fd) / np.linalg.norm(fd) < 1e-6
+
+
+def test_aggregate_is_conservative_and_tight(panda):
+    limits = panda.limits
+    rng = np.random.default_rng(1)
+    for _ in range(5):
+        alpha = limits.random_start(panda.trajectory.n_coefficients, rng, rng.uniform(0.3, 0.99))
+        alpha[:, 1:] *= rng.uniform(0.8, 1.3)  # some beyond the limits
+        g = limits.evaluate(alpha)[0].reshape(6, -1)
+        z = np.stack([(B @ alpha.T - limits.centre[d]) / limits.half[d] for d, B in enumerate((panda.grid_basis.q, panda.grid_basis.qd, panda.grid_basis.qdd))])
+        exact = np.concatenate([z.max(axis=1) - 1.0, -z.min(axis=1) - 1.0])
+        assert np.all(g >= exact + GRID_MARGIN - 1e-12)
+        assert np.all(g <= exact + GRID_MARGIN + np.log(z.shape[1]) / 300.0)
+
+
+def test_random_start_fills_the_requested_fraction(panda):
+    alpha = panda.limits.random_start(panda.trajectory.n_coefficients, np.random.default_rng(2), 0.6)
+    check = panda.limits.check(alpha, panda.grid_basis)
+    assert check.max_violation == pytest.approx(-0.4, abs=1e-9)
+
+
+def test_fine_check_reports_physical_violation():
+    basis_times = np.linspace(0, 2 * np.pi, 2001)
+    from excite_cli.trajectory import FourierTrajectory
+
+    basis = FourierTrajectory(1, 1.0).basis(basis_times)
+    lower = np.array([[-1.0], [-1.0], [-1.0]])
+    upper = np.array([[1.0], [1.0], [1.0]])
+    limits = JointLimits(lower, upper, basis)
+    check = limits.check(np.array([[0.0, 1.2, 0.0]]), basis)  # q = 1.2 sin t
+    assert check.details["max_violation_position_rad"] == pytest.approx(0.2, abs=1e-6)
+    assert check.max_violation == pytest.approx(0.2, abs=1e-6)
+
+
+def test_restore_repairs_a_violating_trajectory_minimally(panda):
+    limits = panda.limits
+    rng = np.random.default_rng(4)
+    alpha = limits.random_start(panda.trajectory.n_coefficients, rng, 0.9)
+    alpha[:, 1:] *= 1.2  # 8% beyond the limits
+    alpha[0, 0] = limits.upper[0, 0] + 0.3  # offset outside the range
+    assert limits.check(alpha, panda.grid_basis).max_violation > 0
+    repaired = limits.restore(alpha)
+    check = limits.check(repaired, panda.grid_basis)
+    assert check.max_violation == pytest.approx(-GRID_MARGIN, abs=1e-9)
+    # joints that were inside stay untouched up to the common scale; shapes are kept
+    ratio = repaired[:, 1:] / alpha[:, 1:]
+    assert np.allclose(ratio, ratio[:, :1])

@@ -1,0 +1,107 @@
+"""`excite optimize` end to end on a small UR5 problem: HDF5 schema, Table I, limits, interruption, prior."""
+
+import copy
+
+import h5py
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+import excite_cli.sequence as sequence
+from conftest import UR5, write_config
+from excite_cli.cli import app
+
+runner = CliRunner()
+
+
+def _data(iterations=2):
+    data = copy.deepcopy(UR5)
+    data["trajectory"].update(harmonics=3, cost_samples=20, cost_period=0.4, constraint_period=0.05)
+    data["optimizer"] = {"max_iterations": 60, "restarts": 1, "seed": 3}
+    data["sequence"] = {"iterations": iterations}
+    return data
+
+
+@pytest.fixture(scope="module")
+def result(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("run")
+    out = tmp / "ur5.h5"
+    run = runner.invoke(app, ["optimize", str(write_config(tmp, _data(iterations=1))), "-o", str(out), "-k", "3"])
+    assert run.exit_code == 0, run.output
+    return out, run.output
+
+
+def test_schema(result):
+    out, _ = result
+    with h5py.File(out) as f:
+        assert [n.decode() for n in f["robot/joint_names"][()]][0] == "shoulder_pan_joint"
+        b = f["robot/base_parameter_names"].shape[0]
+        assert f["robot/composition_matrix"].shape == (60, b)
+        assert sorted(f["iterations"].keys()) == ["1", "2", "3"]
+        it = f["iterations/2"]
+        assert it["alpha"].shape == (6, 7)
+        assert it["q"].shape == it["qd"].shape == it["qdd"].shape == (it["time"].shape[0], 6)
+        assert it["regressor"].shape == (20 * 6, b)
+        for key in ("cond_own", "cond_stacked", "max_violation", "wall_time_s"):
+            assert key in it.attrs
+        assert list(f["table"]["iteration"]) == [1, 2, 3]
+        assert "harmonics" in f.attrs["config"] and f.attrs["seed"] == 3 and "version_pin" in f.attrs
+
+
+def test_table_is_consistent_and_limits_hold(result):
+    out, output = result
+    with h5py.File(out) as f:
+        blocks = [f[f"iterations/{k}/regressor"][()] for k in "123"]
+        table = f["table"][()]
+        for k in range(3):
+            s = np.linalg.svd(np.vstack(blocks[: k + 1]), compute_uv=False)
+            assert table["cond_stacked"][k] == pytest.approx(s[0] / s[-1], rel=1e-9)
+            s_own = np.linalg.svd(blocks[k], compute_uv=False)
+            assert table["cond_own"][k] == pytest.approx(s_own[0] / s_own[-1], rel=1e-9)
+            attrs = f[f"iterations/{k + 1}"].attrs
+            assert attrs["max_violation"] <= 0.0
+            q, qd = f[f"iterations/{k + 1}/q"][()], f[f"iterations/{k + 1}/qd"][()]
+            assert np.all(np.abs(qd) <= 3.2) and np.all(q >= -6.2) and np.all(q <= 6.2)
+    assert np.all(np.diff(table["cond_stacked"]) <= 0)
+    assert "Table I" in output
+
+
+def test_plots_written(result):
+    out, _ = result
+    assert out.with_name("ur5_trajectories.png").stat().st_size > 10_000
+    assert out.with_name("ur5_cond.png").stat().st_size > 5_000
+
+
+def test_prior_rows_are_stacked_first(result, tmp_path):
+    previous, _ = result
+    data = _data(iterations=1)
+    data["sequence"]["prior"] = str(previous)
+    out = tmp_path / "next.h5"
+    run = runner.invoke(app, ["optimize", str(write_config(tmp_path, data)), "-o", str(out)])
+    assert run.exit_code == 0, run.output
+    with h5py.File(previous) as f:
+        prior = np.vstack([f[f"iterations/{k}/regressor"][()] for k in "123"])
+    with h5py.File(out) as f:
+        own = f["iterations/1/regressor"][()]
+        s = np.linalg.svd(np.vstack([prior, own]), compute_uv=False)
+        assert f["iterations/1"].attrs["cond_stacked"] == pytest.approx(s[0] / s[-1], rel=1e-9)
+
+
+def test_interrupted_run_keeps_finished_iterations(tmp_path, monkeypatch):
+    real = sequence.optimize_trajectory
+    calls = []
+
+    def interrupt_second(*args, **kwargs):
+        calls.append(1)
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(sequence, "optimize_trajectory", interrupt_second)
+    out = tmp_path / "cut.h5"
+    run = runner.invoke(app, ["optimize", str(write_config(tmp_path, _data(iterations=3))), "-o", str(out)])
+    assert run.exit_code == 130
+    assert "kept 1 finished iteration" in run.output
+    with h5py.File(out) as f:
+        assert list(f["iterations"].keys()) == ["1"] and len(f["table"]) == 1
+    assert not out.with_name("cut.h5.partial").exists()
