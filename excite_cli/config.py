@@ -28,6 +28,7 @@ class RobotConfig(_Section):
     floating_base: bool = False
     active_joints: list[str] = Field(min_length=1)
     locked_joints: dict[str, float] = Field(default_factory=dict)
+    home_posture: dict[str, float] = Field(default_factory=dict)
     base_wrench_rows: bool = False
 
 
@@ -51,6 +52,40 @@ class LimitsConfig(_Section):
     check_refinement: int = Field(10, ge=10)
 
 
+class ComConfig(_Section):
+    support_links: list[str] = Field(default_factory=list)
+    centre: Optional[tuple[float, float]] = None
+    radius: Optional[float] = Field(None, gt=0.0)
+    polygon: Optional[list[tuple[float, float]]] = Field(None, min_length=3)
+
+    @model_validator(mode="after")
+    def _one_region(self) -> "ComConfig":
+        if (self.radius is None) == (self.polygon is None):
+            raise ValueError("give exactly one of radius [m] or polygon [[x, y], ...] [m]")
+        if bool(self.support_links) == (self.centre is not None):
+            raise ValueError("give exactly one of support_links or centre [x, y] [m]")
+        return self
+
+
+class CapsuleConfig(_Section):
+    link: str
+    radius: float = Field(gt=0.0)
+    start: tuple[float, float, float]
+    end: tuple[float, float, float]
+
+
+class SelfCollisionConfig(_Section):
+    capsules: Union[Literal["auto"], list[CapsuleConfig]] = "auto"
+    ignore_links: list[str] = Field(default_factory=list)
+    exclude_pairs: list[tuple[str, str]] = Field(default_factory=list)
+    margin: float = Field(0.01, ge=0.0)
+
+
+class ConstraintsConfig(_Section):
+    com: Optional[ComConfig] = None
+    self_collision: Optional[SelfCollisionConfig] = None
+
+
 class OptimizerConfig(_Section):
     method: Literal["SLSQP"] = "SLSQP"
     objective: Literal["log_cond", "cond"] = "log_cond"
@@ -69,6 +104,7 @@ class Problem(_Section):
     robot: RobotConfig
     trajectory: TrajectoryConfig = TrajectoryConfig()
     limits: LimitsConfig
+    constraints: ConstraintsConfig = ConstraintsConfig()
     optimizer: OptimizerConfig = OptimizerConfig()
     sequence: SequenceConfig = SequenceConfig()
     output: str = "results/excite.h5"

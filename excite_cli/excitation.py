@@ -12,9 +12,13 @@ import numpy as np
 
 from excite_cli.base_parameters import BaseParameters, compute_base_parameters
 from excite_cli.config import Problem
-from excite_cli.constraints import Constraint, JointLimits
+from excite_cli.capsules import capsule_pairs, capsules_from_config
+from excite_cli.constraints import Constraint, JointLimits, SelfCollision
+from excite_cli.constraints.com_region import com_region_from_config
 from excite_cli.constraints.joint_limits import joint_limit_bounds
+from excite_cli.constraints.lse import GRID_MARGIN
 from excite_cli.criterion import ConditionNumber
+from excite_cli.errors import ExciteError
 from excite_cli.robot import Robot, load_robot
 from excite_cli.trajectory import FourierBasis, FourierTrajectory, sample_times
 
@@ -31,7 +35,7 @@ class Excitation:
         grid_basis: basis on the constraint grid (every ``constraint_period``, end included).
         fine_basis: basis on the check grid, ``check_refinement`` times finer.
         limits: joint limits (Eq. 51).
-        constraints: all constraints handed to the optimizer.
+        constraints: all constraints handed to the optimizer (joint limits first).
     """
 
     problem: Problem
@@ -54,6 +58,28 @@ class Excitation:
             log=self.problem.optimizer.objective == "log_cond",
         )
 
+    @property
+    def home(self) -> np.ndarray:
+        """(n,) the robot's home posture [rad] moved inside the position bounds by their margin."""
+        inner = (1.0 - GRID_MARGIN) * self.limits.half[0]
+        return np.clip(self.robot.home, self.limits.centre[0] - inner, self.limits.centre[0] + inner)
+
+    def static(self) -> np.ndarray:
+        """α (n, 2N+1) of standing still at the home posture."""
+        alpha = np.zeros((self.robot.n_joints, self.trajectory.n_coefficients))
+        alpha[:, 0] = self.home
+        return alpha
+
+    def random_start(self, rng: np.random.Generator) -> np.ndarray:
+        """Random α (n, 2N+1) about the home posture that every constraint accepts: random Fourier
+        coefficients filling 50-90 % of the joint limits, shrunk until the other constraints hold."""
+        alpha = self.limits.random_start(self.trajectory.n_coefficients, rng, rng.uniform(0.5, 0.9), self.home)
+        for _ in range(40):
+            if all(c.accepts(alpha) for c in self.constraints):
+                return alpha
+            alpha[:, 1:] *= 0.7
+        return self.static()
+
 
 def build_excitation(problem: Problem) -> Excitation:
     """Load the robot and set up bases and constraints for ``problem``.
@@ -61,14 +87,22 @@ def build_excitation(problem: Problem) -> Excitation:
     Raises:
         ExciteError: bad robot or limits input (see :func:`load_robot`, :func:`joint_limit_bounds`).
     """
-    robot = load_robot(problem)
+    ccfg = problem.constraints
+    robot = load_robot(problem, collision=bool(ccfg.self_collision or (ccfg.com and ccfg.com.support_links)))
     base = compute_base_parameters(robot)
     tcfg = problem.trajectory
     trajectory = FourierTrajectory(tcfg.harmonics, tcfg.base_frequency)
     fine_period = tcfg.constraint_period / problem.limits.check_refinement
     grid_basis = trajectory.basis(sample_times(tcfg.duration, tcfg.constraint_period, include_end=True))
     limits = JointLimits(*joint_limit_bounds(problem.limits, robot), grid_basis)
-    return Excitation(
+    constraints: list[Constraint] = [limits]
+    if ccfg.com is not None:
+        constraints.append(com_region_from_config(ccfg.com, robot, grid_basis))
+    if ccfg.self_collision is not None:
+        capsules = capsules_from_config(ccfg.self_collision, robot)
+        pairs = capsule_pairs(ccfg.self_collision, robot, capsules)
+        constraints.append(SelfCollision(robot, grid_basis, capsules, pairs, ccfg.self_collision.margin))
+    excitation = Excitation(
         problem=problem,
         robot=robot,
         base=base,
@@ -77,5 +111,25 @@ def build_excitation(problem: Problem) -> Excitation:
         grid_basis=grid_basis,
         fine_basis=trajectory.basis(sample_times(tcfg.duration, fine_period, include_end=True)),
         limits=limits,
-        constraints=[limits],
+        constraints=constraints,
     )
+    _check_home_posture(excitation)
+    return excitation
+
+
+def _check_home_posture(excitation: Excitation) -> None:
+    """Stop before optimizing when standing still at the home posture already violates a constraint.
+
+    Raises:
+        ExciteError: naming the constraint and where it fails (the capsule pair, the CoM distance).
+    """
+    static = excitation.static()
+    fields = {"joint_limits": "robot.home_posture", "com_region": "constraints.com",
+              "self_collision": "constraints.self_collision"}
+    for c in excitation.constraints:
+        check = c.check(static, excitation.grid_basis)
+        if check.max_violation > -c.grid_margin:
+            raise ExciteError(
+                f"{fields[c.name]}: violated before optimization, at the home posture with the locked "
+                f"joints: {check.where or 'joint limits'}"
+            )

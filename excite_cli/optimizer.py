@@ -15,7 +15,7 @@ import numpy as np
 from scipy.optimize import minimize
 
 from excite_cli.config import OptimizerConfig
-from excite_cli.constraints import Constraint, JointLimits
+from excite_cli.constraints import Constraint
 from excite_cli.criterion import ConditionNumber
 
 #: Progress hook: (restart index, SLSQP iteration, current objective value).
@@ -46,26 +46,55 @@ def _stack(constraints: Sequence[Constraint], x: np.ndarray, shape: tuple[int, i
     return np.concatenate([g for g, _ in parts]), np.vstack([J for _, J in parts])
 
 
+def _accepted(constraints: Sequence[Constraint], alpha: np.ndarray) -> bool:
+    return all(c.accepts(alpha) for c in constraints)
+
+
+def repair(constraints: Sequence[Constraint], alpha: np.ndarray, feasible: np.ndarray, steps: int = 12) -> np.ndarray:
+    """A feasible point near α: the constraints' own exact repairs, then, if some constraint still
+    rejects it, the farthest point towards it from ``feasible`` (bisection on the segment).
+
+    Args:
+        constraints: all constraints.
+        alpha: (n, 2N+1) point to repair, typically the last SQP iterate.
+        feasible: (n, 2N+1) point every constraint accepts (the restart's start).
+        steps: bisection steps.
+    """
+    for c in constraints:
+        alpha = c.restore(alpha)
+    if _accepted(constraints, alpha):
+        return alpha
+    lo, hi = 0.0, 1.0
+    for _ in range(steps):
+        mid = (lo + hi) / 2.0
+        lo, hi = (mid, hi) if _accepted(constraints, feasible + mid * (alpha - feasible)) else (lo, mid)
+    return feasible + lo * (alpha - feasible)
+
+
 def optimize_trajectory(
     criterion: ConditionNumber,
-    limits: JointLimits,
     constraints: Sequence[Constraint],
     options: OptimizerConfig,
     rng: np.random.Generator,
+    start: Callable[[np.random.Generator], np.ndarray],
     progress: Optional[ProgressHook] = None,
 ) -> OptimizationResult:
     """Minimize the criterion over α from ``options.restarts`` random feasible starts.
 
+    SQP iterates approach the constraint boundary from outside, so each restart ends with the best
+    of: the best point whose aggregated constraints were all ≤ 0, and the repaired last iterate
+    (:func:`repair`); both are confirmed by every constraint's exact grid check.
+
     Args:
         criterion: the condition-number criterion (value and gradient).
-        limits: the joint limits; also draw the random feasible starts.
-        constraints: all constraints, joint limits included.
+        constraints: all constraints (values and Jacobians, exact checks, repairs).
         options: method, iterations, tolerance, restarts.
         rng: random generator of the starts.
+        start: draws a random α (n, 2N+1) that every constraint accepts.
         progress: called after every SLSQP iteration.
 
     Returns:
-        The lowest criterion value among the evaluated points whose constraints hold on the grid.
+        The best accepted point over all restarts.
     """
     n = len(criterion.robot.joint_names)
     shape = (n, criterion.basis.q.shape[1])
@@ -79,21 +108,21 @@ def optimize_trajectory(
         return cache[key]
 
     last_value = [np.nan]
-    best_feasible: dict[str, object] = {}
+    inside: dict[str, object] = {}
 
     def objective(x: np.ndarray) -> tuple[float, np.ndarray]:
         value, grad = criterion.value_and_gradient(x.reshape(shape))
         last_value[0] = value
-        if value < best_feasible.get("value", np.inf) and all(c.accepts(x.reshape(shape)) for c in constraints):
-            best_feasible.update(value=value, x=x.copy())
+        if value < inside.get("value", np.inf) and constraint_values(x)[0].max() <= 0.0:
+            inside.update(value=value, x=x.reshape(shape).copy())
         return value, grad.ravel()
 
-    start = time.perf_counter()
+    begin = time.perf_counter()
     best: Optional[tuple[float, np.ndarray, str]] = None
     total_iterations = 0
     for restart in range(options.restarts):
-        x0 = limits.random_start(shape[1], rng, fill=rng.uniform(0.5, 0.9)).ravel()
-        best_feasible.clear()
+        x0 = start(rng)
+        inside.clear()
         counter = [0]
 
         def callback(xk: np.ndarray, restart: int = restart, counter: list = counter) -> None:
@@ -103,7 +132,7 @@ def optimize_trajectory(
 
         result = minimize(
             objective,
-            x0,
+            x0.ravel(),
             jac=True,
             method=options.method,
             constraints=[{
@@ -115,20 +144,20 @@ def optimize_trajectory(
             callback=callback,
         )
         total_iterations += int(result.nit)
-        # SQP iterates approach the boundary from outside: repair the last one where the
-        # constraints can, then keep the best feasible point evaluated (x0 always is one).
-        repaired = result.x.reshape(shape)
-        for c in constraints:
-            repaired = c.restore(repaired)
-        objective(repaired.ravel())
-        candidate = (float(best_feasible["value"]), np.asarray(best_feasible["x"]).reshape(shape), str(result.message))
-        if best is None or candidate[0] < best[0]:
-            best = candidate
-    assert best is not None
+        candidates = [x0, repair(constraints, result.x.reshape(shape), x0)]
+        if "x" in inside:
+            candidates.append(np.asarray(inside["x"]))
+        for alpha in candidates:
+            if not _accepted(constraints, alpha):
+                continue
+            value = criterion.value(alpha)
+            if best is None or value < best[0]:
+                best = (value, alpha, str(result.message))
+    assert best is not None, "the start of every restart is accepted"
     return OptimizationResult(
         alpha=best[1],
         objective=best[0],
         iterations=total_iterations,
         message=best[2],
-        wall_time_s=time.perf_counter() - start,
+        wall_time_s=time.perf_counter() - begin,
     )

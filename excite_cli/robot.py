@@ -76,6 +76,9 @@ class Robot:
         lower, upper: (n,) URDF position limits [rad].
         velocity_limit: (n,) URDF velocity limits [rad/s] (0 or inf where the URDF has none).
         body_names: (model.njoints - 1,) the link carried by each joint, for parameter names.
+        home: (n,) posture [rad] the random starts oscillate about (config ``robot.home_posture``,
+            default 0, clipped into the URDF position limits).
+        collision_model: the URDF's collision geometry attached to the reduced model, if loaded.
     """
 
     model: pin.Model
@@ -88,6 +91,8 @@ class Robot:
     upper: np.ndarray
     velocity_limit: np.ndarray
     body_names: list[str]
+    home: np.ndarray
+    collision_model: pin.GeometryModel | None = None
     data: pin.Data = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
@@ -143,6 +148,14 @@ class Robot:
         """Inverse dynamics τ (RNEA) of the URDF model, rows ``row_idx``: (n_rows,) [Nm, N]."""
         return pin.rnea(self.model, self.data, *self.state(q, qd, qdd))[self.row_idx].copy()
 
+    def com(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Centre of total mass [m] (3,) in the world frame, of the URDF inertias, and its Jacobian
+        (3, n) in the active joints (base held fixed) [m/rad]."""
+        qf = self.q_reference.copy()
+        qf[self.q_idx] = q
+        J = pin.jacobianCenterOfMass(self.model, self.data, qf, False)
+        return self.data.com[0].copy(), J[:, self.v_idx]
+
     def random_states(self, count: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(count, n) random positions within the limits, and standard-normal velocities and accelerations."""
         lo = np.where(np.isfinite(self.lower), self.lower, -np.pi)
@@ -158,15 +171,19 @@ def _body_name(model: pin.Model, joint_id: int) -> str:
     return model.names[joint_id]
 
 
-def load_robot(problem: Problem) -> Robot:
+def load_robot(problem: Problem, collision: bool = False) -> Robot:
     """Build the :class:`Robot` of a problem: load the URDF, lock the non-active joints.
+
+    Args:
+        problem: the validated config.
+        collision: also load the URDF's collision geometry (meshes), reduced with the model.
 
     Raises:
         ExciteError: missing URDF, unknown joint name, a joint that is not 1-DoF, a locked value
             outside the joint's limits.
     """
     cfg: RobotConfig = problem.robot
-    path, _ = resolve_urdf(problem)
+    path, package_dirs = resolve_urdf(problem)
     try:
         if cfg.floating_base:
             full = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
@@ -197,7 +214,15 @@ def load_robot(problem: Problem) -> Robot:
     for name, value in cfg.locked_joints.items():
         q_full[full.idx_qs[full.getJointId(name)]] = value
     lock_ids = [full.getJointId(n) for n in movable if n not in cfg.active_joints]
-    model = pin.buildReducedModel(full, lock_ids, q_full) if lock_ids else full
+    geometry = None
+    if collision:
+        try:
+            geometry = pin.buildGeomFromUrdf(full, str(path), pin.COLLISION, package_dirs=package_dirs)
+        except (RuntimeError, ValueError) as exc:
+            raise ExciteError(f"robot.urdf: cannot load the collision geometry of {path}: {exc}") from None
+        model, geometry = pin.buildReducedModel(full, geometry, lock_ids, q_full)
+    else:
+        model = pin.buildReducedModel(full, lock_ids, q_full)
 
     ids = [model.getJointId(n) for n in cfg.active_joints]
     q_idx = np.array([model.idx_qs[j] for j in ids])
@@ -205,6 +230,12 @@ def load_robot(problem: Problem) -> Robot:
     base_rows = np.arange(6) if (cfg.floating_base and cfg.base_wrench_rows) else np.arange(0)
     if cfg.base_wrench_rows and not cfg.floating_base:
         raise ExciteError("robot.base_wrench_rows: needs robot.floating_base: true")
+    lower, upper = model.lowerPositionLimit[q_idx].copy(), model.upperPositionLimit[q_idx].copy()
+    home = np.zeros(len(ids))
+    for name, value in cfg.home_posture.items():
+        if name not in cfg.active_joints:
+            raise _unknown_joint("robot.home_posture", name, list(cfg.active_joints))
+        home[cfg.active_joints.index(name)] = value
     return Robot(
         model=model,
         joint_names=list(cfg.active_joints),
@@ -212,8 +243,10 @@ def load_robot(problem: Problem) -> Robot:
         v_idx=v_idx,
         row_idx=np.concatenate([base_rows, v_idx]).astype(int),
         q_reference=pin.neutral(model),
-        lower=model.lowerPositionLimit[q_idx].copy(),
-        upper=model.upperPositionLimit[q_idx].copy(),
+        lower=lower,
+        upper=upper,
         velocity_limit=model.velocityLimit[v_idx].copy(),
         body_names=[_body_name(model, j) for j in range(1, model.njoints)],
+        home=np.clip(home, lower, upper),
+        collision_model=geometry,
     )

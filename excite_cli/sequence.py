@@ -73,10 +73,10 @@ def run_sequence(
         criterion = excitation.criterion(stacked)
         best = optimize_trajectory(
             criterion,
-            excitation.limits,
             excitation.constraints,
             excitation.problem.optimizer,
             rng,
+            excitation.random_start,
             progress=progress(k) if progress else None,
         )
         own = criterion.regressor(best.alpha)

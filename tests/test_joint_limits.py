@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from conftest import small
-from excite_cli.constraints.joint_limits import GRID_MARGIN, JointLimits
+from excite_cli.constraints.joint_limits import JointLimits
+from excite_cli.constraints.lse import GRID_MARGIN, SHARPNESS
 from excite_cli.excitation import build_excitation
 
 
@@ -35,7 +36,7 @@ def test_aggregate_is_conservative_and_tight(panda):
         z = np.stack([(B @ alpha.T - limits.centre[d]) / limits.half[d] for d, B in enumerate((panda.grid_basis.q, panda.grid_basis.qd, panda.grid_basis.qdd))])
         exact = np.concatenate([z.max(axis=1) - 1.0, -z.min(axis=1) - 1.0])
         assert np.all(g >= exact + GRID_MARGIN - 1e-12)
-        assert np.all(g <= exact + GRID_MARGIN + np.log(z.shape[1]) / 300.0)
+        assert np.all(g <= exact + GRID_MARGIN + np.log(z.shape[1]) / SHARPNESS)
 
 
 def test_random_start_fills_the_requested_fraction(panda):

@@ -16,11 +16,14 @@ class FineCheck:
 
     Attributes:
         max_violation: largest violation, normalized (dimensionless, ≤ 0 means satisfied).
-        details: named figures with units in the name (e.g. ``max_violation_velocity_rad_s``).
+        details: named figures with units in the name (e.g. ``max_violation_velocity_rad_s``), or
+            names (e.g. ``min_capsule_pair``).
+        where: where the worst sample is, in words (for messages).
     """
 
     max_violation: float
-    details: dict[str, float]
+    details: dict[str, float | str]
+    where: str = ""
 
 
 class Constraint(ABC):

@@ -4,29 +4,22 @@ Sampled on the paper's 0.02 s grid these are T × n × 3 × 2 linear inequalitie
 which makes SLSQP crawl. Each (order, side, joint) is aggregated instead into one smooth inequality:
 with s_t = (x_t − x_max)/h (or (x_min − x_t)/h), h the half-width of the allowed range,
 
-    g = (1/β) log Σ_t exp(β s_t) + δ ≤ 0,
+    g = (1/β) log Σ_t exp(β s_t) + δ ≤ 0      (see ``lse.py``),
 
-a log-sum-exp that over-estimates max_t s_t by at most log(T)/β, so it is conservative. SQP iterates
-approach g = 0 from outside, so a point is accepted when its exact grid samples stay δ/2 inside the
-bounds (``grid_margin``), which covers the overshoot between grid instants. The final trajectory is
-re-checked exactly on a finer grid.
+so SLSQP sees 6n inequalities. The final trajectory is re-checked exactly on a finer grid.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from scipy.special import logsumexp, softmax
 
 from excite_cli.config import LimitsConfig, PerJoint
 from excite_cli.constraints.constraint import Constraint, FineCheck
+from excite_cli.constraints.lse import ACCEPT_MARGIN, GRID_MARGIN, smooth_max
 from excite_cli.errors import ExciteError
 from excite_cli.robot import Robot
 from excite_cli.trajectory import FourierBasis
 
-#: β of the log-sum-exp, in units of the half-range.
-SHARPNESS = 300.0
-#: δ: margin as a fraction of the half-range; half of it must remain on the grid for acceptance.
-GRID_MARGIN = 0.01
 ORDERS = ("position_rad", "velocity_rad_s", "acceleration_rad_s2")
 
 
@@ -42,7 +35,7 @@ class JointLimits(Constraint):
     """
 
     name = "joint_limits"
-    grid_margin = GRID_MARGIN / 2.0
+    grid_margin = ACCEPT_MARGIN
 
     def __init__(self, lower: np.ndarray, upper: np.ndarray, basis: FourierBasis):
         self.lower = np.asarray(lower, dtype=float)
@@ -62,8 +55,7 @@ class JointLimits(Constraint):
         n, m = alpha.shape
         z = self._normalized(alpha, self._orders)
         s = np.concatenate([z - 1.0, -z - 1.0])  # (6, T, n): upper sides, then lower sides
-        g = logsumexp(SHARPNESS * s, axis=1) / SHARPNESS + GRID_MARGIN  # (6, n)
-        w = softmax(SHARPNESS * s, axis=1)
+        g, w = smooth_max(s, axis=1)  # (6, n), (6, T, n)
         J = np.zeros((6, n, n, m))
         idx = np.arange(n)
         for k in range(6):
@@ -100,25 +92,29 @@ class JointLimits(Constraint):
         out[:, 1:] *= np.clip(scale, 0.0, 1.0)[:, None]
         return out
 
-    def random_start(self, coefficients: int, rng: np.random.Generator, fill: float) -> np.ndarray:
-        """Random α (n, coefficients) centred in the position range, scaled so that the largest of its
-        normalized |q − centre|, |q̇|, |q̈| on the grid equals ``fill`` (< 1: strictly feasible).
+    def random_start(self, coefficients: int, rng: np.random.Generator, fill: float, offset: np.ndarray | None = None) -> np.ndarray:
+        """Random α (n, coefficients) oscillating about ``offset`` (n,) [rad] (default: the centre of
+        each position range), scaled so that each joint uses the fraction ``fill`` of its room on the
+        grid in position, velocity and acceleration (fill < 1: strictly feasible).
 
         Raises:
-            ValueError: ``fill`` not in (0, 1).
+            ValueError: ``fill`` not in (0, 1), or ``offset`` outside the position bounds.
         """
         if not 0.0 < fill < 1.0:
             raise ValueError("fill must be in (0, 1)")
+        offset = self.centre[0] if offset is None else np.asarray(offset, dtype=float)
+        z0 = (offset - self.centre[0]) / self.half[0]
+        if np.any(np.abs(z0) >= 1.0):
+            raise ValueError("offset outside the position bounds")
         n = self.lower.shape[1]
         harmonics = (coefficients - 1) // 2
         decay = 1.0 / np.tile(np.arange(1, harmonics + 1), 2)
         alpha = np.zeros((n, coefficients))
         alpha[:, 1:] = rng.standard_normal((n, coefficients - 1)) * decay
-        alpha[:, 0] = self.centre[0]
-        shifted = alpha.copy()
-        shifted[:, 0] = 0.0
-        peak = np.stack([np.abs(B @ shifted.T).max(axis=0) / self.half[d] for d, B in enumerate(self._orders)])
-        alpha[:, 1:] *= (fill / peak.max(axis=0))[:, None]
+        room = np.stack([1.0 - np.abs(z0), np.ones(n), np.ones(n)])
+        peak = np.stack([np.abs(B @ alpha.T).max(axis=0) / self.half[d] for d, B in enumerate(self._orders)])
+        alpha[:, 1:] *= (fill * (room / peak).min(axis=0))[:, None]
+        alpha[:, 0] = offset
         return alpha
 
 

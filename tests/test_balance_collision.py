@@ -1,0 +1,131 @@
+"""CoM region (Eq. 52) and capsule self-collision (Eq. 53): Jacobians against finite differences,
+exact distances against coal, capsule fitting, and problems infeasible before optimization."""
+
+from pathlib import Path
+
+import coal
+import numpy as np
+import pytest
+import yaml
+
+from conftest import CONFIGS, write_config
+from excite_cli.capsules import capsule_placements, fit_capsule, segment_distances
+from excite_cli.config import load_problem
+from excite_cli.errors import ExciteError
+from excite_cli.excitation import build_excitation
+
+HERE = Path(__file__).resolve().parent
+
+
+def _g1(tmp_path, **edits):
+    data = yaml.safe_load((CONFIGS / "g1_arms.yaml").read_text())
+    data["trajectory"].update(harmonics=3, cost_samples=10, cost_period=0.8, constraint_period=0.1)
+    for section, values in edits.items():
+        data["constraints"][section].update(values)
+    return build_excitation(load_problem(write_config(tmp_path, data)))
+
+
+@pytest.fixture(scope="module")
+def g1(tmp_path_factory):
+    return _g1(tmp_path_factory.mktemp("g1"))
+
+
+@pytest.fixture(scope="module")
+def panda():
+    return build_excitation(load_problem(HERE / "panda_capsules.yaml"))
+
+
+def _jacobian_error(constraint, alpha, step=1e-7):
+    g, J = constraint.evaluate(alpha)
+    fd = np.zeros_like(J)
+    for k in range(alpha.size):
+        e = np.zeros(alpha.size)
+        e[k] = step
+        plus = constraint.evaluate(alpha + e.reshape(alpha.shape))[0]
+        minus = constraint.evaluate(alpha - e.reshape(alpha.shape))[0]
+        fd[:, k] = (plus - minus) / (2 * step)
+    return np.linalg.norm(J - fd) / np.linalg.norm(fd)
+
+
+def _lively(excitation, seed):
+    """A start that moves a lot: the joint-limit start at 90 % fill, not shrunk for the others."""
+    return excitation.limits.random_start(excitation.trajectory.n_coefficients, np.random.default_rng(seed), 0.9, excitation.home)
+
+
+@pytest.mark.parametrize("name", ["com_region", "self_collision"])
+def test_g1_constraint_jacobians_match_finite_differences(g1, name):
+    constraint = next(c for c in g1.constraints if c.name == name)
+    assert _jacobian_error(constraint, _lively(g1, 1)) < 1e-6
+
+
+def test_panda_capsule_jacobian_matches_finite_differences(panda):
+    constraint = panda.constraints[1]
+    alpha = _lively(panda, 2)
+    g, _ = constraint.evaluate(alpha)
+    assert g.size == 6 and g.max() > -1.0  # some pair comes close, so the test means something
+    assert _jacobian_error(constraint, alpha) < 1e-6
+
+
+def test_screened_distances_equal_coal(panda):
+    constraint = panda.constraints[1]
+    alpha = _lively(panda, 3)
+    _, rotations, centres = constraint._placements(alpha, panda.grid_basis)
+    screened = constraint._screen(rotations, centres)
+    for t in range(0, screened.shape[0], 7):
+        for p in range(len(constraint.pairs)):
+            assert screened[t, p] == pytest.approx(constraint._distance(rotations, centres, t, p).min_distance, abs=1e-9)
+
+
+def test_segment_distance_closed_forms():
+    z = np.zeros(3)
+    assert segment_distances(z, np.array([1.0, 0, 0]), np.array([0.5, 1, 0]), np.array([0.5, 2, 0])) == pytest.approx(1.0)
+    assert segment_distances(z, np.array([1.0, 0, 0]), np.array([2.0, 0, 0]), np.array([3.0, 0, 0])) == pytest.approx(1.0)
+    assert segment_distances(z, z, np.array([0, 3.0, 4.0]), np.array([0, 3.0, 4.0])) == pytest.approx(5.0)
+    point = np.array([0.5, 2.0, 0.0])
+    assert segment_distances(z, np.array([1.0, 0, 0]), point, point) == pytest.approx(2.0)
+    assert segment_distances(point, point, z, np.array([1.0, 0, 0])) == pytest.approx(2.0)
+    skew = segment_distances(np.array([-1.0, 0, 0]), np.array([1.0, 0, 0]), np.array([0, -1.0, 2]), np.array([0, 1.0, 2]))
+    assert skew == pytest.approx(2.0)
+
+
+def test_fitted_capsule_covers_its_points():
+    rng = np.random.default_rng(0)
+    points = rng.normal(size=(500, 3)) * [0.2, 0.03, 0.02] + [0.1, -0.2, 0.3]
+    radius, start, end = fit_capsule(points)
+    assert segment_distances(np.broadcast_to(start, points.shape), np.broadcast_to(end, points.shape), points, points).max() <= radius + 1e-12
+    assert np.linalg.norm(end - start) > 0.5  # along the long axis
+
+
+def test_com_region_holds_at_home_and_fails_when_too_small(g1, tmp_path):
+    com = next(c for c in g1.constraints if c.name == "com_region")
+    check = com.check(g1.static(), g1.grid_basis)
+    assert check.details["com_max_excursion_m"] < 0.002
+    with pytest.raises(ExciteError, match=r"constraints.com: .*CoM 0\.\d+ cm from the support centre"):
+        _g1(tmp_path, com={"radius": 0.0005})
+
+
+def test_support_centre_comes_from_the_soles(g1):
+    com = next(c for c in g1.constraints if c.name == "com_region")
+    # G1 soles: contact spheres from x = -0.05 to 0.12 m below the ankles, so the centre is ~3.5 cm ahead
+    assert com.centre[0] == pytest.approx(0.0355, abs=0.002) and abs(com.centre[1]) < 1e-6
+
+
+def test_colliding_pair_at_home_is_named(tmp_path):
+    with pytest.raises(ExciteError, match=r"constraints.self_collision: .*torso_link–left_shoulder_yaw_link"):
+        _g1(tmp_path, self_collision={"exclude_pairs": [["torso_link", "left_shoulder_roll_link"]]})
+
+
+def test_capsules_follow_the_links(panda):
+    constraint = panda.constraints[1]
+    q = panda.home[None]
+    rotations, centres = capsule_placements(panda.robot, constraint.capsules, q)
+    import pinocchio as pin
+
+    robot = panda.robot
+    pin.forwardKinematics(robot.model, robot.data, robot.state(q[0], 0 * q[0], 0 * q[0])[0])
+    pin.updateFramePlacements(robot.model, robot.data)
+    hand = robot.data.oMf[robot.model.getFrameId("panda_hand")]
+    # the hand capsule runs from the hand frame origin 0.1 m along its z axis
+    np.testing.assert_allclose(centres[0, 3], hand.act(np.array([0, 0, 0.05])), atol=1e-12)
+    np.testing.assert_allclose(rotations[0, 3][:, 2], hand.rotation[:, 2], atol=1e-12)
+    assert isinstance(constraint._shapes[3], coal.Capsule)
