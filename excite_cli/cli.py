@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import functools
+import time
 from pathlib import Path
 from typing import Callable, Optional
 
@@ -12,14 +13,16 @@ from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
-from excite_cli.config import load_problem
+from excite_cli.config import Problem, load_problem
 from excite_cli.errors import ExciteError
 from excite_cli.criterion import ConditionNumber
 from excite_cli.excitation import Excitation, build_excitation
-from excite_cli.output import read_last_alpha, read_prior, write_result
-from excite_cli.plots import plot_condition_numbers, plot_trajectories
-from excite_cli.sequence import IterationResult, run_sequence
-from excite_cli.verify import check_gradient
+from excite_cli.output import read_last_alpha, read_prior, read_table, write_result
+from excite_cli.constraints import ComRegion, SelfCollision
+from excite_cli.plots import plot_comparison, plot_condition_numbers, plot_constraint_tracks, plot_trajectories
+from excite_cli.random_baseline import draw_pool, greedy_selection, pool_convergence
+from excite_cli.sequence import IterationResult, describe, run_sequence
+from excite_cli.verify import check_gradient, constraint_jacobian_error
 
 app = typer.Typer(
     add_completion=False,
@@ -46,14 +49,76 @@ def _user_errors(command: Callable) -> Callable:
 
 def _table(results: list[IterationResult]) -> Table:
     table = Table(title="Condition numbers (Table I)")
-    for column in ("iter", "cond(C(i))", "cond(C)", "max viol.", "SQP its", "time [s]"):
+    extra = [(key, label) for key, label in (("com_max_excursion_m", "CoM [cm]"), ("min_capsule_distance_m", "dist [cm]"))
+             if results and key in results[0].checks]
+    for column in ("iter", "cond(C(i))", "cond(C)", "max viol.", *[label for _, label in extra], "time [s]"):
         table.add_column(column, justify="right")
     for r in results:
         table.add_row(
-            str(r.index), f"{r.cond_own:.1f}", f"{r.cond_stacked:.1f}", f"{r.max_violation:+.2e}",
-            str(r.sqp_iterations), f"{r.wall_time_s:.1f}",
+            str(r.index), f"{r.cond_own:.1f}", f"{r.cond_stacked:.1f}", f"{r.max_violation:+.1e}",
+            *[f"{100 * float(r.checks[key]):.2f}" for key, _ in extra], f"{r.wall_time_s:.0f}",
         )
     return table
+
+
+def _plots(target: Path, excitation: Excitation, results: list[IterationResult]) -> list[Path]:
+    """PNG figures beside ``target``: trajectories, Table I and, with constraints, their tracks."""
+    stem = target.with_suffix("")
+    plots = [
+        plot_trajectories(stem.with_name(stem.name + "_trajectories.png"), excitation.robot.joint_names, results),
+        plot_condition_numbers(stem.with_name(stem.name + "_cond.png"), results),
+    ]
+    if any(r.tracks for r in results):
+        com = next((c for c in excitation.constraints if isinstance(c, ComRegion)), None)
+        collision = next((c for c in excitation.constraints if isinstance(c, SelfCollision)), None)
+        plots.append(plot_constraint_tracks(
+            stem.with_name(stem.name + "_constraints.png"), results,
+            centre=com.centre if com else None, radius=com.radius if com else None,
+            polygon=com.polygon if com else None, margin=collision.margin if collision else None,
+        ))
+    return plots
+
+
+def _optimize(problem: Problem, excitation: Excitation, target: Path) -> list[IterationResult]:
+    """Run the sequential generation with a progress bar, writing ``target`` after every iteration.
+    Ctrl-C keeps the finished iterations and exits with status 130."""
+    prior = read_prior(problem.resolve(problem.sequence.prior), excitation.base) if problem.sequence.prior else None
+    err.print(
+        f"{len(excitation.robot.joint_names)} active joints, {excitation.base.count} base parameters, "
+        f"{excitation.trajectory.n_coefficients * excitation.robot.n_joints} Fourier coefficients, "
+        f"{len(excitation.constraints)} constraint(s), {0 if prior is None else prior.shape[0]} prior rows",
+        highlight=False,
+    )
+    finished: list[IterationResult] = []
+    opts = problem.optimizer
+    with Progress(
+        TextColumn("{task.description}"), BarColumn(), TextColumn("{task.fields[status]}"), TimeElapsedColumn(),
+        console=err, transient=False,
+    ) as bar:
+        tasks = {
+            k: bar.add_task(f"iteration {k}", total=opts.restarts * opts.max_iterations, status="waiting")
+            for k in range(1, problem.sequence.iterations + 1)
+        }
+
+        def progress(k: int):
+            def hook(restart: int, it: int, value: float) -> None:
+                c = np.exp(value) if opts.objective == "log_cond" else value
+                bar.update(tasks[k], completed=restart * opts.max_iterations + it,
+                           status=f"restart {restart + 1}/{opts.restarts} · cond {c:.1f}")
+            return hook
+
+        def done(result: IterationResult) -> None:
+            finished.append(result)
+            write_result(target, excitation, finished, opts.seed, {"method": "optimized"})
+            bar.update(tasks[result.index], completed=opts.restarts * opts.max_iterations,
+                       status=f"cond(C) {result.cond_stacked:.1f}")
+
+        try:
+            run_sequence(excitation, problem.sequence.iterations, opts.seed, prior, progress, done)
+        except KeyboardInterrupt:
+            err.print(f"interrupted: kept {len(finished)} finished iteration(s) in {target}")
+            raise typer.Exit(130) from None
+    return finished
 
 
 @app.command()
@@ -76,53 +141,85 @@ def optimize(
         problem.optimizer.seed = seed
     target = output if output is not None else Path(problem.output)
     excitation = build_excitation(problem)
-    prior = read_prior(problem.resolve(problem.sequence.prior), excitation.base) if problem.sequence.prior else None
-    err.print(
-        f"{len(excitation.robot.joint_names)} active joints, {excitation.base.count} base parameters, "
-        f"{excitation.trajectory.n_coefficients * excitation.robot.n_joints} Fourier coefficients, "
-        f"{0 if prior is None else prior.shape[0]} prior rows",
-        highlight=False,
-    )
-    finished: list[IterationResult] = []
-
-    def keep(result: IterationResult) -> None:
-        finished.append(result)
-        write_result(target, excitation, finished, problem.optimizer.seed)
-
-    opts = problem.optimizer
-    with Progress(
-        TextColumn("{task.description}"), BarColumn(), TextColumn("{task.fields[status]}"), TimeElapsedColumn(),
-        console=err, transient=False,
-    ) as bar:
-        tasks = {
-            k: bar.add_task(f"iteration {k}", total=opts.restarts * opts.max_iterations, status="waiting")
-            for k in range(1, problem.sequence.iterations + 1)
-        }
-
-        def progress(k: int):
-            def hook(restart: int, it: int, value: float) -> None:
-                c = np.exp(value) if opts.objective == "log_cond" else value
-                bar.update(tasks[k], completed=restart * opts.max_iterations + it,
-                           status=f"restart {restart + 1}/{opts.restarts} · cond {c:.1f}")
-            return hook
-
-        def done(result: IterationResult) -> None:
-            keep(result)
-            bar.update(tasks[result.index], completed=opts.restarts * opts.max_iterations,
-                       status=f"cond(C) {result.cond_stacked:.1f}")
-
-        try:
-            run_sequence(excitation, problem.sequence.iterations, opts.seed, prior, progress, done)
-        except KeyboardInterrupt:
-            err.print(f"interrupted: kept {len(finished)} finished iteration(s) in {target}")
-            raise typer.Exit(130) from None
+    finished = _optimize(problem, excitation, target)
     out.print(_table(finished))
-    stem = target.with_suffix("")
-    plots = [
-        plot_trajectories(stem.with_name(stem.name + "_trajectories.png"), excitation.robot.joint_names, finished),
-        plot_condition_numbers(stem.with_name(stem.name + "_cond.png"), finished),
-    ]
+    plots = _plots(target, excitation, finished)
     out.print(f"wrote {target} and {', '.join(str(p) for p in plots)}", highlight=False)
+
+
+@app.command("compare-random")
+@_user_errors
+def compare_random(
+    config: Path = typer.Argument(..., help="Problem YAML file."),
+    optimized: Optional[Path] = typer.Option(None, "--optimized", help="Optimized result (HDF5) to compare with; computed when not given."),
+    output: Optional[Path] = typer.Option(None, "--output", "-o", help="HDF5 file of the random selection (default: <config output>_random.h5)."),
+    pool: Optional[int] = typer.Option(None, "--pool", min=1, help="Feasible random candidates to draw (overrides random_baseline.pool_size)."),
+    seed: Optional[int] = typer.Option(None, "--seed", help="Seed of the random candidates (overrides random_baseline.seed)."),
+    equal_effort: bool = typer.Option(False, "--equal-effort", help="Draw candidates for as long as the optimizer took, instead of a fixed pool."),
+) -> None:
+    """The conventional baseline of the paper's ref. [16]: random feasible Fourier trajectories and
+    greedy selection (Table II), beside the optimized trajectories (Table I) with the ratio per
+    iteration and the wall time of each method."""
+    problem = load_problem(config)
+    rcfg = problem.random_baseline
+    if pool is not None:
+        rcfg.pool_size = pool
+    if seed is not None:
+        rcfg.seed = seed
+    base_target = Path(problem.output)
+    target = output if output is not None else base_target.with_name(base_target.stem + "_random.h5")
+    excitation = build_excitation(problem)
+    if optimized is None:
+        optimized = base_target.with_name(base_target.stem + "_optimized.h5")
+        _optimize(problem, excitation, optimized)
+    optimized_table, optimized_time = read_table(optimized)
+    count = len(optimized_table)
+    budget = optimized_time if equal_effort else None
+    size = 10**9 if equal_effort else max(rcfg.pool_size, count)
+    with Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.fields[status]}"),
+                  TimeElapsedColumn(), console=err) as bar:
+        task = bar.add_task("random candidates", total=None if equal_effort else size, status="")
+        drawn = draw_pool(excitation, size, np.random.default_rng(rcfg.seed), budget,
+                          lambda kept, tried: bar.update(task, completed=kept, status=f"{kept} kept of {tried} drawn"))
+    if len(drawn.alphas) < count:
+        raise ExciteError(f"random_baseline: only {len(drawn.alphas)} feasible candidates of {drawn.drawn} drawn; "
+                          f"{count} are needed (enlarge the pool or the time)")
+    start = time.perf_counter()
+    chosen, _ = greedy_selection(drawn.regressors, count)
+    selection_time = time.perf_counter() - start
+    stacked = np.zeros((0, excitation.base.count))
+    results = []
+    for k, index in enumerate(chosen, start=1):
+        results.append(describe(excitation, k, drawn.alphas[index], stacked))
+        stacked = np.vstack([stacked, results[-1].regressor])
+    random_time = drawn.generation_time_s + selection_time
+    write_result(target, excitation, results, rcfg.seed, {
+        "method": "random_selection", "pool_size": len(drawn.alphas), "drawn": drawn.drawn,
+        "generation_time_s": drawn.generation_time_s, "selection_time_s": selection_time,
+    })
+    random_table = read_table(target)[0]
+    out.print(_comparison(random_table, optimized_table, random_time, optimized_time, len(drawn.alphas), drawn.drawn))
+    sizes = sorted({s for s in (count, 10, 30, 100, 300, 1000, 3000, len(drawn.alphas)) if count <= s <= len(drawn.alphas)})
+    convergence = Table(title="Random selection: best cond(C) against pool size")
+    convergence.add_column("pool", justify="right")
+    for k in range(1, count + 1):
+        convergence.add_column(f"cond(C) at {k}", justify="right")
+    for size_, conds in pool_convergence(drawn.regressors, count, sizes):
+        convergence.add_row(str(size_), *[f"{c:.1f}" for c in conds])
+    out.print(convergence)
+    plot = plot_comparison(target.with_suffix("").with_name(target.stem + "_comparison.png"), random_table, optimized_table)
+    out.print(f"wrote {target} and {plot}", highlight=False)
+
+
+def _comparison(random_table, optimized_table, random_time: float, optimized_time: float, pool: int, drawn: int) -> Table:
+    table = Table(title=f"Table II (random, {pool} feasible of {drawn} drawn) beside Table I (optimized)")
+    for column in ("motion", "rand cond(C(i))", "rand cond(C)", "opt cond(C(i))", "opt cond(C)", "ratio"):
+        table.add_column(column, justify="right")
+    for r, o in zip(random_table, optimized_table):
+        table.add_row(str(r["iteration"]), f"{r['cond_own']:.1f}", f"{r['cond_stacked']:.1f}", f"{o['cond_own']:.1f}",
+                      f"{o['cond_stacked']:.1f}", f"{r['cond_stacked'] / o['cond_stacked']:.1f}")
+    table.caption = f"wall time: random {random_time:.0f} s, optimized {optimized_time:.0f} s; ratio = random/optimized cond(C)"
+    return table
 
 
 @app.command("verify-gradient")
@@ -150,6 +247,13 @@ def verify_gradient(
                       f"{check.error_forward:.2e}", f"{check.analytic_s:.4f}", f"{check.forward_s:.3f}",
                       f"{check.speedup:.0f}×")
     out.print(table)
+    lively = excitation.limits.random_start(excitation.trajectory.n_coefficients, np.random.default_rng(seed), 0.9, excitation.home)
+    jacobians = Table(title="Constraint Jacobians vs central differences (random trajectory at 90 % of the limits)")
+    for column in ("constraint", "rows", "rel. error"):
+        jacobians.add_column(column, justify="right")
+    for c in excitation.constraints:
+        jacobians.add_row(c.name, str(c.evaluate(lively)[0].size), f"{constraint_jacobian_error(c, lively):.2e}")
+    out.print(jacobians)
 
 
 def _optimum(path: Path, excitation: Excitation) -> tuple[str, ConditionNumber, np.ndarray]:

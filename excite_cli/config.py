@@ -95,6 +95,11 @@ class OptimizerConfig(_Section):
     restarts: int = Field(3, ge=1)
 
 
+class RandomBaselineConfig(_Section):
+    pool_size: int = Field(300, ge=1)
+    seed: int = 1
+
+
 class SequenceConfig(_Section):
     iterations: int = Field(3, ge=1)
     prior: Optional[str] = None
@@ -107,6 +112,7 @@ class Problem(_Section):
     constraints: ConstraintsConfig = ConstraintsConfig()
     optimizer: OptimizerConfig = OptimizerConfig()
     sequence: SequenceConfig = SequenceConfig()
+    random_baseline: RandomBaselineConfig = RandomBaselineConfig()
     output: str = "results/excite.h5"
 
     source_path: Optional[Path] = Field(None, exclude=True)

@@ -21,7 +21,8 @@ from excite_cli.errors import ExciteError
 from excite_cli.excitation import Excitation
 from excite_cli.sequence import IterationResult
 
-UNITS = {"alpha": "rad", "time": "s", "q": "rad", "qd": "rad/s", "qdd": "rad/s^2", "regressor": "SI (N·m per parameter unit)"}
+UNITS = {"alpha": "rad", "time": "s", "q": "rad", "qd": "rad/s", "qdd": "rad/s^2", "regressor": "SI (N·m per parameter unit)",
+         "com_xy": "m", "min_capsule_distance": "m"}
 VERSIONED_PACKAGES = ("excite", "pin", "coal", "numpy", "scipy", "h5py", "example-robot-data")
 
 
@@ -47,7 +48,8 @@ def _table(results: Sequence[IterationResult]) -> np.ndarray:
     return table
 
 
-def write_result(path: Path, excitation: Excitation, results: Sequence[IterationResult], seed: int) -> None:
+def write_result(path: Path, excitation: Excitation, results: Sequence[IterationResult], seed: int,
+                 attributes: dict | None = None) -> None:
     """Write (or replace atomically) the result file of a sequential generation.
 
     Args:
@@ -55,6 +57,7 @@ def write_result(path: Path, excitation: Excitation, results: Sequence[Iteration
         excitation: the problem (robot names, composition matrix, config text).
         results: finished iterations, in order.
         seed: the seed the run used.
+        attributes: extra root attributes (e.g. ``method``, ``pool_size``).
 
     Raises:
         ExciteError: the file cannot be written.
@@ -71,6 +74,8 @@ def write_result(path: Path, excitation: Excitation, results: Sequence[Iteration
             f.attrs["created"] = datetime.now(timezone.utc).isoformat(timespec="seconds")
             for name, version in package_versions().items():
                 f.attrs[f"version_{name}"] = version
+            for name, value in (attributes or {}).items():
+                f.attrs[name] = value
             _write_robot(f.create_group("robot"), excitation)
             iterations = f.create_group("iterations")
             for r in results:
@@ -100,6 +105,8 @@ def _write_iteration(group: h5py.Group, r: IterationResult) -> None:
     for name in ("alpha", "time", "q", "qd", "qdd", "regressor"):
         group.create_dataset(name, data=getattr(r, name)).attrs["unit"] = UNITS[name]
     group["alpha"].attrs["layout"] = "row j: [q0_j, a_j1..a_jN, b_j1..b_jN] (Eq. 50)"
+    for name, series in r.tracks.items():
+        group.create_dataset(name, data=series).attrs["unit"] = UNITS[name]
     group.attrs["cond_own"] = r.cond_own
     group.attrs["cond_stacked"] = r.cond_stacked
     group.attrs["max_violation"] = r.max_violation
@@ -158,5 +165,25 @@ def read_last_alpha(path: Path) -> tuple[int, np.ndarray]:
             if not keys:
                 raise ExciteError(f"{path} has no finished iteration")
             return int(keys[-1]), f["iterations"][keys[-1]]["alpha"][()]
+    except OSError as exc:
+        raise ExciteError(f"cannot read {path} as HDF5: {exc}") from None
+
+
+def read_table(path: Path) -> tuple[np.ndarray, float]:
+    """The condition-number table (iteration, cond_own, cond_stacked) of an excite result and the
+    summed wall time of its iterations [s].
+
+    Raises:
+        ExciteError: missing or unreadable file, or no table in it.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise ExciteError(f"result file not found: {path}")
+    try:
+        with h5py.File(path, "r") as f:
+            if "table" not in f or "iterations" not in f:
+                raise ExciteError(f"{path} is not an excite result (no /table)")
+            wall = sum(float(g.attrs.get("wall_time_s", 0.0)) for g in f["iterations"].values())
+            return f["table"][()], wall
     except OSError as exc:
         raise ExciteError(f"cannot read {path} as HDF5: {exc}") from None

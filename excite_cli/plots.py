@@ -10,6 +10,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+import numpy as np  # noqa: E402
+
 from excite_cli.sequence import IterationResult  # noqa: E402
 
 
@@ -42,6 +44,67 @@ def plot_condition_numbers(path: Path, results: Sequence[IterationResult]) -> Pa
     ax.set_xticks(k)
     ax.grid(alpha=0.3)
     ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def plot_constraint_tracks(path: Path, results: Sequence[IterationResult], centre=None, radius: float | None = None,
+                           polygon=None, margin: float | None = None) -> Path:
+    """Per iteration: the CoM ground track against its region (Eq. 52) and the smallest capsule
+    distance over time against the margin (Eq. 53), in cm; written to ``path`` (PNG).
+
+    Args:
+        centre: (2,) region centre [m]; radius [m] or polygon (K, 2) relative to it [m].
+        margin: capsule safety margin [m].
+    """
+    fig, axes = plt.subplots(2, len(results), figsize=(4.2 * len(results), 7.5), squeeze=False)
+    for col, r in enumerate(results):
+        ax = axes[0, col]
+        if "com_xy" in r.tracks and centre is not None:
+            xy = (r.tracks["com_xy"] - centre) * 100
+            ax.plot(xy[:, 0], xy[:, 1], linewidth=0.8, label="CoM track")
+            if radius is not None:
+                ax.add_patch(plt.Circle((0, 0), radius * 100, fill=False, color="r", label="region"))
+            if polygon is not None:
+                ax.add_patch(plt.Polygon(polygon * 100, fill=False, color="r", label="region"))
+            ax.set_aspect("equal")
+            ax.set_xlabel("x − centre [cm]")
+            ax.set_ylabel("y − centre [cm]")
+            ax.legend(fontsize=7)
+        ax.set_title(f"iteration {r.index}")
+        ax = axes[1, col]
+        if "min_capsule_distance" in r.tracks:
+            ax.plot(r.time, r.tracks["min_capsule_distance"] * 100, linewidth=0.8, label="smallest distance")
+            if margin is not None:
+                ax.axhline(margin * 100, color="r", linestyle="--", label="margin")
+            ax.set_xlabel("time [s]")
+            ax.set_ylabel("capsule distance [cm]")
+            ax.legend(fontsize=7)
+        for a in axes[:, col]:
+            a.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def plot_comparison(path: Path, random_table, optimized_table) -> Path:
+    """Bars of cond(C⁽ⁱ⁾) and cond(C) per motion index, random selection (Table II) beside the
+    optimized trajectories (Table I); log scale; written to ``path`` (PNG)."""
+    fig, axes = plt.subplots(1, 2, figsize=(9, 3.8))
+    for ax, column, title in zip(axes, ("cond_own", "cond_stacked"), ("cond(C⁽ⁱ⁾)", "cond(C) stacked")):
+        k = np.asarray(random_table["iteration"])
+        ax.bar(k - 0.2, random_table[column], width=0.4, label="random + selection")
+        if optimized_table is not None:
+            ax.bar(np.asarray(optimized_table["iteration"]) + 0.2, optimized_table[column], width=0.4, label="optimized")
+        ax.set_yscale("log")
+        ax.set_xticks(k)
+        ax.set_xlabel("motion index")
+        ax.set_title(title)
+        ax.grid(alpha=0.3, axis="y")
+        ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)

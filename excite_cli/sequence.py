@@ -25,6 +25,8 @@ class IterationResult:
         cond_own: cond(C⁽ᵏ⁾); cond_stacked: cond([C₀; C⁽ᵏ⁾]) (Table I).
         max_violation: largest normalized constraint violation on the fine grid (≤ 0: satisfied).
         checks: per-constraint figures from the fine grid, units in the names.
+        tracks: per-constraint time series on the constraint grid (``com_xy`` (T_grid, 2) [m],
+            ``min_capsule_distance`` (T_grid,) [m]).
         wall_time_s: optimization wall time [s]; sqp_iterations: SLSQP iterations; message: SLSQP's.
     """
 
@@ -38,10 +40,37 @@ class IterationResult:
     cond_own: float
     cond_stacked: float
     max_violation: float
-    checks: dict[str, float] = field(default_factory=dict)
+    checks: dict[str, float | str] = field(default_factory=dict)
+    tracks: dict[str, np.ndarray] = field(default_factory=dict)
     wall_time_s: float = 0.0
     sqp_iterations: int = 0
     message: str = ""
+
+
+def describe(excitation: Excitation, index: int, alpha: np.ndarray, prior: np.ndarray, wall_time_s: float = 0.0,
+             sqp_iterations: int = 0, message: str = "") -> IterationResult:
+    """The :class:`IterationResult` of trajectory α (n, 2N+1) stacked under ``prior`` (m, b): its
+    regressor, condition numbers, samples on the constraint grid and every constraint's fine check."""
+    own = excitation.criterion().regressor(alpha)
+    checks = [c.check(alpha, excitation.fine_basis) for c in excitation.constraints]
+    q, qd, qdd = excitation.grid_basis.evaluate(alpha)
+    return IterationResult(
+        index=index,
+        alpha=alpha,
+        time=excitation.grid_basis.time,
+        q=q,
+        qd=qd,
+        qdd=qdd,
+        regressor=own,
+        cond_own=condition_number(own),
+        cond_stacked=condition_number(np.vstack([prior, own])),
+        max_violation=max(c.max_violation for c in checks),
+        checks={key: value for c in checks for key, value in c.details.items()},
+        tracks={key: value for c in excitation.constraints for key, value in c.track(alpha, excitation.grid_basis).items()},
+        wall_time_s=wall_time_s,
+        sqp_iterations=sqp_iterations,
+        message=message,
+    )
 
 
 def run_sequence(
@@ -79,26 +108,8 @@ def run_sequence(
             excitation.random_start,
             progress=progress(k) if progress else None,
         )
-        own = criterion.regressor(best.alpha)
-        stacked = np.vstack([stacked, own])
-        checks = [c.check(best.alpha, excitation.fine_basis) for c in excitation.constraints]
-        q, qd, qdd = excitation.grid_basis.evaluate(best.alpha)
-        result = IterationResult(
-            index=k,
-            alpha=best.alpha,
-            time=excitation.grid_basis.time,
-            q=q,
-            qd=qd,
-            qdd=qdd,
-            regressor=own,
-            cond_own=condition_number(own),
-            cond_stacked=condition_number(stacked),
-            max_violation=max(c.max_violation for c in checks),
-            checks={key: value for c in checks for key, value in c.details.items()},
-            wall_time_s=time.perf_counter() - start,
-            sqp_iterations=best.iterations,
-            message=best.message,
-        )
+        result = describe(excitation, k, best.alpha, stacked, time.perf_counter() - start, best.iterations, best.message)
+        stacked = np.vstack([stacked, result.regressor])
         results.append(result)
         if on_iteration:
             on_iteration(result)

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from excite_cli.constraints import Constraint
 from excite_cli.criterion import ConditionNumber
 
 
@@ -77,3 +78,17 @@ def check_gradient(criterion: ConditionNumber, alpha: np.ndarray, step: float = 
         analytic_s=analytic_s,
         forward_s=forward_s,
     )
+
+
+def constraint_jacobian_error(constraint: Constraint, alpha: np.ndarray, step: float = 1e-7) -> float:
+    """‖J − J_cd‖ / ‖J_cd‖ of a constraint's Jacobian against central differences of step ``step``
+    on each Fourier coefficient of α (n, 2N+1)."""
+    _, J = constraint.evaluate(alpha)
+    fd = np.zeros_like(J)
+    for k in range(alpha.size):
+        e = np.zeros(alpha.size)
+        e[k] = step
+        plus = constraint.evaluate(alpha + e.reshape(alpha.shape))[0]
+        minus = constraint.evaluate(alpha - e.reshape(alpha.shape))[0]
+        fd[:, k] = (plus - minus) / (2 * step)
+    return float(np.linalg.norm(J - fd) / np.linalg.norm(fd))

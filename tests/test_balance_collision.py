@@ -13,6 +13,7 @@ from excite_cli.capsules import capsule_placements, fit_capsule, segment_distanc
 from excite_cli.config import load_problem
 from excite_cli.errors import ExciteError
 from excite_cli.excitation import build_excitation
+from excite_cli.verify import constraint_jacobian_error
 
 HERE = Path(__file__).resolve().parent
 
@@ -35,18 +36,6 @@ def panda():
     return build_excitation(load_problem(HERE / "panda_capsules.yaml"))
 
 
-def _jacobian_error(constraint, alpha, step=1e-7):
-    g, J = constraint.evaluate(alpha)
-    fd = np.zeros_like(J)
-    for k in range(alpha.size):
-        e = np.zeros(alpha.size)
-        e[k] = step
-        plus = constraint.evaluate(alpha + e.reshape(alpha.shape))[0]
-        minus = constraint.evaluate(alpha - e.reshape(alpha.shape))[0]
-        fd[:, k] = (plus - minus) / (2 * step)
-    return np.linalg.norm(J - fd) / np.linalg.norm(fd)
-
-
 def _lively(excitation, seed):
     """A start that moves a lot: the joint-limit start at 90 % fill, not shrunk for the others."""
     return excitation.limits.random_start(excitation.trajectory.n_coefficients, np.random.default_rng(seed), 0.9, excitation.home)
@@ -55,7 +44,7 @@ def _lively(excitation, seed):
 @pytest.mark.parametrize("name", ["com_region", "self_collision"])
 def test_g1_constraint_jacobians_match_finite_differences(g1, name):
     constraint = next(c for c in g1.constraints if c.name == name)
-    assert _jacobian_error(constraint, _lively(g1, 1)) < 1e-6
+    assert constraint_jacobian_error(constraint, _lively(g1, 1)) < 1e-6
 
 
 def test_panda_capsule_jacobian_matches_finite_differences(panda):
@@ -63,7 +52,7 @@ def test_panda_capsule_jacobian_matches_finite_differences(panda):
     alpha = _lively(panda, 2)
     g, _ = constraint.evaluate(alpha)
     assert g.size == 6 and g.max() > -1.0  # some pair comes close, so the test means something
-    assert _jacobian_error(constraint, alpha) < 1e-6
+    assert constraint_jacobian_error(constraint, alpha) < 1e-6
 
 
 def test_screened_distances_equal_coal(panda):

@@ -64,6 +64,7 @@ class ComRegion(Constraint):
                  polygon: np.ndarray | None = None):
         self.robot, self.basis, self.centre = robot, basis, np.asarray(centre, dtype=float)
         self.radius = radius
+        self.polygon = None if polygon is None else np.asarray(polygon, dtype=float)
         if polygon is not None:
             v = np.asarray(polygon, dtype=float)
             if np.sum(v[:, 0] * np.roll(v[:, 1], -1) - np.roll(v[:, 0], -1) * v[:, 1]) < 0:
@@ -97,6 +98,10 @@ class ComRegion(Constraint):
         g, w = smooth_max(s, axis=(0, 1))
         dq = np.einsum("tk,tkx,txn->tn", w, ds, J)
         return np.atleast_1d(g), (dq.T @ self.basis.q).reshape(1, -1)
+
+    def track(self, alpha: np.ndarray, basis: FourierBasis) -> dict[str, np.ndarray]:
+        """``com_xy``: (T, 2) ground projection of the CoM [m]."""
+        return {"com_xy": self._com(basis.q @ alpha.T)[0]}
 
     def check(self, alpha: np.ndarray, basis: FourierBasis) -> FineCheck:
         P, _ = self._com(basis.q @ alpha.T)

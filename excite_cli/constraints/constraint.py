@@ -52,6 +52,10 @@ class Constraint(ABC):
         """Whether α satisfies the constraint on the grid, exactly, with ``grid_margin`` to spare."""
         return self.check(alpha, self.basis).max_violation <= -self.grid_margin
 
+    def track(self, alpha: np.ndarray, basis: FourierBasis) -> dict[str, np.ndarray]:
+        """Named time series worth plotting and storing, on ``basis``'s instants (default: none)."""
+        return {}
+
     def restore(self, alpha: np.ndarray) -> np.ndarray:
         """A nearby α that satisfies this constraint, where a cheap exact repair exists (default: α)."""
         return alpha

@@ -8,7 +8,8 @@ Per pair, s_t = (margin − d_t) / L with L = ``LENGTH_SCALE`` is aggregated by 
 grid. The distances of all (instant, pair) samples are first screened with a vectorized
 segment-to-segment distance (``segment_distances``); coal then gives the exact distance, witness
 points and normal of the samples within ``WINDOW`` of each pair's smallest screened distance, the
-only ones whose log-sum-exp weight exceeds e^-30 of the largest. The fine re-check uses coal alone.
+only ones whose log-sum-exp weight exceeds e^-30 of the largest. The fine re-check takes coal's
+distance at the samples the screen finds within ``CONFIRM`` of the smallest.
 """
 
 from __future__ import annotations
@@ -27,6 +28,8 @@ from excite_cli.trajectory import FourierBasis
 LENGTH_SCALE = 0.05
 #: Exact distances are computed up to this much above a pair's smallest one [m] (30 L / β).
 WINDOW = 30.0 * LENGTH_SCALE / SHARPNESS
+#: The fine check asks coal for every sample screened within this of the smallest distance [m].
+CONFIRM = 1e-3
 #: Samples whose aggregate weight is below this get no Jacobian.
 WEIGHT_FLOOR = 1e-13
 
@@ -48,7 +51,6 @@ class SelfCollision(Constraint):
     def __init__(self, robot: Robot, basis: FourierBasis, capsules: list[Capsule], pairs: list[tuple[int, int]], margin: float):
         self.robot, self.basis, self.capsules, self.pairs, self.margin = robot, basis, capsules, pairs, margin
         self._shapes = [coal.Capsule(c.radius, float(np.linalg.norm(c.end - c.start))) for c in capsules]
-        self._reach = np.array([c.radius + np.linalg.norm(c.end - c.start) / 2.0 for c in capsules])
         self._first = np.array([i for i, _ in pairs], dtype=int)
         self._second = np.array([j for _, j in pairs], dtype=int)
 
@@ -56,11 +58,6 @@ class SelfCollision(Constraint):
         """Q (T, n), capsule rotations (T, C, 3, 3) and centres (T, C, 3) of α on ``basis``."""
         Q = basis.q @ alpha.T
         return (Q, *capsule_placements(self.robot, self.capsules, Q))
-
-    def _lower_bounds(self, centres: np.ndarray) -> np.ndarray:
-        """(T, P) bounding-sphere lower bounds of the pair distances [m]."""
-        gap = np.linalg.norm(centres[:, self._first] - centres[:, self._second], axis=2)
-        return gap - self._reach[self._first] - self._reach[self._second]
 
     def _distance(self, rotations: np.ndarray, centres: np.ndarray, t: int, p: int) -> coal.DistanceResult:
         i, j = self.pairs[p]
@@ -114,18 +111,22 @@ class SelfCollision(Constraint):
         r = point - self.robot.data.oMi[joint].translation
         return J[:3] - pin.skew(r) @ J[3:]
 
+    def track(self, alpha: np.ndarray, basis: FourierBasis) -> dict[str, np.ndarray]:
+        """``min_capsule_distance``: (T,) smallest distance over the pairs at each instant [m]."""
+        if not self.pairs:
+            return {}
+        _, rotations, centres = self._placements(alpha, basis)
+        return {"min_capsule_distance": self._screen(rotations, centres).min(axis=1)}
+
     def check(self, alpha: np.ndarray, basis: FourierBasis) -> FineCheck:
-        """Smallest exact distance over ``basis``'s instants and all pairs: coal is called in order
-        of increasing lower bound until the bound exceeds the smallest distance found."""
+        """Smallest distance over ``basis``'s instants and all pairs: the screen locates it, coal
+        gives it (for every sample screened within ``CONFIRM`` of the smallest)."""
         if not self.pairs:
             return FineCheck(max_violation=-np.inf, details={}, where="no capsule pair")
         _, rotations, centres = self._placements(alpha, basis)
-        bounds = self._lower_bounds(centres)
+        screened = self._screen(rotations, centres)
         best, where = np.inf, (0, 0)
-        for flat in np.argsort(bounds, axis=None):
-            t, p = np.unravel_index(flat, bounds.shape)
-            if bounds[t, p] >= best:
-                break
+        for t, p in zip(*np.nonzero(screened <= screened.min() + CONFIRM)):
             d = self._distance(rotations, centres, t, p).min_distance
             if d < best:
                 best, where = d, (t, p)

@@ -1,0 +1,120 @@
+"""The conventional baseline (the paper's ref. [16], Jovic et al., IROS 2015; Table II): many random
+Fourier trajectories that satisfy the physical constraints, and a greedy selection of the set.
+
+Each candidate has random Fourier coefficients (amplitudes decaying as 1/k) about the home posture,
+scaled per joint to fill its position, velocity and acceleration limits (a fair baseline does not
+waste amplitude); if another constraint (CoM region, capsules) then fails on the grid, all joints'
+oscillations are shrunk together by bisection to the largest scale that every constraint accepts.
+Selection: at iteration i, the candidate that minimizes cond([C⁽¹⁾; …; C⁽ⁱ⁾]) is added.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import Callable, Optional, Sequence
+
+import numpy as np
+
+from excite_cli.constraints.lse import GRID_MARGIN
+from excite_cli.excitation import Excitation
+
+#: Bisection steps on the common oscillation scale.
+SCALE_STEPS = 10
+
+
+@dataclass(frozen=True)
+class Pool:
+    """Feasible random candidates.
+
+    Attributes:
+        alphas: (K, n, 2N+1) Fourier coefficients.
+        regressors: (K, T·rows, b) base regressors at the cost samples.
+        generation_time_s: wall time spent drawing and checking them [s].
+        drawn: candidates drawn, rejected ones included.
+    """
+
+    alphas: np.ndarray
+    regressors: np.ndarray
+    generation_time_s: float
+    drawn: int
+
+
+def random_candidate(excitation: Excitation, rng: np.random.Generator) -> Optional[np.ndarray]:
+    """One feasible random α (n, 2N+1) that uses as much of the limits as the constraints allow, or
+    None when even a small motion violates a constraint."""
+    def accepted(alpha: np.ndarray) -> bool:
+        return all(c.accepts(alpha) for c in excitation.constraints)
+
+    alpha = excitation.limits.random_start(excitation.trajectory.n_coefficients, rng, 1.0 - GRID_MARGIN, excitation.home)
+    if accepted(alpha):
+        return alpha
+    lo, hi = 0.0, 1.0
+    for _ in range(SCALE_STEPS):
+        mid = (lo + hi) / 2.0
+        trial = alpha.copy()
+        trial[:, 1:] *= mid
+        lo, hi = (mid, hi) if accepted(trial) else (lo, mid)
+    if lo == 0.0:
+        return None
+    alpha[:, 1:] *= lo
+    return alpha
+
+
+def draw_pool(excitation: Excitation, size: int, rng: np.random.Generator, time_budget_s: Optional[float] = None,
+              progress: Optional[Callable[[int, int], None]] = None) -> Pool:
+    """Draw feasible candidates until ``size`` are kept (or ``time_budget_s`` [s] is spent, if given).
+
+    Args:
+        progress: called with (kept, drawn) after every draw.
+    """
+    start = time.perf_counter()
+    alphas, drawn = [], 0
+    criterion = excitation.criterion()
+    while len(alphas) < size and (time_budget_s is None or time.perf_counter() - start < time_budget_s):
+        drawn += 1
+        alpha = random_candidate(excitation, rng)
+        if alpha is not None:
+            alphas.append(alpha)
+        if progress:
+            progress(len(alphas), drawn)
+    regressors = np.array([criterion.regressor(a) for a in alphas])
+    return Pool(np.array(alphas), regressors, time.perf_counter() - start, drawn)
+
+
+def greedy_selection(regressors: np.ndarray, count: int, prior: Optional[np.ndarray] = None) -> tuple[list[int], list[float]]:
+    """Greedy set selection: at step i, add the candidate minimizing cond of [prior; selected; it].
+
+    Args:
+        regressors: (K, M, b) candidate regressors.
+        count: number of steps (each candidate is used at most once).
+        prior: optional (m, b) rows stacked first.
+
+    Returns:
+        The chosen indices and cond of the stacked regressor after each step. cond is computed from
+        the eigenvalues of the Gram matrix CᵀC = Σ C_kᵀ C_k: cond(C) = sqrt(λ_max / λ_min).
+
+    Raises:
+        ValueError: fewer candidates than ``count``.
+    """
+    if len(regressors) < count:
+        raise ValueError(f"{len(regressors)} candidates for {count} selections")
+    grams = np.einsum("kmi,kmj->kij", regressors, regressors)
+    base = np.zeros(grams.shape[1:]) if prior is None else prior.T @ prior
+    chosen: list[int] = []
+    conds: list[float] = []
+    for _ in range(count):
+        eig = np.linalg.eigvalsh(base + grams)  # (K, b), ascending
+        with np.errstate(divide="ignore", invalid="ignore"):
+            cond = np.sqrt(eig[:, -1] / np.where(eig[:, 0] > 0, eig[:, 0], 0.0))
+        cond[chosen] = np.inf
+        best = int(np.argmin(cond))
+        chosen.append(best)
+        conds.append(float(cond[best]))
+        base = base + grams[best]
+    return chosen, conds
+
+
+def pool_convergence(regressors: np.ndarray, count: int, sizes: Sequence[int]) -> list[tuple[int, list[float]]]:
+    """Greedy cond of the stacked regressor per step for the first ``size`` candidates, per size."""
+    return [(size, greedy_selection(regressors[:size], count)[1]) for size in sizes if count <= size <= len(regressors)]
