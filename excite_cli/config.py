@@ -150,14 +150,15 @@ def _format_validation_error(path: Path, error: ValidationError) -> str:
     return f"{path}: {field}: {message}{suffix}"
 
 
-def load_problem(path: str | Path) -> Problem:
-    """Read and validate a problem YAML file.
+def load_problem(path: str | Path, kind: type[BaseModel] = Problem):
+    """Read and validate a YAML file as a :class:`Problem` (or another config ``kind``).
 
     Args:
         path: the YAML file.
+        kind: :class:`Problem`, :class:`IdentifyProblem` or :class:`SimulationConfig`.
 
     Returns:
-        The validated :class:`Problem`, with ``source_path`` and ``source_text`` set.
+        The validated config, with ``source_path`` and ``source_text`` set where it has them.
 
     Raises:
         ExciteError: missing file, malformed YAML or an invalid field; the message names the field.
@@ -173,11 +174,93 @@ def load_problem(path: str | Path) -> Problem:
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
         raise ExciteError(f"{path}: malformed YAML{where}: {getattr(exc, 'problem', exc)}") from None
     if not isinstance(raw, dict):
-        raise ExciteError(f"{path}: expected a mapping with sections robot, trajectory, limits, ...")
+        raise ExciteError(f"{path}: expected a mapping of sections (see README 'Config reference')")
     try:
-        problem = Problem.model_validate(raw)
+        problem = kind.model_validate(raw)
     except ValidationError as exc:
         raise ExciteError(_format_validation_error(path, exc)) from None
-    problem.source_path = path.resolve()
-    problem.source_text = text
+    if hasattr(problem, "source_path"):
+        problem.source_path = path.resolve()
+        problem.source_text = text
     return problem
+
+
+# --- identification (excite identify) --------------------------------------------------------
+
+EFFECT_NAMES = ("coulomb", "coulomb_asymmetric", "viscous", "stribeck", "offset", "armature", "spring", "gravity_compensator")
+Effect = Literal["coulomb", "coulomb_asymmetric", "viscous", "stribeck", "offset", "armature", "spring", "gravity_compensator"]
+
+
+class ColumnsConfig(_Section):
+    time: str = "time"
+    q: list[str] = Field(min_length=1)
+    qd: Optional[list[str]] = None
+    qdd: Optional[list[str]] = None
+    tau: Optional[list[str]] = None
+    current: Optional[list[str]] = None
+
+    @model_validator(mode="after")
+    def _torque_source(self) -> "ColumnsConfig":
+        if (self.tau is None) == (self.current is None):
+            raise ValueError("give exactly one of tau or current columns")
+        return self
+
+
+class RunConfig(_Section):
+    file: str
+    crop: Optional[tuple[float, float]] = None
+    role: Literal["fit", "validation", "blocks"] = "blocks"
+
+
+class DataConfig(_Section):
+    runs: list[RunConfig] = Field(min_length=1)
+    columns: ColumnsConfig
+    angle_unit: Literal["rad", "deg"] = "rad"
+    torque_constants: Optional[list[float]] = None
+    signs: Optional[list[float]] = None
+    validation_blocks: int = Field(4, ge=2)
+
+
+class PreprocessingConfig(_Section):
+    sample_rate: float = Field(200.0, gt=0.0)
+    cutoff: Optional[float] = Field(None, gt=0.0)
+    filter_order: int = Field(4, ge=1, le=10)
+
+
+class IdentificationConfig(_Section):
+    method: Literal["wls", "ls"] = "wls"
+    declared_effects: dict[str, list[Effect]] = Field(default_factory=dict)
+    candidates: list[Effect] = Field(default_factory=lambda: list(EFFECT_NAMES))
+    significance: float = Field(1e-3, gt=0.0, lt=1.0)
+    stribeck_velocity: float = Field(0.1, gt=0.0)
+    coulomb_velocity: float = Field(0.01, gt=0.0)
+    max_effects: int = Field(60, ge=0)
+
+
+class IdentifyProblem(_Section):
+    """``excite identify`` config: the robot as for ``optimize``, then data, preprocessing, identification."""
+
+    robot: RobotConfig
+    data: DataConfig
+    preprocessing: PreprocessingConfig = PreprocessingConfig()
+    identification: IdentificationConfig = IdentificationConfig()
+    output: str = "results/identification.h5"
+
+    source_path: Optional[Path] = Field(None, exclude=True)
+    source_text: str = Field("", exclude=True)
+
+    resolve = Problem.resolve
+
+
+class SimulationConfig(_Section):
+    """``excite simulate`` effects file: what the simulated robot has beyond its URDF rigid body."""
+
+    sample_rate: float = Field(1000.0, gt=0.0)
+    periods: int = Field(2, ge=1)
+    timestamp_jitter: float = Field(0.0, ge=0.0, lt=0.5)
+    torque_noise: float = Field(0.0, ge=0.0)
+    position_noise: float = Field(0.0, ge=0.0)
+    seed: int = 0
+    effects: dict[Effect, dict[str, Union[float, tuple[float, float]]]] = Field(default_factory=dict)
+    stribeck_velocity: float = Field(0.1, gt=0.0)
+    coulomb_velocity: float = Field(0.01, gt=0.0)

@@ -77,9 +77,13 @@ def optimize_trajectory(
     options: OptimizerConfig,
     rng: np.random.Generator,
     start: Callable[[np.random.Generator], np.ndarray],
+    scale: np.ndarray,
     progress: Optional[ProgressHook] = None,
 ) -> OptimizationResult:
     """Minimize the criterion over α from ``options.restarts`` random feasible starts.
+
+    SLSQP works on z = α / ``scale`` (diagonal preconditioning, see
+    :meth:`JointLimits.coefficient_scale`); everything else sees α.
 
     SQP iterates approach the constraint boundary from outside, so each restart ends with the best
     of: the best point whose aggregated constraints were all ≤ 0, and the repaired last iterate
@@ -91,31 +95,34 @@ def optimize_trajectory(
         options: method, iterations, tolerance, restarts.
         rng: random generator of the starts.
         start: draws a random α (n, 2N+1) that every constraint accepts.
+        scale: (n, 2N+1) variable scale of the preconditioning.
         progress: called after every SLSQP iteration.
 
     Returns:
         The best accepted point over all restarts.
     """
-    n = len(criterion.robot.joint_names)
-    shape = (n, criterion.basis.q.shape[1])
+    shape = scale.shape
+    s = scale.ravel()
     cache: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
 
-    def constraint_values(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        key = x.tobytes()
+    def constraint_values(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        key = z.tobytes()
         if key not in cache:
             cache.clear()
-            cache[key] = _stack(constraints, x, shape)
+            g, J = _stack(constraints, z * s, shape)
+            cache[key] = (g, J * s)
         return cache[key]
 
     last_value = [np.nan]
     inside: dict[str, object] = {}
 
-    def objective(x: np.ndarray) -> tuple[float, np.ndarray]:
-        value, grad = criterion.value_and_gradient(x.reshape(shape))
+    def objective(z: np.ndarray) -> tuple[float, np.ndarray]:
+        alpha = (z * s).reshape(shape)
+        value, grad = criterion.value_and_gradient(alpha)
         last_value[0] = value
-        if value < inside.get("value", np.inf) and constraint_values(x)[0].max() <= 0.0:
-            inside.update(value=value, x=x.reshape(shape).copy())
-        return value, grad.ravel()
+        if value < inside.get("value", np.inf) and constraint_values(z)[0].max() <= 0.0:
+            inside.update(value=value, x=alpha.copy())
+        return value, grad.ravel() * s
 
     begin = time.perf_counter()
     best: Optional[tuple[float, np.ndarray, str]] = None
@@ -132,7 +139,7 @@ def optimize_trajectory(
 
         result = minimize(
             objective,
-            x0.ravel(),
+            x0.ravel() / s,
             jac=True,
             method=options.method,
             constraints=[{
@@ -144,7 +151,7 @@ def optimize_trajectory(
             callback=callback,
         )
         total_iterations += int(result.nit)
-        candidates = [x0, repair(constraints, result.x.reshape(shape), x0)]
+        candidates = [x0, repair(constraints, (result.x * s).reshape(shape), x0)]
         if "x" in inside:
             candidates.append(np.asarray(inside["x"]))
         for alpha in candidates:

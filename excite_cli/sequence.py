@@ -106,6 +106,7 @@ def run_sequence(
             excitation.problem.optimizer,
             rng,
             excitation.random_start,
+            excitation.limits.coefficient_scale(),
             progress=progress(k) if progress else None,
         )
         result = describe(excitation, k, best.alpha, stacked, time.perf_counter() - start, best.iterations, best.message)

@@ -72,6 +72,13 @@ class JointLimits(Constraint):
             details[f"max_violation_{order}"] = float(np.max(np.maximum(x - self.upper[d], self.lower[d] - x)))
         return FineCheck(max_violation=float(normalized.max()), details=details)
 
+    def coefficient_scale(self) -> np.ndarray:
+        """(n, 2N+1) per-coefficient scale [rad]: the change of a coefficient that moves its joint's
+        normalized q, q̇ or q̈ by at most 1 on the grid. A diagonal preconditioner for the optimizer:
+        without it the k-th harmonic weighs (kω)² more in q̈ than the first."""
+        effect = np.stack([np.abs(B).max(axis=0)[None, :] / self.half[d][:, None] for d, B in enumerate(self._orders)])
+        return 1.0 / effect.max(axis=0)
+
     def restore(self, alpha: np.ndarray) -> np.ndarray:
         """Scale each joint's oscillation about its offset q0 (clamped into the range) so that its
         samples stay 1 − δ inside every bound on the grid: the smallest change of shape that makes a

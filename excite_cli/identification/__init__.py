@@ -1,0 +1,1 @@
+"""Closing the loop on measured data: measurements, preprocessing, candidate effects, identification."""

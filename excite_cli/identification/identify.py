@@ -1,0 +1,198 @@
+"""Base parameters by (weighted) least squares (Eq. 4), and the loop that traces the residual to the
+effects the rigid-body model lacks.
+
+Weighted least squares follows Gautier (1997): each joint's rows are weighted by 1/σ_j, σ_j the
+residual standard deviation of that joint under ordinary least squares; the estimates' standard
+deviations come from σ² (AᵀWA)⁻¹.
+
+Effect selection is forward: at each step every remaining candidate block (effect, joint) is
+added to the current model in turn; the one that lowers the held-out (validation) weighted error
+most is kept if (1) it lowers it at all and (2) an F-test for nested linear models on the fit data
+rejects "no effect" at ``significance`` divided by the number of candidates tried (Bonferroni).
+Candidates whose columns lie in the span of the current model are not identifiable separately and
+are skipped. The loop stops when no candidate passes.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.linalg
+from scipy import stats
+
+from excite_cli.base_parameters import BaseParameters
+from excite_cli.config import IdentificationConfig
+from excite_cli.identification.effects import COEFFICIENTS, effect_columns
+from excite_cli.identification.preprocessing import Samples
+from excite_cli.robot import Robot
+
+#: A candidate whose columns keep less than this fraction of their norm outside the current model's
+#: span is not identifiable separately.
+IDENTIFIABILITY = 1e-6
+
+
+@dataclass(frozen=True)
+class Dataset:
+    """Stacked samples: rows ordered by instant, then joint.
+
+    Attributes:
+        regressor: (N·n, b) base regressor Y_B (Eq. 3).
+        tau: (N·n,) measured torques [Nm].
+        joint: (N·n,) joint index of each row.
+        q, qd, qdd: (N, n) for the effect columns.
+    """
+
+    regressor: np.ndarray
+    tau: np.ndarray
+    joint: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+
+    def block(self, effect: str, j: int, cfg: IdentificationConfig) -> np.ndarray:
+        """(N·n, k) columns of ``effect`` on joint j: nonzero only on joint j's rows."""
+        n = self.q.shape[1]
+        cols = effect_columns(effect, self.q[:, j], self.qd[:, j], self.qdd[:, j], cfg.coulomb_velocity, cfg.stribeck_velocity)
+        out = np.zeros((self.tau.size, cols.shape[1]))
+        out[j::n] = cols
+        return out
+
+
+def build_dataset(robot: Robot, base: BaseParameters, samples: list[Samples]) -> Dataset:
+    """Stack the base regressor and torques of the given preprocessed samples."""
+    q = np.vstack([s.q for s in samples])
+    qd = np.vstack([s.qd for s in samples])
+    qdd = np.vstack([s.qdd for s in samples])
+    tau = np.vstack([s.tau for s in samples])
+    Y = robot.regressor_stack(q, qd, qdd) @ base.composition_matrix
+    return Dataset(Y, tau.ravel(), np.tile(np.arange(q.shape[1]), q.shape[0]), q, qd, qdd)
+
+
+@dataclass(frozen=True)
+class Fit:
+    """A least-squares fit.
+
+    Attributes:
+        x: (p,) estimates; std: (p,) their standard deviations.
+        sigma: (n,) per-joint residual standard deviation [Nm] (ordinary least squares).
+    """
+
+    x: np.ndarray
+    std: np.ndarray
+    sigma: np.ndarray
+
+
+def _joint_sigma(residual: np.ndarray, joint: np.ndarray, n: int, p: int) -> np.ndarray:
+    dof = max(1.0, residual.size - p) / residual.size
+    return np.array([np.sqrt(np.mean(residual[joint == j] ** 2) / dof) for j in range(n)])
+
+
+def least_squares(A: np.ndarray, y: np.ndarray, joint: np.ndarray, n: int, weighted: bool) -> Fit:
+    """Ordinary (Eq. 4) or weighted least squares of y ≈ A x with standard deviations.
+
+    Args:
+        A: (M, p) design matrix; y: (M,) torques; joint: (M,) joint of each row; n: joints.
+        weighted: weight each joint's rows by 1/σ_j from an ordinary fit.
+    """
+    scale = np.linalg.norm(A, axis=0)
+    scale[scale == 0] = 1.0
+    x = np.linalg.lstsq(A / scale, y, rcond=None)[0] / scale
+    sigma = _joint_sigma(y - A @ x, joint, n, A.shape[1])
+    w = 1.0 / np.maximum(sigma[joint], 1e-12) if weighted else np.ones_like(y)
+    Q, R = np.linalg.qr(w[:, None] * A / scale)
+    x = scipy.linalg.solve_triangular(R, Q.T @ (w * y)) / scale
+    residual = w * (y - A @ x)
+    s2 = residual @ residual / max(1, y.size - A.shape[1])
+    Rinv = scipy.linalg.solve_triangular(R, np.eye(R.shape[0]))
+    std = np.sqrt(s2 * np.sum(Rinv**2, axis=1)) / scale
+    return Fit(x, std, sigma)
+
+
+@dataclass
+class Selection:
+    """Outcome of the effect-selection loop.
+
+    Attributes:
+        effects: chosen (effect, joint) in order, the declared ones first.
+        declared: how many of ``effects`` were declared in the config.
+        fit: final fit of [Y_B, effect columns] (base parameters first).
+        rigid: fit of the rigid-body model alone.
+        steps: per added effect: validation weighted SSE after, F statistic, p-value.
+        absorbed: candidates skipped as not separately identifiable.
+    """
+
+    effects: list[tuple[str, int]]
+    declared: int
+    fit: Fit
+    rigid: Fit
+    steps: list[dict] = field(default_factory=list)
+    absorbed: list[tuple[str, int]] = field(default_factory=list)
+
+
+def design(data: Dataset, effects: list[tuple[str, int]], cfg: IdentificationConfig) -> np.ndarray:
+    """[Y_B, effect blocks] (M, b + Σk)."""
+    return np.hstack([data.regressor] + [data.block(e, j, cfg) for e, j in effects])
+
+
+def select_effects(fit_data: Dataset, val_data: Dataset, cfg: IdentificationConfig,
+                   declared: list[tuple[str, int]]) -> Selection:
+    """Forward selection of effects (module docstring); declared effects are in the model from the start."""
+    n = fit_data.q.shape[1]
+    weighted = cfg.method == "wls"
+    rigid = least_squares(fit_data.regressor, fit_data.tau, fit_data.joint, n, weighted)
+    val_w = 1.0 / np.maximum(rigid.sigma[val_data.joint], 1e-12)  # fixed, so errors compare across steps
+    effects = list(declared)
+    remaining = [(e, j) for e in cfg.candidates for j in range(n) if (e, j) not in effects]
+    selection = Selection(effects, len(declared), rigid, rigid)
+    while remaining and len(effects) - len(declared) < cfg.max_effects:
+        A = design(fit_data, effects, cfg)
+        current = least_squares(A, fit_data.tau, fit_data.joint, n, weighted)
+        w = 1.0 / np.maximum(current.sigma[fit_data.joint], 1e-12) if weighted else np.ones(fit_data.tau.size)
+        scale = np.linalg.norm(A, axis=0)
+        scale[scale == 0] = 1.0
+        Q, R = np.linalg.qr(w[:, None] * A / scale)
+        r0 = w * fit_data.tau - Q @ (Q.T @ (w * fit_data.tau))
+        sse0 = r0 @ r0
+        x0 = scipy.linalg.solve_triangular(R, Q.T @ (w * fit_data.tau))
+        A_val = design(val_data, effects, cfg) / scale
+        val0 = np.sum((val_w * (val_data.tau - A_val @ x0)) ** 2)
+        best = None
+        for cand in list(remaining):
+            B = w[:, None] * fit_data.block(*cand, cfg)
+            B_perp = B - Q @ (Q.T @ B)
+            if np.linalg.norm(B_perp) < IDENTIFIABILITY * np.linalg.norm(B):
+                remaining.remove(cand)
+                selection.absorbed.append(cand)
+                continue
+            c, *_ = np.linalg.lstsq(B_perp, r0, rcond=None)
+            gain = r0 @ (B_perp @ c)
+            xa = x0 - scipy.linalg.solve_triangular(R, Q.T @ B @ c)
+            prediction = A_val @ xa + val_data.block(*cand, cfg) @ c
+            val1 = np.sum((val_w * (val_data.tau - prediction)) ** 2)
+            if best is None or val1 < best[1]:
+                best = (cand, val1, gain, B.shape[1])
+        if best is None:
+            break
+        cand, val1, gain, k = best
+        dof = fit_data.tau.size - A.shape[1] - k
+        F = (gain / k) / ((sse0 - gain) / dof)
+        p = float(stats.f.sf(F, k, dof))
+        if not (val1 < val0 and p < cfg.significance / len(remaining)):
+            break
+        effects.append(cand)
+        remaining.remove(cand)
+        selection.steps.append({"effect": cand[0], "joint": cand[1], "validation_sse": float(val1), "F": float(F), "p": p})
+    selection.effects = effects
+    selection.fit = least_squares(design(fit_data, effects, cfg), fit_data.tau, fit_data.joint, n, weighted)
+    return selection
+
+
+def predict(data: Dataset, x: np.ndarray, effects: list[tuple[str, int]], cfg: IdentificationConfig) -> np.ndarray:
+    """Predicted torques (N, n) [Nm] of the model [Y_B, effects] with coefficients x."""
+    return (design(data, effects, cfg) @ x).reshape(-1, data.q.shape[1])
+
+
+def effect_names(effects: list[tuple[str, int]], joints: list[str]) -> list[str]:
+    """``effect:coefficient:joint`` per coefficient of the effect blocks, in column order."""
+    return [f"{e}:{c}:{joints[j]}" for e, j in effects for c in COEFFICIENTS[e]]
