@@ -13,13 +13,22 @@ from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
-from excite_cli.config import Problem, load_problem
+from excite_cli.config import IdentifyProblem, Problem, SimulationConfig, load_problem
 from excite_cli.errors import ExciteError
 from excite_cli.criterion import ConditionNumber
 from excite_cli.excitation import Excitation, build_excitation
-from excite_cli.output import read_last_alpha, read_prior, read_table, write_result
+from excite_cli.identification.effects import UNITS as EFFECT_UNITS
+from excite_cli.identification.pipeline import effect_values, run_identification
+from excite_cli.identification.simulate import simulate_runs
+from excite_cli.output import read_last_alpha, read_prior, read_table, write_identification, write_result
 from excite_cli.constraints import ComRegion, SelfCollision
-from excite_cli.plots import plot_comparison, plot_condition_numbers, plot_constraint_tracks, plot_trajectories
+from excite_cli.plots import (
+    plot_comparison,
+    plot_condition_numbers,
+    plot_constraint_tracks,
+    plot_identification,
+    plot_trajectories,
+)
 from excite_cli.random_baseline import draw_pool, greedy_selection, pool_convergence
 from excite_cli.sequence import IterationResult, describe, run_sequence
 from excite_cli.verify import check_gradient, constraint_jacobian_error
@@ -209,6 +218,61 @@ def compare_random(
     out.print(convergence)
     plot = plot_comparison(target.with_suffix("").with_name(target.stem + "_comparison.png"), random_table, optimized_table)
     out.print(f"wrote {target} and {plot}", highlight=False)
+
+
+@app.command()
+@_user_errors
+def identify(
+    config: Path = typer.Argument(..., help="Identification YAML: robot, data, preprocessing, identification (see README)."),
+    output: Optional[Path] = typer.Option(None, "--output", "-o", help="HDF5 result (overrides config 'output')."),
+) -> None:
+    """Identify base parameters on measured data (Eq. 4), trace the residual to the effects the
+    rigid-body model lacks, add them, and report the torque error before and after on held-out data."""
+    problem = load_problem(config, IdentifyProblem)
+    target = output if output is not None else Path(problem.output)
+    with err.status("preprocessing, fitting and selecting effects ..."):
+        report, robot, base, data = run_identification(problem)
+    sel = report.selection
+    table = Table(title=f"Validation torque error, rigid body only → with the chosen effects ({report.validation_samples} held-out instants)")
+    for column in ("joint", "RMS τ [Nm]", "before [Nm]", "after [Nm]", "before [%]", "after [%]"):
+        table.add_column(column, justify="right")
+    for j, name in enumerate(report.joints):
+        table.add_row(name, f"{report.rms_torque[j]:.3f}", f"{report.rms_before[j]:.3f}", f"{report.rms_after[j]:.3f}",
+                      f"{report.relative_before[j]:.1f}", f"{report.relative_after[j]:.1f}")
+    out.print(table)
+    effects = Table(title="Effects, in the order they were added (declared ones first)")
+    for column in ("#", "effect", "joint", "coefficient", "value", "std"):
+        effects.add_column(column, justify="right")
+    order = {key: k + 1 for k, key in enumerate((e, report.joints[j]) for e, j in sel.effects)}
+    for effect, coefficient, joint, value, std in effect_values(report):
+        effects.add_row(str(order[(effect, joint)]), effect, joint, f"{coefficient} [{EFFECT_UNITS[coefficient]}]", f"{value:.5g}", f"{std:.2g}")
+    out.print(effects)
+    if sel.absorbed:
+        out.print("not separately identifiable (in the span of the base parameters): "
+                  + ", ".join(f"{e}:{report.joints[j]}" for e, j in sel.absorbed), highlight=False)
+    params = Table(title="Identified base parameters")
+    for column in ("base parameter", "value", "std"):
+        params.add_column(column, justify="right")
+    for name, value, std in zip(report.base_names, sel.fit.x, sel.fit.std):
+        params.add_row(name, f"{value:.5g}", f"{std:.2g}")
+    out.print(params)
+    write_identification(target, report, robot, base, problem.source_text, data.regressor, problem.identification.method)
+    plot = plot_identification(target.with_suffix("").with_name(target.stem + "_residuals.png"), report)
+    out.print(f"wrote {target} and {plot}", highlight=False)
+
+
+@app.command()
+@_user_errors
+def simulate(
+    result: Path = typer.Argument(..., help="An optimize (or compare-random) HDF5 result: its trajectories are simulated."),
+    effects: Path = typer.Argument(..., help="Effects file (YAML): effects, noise, sample rate, jitter (see README)."),
+    output_dir: Path = typer.Option(Path("results/simulated"), "--output-dir", "-o", help="Folder for the CSV runs."),
+) -> None:
+    """Make measured-like CSV runs (one per iteration) from a result's trajectories and the URDF model,
+    with the effects and noise of the effects file, in the format `identify` reads."""
+    sim = load_problem(effects, SimulationConfig)
+    files = simulate_runs(result, sim, output_dir)
+    out.print("wrote " + ", ".join(str(f) for f in files), highlight=False)
 
 
 def _comparison(random_table, optimized_table, random_time: float, optimized_time: float, pool: int, drawn: int) -> Table:

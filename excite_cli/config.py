@@ -232,6 +232,7 @@ class IdentificationConfig(_Section):
     declared_effects: dict[str, list[Effect]] = Field(default_factory=dict)
     candidates: list[Effect] = Field(default_factory=lambda: list(EFFECT_NAMES))
     significance: float = Field(1e-3, gt=0.0, lt=1.0)
+    min_improvement: float = Field(0.01, ge=0.0, lt=1.0)
     stribeck_velocity: float = Field(0.1, gt=0.0)
     coulomb_velocity: float = Field(0.01, gt=0.0)
     max_effects: int = Field(60, ge=0)

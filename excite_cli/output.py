@@ -156,17 +156,7 @@ def read_last_alpha(path: Path) -> tuple[int, np.ndarray]:
     Raises:
         ExciteError: missing or unreadable file, or no finished iteration in it.
     """
-    path = Path(path)
-    if not path.is_file():
-        raise ExciteError(f"result file not found: {path}")
-    try:
-        with h5py.File(path, "r") as f:
-            keys = sorted(f["iterations"].keys(), key=int) if "iterations" in f else []
-            if not keys:
-                raise ExciteError(f"{path} has no finished iteration")
-            return int(keys[-1]), f["iterations"][keys[-1]]["alpha"][()]
-    except OSError as exc:
-        raise ExciteError(f"cannot read {path} as HDF5: {exc}") from None
+    return read_alphas(path)[-1]
 
 
 def read_table(path: Path) -> tuple[np.ndarray, float]:
@@ -187,3 +177,84 @@ def read_table(path: Path) -> tuple[np.ndarray, float]:
             return f["table"][()], wall
     except OSError as exc:
         raise ExciteError(f"cannot read {path} as HDF5: {exc}") from None
+
+
+def read_alphas(path: Path) -> list[tuple[int, np.ndarray]]:
+    """(k, α (n, 2N+1)) of every iteration of an excite result, in order.
+
+    Raises:
+        ExciteError: missing or unreadable file, or no iteration in it.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise ExciteError(f"result file not found: {path}")
+    try:
+        with h5py.File(path, "r") as f:
+            keys = sorted(f["iterations"].keys(), key=int) if "iterations" in f else []
+            if not keys:
+                raise ExciteError(f"{path} has no finished iteration")
+            return [(int(k), f["iterations"][k]["alpha"][()]) for k in keys]
+    except OSError as exc:
+        raise ExciteError(f"cannot read {path} as HDF5: {exc}") from None
+
+
+def write_identification(path: Path, report, robot, base: BaseParameters, source_text: str, regressor: np.ndarray,
+                         method: str) -> None:
+    """Write (atomically) an ``identify`` result: ``/identification/...``, plus ``/regressor`` (the
+    base regressor of all preprocessed samples) and ``/robot/base_parameter_names``, so the file can
+    serve as prior data C₀ of ``optimize`` (Eq. 41).
+
+    Args:
+        report: the :class:`~excite_cli.identification.pipeline.Report`.
+        source_text: the identify config's text.
+        regressor: (M, b) base regressor rows of all samples.
+        method: ``wls`` or ``ls``.
+
+    Raises:
+        ExciteError: the file cannot be written.
+    """
+    from excite_cli.identification.pipeline import effect_values
+
+    path = Path(path)
+    tmp = path.with_name(path.name + ".partial")
+    sel = report.selection
+    b = base.count
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with h5py.File(tmp, "w") as f:
+            f.attrs["config"] = source_text
+            f.attrs["created"] = datetime.now(timezone.utc).isoformat(timespec="seconds")
+            for name, version in package_versions().items():
+                f.attrs[f"version_{name}"] = version
+            group = f.create_group("robot")
+            _strings(group, "joint_names", robot.joint_names)
+            _strings(group, "base_parameter_names", base.names)
+            f.create_dataset("regressor", data=regressor).attrs["description"] = "base regressor of all preprocessed samples (prior data C0, Eq. 41)"
+            g = f.create_group("identification")
+            g.attrs["method"] = method
+            g.attrs["cutoff_Hz"] = report.cutoff
+            g.attrs["fit_samples"] = report.fit_samples
+            g.attrs["validation_samples"] = report.validation_samples
+            _strings(g, "joint_names", report.joints)
+            _strings(g, "base_parameter_names", report.base_names)
+            g.create_dataset("base_parameters", data=sel.fit.x[:b])
+            g.create_dataset("base_parameters_std", data=sel.fit.std[:b])
+            g.create_dataset("base_parameters_rigid_only", data=sel.rigid.x)
+            rows = effect_values(report)
+            effects = np.zeros(len(rows), dtype=[("order", "i4"), ("effect", h5py.string_dtype()), ("coefficient", h5py.string_dtype()),
+                                                 ("joint", h5py.string_dtype()), ("value", "f8"), ("std", "f8"), ("declared", "?")])
+            declared = {(e, report.joints[j]) for e, j in sel.effects[: sel.declared]}
+            order = {key: k + 1 for k, key in enumerate((e, report.joints[j]) for e, j in sel.effects)}
+            for row, (effect, coefficient, joint, value, std) in zip(effects, rows):
+                row["order"], row["effect"], row["coefficient"], row["joint"] = order[(effect, joint)], effect, coefficient, joint
+                row["value"], row["std"], row["declared"] = value, std, (effect, joint) in declared
+            g.create_dataset("effects", data=effects)
+            _strings(g, "absorbed_effects", [f"{e}:{report.joints[j]}" for e, j in sel.absorbed])
+            for name, values, unit in (("rms_before", report.rms_before, "Nm"), ("rms_after", report.rms_after, "Nm"),
+                                       ("rms_torque", report.rms_torque, "Nm"), ("relative_before", report.relative_before, "%"),
+                                       ("relative_after", report.relative_after, "%")):
+                g.create_dataset(name, data=values).attrs["unit"] = unit
+        os.replace(tmp, path)
+    except OSError as exc:
+        tmp.unlink(missing_ok=True)
+        raise ExciteError(f"output: cannot write {path}: {exc}") from None

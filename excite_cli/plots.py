@@ -109,3 +109,39 @@ def plot_comparison(path: Path, random_table, optimized_table) -> Path:
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
+
+
+def plot_identification(path: Path, report) -> Path:
+    """Per joint, on validation data: measured torque with the rigid-body and the final prediction,
+    and the residuals before and after; written to ``path`` (PNG)."""
+    n = len(report.joints)
+    data = report.validation
+    measured = data.tau.reshape(-1, n)
+    first = data.run == data.run[0]
+    t = data.time[first]
+    fig, axes = plt.subplots(n, 2, figsize=(12, 1.9 * n), sharex=True, squeeze=False)
+    for j, name in enumerate(report.joints):
+        ax = axes[j, 0]
+        ax.plot(t, measured[first, j], "k", linewidth=0.8, label="measured")
+        ax.plot(t, report.predicted_before[first, j], linewidth=0.7, label="rigid body")
+        ax.plot(t, report.predicted_after[first, j], linewidth=0.7, label="with effects")
+        ax.set_ylabel(f"{name}\nτ [Nm]", fontsize=7)
+        ax = axes[j, 1]
+        ax.plot(t, measured[first, j] - report.predicted_before[first, j], linewidth=0.7,
+                label=f"before: RMS {report.rms_before[j]:.3f} Nm")
+        ax.plot(t, measured[first, j] - report.predicted_after[first, j], linewidth=0.7,
+                label=f"after: RMS {report.rms_after[j]:.3f} Nm")
+        ax.set_ylabel("residual [Nm]", fontsize=7)
+        ax.legend(fontsize=6, loc="upper right")
+        for a in axes[j]:
+            a.grid(alpha=0.3)
+            a.tick_params(labelsize=7)
+    axes[0, 0].legend(fontsize=6, loc="upper right")
+    axes[0, 0].set_title("validation data (first held-out run or blocks)", fontsize=9)
+    axes[0, 1].set_title("residual before / after the effects", fontsize=9)
+    for a in axes[-1]:
+        a.set_xlabel("time [s]")
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return path

@@ -7,8 +7,10 @@ deviations come from σ² (AᵀWA)⁻¹.
 
 Effect selection is forward: at each step every remaining candidate block (effect, joint) is
 added to the current model in turn; the one that lowers the held-out (validation) weighted error
-most is kept if (1) it lowers it at all and (2) an F-test for nested linear models on the fit data
-rejects "no effect" at ``significance`` divided by the number of candidates tried (Bonferroni).
+most is kept if (1) it lowers it by at least ``min_improvement`` (a fraction, default 1 %: with tens
+of thousands of rows a test alone finds sub-milli-newton-metre artefacts significant) and (2) an
+F-test for nested linear models on the fit data rejects "no effect" at ``significance`` divided by
+the number of candidates tried (Bonferroni).
 Candidates whose columns lie in the span of the current model are not identifiable separately and
 are skipped. The loop stops when no candidate passes.
 """
@@ -23,9 +25,11 @@ from scipy import stats
 
 from excite_cli.base_parameters import BaseParameters
 from excite_cli.config import IdentificationConfig
-from excite_cli.identification.effects import COEFFICIENTS, effect_columns
+from excite_cli.identification.effects import COEFFICIENTS, REQUIRES, effect_columns
 from excite_cli.identification.preprocessing import Samples
 from excite_cli.robot import Robot
+
+EFFECTS = tuple(COEFFICIENTS)
 
 #: A candidate whose columns keep less than this fraction of their norm outside the current model's
 #: span is not identifiable separately.
@@ -34,39 +38,65 @@ IDENTIFIABILITY = 1e-6
 
 @dataclass(frozen=True)
 class Dataset:
-    """Stacked samples: rows ordered by instant, then joint.
+    """Stacked, parallel-filtered and decimated samples: rows ordered by instant, then joint.
 
     Attributes:
         regressor: (N·n, b) base regressor Y_B (Eq. 3).
         tau: (N·n,) measured torques [Nm].
-        joint: (N·n,) joint index of each row.
-        q, qd, qdd: (N, n) for the effect columns.
+        time: (N,) [s]; run: (N,) index of the run of each instant.
+        blocks: effect columns by (effect, joint index), (N, k) each, on that joint's rows.
     """
 
     regressor: np.ndarray
     tau: np.ndarray
-    joint: np.ndarray
-    q: np.ndarray
-    qd: np.ndarray
-    qdd: np.ndarray
+    time: np.ndarray
+    run: np.ndarray
+    blocks: dict[tuple[str, int], np.ndarray]
 
-    def block(self, effect: str, j: int, cfg: IdentificationConfig) -> np.ndarray:
+    @property
+    def n(self) -> int:
+        """Number of joints."""
+        return self.tau.size // self.time.size
+
+    @property
+    def joint(self) -> np.ndarray:
+        """(N·n,) joint index of each row."""
+        return np.tile(np.arange(self.n), self.time.size)
+
+    def block(self, effect: str, j: int) -> np.ndarray:
         """(N·n, k) columns of ``effect`` on joint j: nonzero only on joint j's rows."""
-        n = self.q.shape[1]
-        cols = effect_columns(effect, self.q[:, j], self.qd[:, j], self.qdd[:, j], cfg.coulomb_velocity, cfg.stribeck_velocity)
+        cols = self.blocks[(effect, j)]
         out = np.zeros((self.tau.size, cols.shape[1]))
-        out[j::n] = cols
+        out[j :: self.n] = cols
         return out
 
+    def select(self, mask: np.ndarray) -> "Dataset":
+        """The instants where ``mask`` (N,) is true."""
+        rows = np.repeat(mask, self.n)
+        return Dataset(self.regressor[rows], self.tau[rows], self.time[mask], self.run[mask],
+                       {key: cols[mask] for key, cols in self.blocks.items()})
 
-def build_dataset(robot: Robot, base: BaseParameters, samples: list[Samples]) -> Dataset:
-    """Stack the base regressor and torques of the given preprocessed samples."""
-    q = np.vstack([s.q for s in samples])
-    qd = np.vstack([s.qd for s in samples])
-    qdd = np.vstack([s.qdd for s in samples])
-    tau = np.vstack([s.tau for s in samples])
-    Y = robot.regressor_stack(q, qd, qdd) @ base.composition_matrix
-    return Dataset(Y, tau.ravel(), np.tile(np.arange(q.shape[1]), q.shape[0]), q, qd, qdd)
+
+def build_dataset(robot: Robot, base: BaseParameters, samples: list[Samples], cfg: IdentificationConfig) -> Dataset:
+    """Regressor, candidate effect columns and torques of the samples, each low-passed by its run's
+    filter in parallel and decimated (so the filtered τ still equals the filtered columns × φ)."""
+    n, b = robot.n_joints, base.count
+    parts = []
+    for index, s in enumerate(samples):
+        Y = (robot.regressor_stack(s.q, s.qd, s.qdd) @ base.composition_matrix).reshape(-1, n * b)
+        blocks = {
+            (e, j): s.filter.decimate(effect_columns(e, s.q[:, j], s.qd[:, j], s.qdd[:, j], cfg.coulomb_velocity, cfg.stribeck_velocity))
+            for e in EFFECTS for j in range(n)
+        }
+        time = s.time[s.filter.trim : s.time.size - s.filter.trim : s.filter.step]
+        parts.append((s.filter.decimate(Y).reshape(-1, b), s.filter.decimate(s.tau).ravel(), time, np.full(time.size, index), blocks))
+    return Dataset(
+        np.vstack([p[0] for p in parts]),
+        np.concatenate([p[1] for p in parts]),
+        np.concatenate([p[2] for p in parts]),
+        np.concatenate([p[3] for p in parts]),
+        {key: np.vstack([p[4][key] for p in parts]) for key in parts[0][4]},
+    )
 
 
 @dataclass(frozen=True)
@@ -119,7 +149,7 @@ class Selection:
         fit: final fit of [Y_B, effect columns] (base parameters first).
         rigid: fit of the rigid-body model alone.
         steps: per added effect: validation weighted SSE after, F statistic, p-value.
-        absorbed: candidates skipped as not separately identifiable.
+        absorbed: candidates skipped as not separately identifiable (in the span of the model).
     """
 
     effects: list[tuple[str, int]]
@@ -130,23 +160,32 @@ class Selection:
     absorbed: list[tuple[str, int]] = field(default_factory=list)
 
 
-def design(data: Dataset, effects: list[tuple[str, int]], cfg: IdentificationConfig) -> np.ndarray:
+def design(data: Dataset, effects: list[tuple[str, int]]) -> np.ndarray:
     """[Y_B, effect blocks] (M, b + Σk)."""
-    return np.hstack([data.regressor] + [data.block(e, j, cfg) for e, j in effects])
+    return np.hstack([data.regressor] + [data.block(e, j) for e, j in effects])
+
+
+def _open(candidates: list[str], n: int, effects: list[tuple[str, int]]) -> list[tuple[str, int]]:
+    """Candidates not in the model whose required effect (``REQUIRES``) is in it."""
+    return [(e, j) for e in candidates for j in range(n)
+            if (e, j) not in effects and (e not in REQUIRES or (REQUIRES[e], j) in effects)]
 
 
 def select_effects(fit_data: Dataset, val_data: Dataset, cfg: IdentificationConfig,
                    declared: list[tuple[str, int]]) -> Selection:
     """Forward selection of effects (module docstring); declared effects are in the model from the start."""
-    n = fit_data.q.shape[1]
+    n = fit_data.n
     weighted = cfg.method == "wls"
     rigid = least_squares(fit_data.regressor, fit_data.tau, fit_data.joint, n, weighted)
     val_w = 1.0 / np.maximum(rigid.sigma[val_data.joint], 1e-12)  # fixed, so errors compare across steps
     effects = list(declared)
-    remaining = [(e, j) for e in cfg.candidates for j in range(n) if (e, j) not in effects]
+    absorbed: set[tuple[str, int]] = set()
     selection = Selection(effects, len(declared), rigid, rigid)
-    while remaining and len(effects) - len(declared) < cfg.max_effects:
-        A = design(fit_data, effects, cfg)
+    while len(effects) - len(declared) < cfg.max_effects:
+        remaining = [c for c in _open(cfg.candidates, n, effects) if c not in absorbed]
+        if not remaining:
+            break
+        A = design(fit_data, effects)
         current = least_squares(A, fit_data.tau, fit_data.joint, n, weighted)
         w = 1.0 / np.maximum(current.sigma[fit_data.joint], 1e-12) if weighted else np.ones(fit_data.tau.size)
         scale = np.linalg.norm(A, axis=0)
@@ -155,20 +194,19 @@ def select_effects(fit_data: Dataset, val_data: Dataset, cfg: IdentificationConf
         r0 = w * fit_data.tau - Q @ (Q.T @ (w * fit_data.tau))
         sse0 = r0 @ r0
         x0 = scipy.linalg.solve_triangular(R, Q.T @ (w * fit_data.tau))
-        A_val = design(val_data, effects, cfg) / scale
+        A_val = design(val_data, effects) / scale
         val0 = np.sum((val_w * (val_data.tau - A_val @ x0)) ** 2)
         best = None
-        for cand in list(remaining):
-            B = w[:, None] * fit_data.block(*cand, cfg)
+        for cand in remaining:
+            B = w[:, None] * fit_data.block(*cand)
             B_perp = B - Q @ (Q.T @ B)
             if np.linalg.norm(B_perp) < IDENTIFIABILITY * np.linalg.norm(B):
-                remaining.remove(cand)
-                selection.absorbed.append(cand)
+                absorbed.add(cand)
                 continue
             c, *_ = np.linalg.lstsq(B_perp, r0, rcond=None)
             gain = r0 @ (B_perp @ c)
             xa = x0 - scipy.linalg.solve_triangular(R, Q.T @ B @ c)
-            prediction = A_val @ xa + val_data.block(*cand, cfg) @ c
+            prediction = A_val @ xa + val_data.block(*cand) @ c
             val1 = np.sum((val_w * (val_data.tau - prediction)) ** 2)
             if best is None or val1 < best[1]:
                 best = (cand, val1, gain, B.shape[1])
@@ -178,19 +216,19 @@ def select_effects(fit_data: Dataset, val_data: Dataset, cfg: IdentificationConf
         dof = fit_data.tau.size - A.shape[1] - k
         F = (gain / k) / ((sse0 - gain) / dof)
         p = float(stats.f.sf(F, k, dof))
-        if not (val1 < val0 and p < cfg.significance / len(remaining)):
+        if not (val1 < (1.0 - cfg.min_improvement) * val0 and p < cfg.significance / len(remaining)):
             break
         effects.append(cand)
-        remaining.remove(cand)
         selection.steps.append({"effect": cand[0], "joint": cand[1], "validation_sse": float(val1), "F": float(F), "p": p})
     selection.effects = effects
-    selection.fit = least_squares(design(fit_data, effects, cfg), fit_data.tau, fit_data.joint, n, weighted)
+    selection.absorbed = sorted(absorbed)
+    selection.fit = least_squares(design(fit_data, effects), fit_data.tau, fit_data.joint, n, weighted)
     return selection
 
 
-def predict(data: Dataset, x: np.ndarray, effects: list[tuple[str, int]], cfg: IdentificationConfig) -> np.ndarray:
+def predict(data: Dataset, x: np.ndarray, effects: list[tuple[str, int]]) -> np.ndarray:
     """Predicted torques (N, n) [Nm] of the model [Y_B, effects] with coefficients x."""
-    return (design(data, effects, cfg) @ x).reshape(-1, data.q.shape[1])
+    return (design(data, effects) @ x).reshape(-1, data.n)
 
 
 def effect_names(effects: list[tuple[str, int]], joints: list[str]) -> list[str]:

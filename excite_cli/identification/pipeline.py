@@ -13,7 +13,7 @@ from excite_cli.errors import ExciteError
 from excite_cli.identification.effects import COEFFICIENTS
 from excite_cli.identification.identify import Dataset, Selection, build_dataset, effect_names, predict, select_effects
 from excite_cli.identification.measurements import load_run
-from excite_cli.identification.preprocessing import Samples, preprocess
+from excite_cli.identification.preprocessing import default_cutoff, preprocess
 from excite_cli.robot import Robot, load_robot
 
 
@@ -28,7 +28,7 @@ class Report:
         rms_before, rms_after: (n,) validation torque RMS error [Nm], rigid body only / with effects.
         rms_torque: (n,) RMS of the measured validation torques [Nm].
         validation: the validation samples; predicted_before, predicted_after: (N, n) [Nm] on them.
-        cutoffs: low-pass cut-off per run [Hz].
+        cutoff: low-pass cut-off of every run [Hz].
         fit_samples, validation_samples: instants used for fitting / validation.
     """
 
@@ -42,7 +42,7 @@ class Report:
     validation: Dataset
     predicted_before: np.ndarray
     predicted_after: np.ndarray
-    cutoffs: list[float]
+    cutoff: float
     fit_samples: int
     validation_samples: int
 
@@ -57,26 +57,24 @@ class Report:
         return 100.0 * self.rms_after / self.rms_torque
 
 
-def split(samples: list[Samples], blocks: int) -> tuple[list[Samples], list[Samples]]:
-    """Fit and validation samples: runs by their role; a ``blocks`` run is cut into ``blocks``
-    contiguous time blocks, the even ones for fitting and the odd ones held out.
+def split(data: Dataset, roles: list[str], blocks: int) -> np.ndarray:
+    """(N,) mask of the instants used for fitting: runs by their role; a ``blocks`` run is cut into
+    ``blocks`` contiguous time blocks, the even ones for fitting and the odd ones held out.
 
     Raises:
         ExciteError: nothing left for fitting or for validation.
     """
-    fit, val = [], []
-    for s in samples:
-        if s.role == "fit":
-            fit.append(s)
-        elif s.role == "validation":
-            val.append(s)
-        else:
-            index = np.minimum((np.arange(s.time.size) * blocks) // s.time.size, blocks - 1)
-            fit.append(s.select(index % 2 == 0, "fit"))
-            val.append(s.select(index % 2 == 1, "validation"))
-    if not fit or not val:
+    fit = np.zeros(data.time.size, dtype=bool)
+    for index, role in enumerate(roles):
+        rows = np.nonzero(data.run == index)[0]
+        if role == "fit":
+            fit[rows] = True
+        elif role == "blocks":
+            block = np.minimum((np.arange(rows.size) * blocks) // rows.size, blocks - 1)
+            fit[rows] = block % 2 == 0
+    if fit.all() or not fit.any():
         raise ExciteError("data.runs: need data for fitting and for validation (roles fit/validation, or blocks)")
-    return fit, val
+    return fit
 
 
 def declared_effects(problem: IdentifyProblem, robot: Robot) -> list[tuple[str, int]]:
@@ -108,15 +106,16 @@ def run_identification(problem: IdentifyProblem) -> tuple[Report, Robot, BasePar
     robot = load_robot(problem)
     base = compute_base_parameters(robot)
     runs = [load_run(r, problem.data, problem, robot.n_joints) for r in problem.data.runs]
-    samples = [preprocess(r, problem.preprocessing) for r in runs]
-    fit_s, val_s = split(samples, problem.data.validation_blocks)
-    fit_data = build_dataset(robot, base, fit_s)
-    val_data = build_dataset(robot, base, val_s)
+    cutoff = problem.preprocessing.cutoff or default_cutoff(runs)
+    samples = [preprocess(r, problem.preprocessing, cutoff) for r in runs]
     cfg = problem.identification
+    data = build_dataset(robot, base, samples, cfg)
+    fit_mask = split(data, [s.role for s in samples], problem.data.validation_blocks)
+    fit_data, val_data = data.select(fit_mask), data.select(~fit_mask)
     selection = select_effects(fit_data, val_data, cfg, declared_effects(problem, robot))
-    before = predict(val_data, selection.rigid.x, [], cfg)
-    after = predict(val_data, selection.fit.x, selection.effects, cfg)
-    measured = val_data.tau.reshape(-1, robot.n_joints)
+    before = predict(val_data, selection.rigid.x, [])
+    after = predict(val_data, selection.fit.x, selection.effects)
+    measured = val_data.tau.reshape(-1, val_data.n)
     report = Report(
         joints=robot.joint_names,
         base_names=base.names,
@@ -128,11 +127,11 @@ def run_identification(problem: IdentifyProblem) -> tuple[Report, Robot, BasePar
         validation=val_data,
         predicted_before=before,
         predicted_after=after,
-        cutoffs=[s.cutoff for s in samples],
-        fit_samples=fit_data.q.shape[0],
-        validation_samples=val_data.q.shape[0],
+        cutoff=cutoff,
+        fit_samples=fit_data.time.size,
+        validation_samples=val_data.time.size,
     )
-    return report, robot, base, build_dataset(robot, base, samples)
+    return report, robot, base, data
 
 
 def effect_values(report: Report) -> list[tuple[str, str, str, float, float]]:

@@ -1,7 +1,8 @@
-"""Preprocessing of measured runs (scipy.signal): uniform resampling of jittery timestamps, zero-phase
-low-pass filtering of q and τ alike, q̇ and q̈ by differentiation when not measured, edge trimming and
-decimation. The default cut-off is ``CUTOFF_FACTOR`` × the trajectory's bandwidth, estimated from the
-spectrum of q."""
+"""Preprocessing of measured runs (scipy.signal): uniform resampling of jittery timestamps, a
+zero-phase low-pass of q before differentiating it into q̇ and q̈ (when they are not measured), and
+the parallel low-pass and decimation that ``Dataset`` applies to the regressor columns and to τ
+alike (Gautier 1997), so filtering never breaks τ = W φ. The default cut-off is ``CUTOFF_FACTOR`` ×
+the trajectory's bandwidth, estimated from the spectrum of q over all runs."""
 
 from __future__ import annotations
 
@@ -20,14 +21,45 @@ CUTOFF_FACTOR = 5.0
 EDGE_PERIODS = 3.0
 
 
+def bandwidth(q: np.ndarray, rate: float, fraction: float = 0.999) -> float:
+    """Frequency [Hz] below which ``fraction`` of the power of the detrended (T, n) signals lies."""
+    power = np.abs(np.fft.rfft(signal.detrend(q, axis=0), axis=0)) ** 2
+    cumulative = np.cumsum(power.sum(axis=1))
+    freqs = np.fft.rfftfreq(q.shape[0], 1.0 / rate)
+    return float(freqs[np.searchsorted(cumulative, fraction * cumulative[-1])])
+
+
 @dataclass(frozen=True)
-class Samples:
-    """Preprocessed samples of one run on a uniform grid.
+class Filter:
+    """Zero-phase Butterworth low-pass, edge trimming and decimation of one run.
 
     Attributes:
-        name: run name; role: ``fit``, ``validation`` or ``blocks``.
-        time: (T,) [s]; q, qd, qdd, tau: (T, n) [rad, rad/s, rad/s², Nm].
-        cutoff: the low-pass cut-off used [Hz].
+        sos: second-order sections; rate: sample rate [Hz]; cutoff [Hz]; trim: samples dropped at
+        each end; step: decimation step.
+    """
+
+    sos: np.ndarray
+    rate: float
+    cutoff: float
+    trim: int
+    step: int
+
+    def low_pass(self, x: np.ndarray) -> np.ndarray:
+        """Zero-phase filtered x along time (axis 0)."""
+        return signal.sosfiltfilt(self.sos, x, axis=0)
+
+    def decimate(self, x: np.ndarray) -> np.ndarray:
+        """Filtered, trimmed and decimated x (axis 0)."""
+        return self.low_pass(x)[self.trim : x.shape[0] - self.trim : self.step]
+
+
+@dataclass(frozen=True)
+class Samples:
+    """One run on a uniform grid at its own rate, with q̇ and q̈.
+
+    Attributes:
+        name, role: from the run; time: (T,) [s]; q, qd, qdd, tau: (T, n) [rad, rad/s, rad/s², Nm]
+        (τ unfiltered: it is filtered in parallel with the regressor); filter: the run's filter.
     """
 
     name: str
@@ -37,29 +69,30 @@ class Samples:
     qd: np.ndarray
     qdd: np.ndarray
     tau: np.ndarray
-    cutoff: float
-
-    def select(self, mask: np.ndarray, role: str) -> "Samples":
-        """The samples where ``mask`` (T,) is true, with another role."""
-        return Samples(self.name, role, self.time[mask], self.q[mask], self.qd[mask], self.qdd[mask], self.tau[mask], self.cutoff)
+    filter: Filter
 
 
-def bandwidth(q: np.ndarray, rate: float, fraction: float = 0.999) -> float:
-    """Frequency [Hz] below which ``fraction`` of the power of the detrended (T, n) signals lies."""
-    power = np.abs(np.fft.rfft(signal.detrend(q, axis=0), axis=0)) ** 2
-    cumulative = np.cumsum(power.sum(axis=1))
-    freqs = np.fft.rfftfreq(q.shape[0], 1.0 / rate)
-    return float(freqs[np.searchsorted(cumulative, fraction * cumulative[-1])])
+def run_rate(run: Run) -> float:
+    """Mean sample rate of a run [Hz]."""
+    return (run.time.size - 1) / (run.time[-1] - run.time[0])
 
 
-def preprocess(run: Run, cfg: PreprocessingConfig) -> Samples:
-    """Resample, filter, differentiate, trim and decimate one run.
+def default_cutoff(runs: list[Run]) -> float:
+    """``CUTOFF_FACTOR`` × the largest bandwidth of the runs' q [Hz] (at least 0.5 Hz)."""
+    return max(0.5, CUTOFF_FACTOR * max(bandwidth(r.q, run_rate(r)) for r in runs))
+
+
+def preprocess(run: Run, cfg: PreprocessingConfig, cutoff: float) -> Samples:
+    """Resample one run to a uniform grid, low-pass q (and measured q̇, q̈) and differentiate.
+
+    Args:
+        cutoff: low-pass cut-off [Hz] (the same for every run).
 
     Raises:
-        ExciteError: a cut-off at or above the decimated rate's Nyquist frequency, or a run shorter
-            than the filter needs.
+        ExciteError: a cut-off at or above the Nyquist frequency of ``sample_rate``, or a run
+            shorter than the filter needs.
     """
-    rate = (run.time.size - 1) / (run.time[-1] - run.time[0])
+    rate = run_rate(run)
     grid = run.time[0] + np.arange(run.time.size) / rate
     grid = grid[grid <= run.time[-1]]
 
@@ -68,11 +101,10 @@ def preprocess(run: Run, cfg: PreprocessingConfig) -> Samples:
 
     q, qd, qdd, tau = (resample(x) for x in (run.q, run.qd, run.qdd, run.tau))
     target = min(cfg.sample_rate, rate)
-    cutoff = cfg.cutoff or max(CUTOFF_FACTOR * bandwidth(q, rate), 0.5)
     if cutoff >= 0.5 * target:
         raise ExciteError(
             f"preprocessing.cutoff: {cutoff:.3g} Hz is not below the Nyquist frequency {0.5 * target:.3g} Hz of "
-            f"preprocessing.sample_rate; raise sample_rate or lower cutoff"
+            f"preprocessing.sample_rate (and of {run.name}); raise sample_rate or lower cutoff"
         )
     sos = signal.butter(cfg.filter_order, cutoff, fs=rate, output="sos")
     trim = int(np.ceil(EDGE_PERIODS * rate / cutoff))
@@ -80,17 +112,11 @@ def preprocess(run: Run, cfg: PreprocessingConfig) -> Samples:
     if grid.size <= needed:
         raise ExciteError(
             f"data: {run.name}: {grid.size} samples ({grid[-1] - grid[0]:.3g} s) are fewer than the "
-            f"{needed} the {cutoff:.3g} Hz filter needs"
+            f"{needed} that the {cutoff:.3g} Hz filter needs"
         )
+    filt = Filter(sos, rate, cutoff, trim, max(1, int(round(rate / target))))
     dt = 1.0 / rate
-
-    def smooth(x: np.ndarray) -> np.ndarray:
-        return signal.sosfiltfilt(sos, x, axis=0)
-
-    q = smooth(q)
-    qd = smooth(qd) if qd is not None else np.gradient(q, dt, axis=0)
-    qdd = smooth(qdd) if qdd is not None else np.gradient(qd, dt, axis=0)
-    tau = smooth(tau)
-    step = max(1, int(round(rate / target)))
-    keep = slice(trim, grid.size - trim, step)
-    return Samples(run.name, run.role, grid[keep], q[keep], qd[keep], qdd[keep], tau[keep], cutoff)
+    q = filt.low_pass(q)
+    qd = filt.low_pass(qd) if qd is not None else np.gradient(q, dt, axis=0)
+    qdd = filt.low_pass(qdd) if qdd is not None else np.gradient(qd, dt, axis=0)
+    return Samples(run.name, run.role, grid, q, qd, qdd, tau, filt)

@@ -1,0 +1,94 @@
+"""``excite simulate``: measured-like runs from a trajectory result and the URDF model, with effects and
+noise from a separate effects file, written as CSV in the format ``identify`` reads.
+
+τ = RNEA(q, q̇, q̈; URDF inertias) + Σ effects + N(0, σ_τ²); q is written with N(0, σ_q²) added and
+timestamps with uniform jitter. Columns: ``time, q_<joint>..., tau_<joint>...``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from excite_cli.config import Problem, SimulationConfig
+from excite_cli.errors import ExciteError
+from excite_cli.identification.effects import COEFFICIENTS, effect_columns
+from excite_cli.output import read_alphas
+from excite_cli.robot import Robot, load_robot
+from excite_cli.trajectory import FourierTrajectory
+
+
+def problem_of_result(path: Path) -> Problem:
+    """The optimize config stored in a result file (relative paths resolved from its original place).
+
+    Raises:
+        ExciteError: the file has no readable config.
+    """
+    import h5py
+
+    try:
+        with h5py.File(path, "r") as f:
+            text, origin = str(f.attrs["config"]), str(f.attrs.get("config_path", ""))
+    except (OSError, KeyError) as exc:
+        raise ExciteError(f"{path}: not an excite result with a stored config ({exc})") from None
+    problem = Problem.model_validate(yaml.safe_load(text))
+    problem.source_path = Path(origin) if origin else None
+    problem.source_text = text
+    return problem
+
+
+def effect_torques(sim: SimulationConfig, robot: Robot, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
+    """(T, n) torques [Nm] of the effects in ``sim.effects`` ({effect: {joint or "*": value}}).
+
+    Raises:
+        ExciteError: an unknown joint or a value with the wrong number of coefficients.
+    """
+    tau = np.zeros_like(q)
+    for effect, per_joint in sim.effects.items():
+        for name, value in per_joint.items():
+            if name != "*" and name not in robot.joint_names:
+                raise ExciteError(f"effects.{effect}: '{name}' is not an active joint")
+            coefficients = np.atleast_1d(np.asarray(value, dtype=float))
+            if coefficients.size != len(COEFFICIENTS[effect]):
+                raise ExciteError(f"effects.{effect}.{name}: needs {len(COEFFICIENTS[effect])} value(s) {COEFFICIENTS[effect]}")
+            for j in (range(robot.n_joints) if name == "*" else [robot.joint_names.index(name)]):
+                cols = effect_columns(effect, q[:, j], qd[:, j], qdd[:, j], sim.coulomb_velocity, sim.stribeck_velocity)
+                tau[:, j] += cols @ coefficients
+    return tau
+
+
+def simulate_runs(result: Path, sim: SimulationConfig, out_dir: Path, prefix: str = "run") -> list[Path]:
+    """Write one CSV per iteration of ``result`` into ``out_dir``.
+
+    Args:
+        result: an ``optimize`` (or ``compare-random``) HDF5 result.
+        sim: the effects file.
+        out_dir: folder for ``<prefix>_<k>.csv``.
+
+    Returns:
+        The written files.
+    """
+    problem = problem_of_result(result)
+    problem.robot.base_wrench_rows = False
+    robot = load_robot(problem)
+    trajectory = FourierTrajectory(problem.trajectory.harmonics, problem.trajectory.base_frequency)
+    rng = np.random.default_rng(sim.seed)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    written = []
+    for k, alpha in read_alphas(result):
+        count = int(round(sim.periods * trajectory.period * sim.sample_rate)) + 1
+        time = np.arange(count) / sim.sample_rate
+        time[1:-1] += rng.uniform(-sim.timestamp_jitter, sim.timestamp_jitter, count - 2) / sim.sample_rate
+        q, qd, qdd = trajectory.basis(time).evaluate(alpha)
+        tau = np.array([robot.torques(*x) for x in zip(q, qd, qdd)]) + effect_torques(sim, robot, q, qd, qdd)
+        tau += rng.normal(0.0, sim.torque_noise, tau.shape)
+        q_measured = q + rng.normal(0.0, sim.position_noise, q.shape)
+        header = ["time"] + [f"q_{j}" for j in robot.joint_names] + [f"tau_{j}" for j in robot.joint_names]
+        path = out_dir / f"{prefix}_{k}.csv"
+        tmp = path.with_name(path.name + ".partial")
+        np.savetxt(tmp, np.column_stack([time, q_measured, tau]), delimiter=",", header=",".join(header), comments="", fmt="%.10g")
+        tmp.replace(path)
+        written.append(path)
+    return written
