@@ -3,7 +3,9 @@ effects the rigid-body model lacks.
 
 Weighted least squares follows Gautier (1997): each joint's rows are weighted by 1/σ_j, σ_j the
 residual standard deviation of that joint under ordinary least squares; the estimates' standard
-deviations come from σ² (AᵀWA)⁻¹.
+deviations come from σ² (AᵀWA)⁻¹, scaled by √r: after the parallel low-pass at f_c, samples at
+f_s carry only about 2 f_c T independent values (r = f_s / (2 f_c), the oversampling), and the
+F-test below counts its degrees of freedom the same way.
 
 Effect selection is forward: at each step every remaining candidate block (effect, joint) is
 added to the current model in turn; the one that lowers the held-out (validation) weighted error
@@ -118,12 +120,13 @@ def _joint_sigma(residual: np.ndarray, joint: np.ndarray, n: int, p: int) -> np.
     return np.array([np.sqrt(np.mean(residual[joint == j] ** 2) / dof) for j in range(n)])
 
 
-def least_squares(A: np.ndarray, y: np.ndarray, joint: np.ndarray, n: int, weighted: bool) -> Fit:
+def least_squares(A: np.ndarray, y: np.ndarray, joint: np.ndarray, n: int, weighted: bool, oversampling: float = 1.0) -> Fit:
     """Ordinary (Eq. 4) or weighted least squares of y ≈ A x with standard deviations.
 
     Args:
         A: (M, p) design matrix; y: (M,) torques; joint: (M,) joint of each row; n: joints.
         weighted: weight each joint's rows by 1/σ_j from an ordinary fit.
+        oversampling: samples per independent sample (r ≥ 1); the deviations are scaled by √r.
     """
     scale = np.linalg.norm(A, axis=0)
     scale[scale == 0] = 1.0
@@ -135,7 +138,7 @@ def least_squares(A: np.ndarray, y: np.ndarray, joint: np.ndarray, n: int, weigh
     residual = w * (y - A @ x)
     s2 = residual @ residual / max(1, y.size - A.shape[1])
     Rinv = scipy.linalg.solve_triangular(R, np.eye(R.shape[0]))
-    std = np.sqrt(s2 * np.sum(Rinv**2, axis=1)) / scale
+    std = np.sqrt(oversampling * s2 * np.sum(Rinv**2, axis=1)) / scale
     return Fit(x, std, sigma)
 
 
@@ -172,11 +175,15 @@ def _open(candidates: list[str], n: int, effects: list[tuple[str, int]]) -> list
 
 
 def select_effects(fit_data: Dataset, val_data: Dataset, cfg: IdentificationConfig,
-                   declared: list[tuple[str, int]]) -> Selection:
-    """Forward selection of effects (module docstring); declared effects are in the model from the start."""
+                   declared: list[tuple[str, int]], oversampling: float = 1.0) -> Selection:
+    """Forward selection of effects (module docstring); declared effects are in the model from the start.
+
+    Args:
+        oversampling: samples per independent sample r (≥ 1) of the filtered data.
+    """
     n = fit_data.n
     weighted = cfg.method == "wls"
-    rigid = least_squares(fit_data.regressor, fit_data.tau, fit_data.joint, n, weighted)
+    rigid = least_squares(fit_data.regressor, fit_data.tau, fit_data.joint, n, weighted, oversampling)
     val_w = 1.0 / np.maximum(rigid.sigma[val_data.joint], 1e-12)  # fixed, so errors compare across steps
     effects = list(declared)
     absorbed: set[tuple[str, int]] = set()
@@ -213,7 +220,7 @@ def select_effects(fit_data: Dataset, val_data: Dataset, cfg: IdentificationConf
         if best is None:
             break
         cand, val1, gain, k = best
-        dof = fit_data.tau.size - A.shape[1] - k
+        dof = (fit_data.tau.size - A.shape[1] - k) / oversampling
         F = (gain / k) / ((sse0 - gain) / dof)
         p = float(stats.f.sf(F, k, dof))
         if not (val1 < (1.0 - cfg.min_improvement) * val0 and p < cfg.significance / len(remaining)):
@@ -222,7 +229,7 @@ def select_effects(fit_data: Dataset, val_data: Dataset, cfg: IdentificationConf
         selection.steps.append({"effect": cand[0], "joint": cand[1], "validation_sse": float(val1), "F": float(F), "p": p})
     selection.effects = effects
     selection.absorbed = sorted(absorbed)
-    selection.fit = least_squares(design(fit_data, effects), fit_data.tau, fit_data.joint, n, weighted)
+    selection.fit = least_squares(design(fit_data, effects), fit_data.tau, fit_data.joint, n, weighted, oversampling)
     return selection
 
 

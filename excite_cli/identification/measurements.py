@@ -43,9 +43,9 @@ def _read_table(path: Path) -> dict[str, np.ndarray]:
     with path.open() as handle:
         header = handle.readline().strip().split(",")
     try:
-        values = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+        values = np.atleast_2d(np.genfromtxt(path, delimiter=",", skip_header=1, dtype=float))
     except ValueError as exc:
-        raise ExciteError(f"data: {path}: cannot parse the CSV ({exc})") from None
+        raise ExciteError(f"data: {path.name}: cannot parse the CSV ({' '.join(str(exc).split())[:200]})") from None
     if values.shape[1] != len(header):
         raise ExciteError(f"data: {path}: {values.shape[1]} values per row but {len(header)} header names")
     return {name.strip(): values[:, k] for k, name in enumerate(header)}

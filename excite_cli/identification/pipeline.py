@@ -106,13 +106,14 @@ def run_identification(problem: IdentifyProblem) -> tuple[Report, Robot, BasePar
     robot = load_robot(problem)
     base = compute_base_parameters(robot)
     runs = [load_run(r, problem.data, problem, robot.n_joints) for r in problem.data.runs]
-    cutoff = problem.preprocessing.cutoff or default_cutoff(runs)
+    cutoff = problem.preprocessing.cutoff or default_cutoff(runs, problem.preprocessing)
     samples = [preprocess(r, problem.preprocessing, cutoff) for r in runs]
     cfg = problem.identification
     data = build_dataset(robot, base, samples, cfg)
     fit_mask = split(data, [s.role for s in samples], problem.data.validation_blocks)
     fit_data, val_data = data.select(fit_mask), data.select(~fit_mask)
-    selection = select_effects(fit_data, val_data, cfg, declared_effects(problem, robot))
+    rate = max(s.filter.rate / s.filter.step for s in samples)
+    selection = select_effects(fit_data, val_data, cfg, declared_effects(problem, robot), max(1.0, rate / (2.0 * cutoff)))
     before = predict(val_data, selection.rigid.x, [])
     after = predict(val_data, selection.fit.x, selection.effects)
     measured = val_data.tau.reshape(-1, val_data.n)

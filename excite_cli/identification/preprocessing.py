@@ -15,13 +15,16 @@ from excite_cli.config import PreprocessingConfig
 from excite_cli.errors import ExciteError
 from excite_cli.identification.measurements import Run
 
-#: Default cut-off = this × the frequency below which 99.9 % of q's power lies.
-CUTOFF_FACTOR = 5.0
+#: Default cut-off = this × the frequency below which ``POWER_FRACTION`` of q's power lies ...
+CUTOFF_FACTOR = 10.0
+POWER_FRACTION = 0.99
+#: ... and at most this fraction of the decimated sample rate.
+MAX_CUTOFF_FRACTION = 0.4
 #: Samples trimmed at each end: this many periods of the cut-off frequency.
 EDGE_PERIODS = 3.0
 
 
-def bandwidth(q: np.ndarray, rate: float, fraction: float = 0.999) -> float:
+def bandwidth(q: np.ndarray, rate: float, fraction: float = POWER_FRACTION) -> float:
     """Frequency [Hz] below which ``fraction`` of the power of the detrended (T, n) signals lies."""
     power = np.abs(np.fft.rfft(signal.detrend(q, axis=0), axis=0)) ** 2
     cumulative = np.cumsum(power.sum(axis=1))
@@ -77,9 +80,23 @@ def run_rate(run: Run) -> float:
     return (run.time.size - 1) / (run.time[-1] - run.time[0])
 
 
-def default_cutoff(runs: list[Run]) -> float:
-    """``CUTOFF_FACTOR`` × the largest bandwidth of the runs' q [Hz] (at least 0.5 Hz)."""
-    return max(0.5, CUTOFF_FACTOR * max(bandwidth(r.q, run_rate(r)) for r in runs))
+def uniform_grid(run: Run) -> np.ndarray:
+    """(T,) uniform instants at the run's mean rate over its span [s]."""
+    grid = run.time[0] + np.arange(run.time.size) / run_rate(run)
+    return grid[grid <= run.time[-1]]
+
+
+def resample(run: Run, x: np.ndarray | None, grid: np.ndarray) -> np.ndarray | None:
+    """x (T_run, n) linearly interpolated at ``grid`` (removes timestamp jitter)."""
+    return None if x is None else np.column_stack([np.interp(grid, run.time, x[:, j]) for j in range(x.shape[1])])
+
+
+def default_cutoff(runs: list[Run], cfg: PreprocessingConfig) -> float:
+    """``CUTOFF_FACTOR`` × the largest bandwidth of the runs' resampled q, at least 0.5 Hz and at most
+    ``MAX_CUTOFF_FRACTION`` × the decimated rate [Hz]."""
+    widest = max(bandwidth(resample(r, r.q, uniform_grid(r)), run_rate(r)) for r in runs)
+    top = MAX_CUTOFF_FRACTION * min(cfg.sample_rate, min(run_rate(r) for r in runs))
+    return float(min(max(0.5, CUTOFF_FACTOR * widest), top))
 
 
 def preprocess(run: Run, cfg: PreprocessingConfig, cutoff: float) -> Samples:
@@ -93,13 +110,8 @@ def preprocess(run: Run, cfg: PreprocessingConfig, cutoff: float) -> Samples:
             shorter than the filter needs.
     """
     rate = run_rate(run)
-    grid = run.time[0] + np.arange(run.time.size) / rate
-    grid = grid[grid <= run.time[-1]]
-
-    def resample(x: np.ndarray | None) -> np.ndarray | None:
-        return None if x is None else np.column_stack([np.interp(grid, run.time, x[:, j]) for j in range(x.shape[1])])
-
-    q, qd, qdd, tau = (resample(x) for x in (run.q, run.qd, run.qdd, run.tau))
+    grid = uniform_grid(run)
+    q, qd, qdd, tau = (resample(run, x, grid) for x in (run.q, run.qd, run.qdd, run.tau))
     target = min(cfg.sample_rate, rate)
     if cutoff >= 0.5 * target:
         raise ExciteError(

@@ -1,0 +1,195 @@
+"""Closing the loop: effect columns against closed forms, detection of undeclared effects on
+simulated data with known parameters, no false effect, bad data, and the real Panda run."""
+
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from conftest import write_config
+from excite_cli.base_parameters import compute_base_parameters
+from excite_cli.cli import app
+from excite_cli.config import IdentifyProblem, SimulationConfig, load_problem
+from excite_cli.identification.effects import COEFFICIENTS, effect_columns
+from excite_cli.identification.pipeline import effect_values, run_identification
+from excite_cli.identification.preprocessing import Filter, default_cutoff
+from excite_cli.identification.measurements import load_run
+
+runner = CliRunner()
+HERE = Path(__file__).resolve().parent
+SHARED = HERE.parent.parent / "shared" / "data" / "panda-gaz2019"
+JOINTS = [f"panda_joint{k}" for k in range(1, 8)]
+TRUE = {"coulomb": 0.6, "viscous": 0.4}
+ARMATURE = {"panda_joint4": 0.1, "panda_joint6": 0.05}
+NOISE = 0.05
+
+
+def test_effect_columns_closed_forms():
+    q = np.array([-1.0, 0.0, 0.5, 2.0])
+    qd = np.array([-2.0, -1e-4, 0.3, 1.0])
+    qdd = np.array([3.0, 0.0, -1.0, 0.2])
+    col = lambda e: effect_columns(e, q, qd, qdd, 0.01, 0.1)
+    np.testing.assert_allclose(col("coulomb")[:, 0], np.tanh(qd / 0.01))
+    assert col("coulomb")[[0, 2, 3], 0] == pytest.approx([-1, 1, 1], abs=1e-10)  # sign(q̇) away from 0
+    np.testing.assert_allclose(col("coulomb_asymmetric")[:, 0], np.abs(np.tanh(qd / 0.01)))
+    np.testing.assert_allclose(col("viscous")[:, 0], qd)
+    np.testing.assert_allclose(col("stribeck")[:, 0], np.tanh(qd / 0.01) * np.exp(-((qd / 0.1) ** 2)))
+    np.testing.assert_allclose(col("offset")[:, 0], 1.0)
+    np.testing.assert_allclose(col("armature")[:, 0], qdd)
+    np.testing.assert_allclose(col("spring")[:, 0], q)
+    np.testing.assert_allclose(col("gravity_compensator"), np.column_stack([np.sin(q), np.cos(q)]))
+    for effect, names in COEFFICIENTS.items():
+        assert col(effect).shape == (4, len(names))
+
+
+def test_asymmetric_coulomb_gives_direction_dependent_levels():
+    qd = np.array([-1.0, 1.0])
+    fc, fa = 0.5, 0.1
+    z = np.zeros(2)
+    tau = fc * effect_columns("coulomb", z, qd, z, 0.01, 0.1)[:, 0] + fa * effect_columns("coulomb_asymmetric", z, qd, z, 0.01, 0.1)[:, 0]
+    assert tau == pytest.approx([-(fc - fa), fc + fa])
+
+
+@pytest.fixture(scope="module")
+def optimized(tmp_path_factory):
+    """A small optimized Panda result with 3 trajectories."""
+    tmp = tmp_path_factory.mktemp("opt")
+    data = yaml.safe_load((HERE.parent / "configs" / "smoke.yaml").read_text())
+    data.update(sequence={"iterations": 3}, output=str(tmp / "panda.h5"))
+    result = runner.invoke(app, ["optimize", str(write_config(tmp, data))])
+    assert result.exit_code == 0, result.output
+    return tmp / "panda.h5"
+
+
+def _simulate_and_identify(tmp: Path, optimized: Path, effects: dict):
+    # 8 periods per run and time blocks in every run: ~720 independent held-out samples per joint
+    # at the 3 Hz cut-off, so each joint's RMS is known to ~2.6 % (1 sigma)
+    sim = {"sample_rate": 500, "periods": 8, "timestamp_jitter": 0.1, "torque_noise": NOISE, "seed": 4, "effects": effects}
+    result = runner.invoke(app, ["simulate", str(optimized), str(write_config(tmp, sim, "effects.yaml")), "-o", str(tmp)])
+    assert result.exit_code == 0, result.output
+    config = {
+        "robot": {"urdf": "panda_description/urdf/panda.urdf", "source": "example-robot-data", "active_joints": JOINTS},
+        "data": {"runs": [{"file": f"run_{k}.csv", "role": "blocks"} for k in (1, 2, 3)],
+                 "columns": {"q": [f"q_{j}" for j in JOINTS], "tau": [f"tau_{j}" for j in JOINTS]}},
+        "output": str(tmp / "ident.h5"),
+    }
+    problem = load_problem(write_config(tmp, config, "identify.yaml"), IdentifyProblem)
+    report, robot, base, _ = run_identification(problem)
+    # noise level after the same preprocessing: white noise through the same filter
+    runs = [load_run(r, problem.data, problem, 7) for r in problem.data.runs]
+    rate = (runs[2].time.size - 1) / (runs[2].time[-1] - runs[2].time[0])
+    from scipy import signal
+
+    cutoff = default_cutoff(runs, problem.preprocessing)
+    sos = signal.butter(4, cutoff, fs=rate, output="sos")
+    noise = Filter(sos, rate, cutoff, 0, 1).low_pass(np.random.default_rng(0).normal(0, NOISE, (20000, 7)))
+    return report, robot, base, float(noise.std())
+
+
+def test_undeclared_friction_and_armature_are_found(tmp_path, optimized):
+    effects = {"coulomb": {"*": TRUE["coulomb"]}, "viscous": {"*": TRUE["viscous"]}, "armature": ARMATURE}
+    report, robot, base, noise_level = _simulate_and_identify(tmp_path, optimized, effects)
+    expected = {(e, j) for e in TRUE for j in JOINTS} | {("armature", j) for j in ARMATURE}
+    found = {(e, j) for e, _, j, _, _ in effect_values(report)}
+    assert found == expected
+    for effect, _, joint, value, std in effect_values(report):
+        truth = ARMATURE[joint] if effect == "armature" else TRUE[effect]
+        assert abs(value - truth) <= max(0.05 * truth, 3 * std)
+    # rigid-body base parameters: the URDF's
+    truth = base.from_standard(robot.urdf_parameters())
+    estimate, std = report.selection.fit.x[: base.count], report.selection.fit.std[: base.count]
+    assert np.linalg.norm(estimate - truth) < 0.01 * np.linalg.norm(truth)
+    assert np.mean(np.abs(estimate - truth) <= 3 * std) > 0.95  # deviations account for the filtering
+    assert np.all(np.abs(report.rms_after - noise_level) <= 0.1 * noise_level)
+    assert np.all(report.rms_before >= 3 * report.rms_after)
+
+
+def test_no_effect_in_the_data_adds_none(tmp_path, optimized):
+    report, *_ = _simulate_and_identify(tmp_path, optimized, {})
+    assert report.selection.effects == []
+    assert np.allclose(report.rms_before, report.rms_after)
+
+
+def test_identify_command_writes_report_and_prior(tmp_path, optimized):
+    effects = {"coulomb": {"*": 0.5}}
+    _simulate_and_identify(tmp_path, optimized, effects)
+    result = runner.invoke(app, ["identify", str(tmp_path / "identify.yaml")], env={"COLUMNS": "200"})
+    assert result.exit_code == 0, result.output
+    assert "before [Nm]" in result.output and "coulomb" in result.output
+    with h5py.File(tmp_path / "ident.h5") as f:
+        g = f["identification"]
+        assert g["rms_after"].shape == (7,) and np.all(g["rms_after"][()] < g["rms_before"][()])
+        assert {e.decode() for e in g["effects"]["effect"]} == {"coulomb"}
+        assert f["regressor"].shape[1] == g["base_parameters"].shape[0]
+    assert (tmp_path / "ident_residuals.png").stat().st_size > 20000
+    # the measured regressor serves as prior data C0 of optimize (Eq. 41)
+    data = yaml.safe_load((HERE.parent / "configs" / "smoke.yaml").read_text())
+    data.update(sequence={"iterations": 1, "prior": str(tmp_path / "ident.h5")}, optimizer={"max_iterations": 10, "restarts": 1})
+    result = runner.invoke(app, ["optimize", str(write_config(tmp_path, data, "prior.yaml")), "-o", str(tmp_path / "p.h5")])
+    assert result.exit_code == 0, result.output
+
+
+def _bad_csv(tmp_path, text: str, columns=None, crop=None):
+    (tmp_path / "bad.csv").write_text(text)
+    run = {"file": "bad.csv", "role": "blocks"}
+    if crop:
+        run["crop"] = crop
+    config = {
+        "robot": {"urdf": "panda_description/urdf/panda.urdf", "source": "example-robot-data", "active_joints": JOINTS},
+        "data": {"runs": [run], "columns": columns or {"q": [f"q{k}" for k in range(1, 8)], "tau": [f"t{k}" for k in range(1, 8)]}},
+        "output": str(tmp_path / "out.h5"),
+    }
+    result = runner.invoke(app, ["identify", str(write_config(tmp_path, config, "bad.yaml"))])
+    assert result.exit_code == 2 and "Traceback" not in result.output
+    assert not (tmp_path / "out.h5").exists()
+    return " ".join(result.output.split())
+
+
+def _csv(rows: int, nan_at=None, repeat_time_at=None):
+    header = "time," + ",".join(f"q{k}" for k in range(1, 8)) + "," + ",".join(f"t{k}" for k in range(1, 8))
+    t = np.arange(rows) * 0.001
+    if repeat_time_at is not None:
+        t[repeat_time_at] = t[repeat_time_at - 1]
+    values = np.column_stack([t, np.sin(np.outer(t, np.arange(1, 15)))])
+    if nan_at is not None:
+        values[nan_at, 3] = np.nan
+    lines = [header] + [",".join("" if np.isnan(v) else f"{v:.6g}" for v in row) for row in values]
+    return "\n".join(lines) + "\n"
+
+
+def test_bad_data_gets_one_clear_message(tmp_path):
+    assert "NaN or missing value in q at data row 6" in _bad_csv(tmp_path, _csv(3000, nan_at=5))
+    assert "time is not strictly increasing at data row 11" in _bad_csv(tmp_path, _csv(3000, repeat_time_at=10))
+    assert "data.columns.q: 6 columns for the robot's 7 active joints" in _bad_csv(
+        tmp_path, _csv(3000), {"q": [f"q{k}" for k in range(1, 7)], "tau": [f"t{k}" for k in range(1, 8)]})
+    assert "has no column 'q9'" in _bad_csv(
+        tmp_path, _csv(3000), {"q": [f"q{k}" for k in range(1, 7)] + ["q9"], "tau": [f"t{k}" for k in range(1, 8)]})
+    assert "fewer than the" in _bad_csv(tmp_path, _csv(3000), crop=[0.0, 0.05])
+
+
+def test_unknown_joint_in_declared_effects(tmp_path):
+    config = {
+        "robot": {"urdf": "panda_description/urdf/panda.urdf", "source": "example-robot-data", "active_joints": JOINTS},
+        "data": {"runs": [{"file": "x.csv"}], "columns": {"q": ["a"], "tau": ["b"]}},
+        "identification": {"declared_effects": {"panda_joint9": ["viscous"]}},
+    }
+    (tmp_path / "x.csv").write_text(_csv(3000))
+    result = runner.invoke(app, ["identify", str(write_config(tmp_path, config, "j.yaml"))])
+    assert result.exit_code == 2 and ("panda_joint9" in result.output or "data.columns.q" in result.output)
+
+
+@pytest.mark.skipif(not (SHARED / "exciting_traj_1.csv").exists(), reason="shared Panda data not present")
+def test_real_panda_run(tmp_path):
+    config = {
+        "robot": {"urdf": "panda_description/urdf/panda.urdf", "source": "example-robot-data", "active_joints": JOINTS},
+        "data": {"runs": [{"file": str(SHARED / "exciting_traj_1.csv"), "role": "blocks"}],
+                 "columns": {"q": [f"q{k}" for k in range(1, 8)], "qd": [f"dq{k}" for k in range(1, 8)],
+                             "tau": [f"tau{k}" for k in range(1, 8)]}},
+    }
+    report, *_ = run_identification(load_problem(write_config(tmp_path, config), IdentifyProblem))
+    assert report.selection.effects  # real joints have friction
+    assert np.all(report.rms_after <= report.rms_before + 1e-9)
+    assert report.rms_after[6] < 0.5 * report.rms_before[6]  # the wrist is friction-dominated
