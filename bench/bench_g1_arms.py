@@ -2,13 +2,13 @@
 and the wall time of a full `excite optimize configs/g1_arms.yaml`.
 
 Run: `make bench` (or `.venv/bin/python bench/bench_g1_arms.py [CONFIG]`). Prints figures; asserts nothing.
+The optimize result is kept in results/bench_<config>.h5.
 """
 
 from __future__ import annotations
 
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -34,13 +34,12 @@ def main(config: Path) -> None:
     print(f"speed-up                       {check.speedup:.0f}x")
     print(f"relative error (central FD)    {check.error_central:.1e}")
     print(f"relative error (one-sided FD)  {check.error_forward:.1e}")
-    with tempfile.TemporaryDirectory() as tmp:
-        start = time.perf_counter()
-        subprocess.run(
-            [sys.executable, "-m", "excite_cli", "optimize", str(config), "-o", str(Path(tmp) / "bench.h5")],
-            check=True, capture_output=True,
-        )
-        print(f"full optimize wall time        {time.perf_counter() - start:.1f} s")
+    target = ROOT / "results" / f"bench_{config.stem}.h5"
+    start = time.perf_counter()
+    run = subprocess.run([sys.executable, "-m", "excite_cli", "optimize", str(config), "-o", str(target)],
+                         check=True, capture_output=True, text=True)
+    print(f"full optimize wall time        {time.perf_counter() - start:.1f} s  ({target})")
+    print(run.stdout)
 
 
 if __name__ == "__main__":

@@ -121,6 +121,9 @@ def _optimize(problem: Problem, excitation: Excitation, target: Path) -> list[It
             write_result(target, excitation, finished, opts.seed, {"method": "optimized"})
             bar.update(tasks[result.index], completed=opts.restarts * opts.max_iterations,
                        status=f"cond(C) {result.cond_stacked:.1f}")
+            if not err.is_terminal:  # logs get a line per iteration instead of a live bar
+                err.print(f"iteration {result.index}: cond(C(i)) {result.cond_own:.1f}, cond(C) {result.cond_stacked:.1f}, "
+                          f"{result.wall_time_s:.0f} s", highlight=False)
 
         try:
             run_sequence(excitation, problem.sequence.iterations, opts.seed, prior, progress, done)

@@ -188,35 +188,41 @@ def select_effects(fit_data: Dataset, val_data: Dataset, cfg: IdentificationConf
     effects = list(declared)
     absorbed: set[tuple[str, int]] = set()
     selection = Selection(effects, len(declared), rigid, rigid)
+    sigma = rigid.sigma
     while len(effects) - len(declared) < cfg.max_effects:
         remaining = [c for c in _open(cfg.candidates, n, effects) if c not in absorbed]
         if not remaining:
             break
         A = design(fit_data, effects)
-        current = least_squares(A, fit_data.tau, fit_data.joint, n, weighted)
-        w = 1.0 / np.maximum(current.sigma[fit_data.joint], 1e-12) if weighted else np.ones(fit_data.tau.size)
+        w = 1.0 / np.maximum(sigma[fit_data.joint], 1e-12) if weighted else np.ones(fit_data.tau.size)
         scale = np.linalg.norm(A, axis=0)
         scale[scale == 0] = 1.0
         Q, R = np.linalg.qr(w[:, None] * A / scale)
-        r0 = w * fit_data.tau - Q @ (Q.T @ (w * fit_data.tau))
+        wy = w * fit_data.tau
+        x0 = scipy.linalg.solve_triangular(R, Q.T @ wy)
+        r0 = wy - Q @ (Q.T @ wy)
         sse0 = r0 @ r0
-        x0 = scipy.linalg.solve_triangular(R, Q.T @ (w * fit_data.tau))
+        sigma = _joint_sigma(r0 / w, fit_data.joint, n, A.shape[1])
         A_val = design(val_data, effects) / scale
-        val0 = np.sum((val_w * (val_data.tau - A_val @ x0)) ** 2)
+        base_prediction = A_val @ x0
+        val0 = np.sum((val_w * (val_data.tau - base_prediction)) ** 2)
         best = None
         for cand in remaining:
-            B = w[:, None] * fit_data.block(*cand)
-            B_perp = B - Q @ (Q.T @ B)
-            if np.linalg.norm(B_perp) < IDENTIFIABILITY * np.linalg.norm(B):
+            j = cand[1]
+            cols = w[j::n, None] * fit_data.blocks[cand]  # (N, k) on joint j's rows
+            QtB = Q[j::n].T @ cols
+            B_perp = -(Q @ QtB)
+            B_perp[j::n] += cols
+            if np.linalg.norm(B_perp) < IDENTIFIABILITY * np.linalg.norm(cols):
                 absorbed.add(cand)
                 continue
-            c, *_ = np.linalg.lstsq(B_perp, r0, rcond=None)
+            c = np.linalg.solve(B_perp.T @ B_perp, B_perp.T @ r0)
             gain = r0 @ (B_perp @ c)
-            xa = x0 - scipy.linalg.solve_triangular(R, Q.T @ B @ c)
-            prediction = A_val @ xa + val_data.block(*cand) @ c
+            prediction = base_prediction - A_val @ scipy.linalg.solve_triangular(R, QtB @ c)
+            prediction[j::n] += val_data.blocks[cand] @ c
             val1 = np.sum((val_w * (val_data.tau - prediction)) ** 2)
             if best is None or val1 < best[1]:
-                best = (cand, val1, gain, B.shape[1])
+                best = (cand, val1, gain, cols.shape[1])
         if best is None:
             break
         cand, val1, gain, k = best
