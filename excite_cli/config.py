@@ -23,6 +23,8 @@ class _Section(BaseModel):
 
 
 class RobotConfig(_Section):
+    """URDF, floating or fixed base, active and locked joints, home posture (README: `robot`)."""
+
     urdf: str = Field(description="URDF path (relative to the config file) or a path inside example-robot-data")
     source: Literal["file", "example-robot-data"] = "file"
     floating_base: bool = False
@@ -33,6 +35,8 @@ class RobotConfig(_Section):
 
 
 class TrajectoryConfig(_Section):
+    """Fourier series (Eq. 50) and sampling: harmonics N, ω [rad/s], cost samples and period [s], constraint grid [s]."""
+
     harmonics: int = Field(10, ge=1)
     base_frequency: float = Field(math.pi / 4, gt=0.0)
     cost_samples: int = Field(40, ge=1)
@@ -46,6 +50,8 @@ class TrajectoryConfig(_Section):
 
 
 class LimitsConfig(_Section):
+    """Joint limits (Eq. 51): position margin [rad], velocity [rad/s], acceleration [rad/s²], check refinement."""
+
     position_margin: float = Field(0.0, ge=0.0)
     velocity: Optional[PerJoint] = None
     acceleration: PerJoint
@@ -53,6 +59,8 @@ class LimitsConfig(_Section):
 
 
 class ComConfig(_Section):
+    """Centre-of-mass region (Eq. 52): support links or centre [m], radius [m] or polygon [m]."""
+
     support_links: list[str] = Field(default_factory=list)
     centre: Optional[tuple[float, float]] = None
     radius: Optional[float] = Field(None, gt=0.0)
@@ -68,6 +76,8 @@ class ComConfig(_Section):
 
 
 class CapsuleConfig(_Section):
+    """One capsule on a link: radius [m], segment end points in the link frame [m]."""
+
     link: str
     radius: float = Field(gt=0.0)
     start: tuple[float, float, float]
@@ -75,6 +85,8 @@ class CapsuleConfig(_Section):
 
 
 class SelfCollisionConfig(_Section):
+    """Self-collision (Eq. 53): capsules (``auto`` or given), ignored links, excluded pairs, margin [m]."""
+
     capsules: Union[Literal["auto"], list[CapsuleConfig]] = "auto"
     ignore_links: list[str] = Field(default_factory=list)
     exclude_pairs: list[tuple[str, str]] = Field(default_factory=list)
@@ -82,11 +94,15 @@ class SelfCollisionConfig(_Section):
 
 
 class ConstraintsConfig(_Section):
+    """Optional balance and self-collision constraints."""
+
     com: Optional[ComConfig] = None
     self_collision: Optional[SelfCollisionConfig] = None
 
 
 class OptimizerConfig(_Section):
+    """SLSQP settings: objective, iterations, tolerance, seed, restarts."""
+
     method: Literal["SLSQP"] = "SLSQP"
     objective: Literal["log_cond", "cond"] = "log_cond"
     max_iterations: int = Field(200, ge=1)
@@ -96,16 +112,22 @@ class OptimizerConfig(_Section):
 
 
 class RandomBaselineConfig(_Section):
+    """``compare-random``: pool size and seed of the random candidates."""
+
     pool_size: int = Field(300, ge=1)
     seed: int = 1
 
 
 class SequenceConfig(_Section):
+    """Sequential generation (Sec. IV-B): iterations and optional prior data file (Eq. 41)."""
+
     iterations: int = Field(3, ge=1)
     prior: Optional[str] = None
 
 
 class Problem(_Section):
+    """An ``optimize`` problem: the whole YAML file, validated."""
+
     robot: RobotConfig
     trajectory: TrajectoryConfig = TrajectoryConfig()
     limits: LimitsConfig
@@ -192,6 +214,8 @@ Effect = Literal["coulomb", "coulomb_asymmetric", "viscous", "stribeck", "offset
 
 
 class ColumnsConfig(_Section):
+    """Column names of measured data, in active-joint order (README: identification config)."""
+
     time: str = "time"
     q: list[str] = Field(min_length=1)
     qd: Optional[list[str]] = None
@@ -207,12 +231,16 @@ class ColumnsConfig(_Section):
 
 
 class RunConfig(_Section):
+    """One measured run: file, optional crop [s], role (fit, validation or time blocks)."""
+
     file: str
     crop: Optional[tuple[float, float]] = None
     role: Literal["fit", "validation", "blocks"] = "blocks"
 
 
 class DataConfig(_Section):
+    """Measured runs, their columns, angle unit, torque constants [Nm/A], signs, validation blocks."""
+
     runs: list[RunConfig] = Field(min_length=1)
     columns: ColumnsConfig
     angle_unit: Literal["rad", "deg"] = "rad"
@@ -222,12 +250,16 @@ class DataConfig(_Section):
 
 
 class PreprocessingConfig(_Section):
+    """Decimated rate [Hz], low-pass cut-off [Hz] (default from the bandwidth), filter order."""
+
     sample_rate: float = Field(200.0, gt=0.0)
     cutoff: Optional[float] = Field(None, gt=0.0)
     filter_order: int = Field(4, ge=1, le=10)
 
 
 class IdentificationConfig(_Section):
+    """LS or WLS, declared and candidate effects, selection thresholds, friction shape constants [rad/s]."""
+
     method: Literal["wls", "ls"] = "wls"
     declared_effects: dict[str, list[Effect]] = Field(default_factory=dict)
     candidates: list[Effect] = Field(default_factory=lambda: list(EFFECT_NAMES))

@@ -84,16 +84,20 @@ class ConditionNumber:
         """
         Q, QD, QDD = self.basis.evaluate(alpha)
         C = self.stacked(self.robot.regressor_stack(Q, QD, QDD) @ self.base.composition_matrix)
-        U, s, Vt = np.linalg.svd(C, full_matrices=False)
-        s_min = max(s[-1], RANK_FLOOR * s[0])
-        c = s[0] / s_min
-        w_max, w_min = 1.0 / s_min, -s[0] / s_min**2
+        # σ and v of the extreme singular pairs from the b×b Gram matrix, u = C v / σ: only four
+        # singular vectors are needed, not the full SVD (Eqs. 8, 16).
+        eig, V = np.linalg.eigh(C.T @ C)
+        s_max = np.sqrt(max(eig[-1], 0.0))
+        s_min = max(np.sqrt(max(eig[0], 0.0)), RANK_FLOOR * s_max)
+        c = s_max / s_min
+        w_max, w_min = 1.0 / s_min, -s_max / s_min**2
         if self.log:
             w_max, w_min = w_max / c, w_min / c
         T, rows = Q.shape[0], self.robot.n_rows
-        u_max = U[self.prior.shape[0] :, 0].reshape(T, rows) * w_max
-        u_min = U[self.prior.shape[0] :, -1].reshape(T, rows) * w_min
-        phis = self.base.composition_matrix @ np.stack([Vt[0], Vt[-1]], axis=1)
+        own = slice(self.prior.shape[0], None)
+        u_max = (C[own] @ V[:, -1]).reshape(T, rows) * (w_max / s_max)
+        u_min = (C[own] @ V[:, 0]).reshape(T, rows) * (w_min / s_min)
+        phis = self.base.composition_matrix @ np.stack([V[:, -1], V[:, 0]], axis=1)
         self._set_virtual_parameters(phis)
         # Row weights padded to the model's nv, for the shift pass and the two virtual passes.
         weights = np.zeros((3, T, self.robot.model.nv))

@@ -79,6 +79,7 @@ def optimize_trajectory(
     start: Callable[[np.random.Generator], np.ndarray],
     scale: np.ndarray,
     progress: Optional[ProgressHook] = None,
+    warm_start: Optional[np.ndarray] = None,
 ) -> OptimizationResult:
     """Minimize the criterion over α from ``options.restarts`` random feasible starts.
 
@@ -97,6 +98,8 @@ def optimize_trajectory(
         start: draws a random α (n, 2N+1) that every constraint accepts.
         scale: (n, 2N+1) variable scale of the preconditioning.
         progress: called after every SLSQP iteration.
+        warm_start: an accepted α (n, 2N+1) to start the first restart from instead of a random one
+            (the sequence passes the previous iteration's optimum).
 
     Returns:
         The best accepted point over all restarts.
@@ -128,7 +131,7 @@ def optimize_trajectory(
     best: Optional[tuple[float, np.ndarray, str]] = None
     total_iterations = 0
     for restart in range(options.restarts):
-        x0 = start(rng)
+        x0 = warm_start.copy() if (restart == 0 and warm_start is not None) else start(rng)
         inside.clear()
         counter = [0]
 

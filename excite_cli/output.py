@@ -8,10 +8,11 @@ iterations and never a half-written one.
 from __future__ import annotations
 
 import os
+from contextlib import contextmanager
 from datetime import datetime, timezone
 from importlib import metadata
 from pathlib import Path
-from typing import Sequence
+from typing import Iterator, Sequence
 
 import h5py
 import numpy as np
@@ -24,6 +25,27 @@ from excite_cli.sequence import IterationResult
 UNITS = {"alpha": "rad", "time": "s", "q": "rad", "qd": "rad/s", "qdd": "rad/s^2", "regressor": "SI (N·m per parameter unit)",
          "com_xy": "m", "min_capsule_distance": "m"}
 VERSIONED_PACKAGES = ("excite", "pin", "coal", "numpy", "scipy", "h5py", "example-robot-data")
+
+
+@contextmanager
+def open_result(path: Path, field: str = "") -> Iterator[h5py.File]:
+    """An HDF5 file opened for reading, with one clear message when it is missing or unreadable.
+
+    Args:
+        field: config field or option named in the messages (e.g. ``sequence.prior``).
+
+    Raises:
+        ExciteError: the file does not exist or is not HDF5.
+    """
+    prefix = f"{field}: " if field else ""
+    path = Path(path)
+    if not path.is_file():
+        raise ExciteError(f"{prefix}file not found: {path}")
+    try:
+        with h5py.File(path, "r") as f:
+            yield f
+    except OSError as exc:
+        raise ExciteError(f"{prefix}cannot read {path} as HDF5: {exc}") from None
 
 
 def package_versions() -> dict[str, str]:
@@ -124,22 +146,16 @@ def read_prior(path: Path, base: BaseParameters) -> np.ndarray:
     Raises:
         ExciteError: missing or unreadable file, no regressor inside, or base parameters that differ.
     """
-    path = Path(path)
-    if not path.is_file():
-        raise ExciteError(f"sequence.prior: file not found: {path}")
-    try:
-        with h5py.File(path, "r") as f:
-            if "iterations" in f:
-                keys = sorted(f["iterations"].keys(), key=int)
-                blocks = [f["iterations"][k]["regressor"][()] for k in keys]
-                prior = np.vstack(blocks) if blocks else np.zeros((0, base.count))
-            elif "regressor" in f:
-                prior = np.asarray(f["regressor"][()], dtype=float)
-            else:
-                raise ExciteError(f"sequence.prior: {path} has neither /iterations nor /regressor")
-            names = [n.decode() if isinstance(n, bytes) else n for n in f["robot/base_parameter_names"][()]] if "robot/base_parameter_names" in f else None
-    except OSError as exc:
-        raise ExciteError(f"sequence.prior: cannot read {path} as HDF5: {exc}") from None
+    with open_result(path, "sequence.prior") as f:
+        if "iterations" in f:
+            keys = sorted(f["iterations"].keys(), key=int)
+            blocks = [f["iterations"][k]["regressor"][()] for k in keys]
+            prior = np.vstack(blocks) if blocks else np.zeros((0, base.count))
+        elif "regressor" in f:
+            prior = np.asarray(f["regressor"][()], dtype=float)
+        else:
+            raise ExciteError(f"sequence.prior: {path} has neither /iterations nor /regressor")
+        names = [n.decode() if isinstance(n, bytes) else n for n in f["robot/base_parameter_names"][()]] if "robot/base_parameter_names" in f else None
     if prior.ndim != 2 or prior.shape[1] != base.count or (names is not None and names != base.names):
         raise ExciteError(
             f"sequence.prior: {path} was made for other base parameters "
@@ -166,17 +182,11 @@ def read_table(path: Path) -> tuple[np.ndarray, float]:
     Raises:
         ExciteError: missing or unreadable file, or no table in it.
     """
-    path = Path(path)
-    if not path.is_file():
-        raise ExciteError(f"result file not found: {path}")
-    try:
-        with h5py.File(path, "r") as f:
-            if "table" not in f or "iterations" not in f:
-                raise ExciteError(f"{path} is not an excite result (no /table)")
-            wall = sum(float(g.attrs.get("wall_time_s", 0.0)) for g in f["iterations"].values())
-            return f["table"][()], wall
-    except OSError as exc:
-        raise ExciteError(f"cannot read {path} as HDF5: {exc}") from None
+    with open_result(path) as f:
+        if "table" not in f or "iterations" not in f:
+            raise ExciteError(f"{path} is not an excite result (no /table)")
+        wall = sum(float(g.attrs.get("wall_time_s", 0.0)) for g in f["iterations"].values())
+        return f["table"][()], wall
 
 
 def read_alphas(path: Path) -> list[tuple[int, np.ndarray]]:
@@ -185,17 +195,11 @@ def read_alphas(path: Path) -> list[tuple[int, np.ndarray]]:
     Raises:
         ExciteError: missing or unreadable file, or no iteration in it.
     """
-    path = Path(path)
-    if not path.is_file():
-        raise ExciteError(f"result file not found: {path}")
-    try:
-        with h5py.File(path, "r") as f:
-            keys = sorted(f["iterations"].keys(), key=int) if "iterations" in f else []
-            if not keys:
-                raise ExciteError(f"{path} has no finished iteration")
-            return [(int(k), f["iterations"][k]["alpha"][()]) for k in keys]
-    except OSError as exc:
-        raise ExciteError(f"cannot read {path} as HDF5: {exc}") from None
+    with open_result(path) as f:
+        keys = sorted(f["iterations"].keys(), key=int) if "iterations" in f else []
+        if not keys:
+            raise ExciteError(f"{path} has no finished iteration")
+        return [(int(k), f["iterations"][k]["alpha"][()]) for k in keys]
 
 
 def write_identification(path: Path, report, robot, base: BaseParameters, source_text: str, regressor: np.ndarray,

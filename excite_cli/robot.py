@@ -100,6 +100,7 @@ class Robot:
 
     @property
     def n_joints(self) -> int:
+        """Number n of active joints."""
         return len(self.joint_names)
 
     @property

@@ -83,6 +83,10 @@ def run_sequence(
 ) -> list[IterationResult]:
     """Generate ``iterations`` trajectories, each stacking the regressors of the earlier ones (Eq. 41).
 
+    From iteration 2 on, the first restart starts from the previous optimum (repeating earlier data
+    keeps cond(C) near cond(C₀), and random starts that satisfy tight balance constraints are far
+    from it); the other restarts are random.
+
     Args:
         excitation: the problem.
         iterations: number K of trajectories.
@@ -108,6 +112,7 @@ def run_sequence(
             excitation.random_start,
             excitation.limits.coefficient_scale(),
             progress=progress(k) if progress else None,
+            warm_start=results[-1].alpha if results else None,
         )
         result = describe(excitation, k, best.alpha, stacked, time.perf_counter() - start, best.iterations, best.message)
         stacked = np.vstack([stacked, result.regressor])

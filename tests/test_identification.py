@@ -116,13 +116,19 @@ def test_no_effect_in_the_data_adds_none(tmp_path, optimized):
 def test_identify_command_writes_report_and_prior(tmp_path, optimized):
     effects = {"coulomb": {"*": 0.5}}
     _simulate_and_identify(tmp_path, optimized, effects)
-    result = runner.invoke(app, ["identify", str(tmp_path / "identify.yaml")], env={"COLUMNS": "200"})
+    config = yaml.safe_load((tmp_path / "identify.yaml").read_text())
+    config["identification"] = {"declared_effects": {"panda_joint1": ["viscous"]}}  # not in the data
+    result = runner.invoke(app, ["identify", str(write_config(tmp_path, config, "identify.yaml"))], env={"COLUMNS": "200"})
     assert result.exit_code == 0, result.output
     assert "before [Nm]" in result.output and "coulomb" in result.output
     with h5py.File(tmp_path / "ident.h5") as f:
         g = f["identification"]
         assert g["rms_after"].shape == (7,) and np.all(g["rms_after"][()] < g["rms_before"][()])
-        assert {e.decode() for e in g["effects"]["effect"]} == {"coulomb"}
+        effects = g["effects"][()]
+        assert {e.decode() for e in effects["effect"]} == {"coulomb", "viscous"}
+        declared = effects[effects["declared"]]
+        assert len(declared) == 1 and declared["joint"][0].decode() == "panda_joint1" and declared["order"][0] == 1
+        assert abs(declared["value"][0]) < 3 * declared["std"][0] + 1e-3  # declared but absent: ~0
         assert f["regressor"].shape[1] == g["base_parameters"].shape[0]
     assert (tmp_path / "ident_residuals.png").stat().st_size > 20000
     # the measured regressor serves as prior data C0 of optimize (Eq. 41)

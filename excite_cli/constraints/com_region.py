@@ -93,6 +93,7 @@ class ComRegion(Constraint):
         return s, np.broadcast_to(self.normals / scale, (len(P),) + self.normals.shape)
 
     def evaluate(self, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """One aggregated value (1,) and its Jacobian (1, α.size), see :meth:`Constraint.evaluate`."""
         P, J = self._com(self.basis.q @ alpha.T)
         s, ds = self._normalized(P)
         g, w = smooth_max(s, axis=(0, 1))
@@ -104,6 +105,7 @@ class ComRegion(Constraint):
         return {"com_xy": self._com(basis.q @ alpha.T)[0]}
 
     def check(self, alpha: np.ndarray, basis: FourierBasis) -> FineCheck:
+        """Largest CoM excursion from the centre [m] and the normalized violation on ``basis``."""
         P, _ = self._com(basis.q @ alpha.T)
         s, _ = self._normalized(P)
         excursion = float(np.linalg.norm(P - self.centre, axis=1).max())

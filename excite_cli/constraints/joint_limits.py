@@ -52,6 +52,7 @@ class JointLimits(Constraint):
         return np.stack([(B @ alpha.T - self.centre[d]) / self.half[d] for d, B in enumerate(orders)])
 
     def evaluate(self, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """6n aggregated values (order × side × joint) and their Jacobian (6n, α.size)."""
         n, m = alpha.shape
         z = self._normalized(alpha, self._orders)
         s = np.concatenate([z - 1.0, -z - 1.0])  # (6, T, n): upper sides, then lower sides
@@ -64,6 +65,7 @@ class JointLimits(Constraint):
         return g.ravel(), J.reshape(6 * n, n * m)
 
     def check(self, alpha: np.ndarray, basis: FourierBasis) -> FineCheck:
+        """Largest violation per order in rad, rad/s, rad/s² and normalized by the half-ranges, on ``basis``."""
         z = self._normalized(alpha, (basis.q, basis.qd, basis.qdd))
         normalized = np.abs(z).max(axis=1) - 1.0  # (3, n)
         details = {}

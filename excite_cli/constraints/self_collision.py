@@ -85,6 +85,7 @@ class SelfCollision(Constraint):
         return d, exact
 
     def evaluate(self, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """One aggregated value per pair (P,) and the Jacobian (P, α.size), see :meth:`Constraint.evaluate`."""
         n, m = alpha.shape
         if not self.pairs:
             return np.zeros(0), np.zeros((0, n * m))

@@ -15,7 +15,7 @@ import yaml
 from excite_cli.config import Problem, SimulationConfig
 from excite_cli.errors import ExciteError
 from excite_cli.identification.effects import COEFFICIENTS, effect_columns
-from excite_cli.output import read_alphas
+from excite_cli.output import open_result, read_alphas
 from excite_cli.robot import Robot, load_robot
 from excite_cli.trajectory import FourierTrajectory
 
@@ -26,13 +26,10 @@ def problem_of_result(path: Path) -> Problem:
     Raises:
         ExciteError: the file has no readable config.
     """
-    import h5py
-
-    try:
-        with h5py.File(path, "r") as f:
-            text, origin = str(f.attrs["config"]), str(f.attrs.get("config_path", ""))
-    except (OSError, KeyError) as exc:
-        raise ExciteError(f"{path}: not an excite result with a stored config ({exc})") from None
+    with open_result(path) as f:
+        if "config" not in f.attrs:
+            raise ExciteError(f"{path}: not an excite result with a stored config")
+        text, origin = str(f.attrs["config"]), str(f.attrs.get("config_path", ""))
     problem = Problem.model_validate(yaml.safe_load(text))
     problem.source_path = Path(origin) if origin else None
     problem.source_text = text
