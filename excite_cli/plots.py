@@ -116,9 +116,11 @@ def plot_identification(path: Path, report) -> Path:
     and the residuals before and after; written to ``path`` (PNG)."""
     n = len(report.joints)
     data = report.validation
-    measured = data.tau.reshape(-1, n)
     first = data.run == data.run[0]
-    t = data.time[first]
+    t = data.time[first].copy()
+    # break the lines between held-out time blocks
+    t[1:][np.diff(t) > 2 * np.median(np.diff(t))] = np.nan
+    measured = data.tau.reshape(-1, n)
     fig, axes = plt.subplots(n, 2, figsize=(12, 1.9 * n), sharex=True, squeeze=False)
     for j, name in enumerate(report.joints):
         ax = axes[j, 0]
