@@ -10,18 +10,19 @@ from typing import Callable, Optional
 import numpy as np
 import typer
 from rich.console import Console
+from rich.markup import escape
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
 from excite_cli.config import IdentifyProblem, Problem, SimulationConfig, load_problem
-from excite_cli.errors import ExciteError
+from excite_cli.constraints import ComRegion, SelfCollision
 from excite_cli.criterion import ConditionNumber
+from excite_cli.errors import ExciteError
 from excite_cli.excitation import Excitation, build_excitation
 from excite_cli.identification.effects import UNITS as EFFECT_UNITS
 from excite_cli.identification.pipeline import effect_values, run_identification
 from excite_cli.identification.simulate import simulate_runs
 from excite_cli.output import read_last_alpha, read_prior, read_table, write_identification, write_result
-from excite_cli.constraints import ComRegion, SelfCollision
 from excite_cli.plots import (
     plot_comparison,
     plot_condition_numbers,
@@ -43,14 +44,14 @@ err = Console(stderr=True)
 
 
 def _user_errors(command: Callable) -> Callable:
-    """Turn ExciteError into one line on stderr and exit status 2; Ctrl-C into status 130."""
+    """Turn ExciteError into one line on stderr and exit status 2 (no traceback)."""
 
     @functools.wraps(command)
     def wrapper(*args, **kwargs):
         try:
             return command(*args, **kwargs)
         except ExciteError as exc:
-            err.print(f"[bold red]error:[/] {exc}", highlight=False, soft_wrap=True)
+            err.print(f"[bold red]error:[/] {escape(str(exc))}", highlight=False, soft_wrap=True)
             raise typer.Exit(2) from None
 
     return wrapper

@@ -160,7 +160,7 @@ class Problem(_Section):
 def _format_validation_error(path: Path, error: ValidationError) -> str:
     first = error.errors()[0]
     field = ".".join(str(part) for part in first["loc"]) or "(top level)"
-    message = first["msg"]
+    message = first["msg"].removeprefix("Value error, ")
     if first["type"] == "missing":
         message = "is required but missing"
     elif first["type"] == "extra_forbidden":
