@@ -10,9 +10,8 @@ import yaml
 from typer.testing import CliRunner
 
 from conftest import write_config
-from excite_cli.base_parameters import compute_base_parameters
 from excite_cli.cli import app
-from excite_cli.config import IdentifyProblem, SimulationConfig, load_problem
+from excite_cli.config import IdentifyProblem, load_problem
 from excite_cli.identification.effects import COEFFICIENTS, effect_columns
 from excite_cli.identification.pipeline import effect_values, run_identification
 from excite_cli.identification.preprocessing import Filter, default_cutoff

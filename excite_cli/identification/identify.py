@@ -242,8 +242,3 @@ def select_effects(fit_data: Dataset, val_data: Dataset, cfg: IdentificationConf
 def predict(data: Dataset, x: np.ndarray, effects: list[tuple[str, int]]) -> np.ndarray:
     """Predicted torques (N, n) [Nm] of the model [Y_B, effects] with coefficients x."""
     return (design(data, effects) @ x).reshape(-1, data.n)
-
-
-def effect_names(effects: list[tuple[str, int]], joints: list[str]) -> list[str]:
-    """``effect:coefficient:joint`` per coefficient of the effect blocks, in column order."""
-    return [f"{e}:{c}:{joints[j]}" for e, j in effects for c in COEFFICIENTS[e]]

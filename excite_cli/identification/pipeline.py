@@ -11,7 +11,7 @@ from excite_cli.base_parameters import BaseParameters, compute_base_parameters
 from excite_cli.config import IdentifyProblem
 from excite_cli.errors import ExciteError
 from excite_cli.identification.effects import COEFFICIENTS
-from excite_cli.identification.identify import Dataset, Selection, build_dataset, effect_names, predict, select_effects
+from excite_cli.identification.identify import Dataset, Selection, build_dataset, predict, select_effects
 from excite_cli.identification.measurements import load_run
 from excite_cli.identification.preprocessing import default_cutoff, preprocess
 from excite_cli.robot import Robot, load_robot
@@ -23,7 +23,7 @@ class Report:
 
     Attributes:
         joints: (n,) active joint names.
-        base_names: (b,) base-parameter names; effect_names: names of the effect coefficients.
+        base_names: (b,) base-parameter names.
         selection: chosen effects, fits and selection steps.
         rms_before, rms_after: (n,) validation torque RMS error [Nm], rigid body only / with effects.
         rms_torque: (n,) RMS of the measured validation torques [Nm].
@@ -34,7 +34,6 @@ class Report:
 
     joints: list[str]
     base_names: list[str]
-    effect_names: list[str]
     selection: Selection
     rms_before: np.ndarray
     rms_after: np.ndarray
@@ -120,7 +119,6 @@ def run_identification(problem: IdentifyProblem) -> tuple[Report, Robot, BasePar
     report = Report(
         joints=robot.joint_names,
         base_names=base.names,
-        effect_names=effect_names(selection.effects, robot.joint_names),
         selection=selection,
         rms_before=np.sqrt(np.mean((measured - before) ** 2, axis=0)),
         rms_after=np.sqrt(np.mean((measured - after) ** 2, axis=0)),
