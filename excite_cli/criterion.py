@@ -59,8 +59,7 @@ class ConditionNumber:
             self.prior = np.zeros((0, self.base.count))
         if self.prior.shape[1] != self.base.count:
             raise ValueError(f"prior has {self.prior.shape[1]} columns, the robot has {self.base.count} base parameters")
-        self._models = [pin.Model(self.robot.model) for _ in range(3)]
-        self._datas = [m.createData() for m in self._models]
+        self._models, self._datas = [], []  # the gradient's model copies, made on first use
 
     def regressor(self, alpha: np.ndarray) -> np.ndarray:
         """Ŷ_B of the trajectory α (n, 2N+1): (T·n_rows, b) (Eq. 3 with Y_B = Y X)."""
@@ -117,6 +116,9 @@ class ConditionNumber:
 
     def _set_virtual_parameters(self, phis: np.ndarray) -> None:
         """Models 0, 1, 2 get inertias φ_s, φ_s + φ₁, φ_s + φ₂ from ``phis`` (p, 2)."""
+        if not self._models:
+            self._models = [pin.Model(self.robot.model) for _ in range(3)]
+            self._datas = [m.createData() for m in self._models]
         blocks = phis.reshape(-1, 10, 2)
         masses = 1.0 + 2.0 * np.abs(blocks[:, 0, :]).max(axis=1)
         for j in range(blocks.shape[0]):
