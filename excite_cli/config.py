@@ -35,13 +35,17 @@ class RobotConfig(_Section):
 
 
 class TrajectoryConfig(_Section):
-    """Fourier series (Eq. 50) and sampling: harmonics N, ω [rad/s], cost samples and period [s], constraint grid [s]."""
+    """Fourier series (Eq. 50) and sampling: harmonics N, ω [rad/s], cost samples and period [s],
+    constraint grid [s]; boundary conditions (``rest``: q̇ = q̈ = 0 at both ends, ``periodic``: Eq. 50
+    as it is) and whether both ends are at the home posture."""
 
     harmonics: int = Field(10, ge=1)
     base_frequency: float = Field(math.pi / 4, gt=0.0)
     cost_samples: int = Field(40, ge=1)
     cost_period: float = Field(0.2, gt=0.0)
     constraint_period: float = Field(0.02, gt=0.0)
+    boundary: Literal["rest", "periodic"] = "rest"
+    ends_at_home: bool = False
 
     @property
     def duration(self) -> float:

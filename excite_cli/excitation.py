@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from excite_cli.base_parameters import BaseParameters, compute_base_parameters
+from excite_cli.boundary import BoundaryConditions, boundary_rows
 from excite_cli.config import Problem
 from excite_cli.capsules import capsule_pairs, capsules_from_config
 from excite_cli.constraints import Constraint, JointLimits, SelfCollision
@@ -36,6 +37,7 @@ class Excitation:
         fine_basis: basis on the check grid, ``check_refinement`` times finer.
         limits: joint limits (Eq. 51).
         constraints: all constraints handed to the optimizer (joint limits first).
+        boundary: boundary conditions (rest or periodic) and the optimizer's coordinates.
     """
 
     problem: Problem
@@ -47,6 +49,7 @@ class Excitation:
     fine_basis: FourierBasis
     limits: JointLimits
     constraints: list[Constraint]
+    boundary: BoundaryConditions
 
     def criterion(self, prior: np.ndarray | None = None) -> ConditionNumber:
         """The condition-number criterion with C₀ = ``prior`` (m₁, b) (Eq. 41)."""
@@ -61,8 +64,7 @@ class Excitation:
     @property
     def home(self) -> np.ndarray:
         """(n,) the robot's home posture [rad] moved inside the position bounds by their margin."""
-        inner = (1.0 - GRID_MARGIN) * self.limits.half[0]
-        return np.clip(self.robot.home, self.limits.centre[0] - inner, self.limits.centre[0] + inner)
+        return home_posture(self.robot, self.limits)
 
     def static(self) -> np.ndarray:
         """α (n, 2N+1) of standing still at the home posture."""
@@ -70,15 +72,27 @@ class Excitation:
         alpha[:, 0] = self.home
         return alpha
 
+    def random_motion(self, rng: np.random.Generator, fill: float) -> np.ndarray:
+        """Random α (n, 2N+1) about the home posture that meets the boundary conditions and fills the
+        fraction ``fill`` of each joint's position, velocity and acceleration room on the grid."""
+        return self.limits.random_start(self.trajectory.n_coefficients, rng, fill, self.home, self.boundary.wave_space)
+
     def random_start(self, rng: np.random.Generator) -> np.ndarray:
-        """Random α (n, 2N+1) about the home posture that every constraint accepts: random Fourier
-        coefficients filling 50-90 % of the joint limits, shrunk until the other constraints hold."""
-        alpha = self.limits.random_start(self.trajectory.n_coefficients, rng, rng.uniform(0.5, 0.9), self.home)
+        """Random α (n, 2N+1) about the home posture that every constraint and the boundary
+        conditions accept: random Fourier coefficients filling 50-90 % of the joint limits, shrunk
+        until the other constraints hold."""
+        alpha = self.random_motion(rng, rng.uniform(0.5, 0.9))
         for _ in range(40):
             if all(c.accepts(alpha) for c in self.constraints):
                 return alpha
             alpha[:, 1:] *= 0.7
         return self.static()
+
+
+def home_posture(robot: Robot, limits: JointLimits) -> np.ndarray:
+    """(n,) the robot's home posture [rad] moved inside the position bounds by their margin."""
+    inner = (1.0 - GRID_MARGIN) * limits.half[0]
+    return np.clip(robot.home, limits.centre[0] - inner, limits.centre[0] + inner)
 
 
 def build_excitation(problem: Problem) -> Excitation:
@@ -95,6 +109,7 @@ def build_excitation(problem: Problem) -> Excitation:
     fine_period = tcfg.constraint_period / problem.limits.check_refinement
     grid_basis = trajectory.basis(sample_times(tcfg.duration, tcfg.constraint_period, include_end=True))
     limits = JointLimits(*joint_limit_bounds(problem.limits, robot), grid_basis)
+    boundary = _boundary_conditions(problem, trajectory, limits, home_posture(robot, limits))
     constraints: list[Constraint] = [limits]
     if ccfg.com is not None:
         constraints.append(com_region_from_config(ccfg.com, robot, grid_basis))
@@ -112,9 +127,31 @@ def build_excitation(problem: Problem) -> Excitation:
         fine_basis=trajectory.basis(sample_times(tcfg.duration, fine_period, include_end=True)),
         limits=limits,
         constraints=constraints,
+        boundary=boundary,
     )
     _check_home_posture(excitation)
     return excitation
+
+
+def _boundary_conditions(problem: Problem, trajectory: FourierTrajectory, limits: JointLimits,
+                         home: np.ndarray) -> BoundaryConditions:
+    """The boundary conditions of ``trajectory.boundary`` / ``ends_at_home`` (see :mod:`excite_cli.boundary`).
+
+    Raises:
+        ExciteError: the conditions leave the joints no oscillation (too few harmonics).
+    """
+    tcfg = problem.trajectory
+    rows = boundary_rows(trajectory, tcfg.duration, tcfg.boundary == "rest", tcfg.ends_at_home)
+    targets = np.zeros((home.size, rows.shape[0]))
+    if tcfg.ends_at_home:
+        targets[:, -2:] = home[:, None]
+    boundary = BoundaryConditions(rows, targets, limits.coefficient_scale())
+    if boundary.wave_space.shape[1] == 0:
+        raise ExciteError(
+            f"trajectory.harmonics: {tcfg.harmonics} harmonic(s) leave no free oscillation under "
+            f"boundary '{tcfg.boundary}'{' with ends_at_home' if tcfg.ends_at_home else ''}; use more harmonics"
+        )
+    return boundary
 
 
 def _check_home_posture(excitation: Excitation) -> None:

@@ -14,6 +14,7 @@ from typing import Callable, Optional, Sequence
 import numpy as np
 from scipy.optimize import minimize
 
+from excite_cli.boundary import BoundaryConditions
 from excite_cli.config import OptimizerConfig
 from excite_cli.constraints import Constraint
 from excite_cli.criterion import ConditionNumber
@@ -41,8 +42,8 @@ class OptimizationResult:
     wall_time_s: float
 
 
-def _stack(constraints: Sequence[Constraint], x: np.ndarray, shape: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
-    parts = [c.evaluate(x.reshape(shape)) for c in constraints]
+def _stack(constraints: Sequence[Constraint], alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    parts = [c.evaluate(alpha) for c in constraints]
     return np.concatenate([g for g, _ in parts]), np.vstack([J for _, J in parts])
 
 
@@ -50,18 +51,23 @@ def _accepted(constraints: Sequence[Constraint], alpha: np.ndarray) -> bool:
     return all(c.accepts(alpha) for c in constraints)
 
 
-def repair(constraints: Sequence[Constraint], alpha: np.ndarray, feasible: np.ndarray, steps: int = 12) -> np.ndarray:
-    """A feasible point near α: the constraints' own exact repairs, then, if some constraint still
-    rejects it, the farthest point towards it from ``feasible`` (bisection on the segment).
+def repair(constraints: Sequence[Constraint], alpha: np.ndarray, feasible: np.ndarray,
+           boundary: Optional[BoundaryConditions] = None, steps: int = 12) -> np.ndarray:
+    """A feasible point near α: the constraints' own exact repairs, moved back onto the boundary
+    conditions, then, if some constraint still rejects it, the farthest point towards it from
+    ``feasible`` (bisection on the segment, which keeps the boundary conditions: they are affine).
 
     Args:
         constraints: all constraints.
         alpha: (n, 2N+1) point to repair, typically the last SQP iterate.
         feasible: (n, 2N+1) point every constraint accepts (the restart's start).
+        boundary: the boundary conditions both points meet, if any.
         steps: bisection steps.
     """
     for c in constraints:
         alpha = c.restore(alpha)
+    if boundary is not None:
+        alpha = boundary.project(alpha)
     if _accepted(constraints, alpha):
         return alpha
     lo, hi = 0.0, 1.0
@@ -77,14 +83,15 @@ def optimize_trajectory(
     options: OptimizerConfig,
     rng: np.random.Generator,
     start: Callable[[np.random.Generator], np.ndarray],
-    scale: np.ndarray,
+    boundary: BoundaryConditions,
     progress: Optional[ProgressHook] = None,
     warm_start: Optional[np.ndarray] = None,
 ) -> OptimizationResult:
     """Minimize the criterion over α from ``options.restarts`` random feasible starts.
 
-    SLSQP works on z = α / ``scale`` (diagonal preconditioning, see
-    :meth:`JointLimits.coefficient_scale`); everything else sees α.
+    SLSQP works on the variables z of ``boundary`` (α = s ⊙ (w* + Z z): the boundary conditions
+    hold exactly, with diagonal preconditioning s, see :mod:`excite_cli.boundary`); everything else
+    sees α.
 
     SQP iterates approach the constraint boundary from outside, so each restart ends with the best
     of: the best point whose aggregated constraints were all ≤ 0, and the repaired last iterate
@@ -95,8 +102,8 @@ def optimize_trajectory(
         constraints: all constraints (values and Jacobians, exact checks, repairs).
         options: method, iterations, tolerance, restarts.
         rng: random generator of the starts.
-        start: draws a random α (n, 2N+1) that every constraint accepts.
-        scale: (n, 2N+1) variable scale of the preconditioning.
+        start: draws a random α (n, 2N+1) that every constraint and the boundary conditions accept.
+        boundary: the boundary conditions and the optimizer's coordinates.
         progress: called after every SLSQP iteration.
         warm_start: an accepted α (n, 2N+1) to start the first restart from instead of a random one
             (the sequence passes the previous iteration's optimum).
@@ -104,28 +111,26 @@ def optimize_trajectory(
     Returns:
         The best accepted point over all restarts.
     """
-    shape = scale.shape
-    s = scale.ravel()
     cache: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
 
     def constraint_values(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         key = z.tobytes()
         if key not in cache:
             cache.clear()
-            g, J = _stack(constraints, z * s, shape)
-            cache[key] = (g, J * s)
+            g, J = _stack(constraints, boundary.to_alpha(z))
+            cache[key] = (g, boundary.chain(J))
         return cache[key]
 
     last_value = [np.nan]
     inside: dict[str, object] = {}
 
     def objective(z: np.ndarray) -> tuple[float, np.ndarray]:
-        alpha = (z * s).reshape(shape)
+        alpha = boundary.to_alpha(z)
         value, grad = criterion.value_and_gradient(alpha)
         last_value[0] = value
         if value < inside.get("value", np.inf) and constraint_values(z)[0].max() <= 0.0:
             inside.update(value=value, x=alpha.copy())
-        return value, grad.ravel() * s
+        return value, boundary.chain(grad.ravel())
 
     begin = time.perf_counter()
     best: Optional[tuple[float, np.ndarray, str]] = None
@@ -142,7 +147,7 @@ def optimize_trajectory(
 
         result = minimize(
             objective,
-            x0.ravel() / s,
+            boundary.to_variables(x0),
             jac=True,
             method=options.method,
             constraints=[{
@@ -154,7 +159,7 @@ def optimize_trajectory(
             callback=callback,
         )
         total_iterations += int(result.nit)
-        candidates = [x0, repair(constraints, (result.x * s).reshape(shape), x0)]
+        candidates = [x0, repair(constraints, boundary.to_alpha(result.x), x0, boundary)]
         if "x" in inside:
             candidates.append(np.asarray(inside["x"]))
         for alpha in candidates:

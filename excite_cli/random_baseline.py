@@ -46,7 +46,7 @@ def random_candidate(excitation: Excitation, rng: np.random.Generator) -> Option
     def accepted(alpha: np.ndarray) -> bool:
         return all(c.accepts(alpha) for c in excitation.constraints)
 
-    alpha = excitation.limits.random_start(excitation.trajectory.n_coefficients, rng, 1.0 - GRID_MARGIN, excitation.home)
+    alpha = excitation.random_motion(rng, 1.0 - GRID_MARGIN)
     if accepted(alpha):
         return alpha
     lo, hi = 0.0, 1.0

@@ -9,8 +9,10 @@ from typing import Callable, Optional
 import numpy as np
 
 from excite_cli.criterion import condition_number
+from excite_cli.errors import ExciteError
 from excite_cli.excitation import Excitation
 from excite_cli.optimizer import ProgressHook, optimize_trajectory
+from excite_cli.playback import check_motion, plan_playback
 
 
 @dataclass(frozen=True)
@@ -24,7 +26,8 @@ class IterationResult:
         regressor: C⁽ᵏ⁾, (T·n_rows, b) base regressor at the cost samples.
         cond_own: cond(C⁽ᵏ⁾); cond_stacked: cond([C₀; C⁽ᵏ⁾]) (Table I).
         max_violation: largest normalized constraint violation on the fine grid (≤ 0: satisfied).
-        checks: per-constraint figures from the fine grid, units in the names.
+        checks: per-constraint figures from the fine grid, units in the names, and those of the
+            transitions from and to the home posture (:func:`transition_checks`).
         tracks: per-constraint time series on the constraint grid (``com_xy`` (T_grid, 2) [m],
             ``min_capsule_distance`` (T_grid,) [m]).
         wall_time_s: optimization wall time [s]; sqp_iterations: SLSQP iterations; message: SLSQP's.
@@ -53,6 +56,8 @@ def describe(excitation: Excitation, index: int, alpha: np.ndarray, prior: np.nd
     regressor, condition numbers, samples on the constraint grid and every constraint's fine check."""
     own = excitation.criterion().regressor(alpha)
     checks = [c.check(alpha, excitation.fine_basis) for c in excitation.constraints]
+    details = {key: value for c in checks for key, value in c.details.items()}
+    details.update(transition_checks(excitation, alpha))
     q, qd, qdd = excitation.grid_basis.evaluate(alpha)
     return IterationResult(
         index=index,
@@ -65,12 +70,28 @@ def describe(excitation: Excitation, index: int, alpha: np.ndarray, prior: np.nd
         cond_own=condition_number(own),
         cond_stacked=condition_number(np.vstack([prior, own])),
         max_violation=max(c.max_violation for c in checks),
-        checks={key: value for c in checks for key, value in c.details.items()},
+        checks=details,
         tracks={key: value for c in excitation.constraints for key, value in c.track(alpha, excitation.grid_basis).items()},
         wall_time_s=wall_time_s,
         sqp_iterations=sqp_iterations,
         message=message,
     )
+
+
+def transition_checks(excitation: Excitation, alpha: np.ndarray) -> dict[str, float | str]:
+    """Durations [s] of the quintic transitions home → q(0) and q(T) → home (:mod:`excite_cli.playback`)
+    and every constraint's largest normalized violation on them, on the fine grid
+    (``transition_max_violation`` ≤ 0: satisfied; +inf when no transition keeps the limits)."""
+    try:
+        playback = plan_playback(excitation, alpha)
+    except ExciteError as exc:
+        return {"transition_max_violation": np.inf, "transition_worst": str(exc)}
+    durations = {s.name: s.duration for s in playback.segments}
+    fine_period = excitation.fine_basis.time[1] - excitation.fine_basis.time[0]
+    samples = playback.sample(1.0 / fine_period, only=("transition in", "transition out"))
+    violation, where = check_motion(excitation.constraints, *samples)
+    return {"transition_in_s": durations.get("transition in", 0.0), "transition_out_s": durations.get("transition out", 0.0),
+            "transition_max_violation": violation, "transition_worst": where}
 
 
 def run_sequence(
@@ -110,7 +131,7 @@ def run_sequence(
             excitation.problem.optimizer,
             rng,
             excitation.random_start,
-            excitation.limits.coefficient_scale(),
+            excitation.boundary,
             progress=progress(k) if progress else None,
             warm_start=results[-1].alpha if results else None,
         )

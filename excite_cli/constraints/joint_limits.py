@@ -47,14 +47,14 @@ class JointLimits(Constraint):
         self.basis = basis
         self._orders = (basis.q, basis.qd, basis.qdd)
 
-    def _normalized(self, alpha: np.ndarray, orders: tuple[np.ndarray, ...]) -> np.ndarray:
-        """(3, T, n) samples scaled so that ±1 is a bound and 0 the centre."""
-        return np.stack([(B @ alpha.T - self.centre[d]) / self.half[d] for d, B in enumerate(orders)])
+    def _normalized(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
+        """(3, T, n) samples q, q̇, q̈ (T, n) scaled so that ±1 is a bound and 0 the centre."""
+        return np.stack([(x - self.centre[d]) / self.half[d] for d, x in enumerate((q, qd, qdd))])
 
     def evaluate(self, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """6n aggregated values (order × side × joint) and their Jacobian (6n, α.size)."""
         n, m = alpha.shape
-        z = self._normalized(alpha, self._orders)
+        z = self._normalized(*(B @ alpha.T for B in self._orders))
         s = np.concatenate([z - 1.0, -z - 1.0])  # (6, T, n): upper sides, then lower sides
         g, w = smooth_max(s, axis=1)  # (6, n), (6, T, n)
         J = np.zeros((6, n, n, m))
@@ -64,15 +64,17 @@ class JointLimits(Constraint):
             J[k, idx, idx, :] = sign * (w[k].T @ self._orders[d]) / self.half[d][:, None]
         return g.ravel(), J.reshape(6 * n, n * m)
 
-    def check(self, alpha: np.ndarray, basis: FourierBasis) -> FineCheck:
-        """Largest violation per order in rad, rad/s, rad/s² and normalized by the half-ranges, on ``basis``."""
-        z = self._normalized(alpha, (basis.q, basis.qd, basis.qdd))
+    def check_samples(self, time: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> FineCheck:
+        """Largest violation per order in rad, rad/s, rad/s² and normalized by the half-ranges."""
+        z = self._normalized(q, qd, qdd)
         normalized = np.abs(z).max(axis=1) - 1.0  # (3, n)
         details = {}
         for d, order in enumerate(ORDERS):
             x = z[d] * self.half[d] + self.centre[d]
             details[f"max_violation_{order}"] = float(np.max(np.maximum(x - self.upper[d], self.lower[d] - x)))
-        return FineCheck(max_violation=float(normalized.max()), details=details)
+        d, j = np.unravel_index(np.argmax(normalized), normalized.shape)
+        where = f"{ORDERS[d].split('_')[0]} of joint {j + 1} at {normalized[d, j] + 1:.3f} of its half-range"
+        return FineCheck(max_violation=float(normalized.max()), details=details, where=where)
 
     def coefficient_scale(self) -> np.ndarray:
         """(n, 2N+1) per-coefficient scale [rad]: the change of a coefficient that moves its joint's
@@ -101,10 +103,13 @@ class JointLimits(Constraint):
         out[:, 1:] *= np.clip(scale, 0.0, 1.0)[:, None]
         return out
 
-    def random_start(self, coefficients: int, rng: np.random.Generator, fill: float, offset: np.ndarray | None = None) -> np.ndarray:
+    def random_start(self, coefficients: int, rng: np.random.Generator, fill: float, offset: np.ndarray | None = None,
+                     wave_space: np.ndarray | None = None) -> np.ndarray:
         """Random α (n, coefficients) oscillating about ``offset`` (n,) [rad] (default: the centre of
         each position range), scaled so that each joint uses the fraction ``fill`` of its room on the
-        grid in position, velocity and acceleration (fill < 1: strictly feasible).
+        grid in position, velocity and acceleration (fill < 1: strictly feasible). With
+        ``wave_space`` (coefficients − 1, r), an orthonormal basis, the oscillations are drawn in it
+        (see :attr:`BoundaryConditions.wave_space`: rest at both ends).
 
         Raises:
             ValueError: ``fill`` not in (0, 1), or ``offset`` outside the position bounds.
@@ -120,6 +125,8 @@ class JointLimits(Constraint):
         decay = 1.0 / np.tile(np.arange(1, harmonics + 1), 2)
         alpha = np.zeros((n, coefficients))
         alpha[:, 1:] = rng.standard_normal((n, coefficients - 1)) * decay
+        if wave_space is not None:
+            alpha[:, 1:] = alpha[:, 1:] @ wave_space @ wave_space.T
         room = np.stack([1.0 - np.abs(z0), np.ones(n), np.ones(n)])
         peak = np.stack([np.abs(B @ alpha.T).max(axis=0) / self.half[d] for d, B in enumerate(self._orders)])
         alpha[:, 1:] *= (fill * (room / peak).min(axis=0))[:, None]
