@@ -16,8 +16,11 @@ from typing import Iterator, Sequence
 
 import h5py
 import numpy as np
+import yaml
+from pydantic import ValidationError
 
 from excite_cli.base_parameters import BaseParameters
+from excite_cli.config import Problem
 from excite_cli.errors import ExciteError
 from excite_cli.excitation import Excitation
 from excite_cli.sequence import IterationResult
@@ -164,6 +167,25 @@ def read_prior(path: Path, base: BaseParameters) -> np.ndarray:
     if not np.all(np.isfinite(prior)):
         raise ExciteError(f"sequence.prior: {path} contains NaN or infinite values")
     return prior
+
+
+def problem_of_result(path: Path) -> Problem:
+    """The optimize config stored in a result file (relative paths resolved from its original place).
+
+    Raises:
+        ExciteError: missing or unreadable file, or no valid stored config (not an excite result).
+    """
+    with open_result(path) as f:
+        if "config" not in f.attrs or "iterations" not in f:
+            raise ExciteError(f"{path}: not an excite optimize result (no stored config or /iterations)")
+        text, origin = str(f.attrs["config"]), str(f.attrs.get("config_path", ""))
+    try:
+        problem = Problem.model_validate(yaml.safe_load(text))
+    except (yaml.YAMLError, ValidationError):
+        raise ExciteError(f"{path}: its stored config is not a valid optimize problem (not an excite optimize result?)") from None
+    problem.source_path = Path(origin) if origin else None
+    problem.source_text = text
+    return problem
 
 
 def read_last_alpha(path: Path) -> tuple[int, np.ndarray]:

@@ -58,7 +58,7 @@ def test_panda_capsule_jacobian_matches_finite_differences(panda):
 def test_screened_distances_equal_coal(panda):
     constraint = panda.constraints[1]
     alpha = _lively(panda, 3)
-    _, rotations, centres = constraint._placements(alpha, panda.grid_basis)
+    rotations, centres = capsule_placements(panda.robot, constraint.capsules, panda.grid_basis.q @ alpha.T)
     screened = constraint._screen(rotations, centres)
     for t in range(0, screened.shape[0], 7):
         for p in range(len(constraint.pairs)):

@@ -104,9 +104,9 @@ class ComRegion(Constraint):
         """``com_xy``: (T, 2) ground projection of the CoM [m]."""
         return {"com_xy": self._com(basis.q @ alpha.T)[0]}
 
-    def check(self, alpha: np.ndarray, basis: FourierBasis) -> FineCheck:
-        """Largest CoM excursion from the centre [m] and the normalized violation on ``basis``."""
-        P, _ = self._com(basis.q @ alpha.T)
+    def check_samples(self, time: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> FineCheck:
+        """Largest CoM excursion from the centre [m] and the normalized violation at the postures q (T, n)."""
+        P, _ = self._com(q)
         s, _ = self._normalized(P)
         excursion = float(np.linalg.norm(P - self.centre, axis=1).max())
         if self.radius is not None:

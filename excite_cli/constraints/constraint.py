@@ -45,8 +45,13 @@ class Constraint(ABC):
         """Values g (m,) and Jacobian ∂g/∂α (m, α.size), α flattened row-major."""
 
     @abstractmethod
+    def check_samples(self, time: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> FineCheck:
+        """Exact (not aggregated) check of sampled motion: ``time`` (T,) [s], q, q̇, q̈ (T, n) [rad, rad/s,
+        rad/s²] (any motion, e.g. a transition or a file at the controller's rate)."""
+
     def check(self, alpha: np.ndarray, basis: FourierBasis) -> FineCheck:
         """Exact (not aggregated) re-check of α on the instants of ``basis``."""
+        return self.check_samples(basis.time, *basis.evaluate(alpha))
 
     def accepts(self, alpha: np.ndarray) -> bool:
         """Whether α satisfies the constraint on the grid, exactly, with ``grid_margin`` to spare."""

@@ -54,10 +54,6 @@ class SelfCollision(Constraint):
         self._first = np.array([i for i, _ in pairs], dtype=int)
         self._second = np.array([j for _, j in pairs], dtype=int)
 
-    def _placements(self, alpha: np.ndarray, basis: FourierBasis) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Q (T, n), capsule rotations (T, C, 3, 3) and centres (T, C, 3) of α on ``basis``."""
-        Q = basis.q @ alpha.T
-        return (Q, *capsule_placements(self.robot, self.capsules, Q))
 
     def _distance(self, rotations: np.ndarray, centres: np.ndarray, t: int, p: int) -> coal.DistanceResult:
         i, j = self.pairs[p]
@@ -89,7 +85,8 @@ class SelfCollision(Constraint):
         n, m = alpha.shape
         if not self.pairs:
             return np.zeros(0), np.zeros((0, n * m))
-        Q, rotations, centres = self._placements(alpha, self.basis)
+        Q = self.basis.q @ alpha.T
+        rotations, centres = capsule_placements(self.robot, self.capsules, Q)
         d, exact = self._distances(rotations, centres)
         g, w = smooth_max((self.margin - d) / LENGTH_SCALE, axis=0)  # (P,), (T, P)
         J = np.zeros((len(self.pairs), n, m))
@@ -116,15 +113,15 @@ class SelfCollision(Constraint):
         """``min_capsule_distance``: (T,) smallest distance over the pairs at each instant [m]."""
         if not self.pairs:
             return {}
-        _, rotations, centres = self._placements(alpha, basis)
+        rotations, centres = capsule_placements(self.robot, self.capsules, basis.q @ alpha.T)
         return {"min_capsule_distance": self._screen(rotations, centres).min(axis=1)}
 
-    def check(self, alpha: np.ndarray, basis: FourierBasis) -> FineCheck:
-        """Smallest distance over ``basis``'s instants and all pairs: the screen locates it, coal
+    def check_samples(self, time: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> FineCheck:
+        """Smallest distance over the postures q (T, n) and all pairs: the screen locates it, coal
         gives it (for every sample screened within ``CONFIRM`` of the smallest)."""
         if not self.pairs:
             return FineCheck(max_violation=-np.inf, details={}, where="no capsule pair")
-        _, rotations, centres = self._placements(alpha, basis)
+        rotations, centres = capsule_placements(self.robot, self.capsules, q)
         screened = self._screen(rotations, centres)
         best, where = np.inf, (0, 0)
         for t, p in zip(*np.nonzero(screened <= screened.min() + CONFIRM)):
@@ -136,6 +133,6 @@ class SelfCollision(Constraint):
         return FineCheck(
             max_violation=(self.margin - best) / LENGTH_SCALE,
             details={"min_capsule_distance_m": float(best), "min_capsule_pair": pair,
-                     "min_capsule_time_s": float(basis.time[where[0]])},
+                     "min_capsule_time_s": float(time[where[0]])},
             where=f"capsules {pair} {best * 100:.2f} cm apart (margin {self.margin * 100:.1f} cm)",
         )

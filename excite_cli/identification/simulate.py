@@ -10,30 +10,13 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-import yaml
 
-from excite_cli.config import Problem, SimulationConfig
+from excite_cli.config import SimulationConfig
 from excite_cli.errors import ExciteError
 from excite_cli.identification.effects import COEFFICIENTS, effect_columns
-from excite_cli.output import open_result, read_alphas
+from excite_cli.output import problem_of_result, read_alphas
 from excite_cli.robot import Robot, load_robot
 from excite_cli.trajectory import FourierTrajectory
-
-
-def problem_of_result(path: Path) -> Problem:
-    """The optimize config stored in a result file (relative paths resolved from its original place).
-
-    Raises:
-        ExciteError: the file has no readable config.
-    """
-    with open_result(path) as f:
-        if "config" not in f.attrs:
-            raise ExciteError(f"{path}: not an excite result with a stored config")
-        text, origin = str(f.attrs["config"]), str(f.attrs.get("config_path", ""))
-    problem = Problem.model_validate(yaml.safe_load(text))
-    problem.source_path = Path(origin) if origin else None
-    problem.source_text = text
-    return problem
 
 
 def effect_torques(sim: SimulationConfig, robot: Robot, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
