@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import functools
+from enum import Enum
 import time
 from pathlib import Path
 from typing import Callable, Optional
@@ -15,21 +16,17 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
 from excite_cli.config import IdentifyProblem, Problem, SimulationConfig, load_problem
-from excite_cli.constraints import ComRegion, SelfCollision
 from excite_cli.criterion import ConditionNumber
 from excite_cli.errors import ExciteError
 from excite_cli.excitation import Excitation, build_excitation
+from excite_cli.export import FORMATS, export_trajectory, write_export
+
+ExportFormat = Enum("ExportFormat", {name: name for name in FORMATS}, type=str)
 from excite_cli.identification.effects import UNITS as EFFECT_UNITS
 from excite_cli.identification.pipeline import effect_values, run_identification
 from excite_cli.identification.simulate import simulate_runs
 from excite_cli.output import read_last_alpha, read_prior, read_table, write_identification, write_result
-from excite_cli.plots import (
-    plot_comparison,
-    plot_condition_numbers,
-    plot_constraint_tracks,
-    plot_identification,
-    plot_trajectories,
-)
+from excite_cli.plots import plot_comparison, plot_identification, plot_result
 from excite_cli.random_baseline import draw_pool, greedy_selection, pool_convergence
 from excite_cli.sequence import IterationResult, describe, run_sequence
 from excite_cli.verify import check_gradient, constraint_jacobian_error
@@ -61,32 +58,17 @@ def _table(results: list[IterationResult]) -> Table:
     table = Table(title="Condition numbers (Table I)")
     extra = [(key, label) for key, label in (("com_max_excursion_m", "CoM [cm]"), ("min_capsule_distance_m", "dist [cm]"))
              if results and key in results[0].checks]
-    for column in ("iter", "cond(C(i))", "cond(C)", "max viol.", *[label for _, label in extra], "time [s]"):
+    for column in ("iter", "cond(C(i))", "cond(C)", "max viol.", *[label for _, label in extra], "in/out [s]", "time [s]"):
         table.add_column(column, justify="right")
     for r in results:
+        ok = float(r.checks.get("transition_max_violation", -np.inf)) <= 0.0
+        transitions = f"{r.checks.get('transition_in_s', 0.0):.1f}/{r.checks.get('transition_out_s', 0.0):.1f}" if ok else "violated"
         table.add_row(
             str(r.index), f"{r.cond_own:.1f}", f"{r.cond_stacked:.1f}", f"{r.max_violation:+.1e}",
-            *[f"{100 * float(r.checks[key]):.2f}" for key, _ in extra], f"{r.wall_time_s:.0f}",
+            *[f"{100 * float(r.checks[key]):.2f}" for key, _ in extra], transitions, f"{r.wall_time_s:.0f}",
         )
+    table.caption = "in/out: quintic transitions from and to the home posture at rest (checked on the fine grid)"
     return table
-
-
-def _plots(target: Path, excitation: Excitation, results: list[IterationResult]) -> list[Path]:
-    """PNG figures beside ``target``: trajectories, Table I and, with constraints, their tracks."""
-    stem = target.with_suffix("")
-    plots = [
-        plot_trajectories(stem.with_name(stem.name + "_trajectories.png"), excitation.robot.joint_names, results),
-        plot_condition_numbers(stem.with_name(stem.name + "_cond.png"), results),
-    ]
-    if any(r.tracks for r in results):
-        com = next((c for c in excitation.constraints if isinstance(c, ComRegion)), None)
-        collision = next((c for c in excitation.constraints if isinstance(c, SelfCollision)), None)
-        plots.append(plot_constraint_tracks(
-            stem.with_name(stem.name + "_constraints.png"), results,
-            centre=com.centre if com else None, radius=com.radius if com else None,
-            polygon=com.polygon if com else None, margin=collision.margin if collision else None,
-        ))
-    return plots
 
 
 def _optimize(problem: Problem, excitation: Excitation, target: Path) -> list[IterationResult]:
@@ -156,7 +138,7 @@ def optimize(
     excitation = build_excitation(problem)
     finished = _optimize(problem, excitation, target)
     out.print(_table(finished))
-    plots = _plots(target, excitation, finished)
+    plots = plot_result(target, excitation, finished)
     out.print(f"wrote {target} and {', '.join(str(p) for p in plots)}", highlight=False)
 
 
@@ -263,6 +245,28 @@ def identify(
     write_identification(target, report, robot, base, problem.source_text, data.regressor, problem.identification.method)
     plot = plot_identification(target.with_suffix("").with_name(target.stem + "_residuals.png"), report)
     out.print(f"wrote {target} and {plot}", highlight=False)
+
+
+@app.command()
+@_user_errors
+def export(
+    result: Path = typer.Argument(..., help="An optimize (or compare-random) HDF5 result."),
+    iteration: Optional[int] = typer.Option(None, "--iteration", "-k", help="Iteration to export (default: the last)."),
+    rate: float = typer.Option(1000.0, "--rate", help="Controller rate [Hz]."),
+    fmt: ExportFormat = typer.Option("csv", "--format", help="File format."),
+    periods: int = typer.Option(1, "--periods", help="Periods of the trajectory to play."),
+    output: Optional[Path] = typer.Option(None, "--output", "-o", help="File to write (default: beside the result)."),
+) -> None:
+    """Write a trajectory as a robot plays it: from the home posture at rest, P periods, back to rest,
+    at the controller's rate, with the feed-forward torques; every constraint is re-checked."""
+    exported = export_trajectory(result, iteration, rate, periods)
+    target = output if output is not None else result.with_name(f"{result.stem}_iteration{exported.iteration}_{rate:g}Hz.{fmt.value}")
+    write_export(target, exported, fmt.value)
+    for name, start, duration in exported.segments:
+        out.print(f"{name:>15}: {start:8.3f} s → {start + duration:8.3f} s", highlight=False)
+    out.print(f"{exported.time.size} samples at {rate:g} Hz; every constraint holds: largest normalized violation "
+              f"{exported.max_violation:+.2e} (≤ 0 satisfied), closest: {exported.worst}", highlight=False)
+    out.print(f"wrote {target}", highlight=False)
 
 
 @app.command()

@@ -1,0 +1,166 @@
+"""From an optimized trajectory to a robot: rest at both ends on the Panda, quintic transitions, the
+exported file at 1 kHz against pinocchio's RNEA and the URDF's limits, the posture strip."""
+
+import h5py
+import numpy as np
+import pinocchio as pin
+import pytest
+from typer.testing import CliRunner
+
+from conftest import CONFIGS
+from excite_cli.cli import app
+from excite_cli.constraints import JointLimits
+from excite_cli.constraints.lse import GRID_MARGIN
+from excite_cli.playback import RESOLUTION, Transition, plan_transition
+from excite_cli.robot import example_robot_data_root
+from excite_cli.skeleton import skeleton
+
+runner = CliRunner()
+PANDA_URDF = "example-robot-data/robots/panda_description/urdf/panda.urdf"
+
+
+def _fourier_rates(alpha, omega, t):
+    """q̇, q̈ (n,) of Eq. 50 at time t, written out independently of the library."""
+    N = (alpha.shape[1] - 1) // 2
+    k = np.arange(1, N + 1) * omega
+    a, b = alpha[:, 1:N + 1], alpha[:, N + 1:]
+    qd = (a * k * np.cos(k * t) - b * k * np.sin(k * t)).sum(axis=1)
+    qdd = (-a * k**2 * np.sin(k * t) - b * k**2 * np.cos(k * t)).sum(axis=1)
+    return qd, qdd
+
+
+@pytest.fixture(scope="module")
+def panda_runs(tmp_path_factory):
+    """`excite optimize configs/panda.yaml` as shipped (boundary rest) and with boundary periodic."""
+    tmp = tmp_path_factory.mktemp("panda")
+    periodic_config = tmp / "periodic.yaml"
+    periodic_config.write_text((CONFIGS / "panda.yaml").read_text().replace("  constraint_period: 0.02", "  constraint_period: 0.02\n  boundary: periodic"))
+    runs = {}
+    for name, config in (("rest", CONFIGS / "panda.yaml"), ("periodic", periodic_config)):
+        out = tmp / f"{name}.h5"
+        run = runner.invoke(app, ["optimize", str(config), "-o", str(out)])
+        assert run.exit_code == 0, run.output
+        runs[name] = out
+    return runs
+
+
+def test_rest_run_starts_and_ends_at_rest_and_keeps_every_constraint(panda_runs):
+    with h5py.File(panda_runs["rest"]) as f:
+        assert "boundary: periodic" not in f.attrs["config"]
+        for k in f["iterations"]:
+            it = f["iterations"][k]
+            alpha, T = it["alpha"][()], it["time"][-1]
+            for t in (0.0, T):
+                qd, qdd = _fourier_rates(alpha, 2 * np.pi / 10.0, t)
+                assert np.abs(qd).max() <= 1e-9 and np.abs(qdd).max() <= 1e-9
+            assert it.attrs["max_violation"] <= 0.0
+            assert it.attrs["transition_max_violation"] <= 0.0 and it.attrs["transition_in_s"] > 0.0
+
+
+def test_rest_keeps_excitation_within_25_percent_of_periodic(panda_runs):
+    conds = {}
+    for name, path in panda_runs.items():
+        with h5py.File(path) as f:
+            conds[name] = f["table"]["cond_stacked"][-1]
+    assert conds["rest"] <= 1.25 * conds["periodic"], conds
+
+
+def test_posture_strip_and_plots_are_written(panda_runs):
+    for suffix in ("postures", "trajectories", "cond"):
+        assert panda_runs["rest"].with_name(f"rest_{suffix}.png").stat().st_size > 10_000
+
+
+def test_export_at_1khz_plays_from_home_to_home_with_rnea_torques(panda_runs, tmp_path):
+    target = tmp_path / "panda_1khz.csv"
+    run = runner.invoke(app, ["export", str(panda_runs["rest"]), "--rate", "1000", "--periods", "2", "-o", str(target)])
+    assert run.exit_code == 0, run.output
+    body = [line for line in target.read_text().splitlines() if not line.startswith("#")]
+    header, table = body[0].split(","), np.loadtxt(body[1:], delimiter=",")
+    n = 7
+    time, q, qd, qdd, tau = table[:, 0], *np.split(table[:, 1:], 4, axis=1)
+    assert header[1] == "q_panda_joint1_rad" and header[-1] == "tau_panda_joint7_Nm"
+    assert np.allclose(np.diff(time), 1e-3, atol=1e-9)
+    # rest at the home posture at both ends; home is 0 rad where 0 is inside the limits (joints 1-5, 7)
+    for row in (0, -1):
+        assert np.abs(qd[row]).max() < 1e-9 and np.abs(qdd[row]).max() < 1e-9
+        assert np.abs(q[row][[0, 1, 2, 4, 6]]).max() < 1e-9
+    assert np.allclose(q[0], q[-1], atol=1e-9)
+    # the limits of configs/panda.yaml from the URDF, checked on every exported sample
+    full = pin.buildModelFromUrdf(str(example_robot_data_root() / PANDA_URDF))
+    lower, upper = full.lowerPositionLimit[:n] + 0.1, full.upperPositionLimit[:n] - 0.1
+    assert np.all(q >= lower - 1e-9) and np.all(q <= upper + 1e-9)
+    assert np.abs(qd).max() <= 1.5 and np.abs(qdd).max() <= 5.0
+    # feed-forward torques against pinocchio's RNEA of the full URDF (fingers at 0) at random rows
+    data = full.createData()
+    for row in np.random.default_rng(0).choice(len(time), 25, replace=False):
+        expected = pin.rnea(full, data, np.r_[q[row], 0.0, 0.0], np.r_[qd[row], 0.0, 0.0], np.r_[qdd[row], 0.0, 0.0])[:n]
+        assert np.allclose(tau[row], expected, rtol=1e-8, atol=1e-8)
+    assert "every constraint holds" in run.output
+
+
+def test_export_npz_has_the_same_samples(panda_runs, tmp_path):
+    run = runner.invoke(app, ["export", str(panda_runs["rest"]), "-k", "1", "--rate", "200", "--format", "npz", "-o", str(tmp_path / "a.npz")])
+    assert run.exit_code == 0, run.output
+    data = np.load(tmp_path / "a.npz")
+    assert list(data["joint_names"])[0] == "panda_joint1" and data["q"].shape == data["tau"].shape
+    assert np.allclose(np.diff(data["time"]), 5e-3)
+
+
+@pytest.mark.parametrize("args, message", [
+    (["-k", "9"], "--iteration"),
+    (["--rate", "0"], "--rate"),
+    (["--periods", "0"], "--periods"),
+])
+def test_export_rejects_bad_options_without_writing(panda_runs, tmp_path, args, message):
+    target = tmp_path / "x.csv"
+    run = runner.invoke(app, ["export", str(panda_runs["rest"]), *args, "-o", str(target)])
+    assert run.exit_code == 2 and message in run.output and "Traceback" not in run.output
+    assert not target.exists() and not target.with_name("x.csv.partial").exists()
+
+
+def test_export_of_a_file_that_is_not_a_result(tmp_path):
+    path = tmp_path / "other.h5"
+    with h5py.File(path, "w") as f:
+        f["regressor"] = np.zeros((3, 3))
+    run = runner.invoke(app, ["export", str(path)])
+    assert run.exit_code == 2 and "not an excite optimize result" in run.output
+
+
+def test_quintic_meets_both_end_states_and_is_smooth():
+    rng = np.random.default_rng(1)
+    start, end = rng.normal(size=(3, 4)), rng.normal(size=(3, 4))
+    transition = Transition(start, end, 1.7)
+    q, qd, qdd = transition.evaluate(np.array([0.0, 1.7]))
+    assert np.allclose(np.stack([q[0], qd[0], qdd[0]]), start, atol=1e-12)
+    assert np.allclose(np.stack([q[1], qd[1], qdd[1]]), end, atol=1e-12)
+    t = np.linspace(0.0, 1.7, 20001)
+    q, qd, qdd = transition.evaluate(t)
+    assert np.allclose(np.gradient(q, t, axis=0)[5:-5], qd[5:-5], atol=1e-6)
+    assert np.allclose(np.gradient(qd, t, axis=0)[5:-5], qdd[5:-5], atol=1e-6)
+
+
+def test_rest_to_rest_transition_is_as_short_as_the_velocity_limit_allows():
+    basis_time = np.linspace(0.0, 1.0, 3)
+    from excite_cli.trajectory import FourierTrajectory
+
+    limits = JointLimits(np.array([[-3.0], [-1.0], [-100.0]]), np.array([[3.0], [1.0], [100.0]]),
+                         FourierTrajectory(1, 1.0).basis(basis_time))
+    start, end = np.zeros((3, 1)), np.zeros((3, 1))
+    end[0, 0] = 2.0
+    transition = plan_transition(start, end, limits, "test")
+    shortest = 15.0 * 2.0 / (8.0 * (1.0 - GRID_MARGIN))  # minimum-jerk peak speed 15Δ/(8D)
+    assert shortest <= transition.duration < shortest + RESOLUTION + 1e-12
+    _, qd, _ = transition.evaluate(np.linspace(0.0, transition.duration, 2001))
+    assert np.abs(qd).max() <= 1.0 - GRID_MARGIN + 1e-12
+    assert plan_transition(start, start, limits, "none") is None
+
+
+def test_skeleton_of_the_panda_at_zero_reaches_the_flange():
+    from excite_cli.config import load_problem
+    from excite_cli.robot import load_robot
+
+    robot = load_robot(load_problem(CONFIGS / "panda.yaml"))
+    points = skeleton(robot, np.zeros(7)).reshape(-1, 3)
+    # Panda kinematics at q = 0 (Franka's DH table): flange at x = 0.088 m, z = 0.333 + 0.316 + 0.384 − 0.107 m
+    assert np.min(np.linalg.norm(points - [0.088, 0.0, 0.926], axis=1)) < 1e-6
+    assert np.min(np.linalg.norm(points - [0.0825, 0.0, 0.649], axis=1)) < 1e-6
