@@ -22,6 +22,7 @@ test: $(STAMP)
 
 smoke: $(STAMP)
 	$(VENV)/bin/excite optimize configs/smoke.yaml --output results/smoke.h5
+	$(VENV)/bin/excite export results/smoke.h5 --rate 1000
 	$(VENV)/bin/excite verify-gradient configs/smoke.yaml
 
 bench: $(STAMP)

@@ -92,6 +92,7 @@ def plot_condition_numbers(path: Path, results: Sequence[IterationResult]) -> Pa
     for r in results:
         ax.annotate(f"{r.cond_stacked:.1f}", (r.index, r.cond_stacked), textcoords="offset points", xytext=(4, -10), fontsize=7)
     ax.set_yscale("log")
+    ax.margins(x=0.12)
     ax.set_xlabel("iteration")
     ax.set_ylabel("condition number (log)")
     ax.set_xticks(k)
