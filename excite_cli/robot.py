@@ -79,6 +79,9 @@ class Robot:
         home: (n,) posture [rad] the random starts oscillate about (config ``robot.home_posture``,
             default 0, clipped into the URDF position limits).
         collision_model: the URDF's collision geometry attached to the reduced model, if loaded.
+        links: (parent, child) names of consecutive joint frames (moving, locked or fixed) of the
+            full URDF tree, for drawing the robot (the reduced model's frames keep no parent for
+            locked joints).
     """
 
     model: pin.Model
@@ -93,6 +96,7 @@ class Robot:
     body_names: list[str]
     home: np.ndarray
     collision_model: pin.GeometryModel | None = None
+    links: list[tuple[str, str]] = field(default_factory=list)
     data: pin.Data = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
@@ -163,6 +167,20 @@ class Robot:
         hi = np.where(np.isfinite(self.upper), self.upper, np.pi)
         Q = rng.uniform(lo, hi, size=(count, self.n_joints))
         return Q, rng.standard_normal(Q.shape), rng.standard_normal(Q.shape)
+
+
+def joint_frame_links(model: pin.Model) -> list[tuple[str, str]]:
+    """(parent, child) names of each joint frame (moving or fixed) and its nearest joint-frame ancestor."""
+    kinds = (pin.FrameType.JOINT, pin.FrameType.FIXED_JOINT)
+    pairs = []
+    for index, frame in enumerate(model.frames):
+        if index == 0 or frame.type not in kinds:
+            continue
+        parent = frame.parentFrame
+        while 0 < parent < index and model.frames[parent].type not in kinds:
+            parent = model.frames[parent].parentFrame
+        pairs.append((model.frames[parent].name, frame.name))
+    return pairs
 
 
 def _body_name(model: pin.Model, joint_id: int) -> str:
@@ -250,4 +268,5 @@ def load_robot(problem: Problem, collision: bool = False) -> Robot:
         body_names=[_body_name(model, j) for j in range(1, model.njoints)],
         home=np.clip(home, lower, upper),
         collision_model=geometry,
+        links=joint_frame_links(full),
     )

@@ -1,5 +1,6 @@
 """The robot drawn as lines: each joint frame (moving, locked or fixed) joined to its parent joint
-frame, from pinocchio's frame placements, and the capsules' segments, for pictures of postures."""
+frame (``Robot.links``), from pinocchio's frame placements, and the capsules' segments, for
+pictures of postures."""
 
 from __future__ import annotations
 
@@ -8,21 +9,6 @@ import pinocchio as pin
 
 from excite_cli.capsules import Capsule, capsule_placements
 from excite_cli.robot import Robot
-
-_JOINT_FRAMES = (pin.FrameType.JOINT, pin.FrameType.FIXED_JOINT)
-
-
-def _links(model: pin.Model) -> list[tuple[int, int]]:
-    """(parent frame, frame) index pairs of consecutive joint frames (moving or fixed)."""
-    pairs = []
-    for index, frame in enumerate(model.frames):
-        if index == 0 or frame.type not in _JOINT_FRAMES:
-            continue
-        parent = frame.parentFrame
-        while parent > 0 and model.frames[parent].type not in _JOINT_FRAMES:
-            parent = model.frames[parent].parentFrame
-        pairs.append((parent, index))
-    return pairs
 
 
 def skeleton(robot: Robot, q: np.ndarray) -> np.ndarray:
@@ -33,7 +19,8 @@ def skeleton(robot: Robot, q: np.ndarray) -> np.ndarray:
     qf = robot.q_reference.copy()
     qf[robot.q_idx] = q
     pin.framesForwardKinematics(model, data, qf)
-    return np.array([[data.oMf[a].translation, data.oMf[b].translation] for a, b in _links(model)])
+    ids = {name: model.getFrameId(name) for pair in robot.links for name in pair}
+    return np.array([[data.oMf[ids[a]].translation, data.oMf[ids[b]].translation] for a, b in robot.links])
 
 
 def capsule_segments(robot: Robot, capsules: list[Capsule], q: np.ndarray) -> np.ndarray:
