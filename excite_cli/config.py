@@ -262,7 +262,8 @@ class PreprocessingConfig(_Section):
 
 
 class IdentificationConfig(_Section):
-    """LS or WLS, declared and candidate effects, selection thresholds, friction shape constants [rad/s]."""
+    """LS or WLS, declared and candidate effects, selection thresholds, friction shape constants [rad/s],
+    physically consistent standard parameters and their regularization toward the URDF."""
 
     method: Literal["wls", "ls"] = "wls"
     declared_effects: dict[str, list[Effect]] = Field(default_factory=dict)
@@ -272,6 +273,8 @@ class IdentificationConfig(_Section):
     stribeck_velocity: float = Field(0.1, gt=0.0)
     coulomb_velocity: float = Field(0.01, gt=0.0)
     max_effects: int = Field(60, ge=0)
+    physical_consistency: bool = False
+    regularization: float = Field(1e-3, ge=0.0)
 
 
 class IdentifyProblem(_Section):

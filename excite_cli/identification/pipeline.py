@@ -4,6 +4,7 @@ effect selection ─► report of the torque error before and after on the valid
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -11,10 +12,12 @@ from excite_cli.base_parameters import BaseParameters, compute_base_parameters
 from excite_cli.config import IdentifyProblem
 from excite_cli.errors import ExciteError
 from excite_cli.identification.effects import COEFFICIENTS
-from excite_cli.identification.identify import Dataset, Selection, build_dataset, predict, select_effects
+from excite_cli.identification.identify import Dataset, Selection, build_dataset, design, predict, select_effects
 from excite_cli.identification.measurements import load_run
+from excite_cli.identification.physical import ConsistentFit, consistent_fit
 from excite_cli.identification.preprocessing import default_cutoff, preprocess
-from excite_cli.robot import Robot, load_robot
+from excite_cli.identification.urdf_out import urdf_deviation, write_urdf
+from excite_cli.robot import Robot, load_robot, resolve_urdf
 
 
 @dataclass
@@ -30,6 +33,8 @@ class Report:
         validation: the validation samples; predicted_before, predicted_after: (N, n) [Nm] on them.
         cutoff: low-pass cut-off of every run [Hz].
         fit_samples, validation_samples: instants used for fitting / validation.
+        consistent: the physically consistent fit with the same effects, or None.
+        rms_consistent: (n,) its validation torque RMS error [Nm] (None without it).
     """
 
     joints: list[str]
@@ -44,6 +49,8 @@ class Report:
     cutoff: float
     fit_samples: int
     validation_samples: int
+    consistent: ConsistentFit | None = None
+    rms_consistent: np.ndarray | None = None
 
     @property
     def relative_before(self) -> np.ndarray:
@@ -54,6 +61,11 @@ class Report:
     def relative_after(self) -> np.ndarray:
         """(n,) RMS error / RMS torque [%] after."""
         return 100.0 * self.rms_after / self.rms_torque
+
+    @property
+    def relative_consistent(self) -> np.ndarray | None:
+        """(n,) RMS error / RMS torque [%] of the physically consistent fit, or None."""
+        return None if self.rms_consistent is None else 100.0 * self.rms_consistent / self.rms_torque
 
 
 def split(data: Dataset, roles: list[str], blocks: int) -> np.ndarray:
@@ -116,6 +128,11 @@ def run_identification(problem: IdentifyProblem) -> tuple[Report, Robot, BasePar
     before = predict(val_data, selection.rigid.x, [])
     after = predict(val_data, selection.fit.x, selection.effects)
     measured = val_data.tau.reshape(-1, val_data.n)
+    consistent = fit_consistent(fit_data, selection, robot, base, cfg) if cfg.physical_consistency else None
+    rms_consistent = None
+    if consistent is not None:
+        predicted = predict(val_data, np.concatenate([consistent.base, consistent.effects]), selection.effects)
+        rms_consistent = np.sqrt(np.mean((measured - predicted) ** 2, axis=0))
     report = Report(
         joints=robot.joint_names,
         base_names=base.names,
@@ -129,16 +146,52 @@ def run_identification(problem: IdentifyProblem) -> tuple[Report, Robot, BasePar
         cutoff=cutoff,
         fit_samples=fit_data.time.size,
         validation_samples=val_data.time.size,
+        consistent=consistent,
+        rms_consistent=rms_consistent,
     )
     return report, robot, base, data
 
 
-def effect_values(report: Report) -> list[tuple[str, str, str, float, float]]:
-    """(effect, coefficient, joint, value, std) for every chosen effect coefficient, in order."""
+def fit_consistent(fit_data: Dataset, selection: Selection, robot: Robot, base: BaseParameters, cfg) -> ConsistentFit:
+    """The physically consistent fit (:mod:`excite_cli.identification.physical`) of the selected model
+    on the fit data, with the selection's per-joint weights (WLS) or none (LS).
+
+    Raises:
+        ExciteError: the semidefinite program has no solution.
+    """
+    b = base.count
+    weights = 1.0 / np.maximum(selection.fit.sigma[fit_data.joint], 1e-12) if cfg.method == "wls" else np.ones(fit_data.tau.size)
+    names = [f"{c} {robot.joint_names[j]}" for e, j in selection.effects for c in COEFFICIENTS[e]]
+    return consistent_fit(fit_data.regressor, design(fit_data, selection.effects)[:, b:], fit_data.tau, weights,
+                          base.regrouping, robot.urdf_parameters(), names, cfg.regularization, robot.body_names)
+
+
+def effect_values(report: Report, consistent: bool = False) -> list[tuple[str, str, str, float, float]]:
+    """(effect, coefficient, joint, value, std) for every chosen effect coefficient, in order: of the
+    selected least-squares fit, or with ``consistent`` of the physically consistent one (std NaN)."""
     b = len(report.base_names)
-    rows, k = [], b
+    values = report.consistent.effects if consistent else report.selection.fit.x[b:]
+    stds = np.full(values.size, np.nan) if consistent else report.selection.fit.std[b:]
+    rows, k = [], 0
     for effect, j in report.selection.effects:
         for coefficient in COEFFICIENTS[effect]:
-            rows.append((effect, coefficient, report.joints[j], float(report.selection.fit.x[k]), float(report.selection.fit.std[k])))
+            rows.append((effect, coefficient, report.joints[j], float(values[k]), float(stds[k])))
             k += 1
     return rows
+
+
+def write_identified_urdf(problem: IdentifyProblem, report: Report, robot: Robot, base: BaseParameters, target: Path) -> float:
+    """Write the URDF of the physically consistent fit (:mod:`excite_cli.identification.urdf_out`) and
+    return the largest deviation [Nm] of its RNEA from the identified rigid-body torques.
+
+    Raises:
+        ExciteError: no consistent fit in ``report``, or the file cannot be written or loaded back.
+    """
+    if report.consistent is None:
+        raise ExciteError("--urdf-out: needs the physically consistent fit (identification.physical_consistency)")
+    source, _ = resolve_urdf(problem)
+    effects = [(e, c, j, v) for e, c, j, v, _ in effect_values(report, consistent=True)]
+    write_urdf(source, target, robot, report.consistent.standard, effects,
+               f"physically consistent parameters identified from {problem.source_path or 'measured data'}")
+    X, phi_base = base.composition_matrix, report.consistent.base
+    return urdf_deviation(problem, robot, lambda q, qd, qdd: robot.regressor(q, qd, qdd) @ X @ phi_base, target)
