@@ -23,7 +23,8 @@ from excite_cli.export import FORMATS, export_trajectory, write_export
 
 ExportFormat = Enum("ExportFormat", {name: name for name in FORMATS}, type=str)
 from excite_cli.identification.effects import UNITS as EFFECT_UNITS
-from excite_cli.identification.pipeline import effect_values, run_identification
+from excite_cli.identification.physical import body_properties, pseudo_inertia
+from excite_cli.identification.pipeline import effect_values, run_identification, write_identified_urdf
 from excite_cli.identification.simulate import simulate_runs
 from excite_cli.output import read_last_alpha, read_prior, read_table, write_identification, write_result
 from excite_cli.plots import plot_comparison, plot_identification, plot_result
@@ -211,20 +212,30 @@ def compare_random(
 def identify(
     config: Path = typer.Argument(..., help="Identification YAML: robot, data, preprocessing, identification (see README)."),
     output: Optional[Path] = typer.Option(None, "--output", "-o", help="HDF5 result (overrides config 'output')."),
+    physical_consistency: bool = typer.Option(False, "--physical-consistency", help="Also fit physically consistent standard parameters (identification.physical_consistency)."),
+    urdf_out: Optional[Path] = typer.Option(None, "--urdf-out", help="Write the URDF with the identified inertias and friction (implies --physical-consistency)."),
 ) -> None:
     """Identify base parameters on measured data (Eq. 4), trace the residual to the effects the
-    rigid-body model lacks, add them, and report the torque error before and after on held-out data."""
+    rigid-body model lacks, add them, and report the torque error before and after on held-out data;
+    optionally fit physically consistent standard parameters and write them as a URDF."""
     problem = load_problem(config, IdentifyProblem)
+    if physical_consistency or urdf_out is not None:
+        problem = problem.model_copy(deep=True)
+        problem.identification.physical_consistency = True
     target = output if output is not None else Path(problem.output)
     with err.status("preprocessing, fitting and selecting effects ..."):
         report, robot, base, data = run_identification(problem)
     sel = report.selection
     table = Table(title=f"Validation torque error, rigid body only → with the chosen effects ({report.validation_samples} held-out instants)")
-    for column in ("joint", "RMS τ [Nm]", "before [Nm]", "after [Nm]", "before [%]", "after [%]"):
+    consistent = report.relative_consistent
+    for column in ("joint", "RMS τ [Nm]", "before [Nm]", "after [Nm]", "before [%]", "after [%]") + (("consistent [%]",) if consistent is not None else ()):
         table.add_column(column, justify="right")
     for j, name in enumerate(report.joints):
         table.add_row(name, f"{report.rms_torque[j]:.3f}", f"{report.rms_before[j]:.3f}", f"{report.rms_after[j]:.3f}",
-                      f"{report.relative_before[j]:.1f}", f"{report.relative_after[j]:.1f}")
+                      f"{report.relative_before[j]:.1f}", f"{report.relative_after[j]:.1f}",
+                      *((f"{consistent[j]:.1f}",) if consistent is not None else ()))
+    table.caption = (f"mean: before {report.relative_before.mean():.1f} %, after {report.relative_after.mean():.1f} %"
+                     + (f", physically consistent {consistent.mean():.1f} %" if consistent is not None else ""))
     out.print(table)
     effects = Table(title="Effects, in the order they were added (declared ones first)")
     for column in ("#", "effect", "joint", "coefficient", "value", "std"):
@@ -242,7 +253,12 @@ def identify(
     for name, value, std in zip(report.base_names, sel.fit.x, sel.fit.std):
         params.add_row(name, f"{value:.5g}", f"{std:.2g}")
     out.print(params)
+    if report.consistent is not None:
+        out.print(_bodies(report, robot))
     write_identification(target, report, robot, base, problem.source_text, data.regressor, problem.identification.method)
+    if urdf_out is not None:
+        deviation = write_identified_urdf(problem, report, robot, base, urdf_out)
+        out.print(f"wrote {urdf_out}: pinocchio's RNEA on it matches the identified rigid-body torques to {deviation:.1e} Nm", highlight=False)
     plot = plot_identification(target.with_suffix("").with_name(target.stem + "_residuals.png"), report)
     out.print(f"wrote {target} and {plot}", highlight=False)
 
@@ -281,6 +297,27 @@ def simulate(
     sim = load_problem(effects, SimulationConfig)
     files = simulate_runs(result, sim, output_dir)
     out.print("wrote " + ", ".join(str(f) for f in files), highlight=False)
+
+
+def _bodies(report, robot) -> Table:
+    """Identified (physically consistent) bodies beside the URDF's, and the active constraints."""
+    table = Table(title=f"Physically consistent bodies (identified / URDF), solver {report.consistent.status}")
+    for column in ("body", "mass [kg]", "CoM [m]", "principal moments about the CoM [kg m²]", "λmin(J)"):
+        table.add_column(column, justify="right")
+    urdf = robot.urdf_parameters()
+    for i, name in enumerate(robot.body_names):
+        m, c, _, moments = body_properties(report.consistent.standard[10 * i: 10 * i + 10])
+        um, uc, _, umoments = body_properties(urdf[10 * i: 10 * i + 10])
+        vector = lambda v: " ".join(f"{x:+.3f}" for x in v)
+        table.add_row(name, f"{m:.3f} / {um:.3f}", f"{vector(c)} / {vector(uc)}",
+                      f"{' '.join(f'{x:.2e}' for x in moments)} / {' '.join(f'{x:.2e}' for x in umoments)}",
+                      f"{report.consistent.min_eigenvalues[i]:.1e}")
+    plain = [(name, body_properties(report.consistent.unconstrained[10 * i: 10 * i + 10])[0]) for i, name in enumerate(robot.body_names)
+             if np.linalg.eigvalsh(pseudo_inertia(report.consistent.unconstrained[10 * i: 10 * i + 10]))[0] <= 0.0]
+    table.caption = ("active: " + (", ".join(report.consistent.active) or "none")
+                     + "\nplain least squares (same regularization) is not physical for: "
+                     + (", ".join(f"{name} (mass {m:.3f} kg)" for name, m in plain) or "none"))
+    return table
 
 
 def _comparison(random_table, optimized_table, random_time: float, optimized_time: float, pool: int, drawn: int) -> Table:

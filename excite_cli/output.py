@@ -224,6 +224,33 @@ def read_alphas(path: Path) -> list[tuple[int, np.ndarray]]:
         return [(int(k), f["iterations"][k]["alpha"][()]) for k in keys]
 
 
+def _write_consistent(g: h5py.Group, report, robot) -> None:
+    """The physically consistent fit: standard parameters, per-body properties beside the URDF's,
+    active constraints, its validation errors."""
+    from excite_cli.identification.physical import body_properties
+
+    consistent = report.consistent
+    g.create_dataset("standard_parameters", data=consistent.standard).attrs["unit"] = "kg, kg m, kg m^2 (pinocchio order per body)"
+    _strings(g, "standard_parameter_names", robot.parameter_names)
+    g.attrs["solver_status"] = consistent.status
+    _strings(g, "active_constraints", consistent.active)
+    urdf = robot.urdf_parameters()
+    bodies = np.zeros(len(robot.body_names), dtype=[("body", h5py.string_dtype()), ("mass", "f8"), ("com", "f8", 3),
+                                                     ("principal_moments", "f8", 3), ("inertia_com", "f8", (3, 3)),
+                                                     ("urdf_mass", "f8"), ("urdf_com", "f8", 3), ("urdf_principal_moments", "f8", 3),
+                                                     ("pseudo_inertia_min_eigenvalue", "f8")])
+    for i, row in enumerate(bodies):
+        m, c, I, moments = body_properties(consistent.standard[10 * i: 10 * i + 10])
+        um, uc, _, umoments = body_properties(urdf[10 * i: 10 * i + 10])
+        row["body"], row["mass"], row["com"], row["principal_moments"], row["inertia_com"] = robot.body_names[i], m, c, moments, I
+        row["urdf_mass"], row["urdf_com"], row["urdf_principal_moments"] = um, uc, umoments
+        row["pseudo_inertia_min_eigenvalue"] = consistent.min_eigenvalues[i]
+    table = g.create_dataset("bodies", data=bodies)
+    table.attrs["units"] = "mass kg, com m, moments and inertia kg m^2 (about the CoM, body axes)"
+    g.create_dataset("rms_consistent", data=report.rms_consistent).attrs["unit"] = "Nm"
+    g.create_dataset("relative_consistent", data=report.relative_consistent).attrs["unit"] = "%"
+
+
 def write_identification(path: Path, report, robot, base: BaseParameters, source_text: str, regressor: np.ndarray,
                          method: str) -> None:
     """Write (atomically) an ``identify`` result: ``/identification/...``, plus ``/regressor`` (the
@@ -263,12 +290,19 @@ def write_identification(path: Path, report, robot, base: BaseParameters, source
             g.attrs["validation_samples"] = report.validation_samples
             _strings(g, "joint_names", report.joints)
             _strings(g, "base_parameter_names", report.base_names)
-            g.create_dataset("base_parameters", data=sel.fit.x[:b])
+            consistent = report.consistent
+            g.create_dataset("base_parameters", data=sel.fit.x[:b] if consistent is None else consistent.base)
+            g.create_dataset("base_parameters_unconstrained", data=sel.fit.x[:b])
             g.create_dataset("base_parameters_std", data=sel.fit.std[:b])
             g.create_dataset("base_parameters_rigid_only", data=sel.rigid.x)
+            g.create_dataset("physically_consistent", data=consistent is not None)
+            if consistent is not None:
+                _write_consistent(g, report, robot)
             rows = effect_values(report)
             effects = np.zeros(len(rows), dtype=[("order", "i4"), ("effect", h5py.string_dtype()), ("coefficient", h5py.string_dtype()),
-                                                 ("joint", h5py.string_dtype()), ("value", "f8"), ("std", "f8"), ("declared", "?")])
+                                                 ("joint", h5py.string_dtype()), ("value", "f8"), ("std", "f8"), ("declared", "?"),
+                                                 ("value_consistent", "f8")])
+            effects["value_consistent"] = np.nan if report.consistent is None else report.consistent.effects
             declared = {(e, report.joints[j]) for e, j in sel.effects[: sel.declared]}
             order = {key: k + 1 for k, key in enumerate((e, report.joints[j]) for e, j in sel.effects)}
             for row, (effect, coefficient, joint, value, std) in zip(effects, rows):

@@ -1,0 +1,125 @@
+"""Physically consistent identification: the pseudo-inertia against pinocchio's, the real Panda run
+with a written URDF, simulated data with known parameters, and data where plain least squares gives
+a negative mass."""
+
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pinocchio as pin
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from conftest import CONFIGS, write_config
+from excite_cli.base_parameters import compute_base_parameters
+from excite_cli.cli import app
+from excite_cli.config import IdentifyProblem, load_problem
+from excite_cli.identification.physical import pseudo_inertia
+from excite_cli.identification.pipeline import run_identification
+from excite_cli.output import problem_of_result, read_alphas
+from excite_cli.robot import load_robot
+from excite_cli.trajectory import FourierTrajectory
+from test_identification import JOINTS, SHARED, optimized  # noqa: F401  (module fixture)
+
+runner = CliRunner()
+
+
+def _eigenvalues(phi: np.ndarray) -> np.ndarray:
+    """Smallest pseudo-inertia eigenvalue of each body, from pinocchio's PseudoInertia (independent)."""
+    return np.array([np.linalg.eigvalsh(pin.Inertia.FromDynamicParameters(phi[10 * i: 10 * i + 10]).toPseudoInertia().toMatrix())[0]
+                     for i in range(phi.size // 10)])
+
+
+def test_pseudo_inertia_matches_pinocchio_and_tells_physical_bodies():
+    rng = np.random.default_rng(0)
+    for _ in range(5):  # boxes (physical by construction) moved and turned about the body frame
+        box = pin.Inertia.FromBox(rng.uniform(0.1, 5.0), *rng.uniform(0.01, 0.5, 3))
+        inertia = pin.SE3.Random().act(box)
+        phi = inertia.toDynamicParameters()
+        assert np.allclose(pseudo_inertia(phi), inertia.toPseudoInertia().toMatrix(), atol=1e-12)
+        assert np.linalg.eigvalsh(pseudo_inertia(phi))[0] > 0
+    rod = pin.Inertia(1.0, np.zeros(3), np.diag([1.0, 1.0, 3.0]))  # violates I_zz ≤ I_xx + I_yy
+    assert np.linalg.eigvalsh(pseudo_inertia(rod.toDynamicParameters()))[0] < 0
+    negative = -pin.Inertia.FromBox(1.0, 0.1, 0.2, 0.3).toDynamicParameters()
+    assert np.linalg.eigvalsh(pseudo_inertia(negative))[0] < 0
+
+
+@pytest.mark.skipif(not (SHARED / "exciting_traj_1.csv").exists(), reason="shared Panda data not present")
+def test_real_panda_consistent_fit_and_its_urdf(tmp_path):
+    config = yaml.safe_load((CONFIGS / "panda_identify.yaml").read_text())
+    config["data"]["runs"][0]["file"] = str(SHARED / "exciting_traj_1.csv")
+    path = write_config(tmp_path, config, "identify.yaml")
+    urdf, report = tmp_path / "panda_identified.urdf", tmp_path / "ident.h5"
+    run = runner.invoke(app, ["identify", str(path), "--urdf-out", str(urdf), "-o", str(report)], env={"COLUMNS": "200"})
+    assert run.exit_code == 0, run.output
+    with h5py.File(report) as f:
+        g = f["identification"]
+        assert g["physically_consistent"][()]
+        standard, base_parameters = g["standard_parameters"][()], g["base_parameters"][()]
+        consistent, unconstrained = g["relative_consistent"][()].mean(), g["relative_after"][()].mean()
+    assert np.all(_eigenvalues(standard) > 0)
+    assert consistent <= unconstrained + 1.0
+    # the written URDF, loaded by pinocchio on its own, against the identified rigid-body torques at
+    # the held-out blocks' measured states (blocks 2 and 4 of 4)
+    data = np.genfromtxt(SHARED / "exciting_traj_1.csv", delimiter=",", names=True)
+    t = data["time"]
+    quarter = np.floor(4 * (t - t[0]) / (t[-1] - t[0] + 1e-9)).astype(int)
+    rows = np.flatnonzero(quarter % 2 == 1)[::97]
+    q = np.column_stack([data[f"q{k}"] for k in range(1, 8)])
+    qd = np.column_stack([data[f"dq{k}"] for k in range(1, 8)])
+    qdd = np.gradient(qd, t, axis=0)
+    written = pin.buildModelFromUrdf(str(urdf))
+    written_data = written.createData()
+    robot = load_robot(load_problem(path, IdentifyProblem))
+    X = compute_base_parameters(robot).composition_matrix
+    for r in rows:
+        tau = pin.rnea(written, written_data, np.r_[q[r], 0, 0], np.r_[qd[r], 0, 0], np.r_[qdd[r], 0, 0])[:7]
+        assert np.allclose(tau, robot.regressor(q[r], qd[r], qdd[r]) @ X @ base_parameters, atol=1e-6)
+    assert "matches the identified rigid-body torques" in run.output
+
+
+def _identify(tmp: Path, runs: list[str], consistency: bool = True):
+    config = {
+        "robot": {"urdf": "panda_description/urdf/panda.urdf", "source": "example-robot-data", "active_joints": JOINTS},
+        "data": {"runs": [{"file": f, "role": "blocks"} for f in runs],
+                 "columns": {"q": [f"q_{j}" for j in JOINTS], "tau": [f"tau_{j}" for j in JOINTS]}},
+        "identification": {"physical_consistency": consistency},
+    }
+    return run_identification(load_problem(write_config(tmp, config, "identify.yaml"), IdentifyProblem))
+
+
+def test_simulated_data_consistent_fit_recovers_the_base_parameters(tmp_path, optimized):  # noqa: F811
+    sim = {"sample_rate": 500, "periods": 8, "timestamp_jitter": 0.1, "torque_noise": 0.05, "seed": 4,
+           "effects": {"coulomb": {"*": 0.6}, "viscous": {"*": 0.4}}}
+    result = runner.invoke(app, ["simulate", str(optimized), str(write_config(tmp_path, sim, "effects.yaml")), "-o", str(tmp_path)])
+    assert result.exit_code == 0, result.output
+    report, robot, base, _ = _identify(tmp_path, [f"run_{k}.csv" for k in (1, 2, 3)])
+    truth = base.from_standard(robot.urdf_parameters())
+    estimate, std = report.consistent.base, report.selection.fit.std[: base.count]
+    assert np.linalg.norm(estimate - truth) < 0.01 * np.linalg.norm(truth)
+    assert np.mean(np.abs(estimate - truth) <= 3 * std) > 0.95
+    assert np.all(_eigenvalues(report.consistent.standard) > 0)
+
+
+def test_negative_mass_data_stays_physical_with_the_consistent_fit(tmp_path, optimized):  # noqa: F811
+    """Torques of a model whose hand body (link 7 with the hand merged) has all parameters negated:
+    plain least squares says its mass is negative, the consistent fit keeps every body physical."""
+    problem = problem_of_result(optimized)
+    robot = load_robot(problem)
+    truth = robot.urdf_parameters()
+    truth[60:70] *= -1.0
+    trajectory = FourierTrajectory(problem.trajectory.harmonics, problem.trajectory.base_frequency)
+    rng = np.random.default_rng(0)
+    files = []
+    for k, alpha in read_alphas(optimized):
+        time = np.arange(int(4 * trajectory.period * 500) + 1) / 500.0
+        q, qd, qdd = trajectory.basis(time).evaluate(alpha)
+        tau = np.array([robot.regressor(*x) @ truth for x in zip(q, qd, qdd)]) + rng.normal(0, 0.05, q.shape)
+        header = ",".join(["time"] + [f"q_{j}" for j in JOINTS] + [f"tau_{j}" for j in JOINTS])
+        files.append(f"neg_{k}.csv")
+        np.savetxt(tmp_path / files[-1], np.column_stack([time, q, tau]), delimiter=",", header=header, comments="")
+    report, *_ = _identify(tmp_path, files)
+    plain, consistent = report.consistent.unconstrained, report.consistent.standard
+    assert plain[60] < 0  # plain least squares: a negative mass of the hand body
+    assert np.all(consistent[0::10] > 0) and np.all(_eigenvalues(consistent) > 0)
