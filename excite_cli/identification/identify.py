@@ -2,17 +2,20 @@
 effects the rigid-body model lacks.
 
 Weighted least squares follows Gautier (1997): each joint's rows are weighted by 1/σ_j, σ_j the
-residual standard deviation of that joint under ordinary least squares; the estimates' standard
+residual standard deviation of that joint under ordinary least squares of the rigid-body model,
+fixed for the whole selection and the final fit (so the reported model is the one that was
+scored); the estimates' standard
 deviations come from σ² (AᵀWA)⁻¹, scaled by √r: after the parallel low-pass at f_c, samples at
 f_s carry only about 2 f_c T independent values (r = f_s / (2 f_c), the oversampling), and the
 F-test below counts its degrees of freedom the same way.
 
 Effect selection is forward: at each step every remaining candidate block (effect, joint) is
-added to the current model in turn; the one that lowers the held-out (validation) weighted error
-most is kept if (1) it lowers it by at least ``min_improvement`` (a fraction, default 1 %: with tens
-of thousands of rows a test alone finds sub-milli-newton-metre artefacts significant) and (2) an
-F-test for nested linear models on the fit data rejects "no effect" at ``significance`` divided by
-the number of candidates tried (Bonferroni).
+added to the current model in turn and ranked by the held-out (validation) weighted error; the
+first in that order is kept that (1) lowers it by at least ``min_improvement`` (a fraction, default
+1 %: with tens of thousands of rows a test alone finds sub-milli-newton-metre artefacts
+significant) and (2) passes an F-test for nested linear models on the fit data, rejecting "no
+effect" at ``significance`` divided by the number of candidates tried (Bonferroni). A candidate
+that fails the test does not end the search while lower-ranked ones pass both.
 Candidates whose columns lie in the span of the current model are not identifiable separately and
 are skipped. The loop stops when no candidate passes.
 """
@@ -107,7 +110,7 @@ class Fit:
 
     Attributes:
         x: (p,) estimates; std: (p,) their standard deviations.
-        sigma: (n,) per-joint residual standard deviation [Nm] (ordinary least squares).
+        sigma: (n,) per-joint residual standard deviation [Nm] of this fit.
     """
 
     x: np.ndarray
@@ -120,26 +123,36 @@ def _joint_sigma(residual: np.ndarray, joint: np.ndarray, n: int, p: int) -> np.
     return np.array([np.sqrt(np.mean(residual[joint == j] ** 2) / dof) for j in range(n)])
 
 
-def least_squares(A: np.ndarray, y: np.ndarray, joint: np.ndarray, n: int, weighted: bool, oversampling: float = 1.0) -> Fit:
+def least_squares(A: np.ndarray, y: np.ndarray, joint: np.ndarray, n: int, weights: np.ndarray | None = None,
+                  oversampling: float = 1.0) -> Fit:
     """Ordinary (Eq. 4) or weighted least squares of y ≈ A x with standard deviations.
 
     Args:
         A: (M, p) design matrix; y: (M,) torques; joint: (M,) joint of each row; n: joints.
-        weighted: weight each joint's rows by 1/σ_j from an ordinary fit.
+        weights: (n,) weight of each joint's rows (WLS, see :func:`joint_weights`), or None (LS).
         oversampling: samples per independent sample (r ≥ 1); the deviations are scaled by √r.
     """
     scale = np.linalg.norm(A, axis=0)
     scale[scale == 0] = 1.0
-    x = np.linalg.lstsq(A / scale, y, rcond=None)[0] / scale
-    sigma = _joint_sigma(y - A @ x, joint, n, A.shape[1])
-    w = 1.0 / np.maximum(sigma[joint], 1e-12) if weighted else np.ones_like(y)
+    w = np.ones_like(y) if weights is None else weights[joint]
     Q, R = np.linalg.qr(w[:, None] * A / scale)
     x = scipy.linalg.solve_triangular(R, Q.T @ (w * y)) / scale
+    sigma = _joint_sigma(y - A @ x, joint, n, A.shape[1])
     residual = w * (y - A @ x)
     s2 = residual @ residual / max(1, y.size - A.shape[1])
     Rinv = scipy.linalg.solve_triangular(R, np.eye(R.shape[0]))
     std = np.sqrt(oversampling * s2 * np.sum(Rinv**2, axis=1)) / scale
     return Fit(x, std, sigma)
+
+
+def joint_weights(data: Dataset, weighted: bool) -> np.ndarray | None:
+    """(n,) WLS weights 1/σ_j, σ_j the rigid-body least-squares residual of joint j (Gautier 1997),
+    or None for LS. Fixed for the whole selection and the final fit, so the reported model is the
+    one the selection scored."""
+    if not weighted:
+        return None
+    sigma = least_squares(data.regressor, data.tau, data.joint, data.n).sigma
+    return 1.0 / np.maximum(sigma, 1e-12)
 
 
 @dataclass
@@ -153,6 +166,7 @@ class Selection:
         rigid: fit of the rigid-body model alone.
         steps: per added effect: validation weighted SSE after, F statistic, p-value.
         absorbed: candidates skipped as not separately identifiable (in the span of the model).
+        weights: (n,) the joints' weights (WLS) or None (LS), the same in every fit.
     """
 
     effects: list[tuple[str, int]]
@@ -161,6 +175,7 @@ class Selection:
     rigid: Fit
     steps: list[dict] = field(default_factory=list)
     absorbed: list[tuple[str, int]] = field(default_factory=list)
+    weights: np.ndarray | None = None
 
 
 def design(data: Dataset, effects: list[tuple[str, int]]) -> np.ndarray:
@@ -182,19 +197,18 @@ def select_effects(fit_data: Dataset, val_data: Dataset, cfg: IdentificationConf
         oversampling: samples per independent sample r (≥ 1) of the filtered data.
     """
     n = fit_data.n
-    weighted = cfg.method == "wls"
-    rigid = least_squares(fit_data.regressor, fit_data.tau, fit_data.joint, n, weighted, oversampling)
+    weights = joint_weights(fit_data, cfg.method == "wls")
+    rigid = least_squares(fit_data.regressor, fit_data.tau, fit_data.joint, n, weights, oversampling)
     val_w = 1.0 / np.maximum(rigid.sigma[val_data.joint], 1e-12)  # fixed, so errors compare across steps
+    w = np.ones(fit_data.tau.size) if weights is None else weights[fit_data.joint]
     effects = list(declared)
     absorbed: set[tuple[str, int]] = set()
-    selection = Selection(effects, len(declared), rigid, rigid)
-    sigma = rigid.sigma
+    selection = Selection(effects, len(declared), rigid, rigid, weights=weights)
     while len(effects) - len(declared) < cfg.max_effects:
         remaining = [c for c in _open(cfg.candidates, n, effects) if c not in absorbed]
         if not remaining:
             break
         A = design(fit_data, effects)
-        w = 1.0 / np.maximum(sigma[fit_data.joint], 1e-12) if weighted else np.ones(fit_data.tau.size)
         scale = np.linalg.norm(A, axis=0)
         scale[scale == 0] = 1.0
         Q, R = np.linalg.qr(w[:, None] * A / scale)
@@ -202,11 +216,10 @@ def select_effects(fit_data: Dataset, val_data: Dataset, cfg: IdentificationConf
         x0 = scipy.linalg.solve_triangular(R, Q.T @ wy)
         r0 = wy - Q @ (Q.T @ wy)
         sse0 = r0 @ r0
-        sigma = _joint_sigma(r0 / w, fit_data.joint, n, A.shape[1])
         A_val = design(val_data, effects) / scale
         base_prediction = A_val @ x0
         val0 = np.sum((val_w * (val_data.tau - base_prediction)) ** 2)
-        best = None
+        tried = []
         for cand in remaining:
             j = cand[1]
             cols = w[j::n, None] * fit_data.blocks[cand]  # (N, k) on joint j's rows
@@ -221,21 +234,24 @@ def select_effects(fit_data: Dataset, val_data: Dataset, cfg: IdentificationConf
             prediction = base_prediction - A_val @ scipy.linalg.solve_triangular(R, QtB @ c)
             prediction[j::n] += val_data.blocks[cand] @ c
             val1 = np.sum((val_w * (val_data.tau - prediction)) ** 2)
-            if best is None or val1 < best[1]:
-                best = (cand, val1, gain, cols.shape[1])
-        if best is None:
+            tried.append((val1, cand, gain, cols.shape[1]))
+        chosen = None
+        for val1, cand, gain, k in sorted(tried, key=lambda t: t[0]):  # best held-out error first
+            if not val1 < (1.0 - cfg.min_improvement) * val0:
+                break  # the rest gain less
+            dof = (fit_data.tau.size - A.shape[1] - k) / oversampling
+            F = (gain / k) / ((sse0 - gain) / dof)
+            p = float(stats.f.sf(F, k, dof))
+            if p < cfg.significance / len(remaining):  # a lower-ranked candidate may pass where the first fails
+                chosen = {"effect": cand[0], "joint": cand[1], "validation_sse": float(val1), "F": float(F), "p": p}
+                break
+        if chosen is None:
             break
-        cand, val1, gain, k = best
-        dof = (fit_data.tau.size - A.shape[1] - k) / oversampling
-        F = (gain / k) / ((sse0 - gain) / dof)
-        p = float(stats.f.sf(F, k, dof))
-        if not (val1 < (1.0 - cfg.min_improvement) * val0 and p < cfg.significance / len(remaining)):
-            break
-        effects.append(cand)
-        selection.steps.append({"effect": cand[0], "joint": cand[1], "validation_sse": float(val1), "F": float(F), "p": p})
+        effects.append((chosen["effect"], chosen["joint"]))
+        selection.steps.append(chosen)
     selection.effects = effects
     selection.absorbed = sorted(absorbed)
-    selection.fit = least_squares(design(fit_data, effects), fit_data.tau, fit_data.joint, n, weighted, oversampling)
+    selection.fit = least_squares(design(fit_data, effects), fit_data.tau, fit_data.joint, n, weights, oversampling)
     return selection
 
 

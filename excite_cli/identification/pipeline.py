@@ -160,7 +160,7 @@ def fit_consistent(fit_data: Dataset, selection: Selection, robot: Robot, base: 
         ExciteError: the semidefinite program has no solution.
     """
     b = base.count
-    weights = 1.0 / np.maximum(selection.fit.sigma[fit_data.joint], 1e-12) if cfg.method == "wls" else np.ones(fit_data.tau.size)
+    weights = np.ones(fit_data.tau.size) if selection.weights is None else selection.weights[fit_data.joint]
     names = [f"{c} {robot.joint_names[j]}" for e, j in selection.effects for c in COEFFICIENTS[e]]
     return consistent_fit(fit_data.regressor, design(fit_data, selection.effects)[:, b:], fit_data.tau, weights,
                           base.regrouping, robot.urdf_parameters(), names, cfg.regularization, robot.body_names)
