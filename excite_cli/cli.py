@@ -226,6 +226,8 @@ def identify(
     with err.status("preprocessing, fitting and selecting effects ..."):
         report, robot, base, data = run_identification(problem)
     sel = report.selection
+    for name, rows in report.dropped:
+        err.print(f"data.bad_rows: dropped {rows} unusable row(s) of {name}", highlight=False)
     table = Table(title=f"Validation torque error, rigid body only → with the chosen effects ({report.validation_samples} held-out instants)")
     consistent = report.relative_consistent
     for column in ("joint", "RMS τ [Nm]", "before [Nm]", "after [Nm]", "before [%]", "after [%]") + (("consistent [%]",) if consistent is not None else ()):

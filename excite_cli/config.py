@@ -11,7 +11,7 @@ from pathlib import Path
 from typing import Literal, Optional, Union
 
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import BaseModel, ConfigDict, Field, NonNegativeInt, ValidationError, model_validator
 
 from excite_cli.errors import ExciteError
 
@@ -217,15 +217,19 @@ EFFECT_NAMES = ("coulomb", "coulomb_asymmetric", "viscous", "stribeck", "offset"
 Effect = Literal["coulomb", "coulomb_asymmetric", "viscous", "stribeck", "offset", "armature", "spring", "gravity_compensator"]
 
 
-class ColumnsConfig(_Section):
-    """Column names of measured data, in active-joint order (README: identification config)."""
+Column = Union[NonNegativeInt, str]
 
-    time: str = "time"
-    q: list[str] = Field(min_length=1)
-    qd: Optional[list[str]] = None
-    qdd: Optional[list[str]] = None
-    tau: Optional[list[str]] = None
-    current: Optional[list[str]] = None
+
+class ColumnsConfig(_Section):
+    """Columns of measured data, in active-joint order, by name or by 0-based position (README:
+    identification config)."""
+
+    time: Column = "time"
+    q: list[Column] = Field(min_length=1)
+    qd: Optional[list[Column]] = None
+    qdd: Optional[list[Column]] = None
+    tau: Optional[list[Column]] = None
+    current: Optional[list[Column]] = None
 
     @model_validator(mode="after")
     def _torque_source(self) -> "ColumnsConfig":
@@ -243,7 +247,8 @@ class RunConfig(_Section):
 
 
 class DataConfig(_Section):
-    """Measured runs, their columns, angle unit, torque constants [Nm/A], signs, validation blocks."""
+    """Measured runs, their columns, angle unit, torque constants [Nm/A], signs, validation blocks,
+    what to do with rows that cannot be used (stop with an error, or drop and count them)."""
 
     runs: list[RunConfig] = Field(min_length=1)
     columns: ColumnsConfig
@@ -251,6 +256,7 @@ class DataConfig(_Section):
     torque_constants: Optional[list[float]] = None
     signs: Optional[list[float]] = None
     validation_blocks: int = Field(4, ge=2)
+    bad_rows: Literal["error", "drop"] = "error"
 
 
 class PreprocessingConfig(_Section):

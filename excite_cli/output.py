@@ -288,6 +288,7 @@ def write_identification(path: Path, report, robot, base: BaseParameters, source
             g.attrs["cutoff_Hz"] = report.cutoff
             g.attrs["fit_samples"] = report.fit_samples
             g.attrs["validation_samples"] = report.validation_samples
+            g.attrs["dropped_rows"] = "; ".join(f"{name}: {rows}" for name, rows in report.dropped) or "none"
             _strings(g, "joint_names", report.joints)
             _strings(g, "base_parameter_names", report.base_names)
             consistent = report.consistent

@@ -1,5 +1,6 @@
-"""Measured runs in: CSV with a header or HDF5 datasets, mapped to time, q, (q̇, q̈) and τ (or motor
-current × torque constants), in SI units and the robot's sign conventions."""
+"""Measured runs in (any format of :mod:`excite_cli.identification.files`), mapped to time, q, (q̇,
+q̈) and τ (or motor current × torque constants), in SI units and the robot's sign conventions, with
+unusable rows stopped on or dropped and counted."""
 
 from __future__ import annotations
 
@@ -7,11 +8,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Optional
 
-import h5py
 import numpy as np
 
 from excite_cli.config import DataConfig, IdentifyProblem, RunConfig
 from excite_cli.errors import ExciteError
+from excite_cli.identification.files import Table, read_table
 
 
 @dataclass(frozen=True)
@@ -24,6 +25,7 @@ class Run:
         time: (T,) strictly increasing [s].
         q: (T, n) [rad]; qd, qdd: (T, n) [rad/s, rad/s²] or None when to be differentiated.
         tau: (T, n) joint torques [Nm].
+        dropped: rows left out as unusable (``data.bad_rows: drop``).
     """
 
     name: str
@@ -33,54 +35,63 @@ class Run:
     qd: Optional[np.ndarray]
     qdd: Optional[np.ndarray]
     tau: np.ndarray
+    dropped: int = 0
 
 
-def _read_table(path: Path) -> dict[str, np.ndarray]:
-    """Columns of a CSV (header row) or the 1-D datasets of an HDF5 file, by name."""
-    if path.suffix.lower() in (".h5", ".hdf5"):
-        with h5py.File(path, "r") as f:
-            return {name: np.asarray(f[name][()], dtype=float) for name in f if isinstance(f[name], h5py.Dataset)}
-    with path.open() as handle:
-        header = handle.readline().strip().split(",")
-    try:
-        values = np.atleast_2d(np.genfromtxt(path, delimiter=",", skip_header=1, dtype=float))
-    except ValueError as exc:
-        raise ExciteError(f"data: {path.name}: cannot parse the CSV ({' '.join(str(exc).split())[:200]})") from None
-    if values.shape[1] != len(header):
-        raise ExciteError(f"data: {path}: {values.shape[1]} values per row but {len(header)} header names")
-    return {name.strip(): values[:, k] for k, name in enumerate(header)}
+#: Values beyond this magnitude (rad, rad/s, rad/s², s, Nm, A) are corrupt, not measured.
+IMPLAUSIBLE = 1e6
 
 
-def _matrix(table: dict[str, np.ndarray], names: list[str], field: str, path: Path, n: int) -> np.ndarray:
-    if len(names) != n:
-        raise ExciteError(f"data.columns.{field}: {len(names)} columns for the robot's {n} active joints")
-    missing = [name for name in names if name not in table]
-    if missing:
-        raise ExciteError(f"data.columns.{field}: {path.name} has no column '{missing[0]}' (it has: {', '.join(list(table)[:12])}, ...)")
-    return np.column_stack([table[name] for name in names])
+def _matrix(table: Table, keys: list, field: str, path: Path, n: int) -> np.ndarray:
+    if len(keys) != n:
+        raise ExciteError(f"data.columns.{field}: {len(keys)} columns for the robot's {n} active joints")
+    return np.column_stack([table.column(key, field, path) for key in keys])
+
+
+def _usable(time: np.ndarray, signals: dict[str, np.ndarray]) -> tuple[np.ndarray, str]:
+    """(T,) rows whose values are finite and plausible, keeping time strictly increasing, and the
+    first problem in words (empty when every row is usable)."""
+    ok = np.ones(time.size, dtype=bool)
+    problem = ""
+    for name, values in signals.items():
+        bad = ~np.all(np.isfinite(values) & (np.abs(values) < IMPLAUSIBLE), axis=1)
+        if bad.any() and not problem:
+            kind = "NaN or missing value" if not np.all(np.isfinite(values[bad])) else f"a value beyond ±{IMPLAUSIBLE:g}"
+            problem = f"{kind} in {name} at data row {int(np.flatnonzero(bad)[0]) + 1}"
+        ok &= ~bad
+    latest = -np.inf
+    for k in np.flatnonzero(ok):  # time going backwards or repeated: keep the first of each
+        if time[k] <= latest:
+            ok[k] = False
+            if not problem:
+                problem = f"time is not strictly increasing at data row {k + 1} ({time[k]:g} s)"
+        else:
+            latest = time[k]
+    return ok, problem
 
 
 def load_run(run: RunConfig, data: DataConfig, problem: IdentifyProblem, n: int) -> Run:
-    """Read, convert and validate one run.
+    """Read, convert and validate one run (CSV with or without header, NPZ, MAT or HDF5, see
+    :mod:`excite_cli.identification.files`).
 
     Args:
         run: the run's entry of ``data.runs``.
-        data: the data section (columns, units, gains, signs).
+        data: the data section (columns, units, gains, signs, bad rows).
         problem: for resolving the file path.
         n: number of active joints.
 
     Raises:
-        ExciteError: missing file, wrong column count or name, NaN or missing values, time not
-            strictly increasing, a crop that leaves nothing.
+        ExciteError: missing or unreadable file, wrong column count or name, NaN, missing or
+            implausible values (> 1e6) or time not strictly increasing (unless ``bad_rows: drop``),
+            a crop that leaves nothing.
     """
     path = problem.resolve(run.file)
     if not path.is_file():
         raise ExciteError(f"data.runs: file not found: {path}")
-    table = _read_table(path)
+    drop = data.bad_rows == "drop"
+    table = read_table(path, drop)
     cols = data.columns
-    if cols.time not in table:
-        raise ExciteError(f"data.columns.time: {path.name} has no column '{cols.time}'")
-    time = table[cols.time]
+    time = table.column(cols.time, "time", path)
     q = _matrix(table, cols.q, "q", path, n)
     qd = _matrix(table, cols.qd, "qd", path, n) if cols.qd else None
     qdd = _matrix(table, cols.qdd, "qdd", path, n) if cols.qdd else None
@@ -89,14 +100,13 @@ def load_run(run: RunConfig, data: DataConfig, problem: IdentifyProblem, n: int)
     else:
         if data.torque_constants is None or len(data.torque_constants) != n:
             raise ExciteError(f"data.torque_constants: give one torque constant [Nm/A] per active joint ({n})")
+        if not np.all(np.isfinite(data.torque_constants)):
+            raise ExciteError("data.torque_constants: every torque constant must be a finite number [Nm/A]")
         tau = _matrix(table, cols.current, "current", path, n) * np.asarray(data.torque_constants)
-    for name, values in (("time", time), ("q", q), ("qd", qd), ("qdd", qdd), ("tau", tau)):
-        if values is not None and not np.all(np.isfinite(values)):
-            row = int(np.nonzero(~np.all(np.isfinite(values.reshape(len(values), -1)), axis=1))[0][0])
-            raise ExciteError(f"data: {path.name}: NaN or missing value in {name} at data row {row + 1}")
-    if np.any(np.diff(time) <= 0):
-        row = int(np.nonzero(np.diff(time) <= 0)[0][0])
-        raise ExciteError(f"data: {path.name}: time is not strictly increasing at data row {row + 2} ({time[row + 1]:g} s)")
+    signals = {name: x for name, x in (("time", time[:, None]), ("q", q), ("qd", qd), ("qdd", qdd), ("tau", tau)) if x is not None}
+    ok, issue = _usable(time, signals)
+    if issue and not drop:
+        raise ExciteError(f"data: {path.name}: {issue} (data.bad_rows: drop leaves such rows out)")
     if data.angle_unit == "deg":
         q, qd, qdd = (None if x is None else np.deg2rad(x) for x in (q, qd, qdd))
     if data.signs is not None:
@@ -104,8 +114,8 @@ def load_run(run: RunConfig, data: DataConfig, problem: IdentifyProblem, n: int)
             raise ExciteError(f"data.signs: {len(data.signs)} signs for {n} active joints")
         s = np.asarray(data.signs, dtype=float)
         q, qd, qdd, tau = (None if x is None else x * s for x in (q, qd, qdd, tau))
-    keep = np.ones(time.size, dtype=bool) if run.crop is None else (time >= run.crop[0]) & (time <= run.crop[1])
+    keep = ok if run.crop is None else ok & (time >= run.crop[0]) & (time <= run.crop[1])
     if keep.sum() < 2:
         raise ExciteError(f"data.runs.crop: {run.crop} leaves no samples of {path.name} ({time[0]:g} to {time[-1]:g} s)")
     pick = (lambda x: None if x is None else x[keep])
-    return Run(path.name, run.role, time[keep], q[keep], pick(qd), pick(qdd), tau[keep])
+    return Run(path.name, run.role, time[keep], q[keep], pick(qd), pick(qdd), tau[keep], table.dropped + int((~ok).sum()))

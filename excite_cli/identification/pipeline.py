@@ -3,7 +3,7 @@ effect selection ─► report of the torque error before and after on the valid
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -33,6 +33,7 @@ class Report:
         validation: the validation samples; predicted_before, predicted_after: (N, n) [Nm] on them.
         cutoff: low-pass cut-off of every run [Hz].
         fit_samples, validation_samples: instants used for fitting / validation.
+        dropped: (file, rows) left out as unusable, per run with ``data.bad_rows: drop``.
         consistent: the physically consistent fit with the same effects, or None.
         rms_consistent: (n,) its validation torque RMS error [Nm] (None without it).
     """
@@ -49,6 +50,7 @@ class Report:
     cutoff: float
     fit_samples: int
     validation_samples: int
+    dropped: list[tuple[str, int]] = field(default_factory=list)
     consistent: ConsistentFit | None = None
     rms_consistent: np.ndarray | None = None
 
@@ -146,6 +148,7 @@ def run_identification(problem: IdentifyProblem) -> tuple[Report, Robot, BasePar
         cutoff=cutoff,
         fit_samples=fit_data.time.size,
         validation_samples=val_data.time.size,
+        dropped=[(r.name, r.dropped) for r in runs if r.dropped],
         consistent=consistent,
         rms_consistent=rms_consistent,
     )

@@ -1,0 +1,101 @@
+"""Measured data as labs have it: headerless CSV with currents and torque constants, NPZ, MAT, other
+delimiters, and corrupt rows stopped on (naming file and line) or dropped and counted."""
+
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+import scipy.io
+
+from excite_cli.config import IdentifyProblem
+from excite_cli.errors import ExciteError
+from excite_cli.identification.measurements import load_run
+
+JOINTS = [f"panda_joint{k}" for k in range(1, 8)]
+T = 400
+TIME = np.arange(T) * 0.002
+Q = np.sin(np.outer(TIME, np.arange(1, 8)))
+TAU = 3.0 * np.cos(np.outer(TIME, np.arange(1, 8)))
+KT = np.array([2.0, 2.5, 1.5, 3.0, 0.5, 0.8, 1.2])
+
+
+def _load(tmp_path: Path, name: str, columns: dict, **data):
+    problem = IdentifyProblem.model_validate({
+        "robot": {"urdf": "panda_description/urdf/panda.urdf", "source": "example-robot-data", "active_joints": JOINTS},
+        "data": {"runs": [{"file": name}], "columns": columns, **data},
+    })
+    problem.source_path = tmp_path / "identify.yaml"
+    return load_run(problem.data.runs[0], problem.data, problem, 7)
+
+
+def _check(run, dropped=0):
+    rows = np.ones(T, bool)
+    if dropped:
+        rows[[5, 9][:dropped]] = False
+    np.testing.assert_allclose(run.time, TIME[rows], rtol=1e-12)
+    np.testing.assert_allclose(run.q, Q[rows], rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(run.tau, TAU[rows], rtol=1e-12, atol=1e-14)
+    assert run.dropped == dropped
+
+
+def test_headerless_csv_with_currents_and_torque_constants(tmp_path):
+    np.savetxt(tmp_path / "run.csv", np.column_stack([TIME, TAU / KT, Q]), delimiter=",", fmt="%.17g")
+    run = _load(tmp_path, "run.csv", {"time": 0, "q": list(range(8, 15)), "current": list(range(1, 8))},
+                torque_constants=KT.tolist())
+    _check(run)
+
+
+def test_npz_and_mat_runs(tmp_path):
+    np.savez(tmp_path / "run.npz", t=TIME, q=Q, tau=TAU)
+    _check(_load(tmp_path, "run.npz", {"time": "t", "q": [f"q[{k}]" for k in range(7)], "tau": [f"tau[{k}]" for k in range(7)]}))
+    scipy.io.savemat(tmp_path / "run.mat", {"t": TIME, "Q": Q.T, "tau": TAU})  # Q stored joints × samples
+    _check(_load(tmp_path, "run.mat", {"time": "t", "q": [f"Q[{k}]" for k in range(7)], "tau": [f"tau[{k}]" for k in range(7)]}))
+
+
+def test_semicolon_csv_with_header(tmp_path):
+    header = ";".join(["time"] + [f"q{k}" for k in range(7)] + [f"t{k}" for k in range(7)])
+    np.savetxt(tmp_path / "run.csv", np.column_stack([TIME, Q, TAU]), delimiter=";", header=header, comments="", fmt="%.17g")
+    _check(_load(tmp_path, "run.csv", {"q": [f"q{k}" for k in range(7)], "tau": [f"t{k}" for k in range(7)]}))
+
+
+def _corrupt_csv(tmp_path: Path) -> dict:
+    lines = [",".join(["time"] + [f"q{k}" for k in range(7)] + [f"t{k}" for k in range(7)])]
+    lines += [",".join(f"{v:.17g}" for v in row) for row in np.column_stack([TIME, Q, TAU])]
+    lines[6] = lines[6].replace(lines[6].split(",")[3], "1e306", 1)  # data row 6: a corrupt value
+    lines[10] = ",".join(lines[10].split(",")[:5])  # data row 10: too few columns
+    (tmp_path / "run.csv").write_text("\n".join(lines) + "\n")
+    return {"q": [f"q{k}" for k in range(7)], "tau": [f"t{k}" for k in range(7)]}
+
+
+def test_corrupt_rows_stop_with_file_and_line_or_are_dropped_and_counted(tmp_path):
+    columns = _corrupt_csv(tmp_path)
+    with pytest.raises(ExciteError, match=r"run.csv: line 11: 5 values where the header has 15"):
+        _load(tmp_path, "run.csv", columns)
+    lines = (tmp_path / "run.csv").read_text().splitlines()
+    del lines[10]
+    (tmp_path / "run.csv").write_text("\n".join(lines) + "\n")
+    with pytest.raises(ExciteError, match=r"run.csv: a value beyond ±1e\+06 in q at data row 6"):
+        _load(tmp_path, "run.csv", columns)
+    _corrupt_csv(tmp_path)
+    _check(_load(tmp_path, "run.csv", columns, bad_rows="drop"), dropped=2)
+
+
+@pytest.mark.parametrize("name, content, message", [
+    ("run.csv", bytes(range(256)) * 4, "is not a text file"),
+    ("run.npz", b"not a zip archive", "cannot read run.npz as NPZ"),
+    ("run.h5", b"not HDF5 at all", "cannot read run.h5 as H5"),
+    ("run.csv", b"", "has no data rows"),
+])
+def test_unreadable_files_give_one_message(tmp_path, name, content, message):
+    (tmp_path / name).write_bytes(content)
+    with pytest.raises(ExciteError, match=message):
+        _load(tmp_path, name, {"q": ["q0"] * 7, "tau": ["t0"] * 7})
+
+
+def test_an_excite_result_given_as_data_names_the_missing_column(tmp_path):
+    with h5py.File(tmp_path / "result.h5", "w") as f:
+        f["table"] = np.zeros(3, dtype=[("iteration", "i4"), ("cond_own", "f8")])
+        f["iterations/1/alpha"] = np.zeros((7, 3))
+    with pytest.raises(ExciteError, match="data"):
+        _load(tmp_path, "result.h5", {"q": ["q0"] * 7, "tau": ["t0"] * 7})
