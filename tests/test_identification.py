@@ -11,7 +11,7 @@ from typer.testing import CliRunner
 
 from conftest import write_config
 from excite_cli.cli import app
-from excite_cli.config import IdentifyProblem, load_problem
+from excite_cli.config import EFFECT_NAMES, IdentifyProblem, load_problem
 from excite_cli.identification.effects import COEFFICIENTS, effect_columns
 from excite_cli.identification.pipeline import effect_values, run_identification
 from excite_cli.identification.preprocessing import Filter, default_cutoff
@@ -30,7 +30,8 @@ def test_effect_columns_closed_forms():
     q = np.array([-1.0, 0.0, 0.5, 2.0])
     qd = np.array([-2.0, -1e-4, 0.3, 1.0])
     qdd = np.array([3.0, 0.0, -1.0, 0.2])
-    col = lambda e: effect_columns(e, q, qd, qdd, 0.01, 0.1)
+    rigid = np.array([5.0, -2.0, 0.5, 1.0])
+    col = lambda e: effect_columns(e, q, qd, qdd, 0.01, 0.1, 0.02, rigid)
     np.testing.assert_allclose(col("coulomb")[:, 0], np.tanh(qd / 0.01))
     assert col("coulomb")[[0, 2, 3], 0] == pytest.approx([-1, 1, 1], abs=1e-10)  # sign(q̇) away from 0
     np.testing.assert_allclose(col("coulomb_asymmetric")[:, 0], np.abs(np.tanh(qd / 0.01)))
@@ -40,8 +41,21 @@ def test_effect_columns_closed_forms():
     np.testing.assert_allclose(col("armature")[:, 0], qdd)
     np.testing.assert_allclose(col("spring")[:, 0], q)
     np.testing.assert_allclose(col("gravity_compensator"), np.column_stack([np.sin(q), np.cos(q)]))
+    np.testing.assert_allclose(col("position_2"), np.column_stack([np.sin(2 * q), np.cos(2 * q)]))
+    np.testing.assert_allclose(col("viscous_asymmetric")[:, 0], np.abs(qd))
+    np.testing.assert_allclose(col("load_coulomb")[:, 0], np.abs(rigid) * np.tanh(qd / 0.01))
+    with pytest.raises(ValueError):
+        effect_columns("load_coulomb", q, qd, qdd, 0.01, 0.1)
     for effect, names in COEFFICIENTS.items():
         assert col(effect).shape == (4, len(names))
+
+
+def test_held_friction_holds_the_sign_of_the_last_motion():
+    qd = np.array([0.0, 0.5, 0.01, 0.0, -0.3, -0.001, 0.005, 0.2, 0.0])
+    z = np.zeros_like(qd)
+    # at rest before any motion: 0; slow samples take the sign of the last fast one
+    expected = [0.0, 0.0, 1.0, 1.0, 0.0, -1.0, -1.0, 0.0, 1.0]
+    np.testing.assert_array_equal(effect_columns("held", z, qd, z, 0.01, 0.1, 0.02)[:, 0], expected)
 
 
 def test_asymmetric_coulomb_gives_direction_dependent_levels():
@@ -63,7 +77,7 @@ def optimized(tmp_path_factory):
     return tmp / "panda.h5"
 
 
-def _simulate_and_identify(tmp: Path, optimized: Path, effects: dict):
+def _simulate_and_identify(tmp: Path, optimized: Path, effects: dict, candidates: list | None = None):
     # 8 periods per run and time blocks in every run: ~720 independent held-out samples per joint
     # at the 3 Hz cut-off, so each joint's RMS is known to ~2.6 % (1 sigma)
     sim = {"sample_rate": 500, "periods": 8, "timestamp_jitter": 0.1, "torque_noise": NOISE, "seed": 4, "effects": effects}
@@ -75,6 +89,8 @@ def _simulate_and_identify(tmp: Path, optimized: Path, effects: dict):
                  "columns": {"q": [f"q_{j}" for j in JOINTS], "tau": [f"tau_{j}" for j in JOINTS]}},
         "output": str(tmp / "ident.h5"),
     }
+    if candidates is not None:
+        config["identification"] = {"candidates": candidates}
     problem = load_problem(write_config(tmp, config, "identify.yaml"), IdentifyProblem)
     report, robot, base, _ = run_identification(problem)
     # noise level after the same preprocessing: white noise through the same filter
@@ -106,8 +122,9 @@ def test_undeclared_friction_and_armature_are_found(tmp_path, optimized):
     assert np.all(report.rms_before >= 3 * report.rms_after)
 
 
-def test_no_effect_in_the_data_adds_none(tmp_path, optimized):
-    report, *_ = _simulate_and_identify(tmp_path, optimized, {})
+@pytest.mark.parametrize("candidates", [None, list(EFFECT_NAMES)])
+def test_no_effect_in_the_data_adds_none(tmp_path, optimized, candidates):
+    report, *_ = _simulate_and_identify(tmp_path, optimized, {}, candidates)
     assert report.selection.effects == []
     assert np.allclose(report.rms_before, report.rms_after)
 
@@ -214,3 +231,25 @@ def test_real_panda_unseen_phase_at_5_hz_reports_the_selected_model():
     # at 5 Hz the F-test fails the best-ranked candidate early; the search goes on with the next
     # ones instead of stopping at one effect (27.9 % mean error before)
     assert len(selection.effects) >= 5 and report.relative_after.mean() < 20.0
+
+
+NEW_EFFECTS = {
+    "held": {"held": {"panda_joint4": 1.0}},
+    "load_coulomb": {"load_coulomb": {"panda_joint2": 0.05, "panda_joint4": 0.05}},
+    "position_2": {"position_2": {"panda_joint1": [0.3, 0.2]}},
+    "offset": {"offset": {"panda_joint3": 0.5}},
+    "viscous_asymmetric": {"viscous": {"panda_joint5": 0.3}, "viscous_asymmetric": {"panda_joint5": 0.1}},
+}
+
+
+@pytest.mark.parametrize("case", list(NEW_EFFECTS))
+def test_each_undeclared_effect_is_named_with_its_value(tmp_path, optimized, case):
+    effects = NEW_EFFECTS[case]
+    report, *_ = _simulate_and_identify(tmp_path, optimized, effects, list(EFFECT_NAMES))  # all twelve candidates
+    truth = {(e, c, j): v for e, per_joint in effects.items() for j, value in per_joint.items()
+             for c, v in zip(COEFFICIENTS[e], np.atleast_1d(value))}
+    found = {(e, c, j): (value, std) for e, c, j, value, std in effect_values(report)}
+    assert {(e, j) for e, _, j in found} == {(e, j) for e, _, j in truth}, found
+    for key, value in truth.items():
+        estimate, std = found[key]
+        assert abs(estimate - value) <= max(0.05 * abs(value), 3 * std), (key, estimate, std)

@@ -30,7 +30,7 @@ from scipy import stats
 
 from excite_cli.base_parameters import BaseParameters
 from excite_cli.config import IdentificationConfig
-from excite_cli.identification.effects import COEFFICIENTS, REQUIRES, effect_columns
+from excite_cli.identification.effects import COEFFICIENTS, REQUIRES, TWO_STAGE, effect_columns
 from excite_cli.identification.preprocessing import Samples
 from excite_cli.robot import Robot
 
@@ -75,6 +75,14 @@ class Dataset:
         out[j :: self.n] = cols
         return out
 
+    def with_load_columns(self, base_parameters: np.ndarray) -> "Dataset":
+        """The dataset with the two-stage ``load_coulomb`` blocks: abs(τ_rigid) times the Coulomb
+        block, τ_rigid = Y_B φ_B with the base parameters (b,) of a first, rigid-body fit (the product
+        of the filtered signals stands for the filtered product: both vary slowly at the cut-off)."""
+        rigid = np.abs(self.regressor @ base_parameters).reshape(-1, self.n)
+        extra = {("load_coulomb", j): rigid[:, j:j + 1] * self.blocks[("coulomb", j)] for j in range(self.n)}
+        return Dataset(self.regressor, self.tau, self.time, self.run, {**self.blocks, **extra})
+
     def select(self, mask: np.ndarray) -> "Dataset":
         """The instants where ``mask`` (N,) is true."""
         rows = np.repeat(mask, self.n)
@@ -90,8 +98,9 @@ def build_dataset(robot: Robot, base: BaseParameters, samples: list[Samples], cf
     for index, s in enumerate(samples):
         Y = (robot.regressor_stack(s.q, s.qd, s.qdd) @ base.composition_matrix).reshape(-1, n * b)
         blocks = {
-            (e, j): s.filter.decimate(effect_columns(e, s.q[:, j], s.qd[:, j], s.qdd[:, j], cfg.coulomb_velocity, cfg.stribeck_velocity))
-            for e in EFFECTS for j in range(n)
+            (e, j): s.filter.decimate(effect_columns(e, s.q[:, j], s.qd[:, j], s.qdd[:, j], cfg.coulomb_velocity,
+                                                     cfg.stribeck_velocity, cfg.held_velocity))
+            for e in EFFECTS if e not in TWO_STAGE for j in range(n)
         }
         time = s.time[s.filter.trim : s.time.size - s.filter.trim : s.filter.step]
         parts.append((s.filter.decimate(Y).reshape(-1, b), s.filter.decimate(s.tau).ravel(), time, np.full(time.size, index), blocks))

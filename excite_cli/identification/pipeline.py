@@ -12,7 +12,8 @@ from excite_cli.base_parameters import BaseParameters, compute_base_parameters
 from excite_cli.config import IdentifyProblem
 from excite_cli.errors import ExciteError
 from excite_cli.identification.effects import COEFFICIENTS
-from excite_cli.identification.identify import Dataset, Selection, build_dataset, design, predict, select_effects
+from excite_cli.identification.identify import (Dataset, Selection, build_dataset, design, joint_weights, least_squares,
+                                               predict, select_effects)
 from excite_cli.identification.measurements import load_run
 from excite_cli.identification.physical import ConsistentFit, consistent_fit
 from excite_cli.identification.preprocessing import default_cutoff, preprocess
@@ -125,6 +126,8 @@ def run_identification(problem: IdentifyProblem) -> tuple[Report, Robot, BasePar
     data = build_dataset(robot, base, samples, cfg)
     fit_mask = split(data, [s.role for s in samples], problem.data.validation_blocks)
     fit_data, val_data = data.select(fit_mask), data.select(~fit_mask)
+    first = least_squares(fit_data.regressor, fit_data.tau, fit_data.joint, fit_data.n, joint_weights(fit_data, cfg.method == "wls"))
+    fit_data, val_data = fit_data.with_load_columns(first.x), val_data.with_load_columns(first.x)
     rate = max(s.filter.rate / s.filter.step for s in samples)
     selection = select_effects(fit_data, val_data, cfg, declared_effects(problem, robot), max(1.0, rate / (2.0 * cutoff)))
     before = predict(val_data, selection.rigid.x, [])

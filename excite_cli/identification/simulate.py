@@ -19,8 +19,10 @@ from excite_cli.robot import Robot, load_robot
 from excite_cli.trajectory import FourierTrajectory
 
 
-def effect_torques(sim: SimulationConfig, robot: Robot, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
-    """(T, n) torques [Nm] of the effects in ``sim.effects`` ({effect: {joint or "*": value}}).
+def effect_torques(sim: SimulationConfig, robot: Robot, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray,
+                   rigid: np.ndarray) -> np.ndarray:
+    """(T, n) torques [Nm] of the effects in ``sim.effects`` ({effect: {joint or "*": value}}) at the
+    samples q, q̇, q̈ (T, n) in time order, ``rigid`` (T, n) the rigid-body torques [Nm].
 
     Raises:
         ExciteError: an unknown joint or a value with the wrong number of coefficients.
@@ -34,7 +36,8 @@ def effect_torques(sim: SimulationConfig, robot: Robot, q: np.ndarray, qd: np.nd
             if coefficients.size != len(COEFFICIENTS[effect]):
                 raise ExciteError(f"effects.{effect}.{name}: needs {len(COEFFICIENTS[effect])} value(s) {COEFFICIENTS[effect]}")
             for j in (range(robot.n_joints) if name == "*" else [robot.joint_names.index(name)]):
-                cols = effect_columns(effect, q[:, j], qd[:, j], qdd[:, j], sim.coulomb_velocity, sim.stribeck_velocity)
+                cols = effect_columns(effect, q[:, j], qd[:, j], qdd[:, j], sim.coulomb_velocity, sim.stribeck_velocity,
+                                      sim.held_velocity, rigid[:, j])
                 tau[:, j] += cols @ coefficients
     return tau
 
@@ -62,7 +65,8 @@ def simulate_runs(result: Path, sim: SimulationConfig, out_dir: Path, prefix: st
         time = np.arange(count) / sim.sample_rate
         time[1:-1] += rng.uniform(-sim.timestamp_jitter, sim.timestamp_jitter, count - 2) / sim.sample_rate
         q, qd, qdd = trajectory.basis(time).evaluate(alpha)
-        tau = np.array([robot.torques(*x) for x in zip(q, qd, qdd)]) + effect_torques(sim, robot, q, qd, qdd)
+        rigid = np.array([robot.torques(*x) for x in zip(q, qd, qdd)])
+        tau = rigid + effect_torques(sim, robot, q, qd, qdd, rigid)
         tau += rng.normal(0.0, sim.torque_noise, tau.shape)
         q_measured = q + rng.normal(0.0, sim.position_noise, q.shape)
         header = ["time"] + [f"q_{j}" for j in robot.joint_names] + [f"tau_{j}" for j in robot.joint_names]
