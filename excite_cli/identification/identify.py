@@ -94,16 +94,19 @@ def build_dataset(robot: Robot, base: BaseParameters, samples: list[Samples], cf
     """Regressor, candidate effect columns and torques of the samples, each low-passed by its run's
     filter in parallel and decimated (so the filtered τ still equals the filtered columns × φ)."""
     n, b = robot.n_joints, base.count
+    X = base.composition_matrix
     parts = []
     for index, s in enumerate(samples):
-        Y = (robot.regressor_stack(s.q, s.qd, s.qdd) @ base.composition_matrix).reshape(-1, n * b)
+        # the base regressor at the run's rate is (T·n, b): computed, filtered and decimated in chunks
+        Y = s.filter.decimate_chunks(lambda lo, hi: (robot.regressor_stack(s.q[lo:hi], s.qd[lo:hi], s.qdd[lo:hi]) @ X)
+                                     .reshape(-1, n * b), s.time.size)
         blocks = {
             (e, j): s.filter.decimate(effect_columns(e, s.q[:, j], s.qd[:, j], s.qdd[:, j], cfg.coulomb_velocity,
                                                      cfg.stribeck_velocity, cfg.held_velocity))
             for e in EFFECTS if e not in TWO_STAGE for j in range(n)
         }
         time = s.time[s.filter.trim : s.time.size - s.filter.trim : s.filter.step]
-        parts.append((s.filter.decimate(Y).reshape(-1, b), s.filter.decimate(s.tau).ravel(), time, np.full(time.size, index), blocks))
+        parts.append((Y.reshape(-1, b), s.filter.decimate(s.tau).ravel(), time, np.full(time.size, index), blocks))
     return Dataset(
         np.vstack([p[0] for p in parts]),
         np.concatenate([p[1] for p in parts]),

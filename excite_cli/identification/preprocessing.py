@@ -7,6 +7,7 @@ the trajectory's bandwidth, estimated from the spectrum of q over all runs."""
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 from scipy import signal
@@ -22,6 +23,9 @@ POWER_FRACTION = 0.99
 MAX_CUTOFF_FRACTION = 0.4
 #: Samples trimmed at each end: this many periods of the cut-off frequency.
 EDGE_PERIODS = 3.0
+#: Long signals are filtered in chunks of this many samples, overlapping by this many trims.
+CHUNK = 40_000
+CHUNK_MARGIN = 4
 
 
 def bandwidth(q: np.ndarray, rate: float, fraction: float = POWER_FRACTION) -> float:
@@ -54,6 +58,20 @@ class Filter:
     def decimate(self, x: np.ndarray) -> np.ndarray:
         """Filtered, trimmed and decimated x (axis 0)."""
         return self.low_pass(x)[self.trim : x.shape[0] - self.trim : self.step]
+
+    def decimate_chunks(self, values: Callable[[int, int], np.ndarray], length: int, chunk: int = CHUNK) -> np.ndarray:
+        """The same as :meth:`decimate` of a long signal that is never held whole: ``values(lo, hi)``
+        gives its samples [lo, hi) (rows along axis 0), which are filtered in chunks of about
+        ``chunk`` kept samples with ``CHUNK_MARGIN`` × ``trim`` samples of overlap on each side, where
+        the zero-phase filter's start-up has died out (equal to the whole-run filter to ~1e-12)."""
+        kept = np.arange(self.trim, length - self.trim, self.step)
+        margin = CHUNK_MARGIN * self.trim
+        parts = []
+        for start in range(0, kept.size, max(1, chunk // self.step)):
+            idx = kept[start : start + max(1, chunk // self.step)]
+            lo, hi = max(0, idx[0] - margin), min(length, idx[-1] + margin + 1)
+            parts.append(self.low_pass(values(lo, hi))[idx - lo])
+        return np.concatenate(parts) if parts else np.zeros((0,) + values(0, 1).shape[1:])
 
 
 @dataclass(frozen=True)
