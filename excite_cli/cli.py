@@ -224,7 +224,7 @@ def identify(
         problem.identification.physical_consistency = True
     target = output if output is not None else Path(problem.output)
     with err.status("preprocessing, fitting and selecting effects ..."):
-        report, robot, base, data = run_identification(problem)
+        report, robot, base, regressor = run_identification(problem)
     sel = report.selection
     for name, rows in report.dropped:
         err.print(f"data.bad_rows: dropped {rows} unusable row(s) of {name}", highlight=False)
@@ -257,7 +257,7 @@ def identify(
     out.print(params)
     if report.consistent is not None:
         out.print(_bodies(report, robot))
-    write_identification(target, report, robot, base, problem.source_text, data.regressor, problem.identification.method)
+    write_identification(target, report, robot, base, problem.source_text, regressor, problem.identification.method)
     if urdf_out is not None:
         deviation = write_identified_urdf(problem, report, robot, base, urdf_out)
         out.print(f"wrote {urdf_out}: pinocchio's RNEA on it matches the identified rigid-body torques to {deviation:.1e} Nm", highlight=False)

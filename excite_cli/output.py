@@ -251,7 +251,7 @@ def _write_consistent(g: h5py.Group, report, robot) -> None:
     g.create_dataset("relative_consistent", data=report.relative_consistent).attrs["unit"] = "%"
 
 
-def write_identification(path: Path, report, robot, base: BaseParameters, source_text: str, regressor: np.ndarray,
+def write_identification(path: Path, report, robot, base: BaseParameters, source_text: str, regressor: list[np.ndarray],
                          method: str) -> None:
     """Write (atomically) an ``identify`` result: ``/identification/...``, plus ``/regressor`` (the
     base regressor of all preprocessed samples) and ``/robot/base_parameter_names``, so the file can
@@ -260,7 +260,7 @@ def write_identification(path: Path, report, robot, base: BaseParameters, source
     Args:
         report: the :class:`~excite_cli.identification.pipeline.Report`.
         source_text: the identify config's text.
-        regressor: (M, b) base regressor rows of all samples.
+        regressor: base regressor rows of all samples, in parts ((M_k, b) each, e.g. fit and validation).
         method: ``wls`` or ``ls``.
 
     Raises:
@@ -282,7 +282,12 @@ def write_identification(path: Path, report, robot, base: BaseParameters, source
             group = f.create_group("robot")
             _strings(group, "joint_names", robot.joint_names)
             _strings(group, "base_parameter_names", base.names)
-            f.create_dataset("regressor", data=regressor).attrs["description"] = "base regressor of all preprocessed samples (prior data C0, Eq. 41)"
+            rows = f.create_dataset("regressor", shape=(sum(part.shape[0] for part in regressor), b), dtype="f8")
+            start = 0
+            for part in regressor:
+                rows[start : start + part.shape[0]] = part
+                start += part.shape[0]
+            rows.attrs["description"] = "base regressor of all preprocessed samples, fit then validation (prior data C0, Eq. 41)"
             g = f.create_group("identification")
             g.attrs["method"] = method
             g.attrs["cutoff_Hz"] = report.cutoff

@@ -17,7 +17,8 @@ significant) and (2) passes an F-test for nested linear models on the fit data, 
 effect" at ``significance`` divided by the number of candidates tried (Bonferroni). A candidate
 that fails the test does not end the search while lower-ranked ones pass both.
 Candidates whose columns lie in the span of the current model are not identifiable separately and
-are skipped. The loop stops when no candidate passes.
+are skipped. The loop stops when no candidate passes. Every fit goes through the per-joint normal
+equations of :mod:`excite_cli.identification.normal` (no design matrix is formed).
 """
 
 from __future__ import annotations
@@ -25,95 +26,12 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.linalg
 from scipy import stats
 
-from excite_cli.base_parameters import BaseParameters
 from excite_cli.config import IdentificationConfig
-from excite_cli.identification.effects import COEFFICIENTS, REQUIRES, TWO_STAGE, effect_columns
-from excite_cli.identification.preprocessing import Samples
-from excite_cli.robot import Robot
-
-EFFECTS = tuple(COEFFICIENTS)
-
-#: A candidate whose columns keep less than this fraction of their norm outside the current model's
-#: span is not identifiable separately.
-IDENTIFIABILITY = 1e-6
-
-
-@dataclass(frozen=True)
-class Dataset:
-    """Stacked, parallel-filtered and decimated samples: rows ordered by instant, then joint.
-
-    Attributes:
-        regressor: (N·n, b) base regressor Y_B (Eq. 3).
-        tau: (N·n,) measured torques [Nm].
-        time: (N,) [s]; run: (N,) index of the run of each instant.
-        blocks: effect columns by (effect, joint index), (N, k) each, on that joint's rows.
-    """
-
-    regressor: np.ndarray
-    tau: np.ndarray
-    time: np.ndarray
-    run: np.ndarray
-    blocks: dict[tuple[str, int], np.ndarray]
-
-    @property
-    def n(self) -> int:
-        """Number of joints."""
-        return self.tau.size // self.time.size
-
-    @property
-    def joint(self) -> np.ndarray:
-        """(N·n,) joint index of each row."""
-        return np.tile(np.arange(self.n), self.time.size)
-
-    def block(self, effect: str, j: int) -> np.ndarray:
-        """(N·n, k) columns of ``effect`` on joint j: nonzero only on joint j's rows."""
-        cols = self.blocks[(effect, j)]
-        out = np.zeros((self.tau.size, cols.shape[1]))
-        out[j :: self.n] = cols
-        return out
-
-    def with_load_columns(self, base_parameters: np.ndarray) -> "Dataset":
-        """The dataset with the two-stage ``load_coulomb`` blocks: abs(τ_rigid) times the Coulomb
-        block, τ_rigid = Y_B φ_B with the base parameters (b,) of a first, rigid-body fit (the product
-        of the filtered signals stands for the filtered product: both vary slowly at the cut-off)."""
-        rigid = np.abs(self.regressor @ base_parameters).reshape(-1, self.n)
-        extra = {("load_coulomb", j): rigid[:, j:j + 1] * self.blocks[("coulomb", j)] for j in range(self.n)}
-        return Dataset(self.regressor, self.tau, self.time, self.run, {**self.blocks, **extra})
-
-    def select(self, mask: np.ndarray) -> "Dataset":
-        """The instants where ``mask`` (N,) is true."""
-        rows = np.repeat(mask, self.n)
-        return Dataset(self.regressor[rows], self.tau[rows], self.time[mask], self.run[mask],
-                       {key: cols[mask] for key, cols in self.blocks.items()})
-
-
-def build_dataset(robot: Robot, base: BaseParameters, samples: list[Samples], cfg: IdentificationConfig) -> Dataset:
-    """Regressor, candidate effect columns and torques of the samples, each low-passed by its run's
-    filter in parallel and decimated (so the filtered τ still equals the filtered columns × φ)."""
-    n, b = robot.n_joints, base.count
-    X = base.composition_matrix
-    parts = []
-    for index, s in enumerate(samples):
-        # the base regressor at the run's rate is (T·n, b): computed, filtered and decimated in chunks
-        Y = s.filter.decimate_chunks(lambda lo, hi: (robot.regressor_stack(s.q[lo:hi], s.qd[lo:hi], s.qdd[lo:hi]) @ X)
-                                     .reshape(-1, n * b), s.time.size)
-        blocks = {
-            (e, j): s.filter.decimate(effect_columns(e, s.q[:, j], s.qd[:, j], s.qdd[:, j], cfg.coulomb_velocity,
-                                                     cfg.stribeck_velocity, cfg.held_velocity))
-            for e in EFFECTS if e not in TWO_STAGE for j in range(n)
-        }
-        time = s.time[s.filter.trim : s.time.size - s.filter.trim : s.filter.step]
-        parts.append((Y.reshape(-1, b), s.filter.decimate(s.tau).ravel(), time, np.full(time.size, index), blocks))
-    return Dataset(
-        np.vstack([p[0] for p in parts]),
-        np.concatenate([p[1] for p in parts]),
-        np.concatenate([p[2] for p in parts]),
-        np.concatenate([p[3] for p in parts]),
-        {key: np.vstack([p[4][key] for p in parts]) for key in parts[0][4]},
-    )
+from excite_cli.identification.dataset import Dataset
+from excite_cli.identification.effects import REQUIRES
+from excite_cli.identification.normal import ABSORBED, NormalEquations, covariance_diagonal, outside_fraction, solve, sse
 
 
 @dataclass(frozen=True)
@@ -130,41 +48,32 @@ class Fit:
     sigma: np.ndarray
 
 
-def _joint_sigma(residual: np.ndarray, joint: np.ndarray, n: int, p: int) -> np.ndarray:
-    dof = max(1.0, residual.size - p) / residual.size
-    return np.array([np.sqrt(np.mean(residual[joint == j] ** 2) / dof) for j in range(n)])
-
-
-def least_squares(A: np.ndarray, y: np.ndarray, joint: np.ndarray, n: int, weights: np.ndarray | None = None,
+def least_squares(normal: NormalEquations, effects: list[tuple[str, int]], weights: np.ndarray | None = None,
                   oversampling: float = 1.0) -> Fit:
-    """Ordinary (Eq. 4) or weighted least squares of y ≈ A x with standard deviations.
+    """Ordinary (Eq. 4) or weighted least squares of the model [Y_B, ``effects``] with standard
+    deviations σ² diag((AᵀWA)⁻¹), scaled by √r.
 
     Args:
-        A: (M, p) design matrix; y: (M,) torques; joint: (M,) joint of each row; n: joints.
+        normal: the data's normal equations.
         weights: (n,) weight of each joint's rows (WLS, see :func:`joint_weights`), or None (LS).
-        oversampling: samples per independent sample (r ≥ 1); the deviations are scaled by √r.
+        oversampling: samples per independent sample (r ≥ 1).
     """
-    scale = np.linalg.norm(A, axis=0)
-    scale[scale == 0] = 1.0
-    w = np.ones_like(y) if weights is None else weights[joint]
-    Q, R = np.linalg.qr(w[:, None] * A / scale)
-    x = scipy.linalg.solve_triangular(R, Q.T @ (w * y)) / scale
-    sigma = _joint_sigma(y - A @ x, joint, n, A.shape[1])
-    residual = w * (y - A @ x)
-    s2 = residual @ residual / max(1, y.size - A.shape[1])
-    Rinv = scipy.linalg.solve_triangular(R, np.eye(R.shape[0]))
-    std = np.sqrt(oversampling * s2 * np.sum(Rinv**2, axis=1)) / scale
+    G, c, s = normal.system(weights, effects)
+    x = solve(G, c)
+    dof = max(1, normal.rows - x.size)
+    s2 = sse(G, c, s, x) / dof
+    std = np.sqrt(oversampling * s2 * np.maximum(covariance_diagonal(G), 0.0))
+    sigma = np.sqrt(normal.joint_sse(x, effects) / (normal.rows / normal.n) / (dof / normal.rows))
     return Fit(x, std, sigma)
 
 
-def joint_weights(data: Dataset, weighted: bool) -> np.ndarray | None:
+def joint_weights(normal: NormalEquations, weighted: bool) -> np.ndarray | None:
     """(n,) WLS weights 1/σ_j, σ_j the rigid-body least-squares residual of joint j (Gautier 1997),
     or None for LS. Fixed for the whole selection and the final fit, so the reported model is the
     one the selection scored."""
     if not weighted:
         return None
-    sigma = least_squares(data.regressor, data.tau, data.joint, data.n).sigma
-    return 1.0 / np.maximum(sigma, 1e-12)
+    return 1.0 / np.maximum(least_squares(normal, []).sigma, 1e-12)
 
 
 @dataclass
@@ -209,10 +118,11 @@ def select_effects(fit_data: Dataset, val_data: Dataset, cfg: IdentificationConf
         oversampling: samples per independent sample r (≥ 1) of the filtered data.
     """
     n = fit_data.n
-    weights = joint_weights(fit_data, cfg.method == "wls")
-    rigid = least_squares(fit_data.regressor, fit_data.tau, fit_data.joint, n, weights, oversampling)
-    val_w = 1.0 / np.maximum(rigid.sigma[val_data.joint], 1e-12)  # fixed, so errors compare across steps
-    w = np.ones(fit_data.tau.size) if weights is None else weights[fit_data.joint]
+    keys = list(fit_data.blocks)
+    fit_ne, val_ne = NormalEquations(fit_data, keys), NormalEquations(val_data, keys)
+    weights = joint_weights(fit_ne, cfg.method == "wls")
+    rigid = least_squares(fit_ne, [], weights, oversampling)
+    val_w = 1.0 / np.maximum(rigid.sigma, 1e-12)  # fixed, so errors compare across steps
     effects = list(declared)
     absorbed: set[tuple[str, int]] = set()
     selection = Selection(effects, len(declared), rigid, rigid, weights=weights)
@@ -220,38 +130,24 @@ def select_effects(fit_data: Dataset, val_data: Dataset, cfg: IdentificationConf
         remaining = [c for c in _open(cfg.candidates, n, effects) if c not in absorbed]
         if not remaining:
             break
-        A = design(fit_data, effects)
-        scale = np.linalg.norm(A, axis=0)
-        scale[scale == 0] = 1.0
-        Q, R = np.linalg.qr(w[:, None] * A / scale)
-        wy = w * fit_data.tau
-        x0 = scipy.linalg.solve_triangular(R, Q.T @ wy)
-        r0 = wy - Q @ (Q.T @ wy)
-        sse0 = r0 @ r0
-        A_val = design(val_data, effects) / scale
-        base_prediction = A_val @ x0
-        val0 = np.sum((val_w * (val_data.tau - base_prediction)) ** 2)
+        G, c, s = fit_ne.system(weights, effects)
+        x0 = solve(G, c)
+        sse0 = sse(G, c, s, x0)
+        val0 = sse(*val_ne.system(val_w, effects), x0)
         tried = []
         for cand in remaining:
-            j = cand[1]
-            cols = w[j::n, None] * fit_data.blocks[cand]  # (N, k) on joint j's rows
-            QtB = Q[j::n].T @ cols
-            B_perp = -(Q @ QtB)
-            B_perp[j::n] += cols
-            if np.linalg.norm(B_perp) < IDENTIFIABILITY * np.linalg.norm(cols):
+            G1, c1, s1 = fit_ne.system(weights, effects + [cand])
+            if outside_fraction(G1, G.shape[0]) < ABSORBED:
                 absorbed.add(cand)
                 continue
-            c = np.linalg.solve(B_perp.T @ B_perp, B_perp.T @ r0)
-            gain = r0 @ (B_perp @ c)
-            prediction = base_prediction - A_val @ scipy.linalg.solve_triangular(R, QtB @ c)
-            prediction[j::n] += val_data.blocks[cand] @ c
-            val1 = np.sum((val_w * (val_data.tau - prediction)) ** 2)
-            tried.append((val1, cand, gain, cols.shape[1]))
+            x1 = solve(G1, c1)
+            val1 = sse(*val_ne.system(val_w, effects + [cand]), x1)
+            tried.append((val1, cand, sse0 - sse(G1, c1, s1, x1), G1.shape[0] - G.shape[0]))
         chosen = None
         for val1, cand, gain, k in sorted(tried, key=lambda t: t[0]):  # best held-out error first
             if not val1 < (1.0 - cfg.min_improvement) * val0:
                 break  # the rest gain less
-            dof = (fit_data.tau.size - A.shape[1] - k) / oversampling
+            dof = (fit_ne.rows - G.shape[0] - k) / oversampling
             F = (gain / k) / ((sse0 - gain) / dof)
             p = float(stats.f.sf(F, k, dof))
             if p < cfg.significance / len(remaining):  # a lower-ranked candidate may pass where the first fails
@@ -263,10 +159,18 @@ def select_effects(fit_data: Dataset, val_data: Dataset, cfg: IdentificationConf
         selection.steps.append(chosen)
     selection.effects = effects
     selection.absorbed = sorted(absorbed)
-    selection.fit = least_squares(design(fit_data, effects), fit_data.tau, fit_data.joint, n, weights, oversampling)
+    selection.fit = least_squares(fit_ne, effects, weights, oversampling)
     return selection
 
 
 def predict(data: Dataset, x: np.ndarray, effects: list[tuple[str, int]]) -> np.ndarray:
-    """Predicted torques (N, n) [Nm] of the model [Y_B, effects] with coefficients x."""
-    return (design(data, effects) @ x).reshape(-1, data.n)
+    """Predicted torques (N, n) [Nm] of the model [Y_B, effects] with coefficients x (base
+    parameters first), without forming the design."""
+    b = data.regressor.shape[1]
+    out = (data.regressor @ x[:b]).reshape(-1, data.n)
+    k = b
+    for e, j in effects:
+        cols = data.blocks[(e, j)]
+        out[:, j] += cols @ x[k : k + cols.shape[1]]
+        k += cols.shape[1]
+    return out

@@ -12,8 +12,9 @@ from excite_cli.base_parameters import BaseParameters, compute_base_parameters
 from excite_cli.config import IdentifyProblem
 from excite_cli.errors import ExciteError
 from excite_cli.identification.effects import COEFFICIENTS
-from excite_cli.identification.identify import (Dataset, Selection, build_dataset, design, joint_weights, least_squares,
-                                               predict, select_effects)
+from excite_cli.identification.dataset import Dataset, build_dataset
+from excite_cli.identification.identify import Selection, design, joint_weights, least_squares, predict, select_effects
+from excite_cli.identification.normal import NormalEquations
 from excite_cli.identification.measurements import load_run
 from excite_cli.identification.physical import ConsistentFit, consistent_fit
 from excite_cli.identification.preprocessing import default_cutoff, preprocess
@@ -106,12 +107,14 @@ def declared_effects(problem: IdentifyProblem, robot: Robot) -> list[tuple[str, 
     return out
 
 
-def run_identification(problem: IdentifyProblem) -> tuple[Report, Robot, BaseParameters, Dataset]:
-    """The whole loop on ``problem``'s data.
+def run_identification(problem: IdentifyProblem) -> tuple[Report, Robot, BaseParameters, list[np.ndarray]]:
+    """The whole loop on ``problem``'s data. The runs at their own rate are released once they are
+    filtered and decimated, so memory follows the decimated data.
 
     Returns:
-        The :class:`Report`, the robot, its base parameters and the dataset of all samples (whose
-        regressor can serve as prior data C₀ for ``optimize``, Eq. 41).
+        The :class:`Report`, the robot, its base parameters and the base regressor rows of all
+        samples, fit then validation ((M_fit, b), (M_val, b)), which can serve as prior data C₀ for
+        ``optimize`` (Eq. 41).
 
     Raises:
         ExciteError: bad data or config (see :func:`load_run`, :func:`preprocess`, :func:`split`).
@@ -121,14 +124,18 @@ def run_identification(problem: IdentifyProblem) -> tuple[Report, Robot, BasePar
     base = compute_base_parameters(robot)
     runs = [load_run(r, problem.data, problem, robot.n_joints) for r in problem.data.runs]
     cutoff = problem.preprocessing.cutoff or default_cutoff(runs, problem.preprocessing)
-    samples = [preprocess(r, problem.preprocessing, cutoff) for r in runs]
+    dropped = [(r.name, r.dropped) for r in runs if r.dropped]
+    samples = [preprocess(runs.pop(0), problem.preprocessing, cutoff) for _ in range(len(runs))]
     cfg = problem.identification
+    roles, rate = [s.role for s in samples], max(s.filter.rate / s.filter.step for s in samples)
     data = build_dataset(robot, base, samples, cfg)
-    fit_mask = split(data, [s.role for s in samples], problem.data.validation_blocks)
+    del samples
+    fit_mask = split(data, roles, problem.data.validation_blocks)
     fit_data, val_data = data.select(fit_mask), data.select(~fit_mask)
-    first = least_squares(fit_data.regressor, fit_data.tau, fit_data.joint, fit_data.n, joint_weights(fit_data, cfg.method == "wls"))
+    del data
+    rigid_only = NormalEquations(fit_data, [])
+    first = least_squares(rigid_only, [], joint_weights(rigid_only, cfg.method == "wls"))
     fit_data, val_data = fit_data.with_load_columns(first.x), val_data.with_load_columns(first.x)
-    rate = max(s.filter.rate / s.filter.step for s in samples)
     selection = select_effects(fit_data, val_data, cfg, declared_effects(problem, robot), max(1.0, rate / (2.0 * cutoff)))
     before = predict(val_data, selection.rigid.x, [])
     after = predict(val_data, selection.fit.x, selection.effects)
@@ -151,11 +158,11 @@ def run_identification(problem: IdentifyProblem) -> tuple[Report, Robot, BasePar
         cutoff=cutoff,
         fit_samples=fit_data.time.size,
         validation_samples=val_data.time.size,
-        dropped=[(r.name, r.dropped) for r in runs if r.dropped],
+        dropped=dropped,
         consistent=consistent,
         rms_consistent=rms_consistent,
     )
-    return report, robot, base, data
+    return report, robot, base, [fit_data.regressor, val_data.regressor]
 
 
 def fit_consistent(fit_data: Dataset, selection: Selection, robot: Robot, base: BaseParameters, cfg) -> ConsistentFit:

@@ -24,7 +24,7 @@ MAX_CUTOFF_FRACTION = 0.4
 #: Samples trimmed at each end: this many periods of the cut-off frequency.
 EDGE_PERIODS = 3.0
 #: Long signals are filtered in chunks of this many samples, overlapping by this many trims.
-CHUNK = 40_000
+CHUNK = 8_000
 CHUNK_MARGIN = 4
 
 
