@@ -37,7 +37,7 @@ def simulated_run(rows: int, rate: float = 1000.0) -> dict[str, np.ndarray]:
 
 
 def identify(folder: Path, run_file: str, columns: dict) -> tuple[float, float]:
-    """Wall time [s] and peak resident memory [GB] of `excite identify` on one file."""
+    """Wall time [s] and peak resident memory [GiB] of `excite identify` on one file."""
     config = {"robot": {"urdf": "panda_description/urdf/panda.urdf", "source": "example-robot-data", "active_joints": JOINTS},
               "data": {"runs": [{"file": run_file, "role": "blocks"}], "columns": columns},
               "output": str(folder / "ident.h5")}
@@ -55,7 +55,7 @@ def identify(folder: Path, run_file: str, columns: dict) -> tuple[float, float]:
 
 
 def main(sizes: list[int]) -> None:
-    print(f"{'rows':>9} {'format':>6} {'wall [s]':>9} {'peak [GB]':>10}")
+    print(f"{'rows':>9} {'format':>6} {'wall [s]':>9} {'peak [GiB]':>10}")
     for rows in sizes:
         data = simulated_run(rows)
         with tempfile.TemporaryDirectory() as tmp:

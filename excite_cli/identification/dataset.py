@@ -9,6 +9,7 @@ import numpy as np
 
 from excite_cli.base_parameters import BaseParameters
 from excite_cli.config import IdentificationConfig
+from excite_cli.errors import ExciteError
 from excite_cli.identification.effects import COEFFICIENTS, TWO_STAGE, effect_columns
 from excite_cli.identification.preprocessing import Samples
 from excite_cli.robot import Robot
@@ -58,34 +59,64 @@ class Dataset:
         extra = {("load_coulomb", j): rigid[:, j:j + 1] * self.blocks[("coulomb", j)] for j in range(self.n)}
         return Dataset(self.regressor, self.tau, self.time, self.run, {**self.blocks, **extra})
 
-    def select(self, mask: np.ndarray) -> "Dataset":
-        """The instants where ``mask`` (N,) is true."""
-        rows = np.repeat(mask, self.n)
-        return Dataset(self.regressor[rows], self.tau[rows], self.time[mask], self.run[mask],
-                       {key: cols[mask] for key, cols in self.blocks.items()})
+
+def fit_instants(role: str, count: int, blocks: int) -> np.ndarray:
+    """(count,) which decimated instants of a run are for fitting: all (``fit``), none
+    (``validation``), or the even ones of ``blocks`` contiguous time blocks (``blocks``)."""
+    if role == "fit":
+        return np.ones(count, dtype=bool)
+    if role == "validation":
+        return np.zeros(count, dtype=bool)
+    return np.minimum((np.arange(count) * blocks) // max(count, 1), blocks - 1) % 2 == 0
 
 
-def build_dataset(robot: Robot, base: BaseParameters, samples: list[Samples], cfg: IdentificationConfig) -> Dataset:
-    """Regressor, candidate effect columns and torques of the samples, each low-passed by its run's
-    filter in parallel and decimated (so the filtered τ still equals the filtered columns × φ)."""
+def build_datasets(robot: Robot, base: BaseParameters, samples: list[Samples], cfg: IdentificationConfig,
+                   blocks: int, effects: set[str] | None = None) -> tuple[Dataset, Dataset]:
+    """The fit and validation datasets: regressor, candidate effect columns and torques of the
+    samples, each low-passed by its run's filter in parallel and decimated (so the filtered τ still
+    equals the filtered columns × φ), split by :func:`fit_instants`. Written straight into
+    preallocated arrays, the base regressor chunk by chunk: memory is the decimated data once.
+    ``samples`` is emptied as the runs are used. ``effects``: the effects whose blocks to build
+    (default: all that need no first fit).
+
+    Raises:
+        ExciteError: nothing left for fitting or for validation.
+    """
     n, b = robot.n_joints, base.count
     X = base.composition_matrix
-    parts = []
-    for index, s in enumerate(samples):
-        # the base regressor at the run's rate is (T·n, b): computed, filtered and decimated in chunks
-        Y = s.filter.decimate_chunks(lambda lo, hi: (robot.regressor_stack(s.q[lo:hi], s.qd[lo:hi], s.qdd[lo:hi]) @ X)
-                                     .reshape(-1, n * b), s.time.size)
-        blocks = {
-            (e, j): s.filter.decimate(effect_columns(e, s.q[:, j], s.qd[:, j], s.qdd[:, j], cfg.coulomb_velocity,
-                                                     cfg.stribeck_velocity, cfg.held_velocity))
-            for e in EFFECTS if e not in TWO_STAGE for j in range(n)
-        }
+    masks = [fit_instants(s.role, s.filter.kept(s.time.size), blocks) for s in samples]
+    sizes = {True: sum(int(m.sum()) for m in masks), False: sum(int((~m).sum()) for m in masks)}
+    if not sizes[True] or not sizes[False]:
+        raise ExciteError("data.runs: need data for fitting and for validation (roles fit/validation, or blocks)")
+    keys = [(e, j) for e in EFFECTS if e not in TWO_STAGE and (effects is None or e in effects) for j in range(n)]
+    out = {side: {"Y": np.empty((size, n * b)), "tau": np.empty((size, n)), "time": np.empty(size),
+                  "run": np.empty(size, dtype=int), "blocks": {key: np.empty((size, len(COEFFICIENTS[key[0]]))) for key in keys}}
+           for side, size in sizes.items()}
+    at = {True: 0, False: 0}
+    for index, mask in enumerate(masks):
+        s = samples.pop(0)
+        rows = {side: np.flatnonzero(mask == side) for side in (True, False)}
+        where = {side: slice(at[side], at[side] + rows[side].size) for side in (True, False)}
+        tau = s.filter.decimate(s.tau)
         time = s.time[s.filter.trim : s.time.size - s.filter.trim : s.filter.step]
-        parts.append((Y.reshape(-1, b), s.filter.decimate(s.tau).ravel(), time, np.full(time.size, index), blocks))
-    return Dataset(
-        np.vstack([p[0] for p in parts]),
-        np.concatenate([p[1] for p in parts]),
-        np.concatenate([p[2] for p in parts]),
-        np.concatenate([p[3] for p in parts]),
-        {key: np.vstack([p[4][key] for p in parts]) for key in parts[0][4]},
-    )
+        columns = {(e, j): s.filter.decimate(effect_columns(e, s.q[:, j], s.qd[:, j], s.qdd[:, j], cfg.coulomb_velocity,
+                                                            cfg.stribeck_velocity, cfg.held_velocity)) for e, j in keys}
+        for side in (True, False):
+            out[side]["tau"][where[side]] = tau[rows[side]]
+            out[side]["time"][where[side]] = time[rows[side]]
+            out[side]["run"][where[side]] = index
+            for key in keys:
+                out[side]["blocks"][key][where[side]] = columns[key][rows[side]]
+        del columns
+        # the base regressor at the run's rate is (T·n, b): computed, filtered and decimated in chunks
+        for start, chunk in s.filter.chunks(lambda lo, hi: (robot.regressor_stack(s.q[lo:hi], s.qd[lo:hi], s.qdd[lo:hi]) @ X)
+                                            .reshape(-1, n * b), s.time.size):
+            part = mask[start : start + chunk.shape[0]]
+            for side in (True, False):
+                first = at[side] + int(np.count_nonzero(mask[:start] == side))
+                picked = chunk[part == side]
+                out[side]["Y"][first : first + picked.shape[0]] = picked
+        for side in (True, False):
+            at[side] += rows[side].size
+    fit, val = (Dataset(o["Y"].reshape(-1, b), o["tau"].ravel(), o["time"], o["run"], o["blocks"]) for o in (out[True], out[False]))
+    return fit, val

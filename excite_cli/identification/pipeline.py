@@ -12,7 +12,7 @@ from excite_cli.base_parameters import BaseParameters, compute_base_parameters
 from excite_cli.config import IdentifyProblem
 from excite_cli.errors import ExciteError
 from excite_cli.identification.effects import COEFFICIENTS
-from excite_cli.identification.dataset import Dataset, build_dataset
+from excite_cli.identification.dataset import Dataset, build_datasets
 from excite_cli.identification.identify import Selection, design, joint_weights, least_squares, predict, select_effects
 from excite_cli.identification.normal import NormalEquations
 from excite_cli.identification.measurements import load_run
@@ -72,26 +72,6 @@ class Report:
         return None if self.rms_consistent is None else 100.0 * self.rms_consistent / self.rms_torque
 
 
-def split(data: Dataset, roles: list[str], blocks: int) -> np.ndarray:
-    """(N,) mask of the instants used for fitting: runs by their role; a ``blocks`` run is cut into
-    ``blocks`` contiguous time blocks, the even ones for fitting and the odd ones held out.
-
-    Raises:
-        ExciteError: nothing left for fitting or for validation.
-    """
-    fit = np.zeros(data.time.size, dtype=bool)
-    for index, role in enumerate(roles):
-        rows = np.nonzero(data.run == index)[0]
-        if role == "fit":
-            fit[rows] = True
-        elif role == "blocks":
-            block = np.minimum((np.arange(rows.size) * blocks) // rows.size, blocks - 1)
-            fit[rows] = block % 2 == 0
-    if fit.all() or not fit.any():
-        raise ExciteError("data.runs: need data for fitting and for validation (roles fit/validation, or blocks)")
-    return fit
-
-
 def declared_effects(problem: IdentifyProblem, robot: Robot) -> list[tuple[str, int]]:
     """(effect, joint index) pairs of ``identification.declared_effects`` ({joint or "*": [effects]}).
 
@@ -117,7 +97,7 @@ def run_identification(problem: IdentifyProblem) -> tuple[Report, Robot, BasePar
         ``optimize`` (Eq. 41).
 
     Raises:
-        ExciteError: bad data or config (see :func:`load_run`, :func:`preprocess`, :func:`split`).
+        ExciteError: bad data or config (see :func:`load_run`, :func:`preprocess`, :func:`build_datasets`).
     """
     problem.robot.base_wrench_rows = False
     robot = load_robot(problem)
@@ -127,16 +107,14 @@ def run_identification(problem: IdentifyProblem) -> tuple[Report, Robot, BasePar
     dropped = [(r.name, r.dropped) for r in runs if r.dropped]
     samples = [preprocess(runs.pop(0), problem.preprocessing, cutoff) for _ in range(len(runs))]
     cfg = problem.identification
-    roles, rate = [s.role for s in samples], max(s.filter.rate / s.filter.step for s in samples)
-    data = build_dataset(robot, base, samples, cfg)
-    del samples
-    fit_mask = split(data, roles, problem.data.validation_blocks)
-    fit_data, val_data = data.select(fit_mask), data.select(~fit_mask)
-    del data
+    rate = max(s.filter.rate / s.filter.step for s in samples)
+    declared = declared_effects(problem, robot)
+    needed = set(cfg.candidates) | {e for e, _ in declared} | {"coulomb"}  # Coulomb: the load column's sign
+    fit_data, val_data = build_datasets(robot, base, samples, cfg, problem.data.validation_blocks, needed)
     rigid_only = NormalEquations(fit_data, [])
     first = least_squares(rigid_only, [], joint_weights(rigid_only, cfg.method == "wls"))
     fit_data, val_data = fit_data.with_load_columns(first.x), val_data.with_load_columns(first.x)
-    selection = select_effects(fit_data, val_data, cfg, declared_effects(problem, robot), max(1.0, rate / (2.0 * cutoff)))
+    selection = select_effects(fit_data, val_data, cfg, declared, max(1.0, rate / (2.0 * cutoff)))
     before = predict(val_data, selection.rigid.x, [])
     after = predict(val_data, selection.fit.x, selection.effects)
     measured = val_data.tau.reshape(-1, val_data.n)
