@@ -26,6 +26,7 @@ from excite_cli.identification.effects import UNITS as EFFECT_UNITS
 from excite_cli.identification.physical import body_properties, pseudo_inertia
 from excite_cli.identification.pipeline import effect_values, run_identification, write_identified_urdf
 from excite_cli.identification.simulate import simulate_runs
+from excite_cli.identification.validate import validate_model
 from excite_cli.output import read_last_alpha, read_prior, read_table, write_identification, write_result
 from excite_cli.plots import plot_comparison, plot_identification, plot_result
 from excite_cli.random_baseline import draw_pool, greedy_selection, pool_convergence
@@ -285,6 +286,25 @@ def export(
     out.print(f"{exported.time.size} samples at {rate:g} Hz; every constraint holds: largest normalized violation "
               f"{exported.max_violation:+.2e} (≤ 0 satisfied), closest: {exported.worst}", highlight=False)
     out.print(f"wrote {target}", highlight=False)
+
+
+@app.command()
+@_user_errors
+def validate(
+    report: Path = typer.Argument(..., help="An identify report (HDF5)."),
+    config: Path = typer.Argument(..., help="Identification YAML whose data.runs are the runs to score (roles are ignored)."),
+) -> None:
+    """Score an identified model on other runs: torque error per run and joint, with the report's
+    preprocessing (cut-off), on data its fit and effect selection never saw."""
+    problem = load_problem(config, IdentifyProblem)
+    with err.status("preprocessing and predicting ..."):
+        errors = validate_model(report, problem)
+    table = Table(title=f"Validation of {report.name}: relative RMS torque error [%] per run")
+    for column in ("run", "instants", *problem.robot.active_joints, "mean"):
+        table.add_column(column, justify="right")
+    for e in errors:
+        table.add_row(e.name, str(e.instants), *[f"{x:.1f}" for x in e.relative], f"{e.relative.mean():.1f}")
+    out.print(table)
 
 
 @app.command()

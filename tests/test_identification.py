@@ -253,3 +253,32 @@ def test_each_undeclared_effect_is_named_with_its_value(tmp_path, optimized, cas
     for key, value in truth.items():
         estimate, std = found[key]
         assert abs(estimate - value) <= max(0.05 * abs(value), 3 * std), (key, estimate, std)
+
+
+@pytest.mark.skipif(not (SHARED / "exciting_traj_1.csv").exists(), reason="shared Panda data not present")
+def test_validate_scores_a_report_on_other_runs(tmp_path):
+    config = yaml.safe_load((HERE.parent / "configs" / "panda_identify_phase.yaml").read_text())
+    for run in config["data"]["runs"]:
+        run["file"] = str(SHARED / "exciting_traj_1.csv")
+    config["output"] = str(tmp_path / "phase.h5")
+    identify = load_problem(write_config(tmp_path, config, "phase.yaml"), IdentifyProblem)
+    report, *_ = run_identification(identify)
+    result = runner.invoke(app, ["identify", str(tmp_path / "phase.yaml")], env={"COLUMNS": "200"})
+    assert result.exit_code == 0, result.output
+    # the held-out phase again: exactly identify's validation errors; the whole run: its own
+    config["data"]["runs"] = [{"file": str(SHARED / "exciting_traj_1.csv"), "crop": [7.8, 13.2]},
+                              {"file": str(SHARED / "exciting_traj_1.csv")}]
+    from excite_cli.identification.validate import validate_model
+
+    errors = validate_model(tmp_path / "phase.h5", load_problem(write_config(tmp_path, config, "val.yaml"), IdentifyProblem))
+    np.testing.assert_allclose(errors[0].relative, report.relative_after, rtol=1e-9)
+    assert errors[1].instants > 3 * errors[0].instants and errors[1].relative.mean() < report.relative_before.mean()
+    result = runner.invoke(app, ["validate", str(tmp_path / "phase.h5"), str(tmp_path / "val.yaml")], env={"COLUMNS": "200"})
+    assert result.exit_code == 0 and "[7.8, 13.2] s" in result.output
+    # a report of other joints, and a file that is not a report: one message each
+    config["robot"]["active_joints"] = JOINTS[:6]
+    config["data"]["columns"] = {"q": [f"q{k}" for k in range(1, 7)], "tau": [f"tau{k}" for k in range(1, 7)]}
+    result = runner.invoke(app, ["validate", str(tmp_path / "phase.h5"), str(write_config(tmp_path, config, "other.yaml"))])
+    assert result.exit_code == 2 and "other joints" in result.output
+    result = runner.invoke(app, ["validate", str(HERE / "panda_capsules.yaml"), str(tmp_path / "val.yaml")])
+    assert result.exit_code == 2 and "Traceback" not in result.output

@@ -71,22 +71,23 @@ def fit_instants(role: str, count: int, blocks: int) -> np.ndarray:
 
 
 def build_datasets(robot: Robot, base: BaseParameters, samples: list[Samples], cfg: IdentificationConfig,
-                   blocks: int, effects: set[str] | None = None) -> tuple[Dataset, Dataset]:
+                   blocks: int, effects: set[str] | None = None, split: bool = True) -> tuple[Dataset, Dataset]:
     """The fit and validation datasets: regressor, candidate effect columns and torques of the
     samples, each low-passed by its run's filter in parallel and decimated (so the filtered τ still
     equals the filtered columns × φ), split by :func:`fit_instants`. Written straight into
     preallocated arrays, the base regressor chunk by chunk: memory is the decimated data once.
     ``samples`` is emptied as the runs are used. ``effects``: the effects whose blocks to build
-    (default: all that need no first fit).
+    (default: all that need no first fit). Without ``split`` every instant is validation data (the
+    fit dataset is empty).
 
     Raises:
         ExciteError: nothing left for fitting or for validation.
     """
     n, b = robot.n_joints, base.count
     X = base.composition_matrix
-    masks = [fit_instants(s.role, s.filter.kept(s.time.size), blocks) for s in samples]
+    masks = [fit_instants(s.role if split else "validation", s.filter.kept(s.time.size), blocks) for s in samples]
     sizes = {True: sum(int(m.sum()) for m in masks), False: sum(int((~m).sum()) for m in masks)}
-    if not sizes[True] or not sizes[False]:
+    if split and (not sizes[True] or not sizes[False]):
         raise ExciteError("data.runs: need data for fitting and for validation (roles fit/validation, or blocks)")
     keys = [(e, j) for e in EFFECTS if e not in TWO_STAGE and (effects is None or e in effects) for j in range(n)]
     out = {side: {"Y": np.empty((size, n * b)), "tau": np.empty((size, n)), "time": np.empty(size),

@@ -1,0 +1,92 @@
+"""``excite validate``: an identified model (an ``identify`` report) scored on other runs, ones that
+neither its fit nor its effect selection saw.
+
+The runs of the config are read and preprocessed as ``identify`` does, with the report's cut-off,
+and all of their instants are predicted by the report's model (base parameters, then its effects
+with their coefficients; the load-dependent Coulomb column from the report's rigid-body
+parameters, as in the fit). Errors per run and joint: RMS [Nm] and RMS relative to the measured
+torque's RMS [%].
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from excite_cli.base_parameters import compute_base_parameters
+from excite_cli.config import IdentifyProblem
+from excite_cli.errors import ExciteError
+from excite_cli.identification.dataset import build_datasets
+from excite_cli.identification.identify import predict
+from excite_cli.identification.measurements import load_run
+from excite_cli.identification.preprocessing import preprocess
+from excite_cli.output import open_result
+from excite_cli.robot import load_robot
+
+
+@dataclass(frozen=True)
+class RunError:
+    """One run's validation error: ``name``, ``rms`` (n,) [Nm], ``relative`` (n,) [%], ``instants``."""
+
+    name: str
+    rms: np.ndarray
+    relative: np.ndarray
+    instants: int
+
+
+def _strings(values) -> list[str]:
+    return [v.decode() if isinstance(v, bytes) else str(v) for v in values]
+
+
+def read_model(path: Path) -> dict:
+    """The model of an ``identify`` report: joint and base-parameter names, base parameters, the
+    rigid-body-only ones, effects [(effect, joint name)] in order with their coefficients, cut-off.
+
+    Raises:
+        ExciteError: missing or unreadable file, or not an identify report.
+    """
+    with open_result(path, "REPORT") as f:
+        if "identification" not in f:
+            raise ExciteError(f"REPORT: {path} is not an excite identify report (no /identification)")
+        g = f["identification"]
+        rows = g["effects"][()]
+        consistent = bool(g["physically_consistent"][()]) if "physically_consistent" in g else False
+        values = rows["value_consistent"] if consistent else rows["value"]
+        effects: list[tuple[str, str]] = []
+        for effect, joint in zip(_strings(rows["effect"]), _strings(rows["joint"])):
+            if (effect, joint) not in effects:
+                effects.append((effect, joint))
+        return {"joints": _strings(g["joint_names"][()]), "base_names": _strings(g["base_parameter_names"][()]),
+                "base": g["base_parameters"][()], "rigid": g["base_parameters_rigid_only"][()],
+                "effects": effects, "coefficients": np.asarray(values, dtype=float), "cutoff": float(g.attrs["cutoff_Hz"])}
+
+
+def validate_model(report: Path, problem: IdentifyProblem) -> list[RunError]:
+    """Score the model of ``report`` on every run of ``problem`` (their roles are ignored).
+
+    Raises:
+        ExciteError: a report for another robot (joints or base parameters differ), bad data or
+            config (as ``identify``).
+    """
+    model = read_model(report)
+    problem.robot.base_wrench_rows = False
+    robot = load_robot(problem)
+    base = compute_base_parameters(robot)
+    if model["joints"] != robot.joint_names or model["base_names"] != base.names:
+        raise ExciteError(f"REPORT: {report} was identified for other joints or base parameters than the config's robot")
+    effects = [(e, robot.joint_names.index(j)) for e, j in model["effects"]]
+    needed = {e for e, _ in effects} | {"coulomb"}
+    errors = []
+    for run in problem.data.runs:
+        samples = [preprocess(load_run(run.model_copy(update={"role": "validation"}), problem.data, problem, robot.n_joints),
+                   problem.preprocessing, model["cutoff"])]
+        _, data = build_datasets(robot, base, samples, problem.identification, problem.data.validation_blocks, needed, split=False)
+        data = data.with_load_columns(model["rigid"])
+        predicted = predict(data, np.concatenate([model["base"], model["coefficients"]]), effects)
+        measured = data.tau.reshape(-1, data.n)
+        rms = np.sqrt(np.mean((measured - predicted) ** 2, axis=0))
+        name = Path(run.file).name + (f" [{run.crop[0]:g}, {run.crop[1]:g}] s" if run.crop else "")
+        errors.append(RunError(name, rms, 100.0 * rms / np.sqrt(np.mean(measured**2, axis=0)), data.time.size))
+    return errors
