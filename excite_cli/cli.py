@@ -227,6 +227,8 @@ def identify(
     with err.status("preprocessing, fitting and selecting effects ..."):
         report, robot, base, regressor = run_identification(problem)
     sel = report.selection
+    source = "preprocessing.cutoff" if problem.preprocessing.cutoff else "default: 10 × the 99 % power bandwidth of q"
+    err.print(f"low-pass cut-off {report.cutoff:.3g} Hz ({source}); stored as cutoff_Hz", highlight=False)
     for name, rows in report.dropped:
         err.print(f"data.bad_rows: dropped {rows} unusable row(s) of {name}", highlight=False)
     table = Table(title=f"Validation torque error, rigid body only → with the chosen effects ({report.validation_samples} held-out instants)")
