@@ -315,6 +315,14 @@ def write_identification(path: Path, report, robot, base: BaseParameters, source
                 row["order"], row["effect"], row["coefficient"], row["joint"] = order[(effect, joint)], effect, coefficient, joint
                 row["value"], row["std"], row["declared"] = value, std, (effect, joint) in declared
             g.create_dataset("effects", data=effects)
+            n = len(report.joints)
+            runs = report.per_run()
+            table = np.zeros(len(runs), dtype=[("run", h5py.string_dtype()), ("instants", "i8"), ("rms_before", "f8", n),
+                                                ("rms_after", "f8", n), ("relative_after", "f8", n)])
+            for row, (name, count, before, after, torque) in zip(table, runs):
+                row["run"], row["instants"], row["rms_before"], row["rms_after"] = name, count, before, after
+                row["relative_after"] = 100.0 * after / np.where(torque > 0, torque, 1.0)
+            g.create_dataset("validation_runs", data=table).attrs["units"] = "rms in Nm; relative_after in % of the run's RMS torque"
             _strings(g, "absorbed_effects", [f"{e}:{report.joints[j]}" for e, j in sel.absorbed])
             for name, values, unit in (("rms_before", report.rms_before, "Nm"), ("rms_after", report.rms_after, "Nm"),
                                        ("rms_torque", report.rms_torque, "Nm"), ("relative_before", report.relative_before, "%"),

@@ -219,27 +219,38 @@ def plot_comparison(path: Path, random_table, optimized_table) -> Path:
     return path
 
 
+def _end_to_end(time: np.ndarray, run: np.ndarray) -> np.ndarray:
+    """(N,) time [s] of samples from several runs laid end to end, NaN at every gap (between runs
+    and between held-out blocks of a run), so plotted lines break there."""
+    out = np.empty(time.size)
+    offset, step = 0.0, float(np.median(np.diff(time))) if time.size > 1 else 1.0
+    for r in np.unique(run):
+        rows = np.flatnonzero(run == r)
+        out[rows] = time[rows] - time[rows[0]] + offset
+        offset = out[rows[-1]] + 20 * step
+    out[1:][(np.diff(time) > 2 * step) | (np.diff(run) != 0)] = np.nan
+    return out
+
+
 def plot_identification(path: Path, report) -> Path:
-    """Per joint, on validation data: measured torque with the rigid-body and the final prediction,
-    and the residuals before and after; written to ``path`` (PNG)."""
+    """Per joint, on all validation data (runs laid end to end, a gap between runs and between
+    held-out time blocks): measured torque with the rigid-body and the final prediction, and the
+    residuals before and after; written to ``path`` (PNG)."""
     n = len(report.joints)
     data = report.validation
-    first = data.run == data.run[0]
-    t = data.time[first].copy()
-    # break the lines between held-out time blocks
-    t[1:][np.diff(t) > 2 * np.median(np.diff(t))] = np.nan
+    t = _end_to_end(data.time, data.run)
     measured = data.tau.reshape(-1, n)
     fig, axes = plt.subplots(n, 2, figsize=(12, 1.9 * n), sharex=True, squeeze=False)
     for j, name in enumerate(report.joints):
         ax = axes[j, 0]
-        ax.plot(t, measured[first, j], "k", linewidth=0.8, label="measured")
-        ax.plot(t, report.predicted_before[first, j], linewidth=0.7, label="rigid body")
-        ax.plot(t, report.predicted_after[first, j], linewidth=0.7, label="with effects")
+        ax.plot(t, measured[:, j], "k", linewidth=0.8, label="measured")
+        ax.plot(t, report.predicted_before[:, j], linewidth=0.7, label="rigid body")
+        ax.plot(t, report.predicted_after[:, j], linewidth=0.7, label="with effects")
         ax.set_ylabel(f"{name}\nτ [Nm]", fontsize=7)
         ax = axes[j, 1]
-        ax.plot(t, measured[first, j] - report.predicted_before[first, j], linewidth=0.7,
+        ax.plot(t, measured[:, j] - report.predicted_before[:, j], linewidth=0.7,
                 label=f"before: RMS {report.rms_before[j]:.3f} Nm")
-        ax.plot(t, measured[first, j] - report.predicted_after[first, j], linewidth=0.7,
+        ax.plot(t, measured[:, j] - report.predicted_after[:, j], linewidth=0.7,
                 label=f"after: RMS {report.rms_after[j]:.3f} Nm")
         ax.set_ylabel("residual [Nm]", fontsize=7)
         ax.legend(fontsize=6, loc="upper right")
@@ -247,7 +258,7 @@ def plot_identification(path: Path, report) -> Path:
             a.grid(alpha=0.3)
             a.tick_params(labelsize=7)
     axes[0, 0].legend(fontsize=6, loc="upper right")
-    axes[0, 0].set_title("validation data (first held-out run or blocks)", fontsize=9)
+    axes[0, 0].set_title("validation data (every held-out run and block, laid end to end)", fontsize=9)
     axes[0, 1].set_title("residual before / after the effects", fontsize=9)
     for a in axes[-1]:
         a.set_xlabel("time [s]")

@@ -282,3 +282,23 @@ def test_validate_scores_a_report_on_other_runs(tmp_path):
     assert result.exit_code == 2 and "other joints" in result.output
     result = runner.invoke(app, ["validate", str(HERE / "panda_capsules.yaml"), str(tmp_path / "val.yaml")])
     assert result.exit_code == 2 and "Traceback" not in result.output
+
+
+@pytest.mark.skipif(not (SHARED / "exciting_traj_1.csv").exists(), reason="shared Panda data not present")
+def test_report_has_per_run_validation_errors(tmp_path):
+    config = yaml.safe_load((HERE.parent / "configs" / "panda_identify_phase.yaml").read_text())
+    runs = config["data"]["runs"]
+    for run in runs:
+        run["file"] = str(SHARED / "exciting_traj_1.csv")
+    runs[2:] = [{"file": str(SHARED / "exciting_traj_1.csv"), "crop": crop, "role": "validation"}
+                for crop in ([7.8, 10.5], [10.5, 13.2])]  # the unseen phase as two runs
+    config["output"] = str(tmp_path / "r.h5")
+    result = runner.invoke(app, ["identify", str(write_config(tmp_path, config, "r.yaml"))], env={"COLUMNS": "200"})
+    assert result.exit_code == 0, result.output
+    with h5py.File(tmp_path / "r.h5") as f:
+        table = f["identification/validation_runs"][()]
+        rms_after = f["identification/rms_after"][()]
+    assert [r.decode() for r in table["run"]] == ["exciting_traj_1.csv [7.8, 10.5] s", "exciting_traj_1.csv [10.5, 13.2] s"]
+    # the runs' mean squared errors, weighted by their instants, make up the whole validation's
+    total = (table["instants"][:, None] * table["rms_after"] ** 2).sum(axis=0) / table["instants"].sum()
+    np.testing.assert_allclose(np.sqrt(total), rms_after, rtol=1e-9)

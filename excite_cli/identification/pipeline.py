@@ -36,6 +36,7 @@ class Report:
         cutoff: low-pass cut-off of every run [Hz].
         fit_samples, validation_samples: instants used for fitting / validation.
         dropped: (file, rows) left out as unusable, per run with ``data.bad_rows: drop``.
+        run_names: (runs,) each configured run's file name (with its crop), indexed by ``Dataset.run``.
         consistent: the physically consistent fit with the same effects, or None.
         rms_consistent: (n,) its validation torque RMS error [Nm] (None without it).
     """
@@ -53,6 +54,7 @@ class Report:
     fit_samples: int
     validation_samples: int
     dropped: list[tuple[str, int]] = field(default_factory=list)
+    run_names: list[str] = field(default_factory=list)
     consistent: ConsistentFit | None = None
     rms_consistent: np.ndarray | None = None
 
@@ -65,6 +67,18 @@ class Report:
     def relative_after(self) -> np.ndarray:
         """(n,) RMS error / RMS torque [%] after."""
         return 100.0 * self.rms_after / self.rms_torque
+
+    def per_run(self) -> list[tuple[str, int, np.ndarray, np.ndarray, np.ndarray]]:
+        """(run name, instants, RMS error before (n,) [Nm], after (n,) [Nm], RMS torque (n,) [Nm]) of
+        each validation run."""
+        measured = self.validation.tau.reshape(-1, len(self.joints))
+        out = []
+        for r in np.unique(self.validation.run):
+            rows = self.validation.run == r
+            rms = [np.sqrt(np.mean((measured[rows] - p[rows]) ** 2, axis=0)) for p in (self.predicted_before, self.predicted_after)]
+            torque = np.sqrt(np.mean(measured[rows] ** 2, axis=0))
+            out.append((self.run_names[r] if r < len(self.run_names) else str(r), int(rows.sum()), *rms, torque))
+        return out
 
     @property
     def relative_consistent(self) -> np.ndarray | None:
@@ -137,6 +151,7 @@ def run_identification(problem: IdentifyProblem) -> tuple[Report, Robot, BasePar
         fit_samples=fit_data.time.size,
         validation_samples=val_data.time.size,
         dropped=dropped,
+        run_names=[Path(r.file).name + (f" [{r.crop[0]:g}, {r.crop[1]:g}] s" if r.crop else "") for r in problem.data.runs],
         consistent=consistent,
         rms_consistent=rms_consistent,
     )
