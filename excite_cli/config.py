@@ -250,6 +250,11 @@ class RunConfig(_Section):
     crop: Optional[tuple[float, float]] = None
     role: Literal["fit", "validation", "blocks"] = "blocks"
 
+    @property
+    def label(self) -> str:
+        """The file name with the crop, for tables and reports, e.g. ``run.csv [7.8, 13.2] s``."""
+        return Path(self.file).name + (f" [{self.crop[0]:g}, {self.crop[1]:g}] s" if self.crop else "")
+
 
 class DataConfig(_Section):
     """Measured runs, their columns, angle unit, torque constants [Nm/A], signs, validation blocks,

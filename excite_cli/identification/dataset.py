@@ -114,7 +114,7 @@ def build_datasets(robot: Robot, base: BaseParameters, samples: list[Samples], c
                                             .reshape(-1, n * b), s.time.size):
             part = mask[start : start + chunk.shape[0]]
             for side in (True, False):
-                first = at[side] + int(np.count_nonzero(mask[:start] == side))
+                first = at[side] + int(np.searchsorted(rows[side], start))  # this side's rows before the chunk
                 picked = chunk[part == side]
                 out[side]["Y"][first : first + picked.shape[0]] = picked
         for side in (True, False):

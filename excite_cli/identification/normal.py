@@ -53,20 +53,25 @@ class NormalEquations:
         """Number of unknowns of the model [Y_B, ``effects``]."""
         return self.b + sum(self.local[j][(e, j)].size for e, j in effects)
 
+    def _placement(self, effects: list[tuple[str, int]]) -> list[tuple[np.ndarray, np.ndarray]]:
+        """Per joint j, (indices in j's local pieces, indices among the model's unknowns) of the base
+        parameters and of j's effects in the model [Y_B, ``effects``]."""
+        base = np.arange(self.b)
+        local, glob = [[base] for _ in range(self.n)], [[base] for _ in range(self.n)]
+        start = self.b
+        for e, j in effects:
+            columns = self.local[j][(e, j)]
+            local[j].append(columns)
+            glob[j].append(np.arange(start, start + columns.size))
+            start += columns.size
+        return [(np.concatenate(l), np.concatenate(g)) for l, g in zip(local, glob)]
+
     def system(self, weights: np.ndarray | None, effects: list[tuple[str, int]]) -> tuple[np.ndarray, np.ndarray, float]:
         """(G, c, s) of the model [Y_B, ``effects``] (unknowns in that order) with joint weights (n,)."""
         m = self.columns(effects)
         G, c, s = np.zeros((m, m)), np.zeros(m), 0.0
-        place, start = [], self.b
-        for e, j in effects:
-            size = self.local[j][(e, j)].size
-            place.append((j, self.local[j][(e, j)], np.arange(start, start + size)))
-            start += size
-        for j in range(self.n):
+        for j, (local, glob) in enumerate(self._placement(effects)):
             w2 = 1.0 if weights is None else float(weights[j]) ** 2
-            mine = [(loc, glob) for jj, loc, glob in place if jj == j]
-            local = np.concatenate([np.arange(self.b)] + [loc for loc, _ in mine])
-            glob = np.concatenate([np.arange(self.b)] + [g for _, g in mine])
             G[np.ix_(glob, glob)] += w2 * self.G[j][np.ix_(local, local)]
             c[glob] += w2 * self.c[j][local]
             s += w2 * self.s[j]
@@ -75,24 +80,23 @@ class NormalEquations:
     def joint_sse(self, x: np.ndarray, effects: list[tuple[str, int]]) -> np.ndarray:
         """(n,) unweighted residual sum of squares of each joint [Nm²] for coefficients x."""
         out = np.zeros(self.n)
-        start, blocks = self.b, []
-        for e, j in effects:
-            size = self.local[j][(e, j)].size
-            blocks.append((j, self.local[j][(e, j)], np.arange(start, start + size)))
-            start += size
-        for j in range(self.n):
-            local = np.concatenate([np.arange(self.b)] + [loc for jj, loc, _ in blocks if jj == j])
-            xj = x[np.concatenate([np.arange(self.b)] + [g for jj, _, g in blocks if jj == j])]
+        for j, (local, glob) in enumerate(self._placement(effects)):
+            xj = x[glob]
             G = self.G[j][np.ix_(local, local)]
             out[j] = max(self.s[j] - 2.0 * xj @ self.c[j][local] + xj @ G @ xj, 0.0)
         return out
 
 
-def solve(G: np.ndarray, c: np.ndarray) -> np.ndarray:
-    """x of G x = c, columns scaled to unit diagonal (minimum-norm where G is singular)."""
+def _unit_diagonal(G: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """G scaled to unit diagonal, D⁻¹GD⁻¹, and the scales d = sqrt(diag G) (1 where 0)."""
     d = np.sqrt(np.diag(G))
     d[d == 0] = 1.0
-    scaled = G / np.outer(d, d)
+    return G / np.outer(d, d), d
+
+
+def solve(G: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """x of G x = c, columns scaled to unit diagonal (minimum-norm where G is singular)."""
+    scaled, d = _unit_diagonal(G)
     try:
         z = scipy.linalg.cho_solve(scipy.linalg.cho_factor(scaled), c / d)
     except np.linalg.LinAlgError:
@@ -108,9 +112,7 @@ def sse(G: np.ndarray, c: np.ndarray, s: float, x: np.ndarray) -> float:
 def outside_fraction(G: np.ndarray, model: int) -> float:
     """Fraction of the squared norm of the last columns (after the first ``model``) outside the span
     of the first ones: the Schur complement's trace over the block's, with unit-diagonal scaling."""
-    d = np.sqrt(np.diag(G))
-    d[d == 0] = 1.0
-    scaled = G / np.outer(d, d)
+    scaled, _ = _unit_diagonal(G)
     S, C, SC = scaled[:model, :model], scaled[model:, model:], scaled[:model, model:]
     inside = SC.T @ np.linalg.lstsq(S, SC, rcond=1e-13)[0]
     return float(np.trace(C - inside) / max(np.trace(C), 1e-300))
@@ -118,7 +120,6 @@ def outside_fraction(G: np.ndarray, model: int) -> float:
 
 def covariance_diagonal(G: np.ndarray) -> np.ndarray:
     """diag(G⁻¹) with unit-diagonal scaling."""
-    d = np.sqrt(np.diag(G))
-    d[d == 0] = 1.0
-    inverse = np.linalg.pinv(G / np.outer(d, d), rcond=1e-13, hermitian=True)
+    scaled, d = _unit_diagonal(G)
+    inverse = np.linalg.pinv(scaled, rcond=1e-13, hermitian=True)
     return np.diag(inverse) / d**2

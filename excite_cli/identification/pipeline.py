@@ -151,7 +151,7 @@ def run_identification(problem: IdentifyProblem) -> tuple[Report, Robot, BasePar
         fit_samples=fit_data.time.size,
         validation_samples=val_data.time.size,
         dropped=dropped,
-        run_names=[Path(r.file).name + (f" [{r.crop[0]:g}, {r.crop[1]:g}] s" if r.crop else "") for r in problem.data.runs],
+        run_names=[r.label for r in problem.data.runs],
         consistent=consistent,
         rms_consistent=rms_consistent,
     )

@@ -87,6 +87,5 @@ def validate_model(report: Path, problem: IdentifyProblem) -> list[RunError]:
         predicted = predict(data, np.concatenate([model["base"], model["coefficients"]]), effects)
         measured = data.tau.reshape(-1, data.n)
         rms = np.sqrt(np.mean((measured - predicted) ** 2, axis=0))
-        name = Path(run.file).name + (f" [{run.crop[0]:g}, {run.crop[1]:g}] s" if run.crop else "")
-        errors.append(RunError(name, rms, 100.0 * rms / np.sqrt(np.mean(measured**2, axis=0)), data.time.size))
+        errors.append(RunError(run.label, rms, 100.0 * rms / np.sqrt(np.mean(measured**2, axis=0)), data.time.size))
     return errors
