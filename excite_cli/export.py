@@ -23,6 +23,8 @@ from excite_cli.playback import check_motion, plan_playback
 MAX_RATE = 100_000.0
 #: Most periods accepted.
 MAX_PERIODS = 1000
+#: Most samples in one file (about 1.3 GB of CSV with 7 joints).
+MAX_SAMPLES = 20_000_000
 FORMATS = ("csv", "npz")
 
 
@@ -59,7 +61,8 @@ def export_trajectory(result: Path, iteration: int | None = None, rate: float = 
 
     Raises:
         ExciteError: not an excite result, an iteration it does not have, a rate or period count out
-            of range, or samples that violate a constraint (the message names it).
+            of range or together more than ``MAX_SAMPLES`` samples, or samples that violate a
+            constraint (the message names it).
     """
     if not (np.isfinite(rate) and 0.0 < rate <= MAX_RATE):
         raise ExciteError(f"--rate: must be in (0, {MAX_RATE:g}] Hz (got {rate:g})")
@@ -77,6 +80,9 @@ def export_trajectory(result: Path, iteration: int | None = None, rate: float = 
         raise ExciteError(f"{result}: iteration {k} has α of shape {alpha.shape}, its config needs "
                           f"{(excitation.robot.n_joints, excitation.trajectory.n_coefficients)}")
     playback = plan_playback(excitation, alpha, periods)
+    if playback.duration * rate > MAX_SAMPLES:
+        raise ExciteError(f"--rate / --periods: {playback.duration:.0f} s at {rate:g} Hz is {playback.duration * rate:.3g} samples; "
+                          f"at most {MAX_SAMPLES:.0e} fit in one file (lower the rate or the periods)")
     time, q, qd, qdd = playback.sample(rate)
     violation, worst = check_motion(excitation.constraints, time, q, qd, qdd)
     if violation > 0.0:

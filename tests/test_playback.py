@@ -110,6 +110,7 @@ def test_export_npz_has_the_same_samples(panda_runs, tmp_path):
     (["-k", "9"], "--iteration"),
     (["--rate", "0"], "--rate"),
     (["--periods", "0"], "--periods"),
+    (["--rate", "100000", "--periods", "1000"], "samples"),
 ])
 def test_export_rejects_bad_options_without_writing(panda_runs, tmp_path, args, message):
     target = tmp_path / "x.csv"
