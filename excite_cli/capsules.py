@@ -11,6 +11,7 @@ import pinocchio as pin
 from excite_cli.config import SelfCollisionConfig
 from excite_cli.errors import ExciteError
 from excite_cli.geometry import link_points, links_with_geometry
+from excite_cli.kinematics import BatchKinematics
 from excite_cli.robot import Robot
 
 
@@ -131,40 +132,41 @@ def capsule_frame(capsule: Capsule) -> pin.SE3:
     return pin.SE3(np.column_stack([x, np.cross(z, x), z]), (capsule.start + capsule.end) / 2.0)
 
 
-def capsule_placements(robot: Robot, capsules: list[Capsule], Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def capsule_placements(kinematics: BatchKinematics, capsules: list[Capsule], Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """World placements of every capsule's centred frame (z along the axis) at each configuration of
     the active joints Q (T, n): rotations (T, C, 3, 3) and centres (T, C, 3) [m]."""
+    R, p = kinematics.placements(Q)
+    joints = [c.joint for c in capsules]
     local = [capsule_frame(c) for c in capsules]
-    joints = sorted({c.joint for c in capsules})
-    column = {joint: k for k, joint in enumerate(joints)}
-    R = np.zeros((Q.shape[0], len(joints), 3, 3))
-    p = np.zeros((Q.shape[0], len(joints), 3))
-    for t, q in enumerate(Q):
-        qf = robot.q_reference.copy()
-        qf[robot.q_idx] = q
-        pin.forwardKinematics(robot.model, robot.data, qf)
-        for k, joint in enumerate(joints):
-            R[t, k], p[t, k] = robot.data.oMi[joint].rotation, robot.data.oMi[joint].translation
-    idx = [column[c.joint] for c in capsules]
     local_R = np.stack([m.rotation for m in local])
     local_p = np.stack([m.translation for m in local])
-    rotations = np.einsum("tcij,cjk->tcik", R[:, idx], local_R)
-    centres = np.einsum("tcij,cj->tci", R[:, idx], local_p) + p[:, idx]
+    rotations = np.einsum("tcij,cjk->tcik", R[:, joints], local_R)
+    centres = np.einsum("tcij,cj->tci", R[:, joints], local_p) + p[:, joints]
     return rotations, centres
 
 
-def segment_distances(p1: np.ndarray, q1: np.ndarray, p2: np.ndarray, q2: np.ndarray) -> np.ndarray:
-    """Distances [m] between segments [p1, q1] and [p2, q2], vectorized over leading axes (..., 3).
+def segment_ends(kinematics: BatchKinematics, capsules: list[Capsule], Q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Every capsule's segment in the world frame at each configuration of the active joints Q (T, n):
+    start and end points (3, T, C) [m] (coordinates first, see :func:`segment_closest_points`), with
+    the joint placements they came from (:meth:`BatchKinematics.placements`: rotations (T, J, 3, 3),
+    origins (T, J, 3))."""
+    R, p = kinematics.placements(Q)
+    joints = [c.joint for c in capsules]
+    starts, ends = np.stack([c.start for c in capsules]), np.stack([c.end for c in capsules])
+    Rc, pc = R[:, joints], p[:, joints]
+    return (np.einsum("tcij,cj->itc", Rc, starts) + pc.transpose(2, 0, 1),
+            np.einsum("tcij,cj->itc", Rc, ends) + pc.transpose(2, 0, 1), R, p)
 
-    Closest points of two segments (Ericson, Real-Time Collision Detection, 2005, Sec. 5.1.9),
-    degenerate (point) segments included. Used to screen where exact capsule distances are needed.
+
+def segment_closest_points(p1: np.ndarray, q1: np.ndarray, p2: np.ndarray, q2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Closest points c1 on segment [p1, q1] and c2 on [p2, q2] [m], vectorized: every array has its
+    coordinates on the first axis, (3, ...) (contiguous coordinate planes are faster here).
+
+    Ericson, Real-Time Collision Detection, 2005, Sec. 5.1.9, degenerate (point) segments included.
+    The distance of two capsules is |c2 − c1| minus their radii, its normal (c2 − c1)/|c2 − c1|.
     """
     d1, d2, r = q1 - p1, q2 - p2, p1 - p2
-    a = np.einsum("...x,...x->...", d1, d1)
-    e = np.einsum("...x,...x->...", d2, d2)
-    f = np.einsum("...x,...x->...", d2, r)
-    c = np.einsum("...x,...x->...", d1, r)
-    b = np.einsum("...x,...x->...", d1, d2)
+    a, e, f, c, b = _dot(d1, d1), _dot(d2, d2), _dot(d2, r), _dot(d1, r), _dot(d1, d2)
     tiny = 1e-12
     safe_a, safe_e = np.where(a > tiny, a, 1.0), np.where(e > tiny, e, 1.0)
     denom = a * e - b * b
@@ -175,5 +177,15 @@ def segment_distances(p1: np.ndarray, q1: np.ndarray, p2: np.ndarray, q2: np.nda
     # degenerate segments: the first a point (s = 0), the second a point (t = 0), or both
     s = np.where(a <= tiny, 0.0, np.where(e <= tiny, np.clip(-c / safe_a, 0.0, 1.0), s))
     t = np.where(e <= tiny, 0.0, np.where(a <= tiny, np.clip(f / safe_e, 0.0, 1.0), t))
-    gap = (p1 + s[..., None] * d1) - (p2 + t[..., None] * d2)
-    return np.linalg.norm(gap, axis=-1)
+    return p1 + s * d1, p2 + t * d2
+
+
+def segment_distances(p1: np.ndarray, q1: np.ndarray, p2: np.ndarray, q2: np.ndarray) -> np.ndarray:
+    """Distances [m] between segments [p1, q1] and [p2, q2], coordinates on the first axis (3, ...)
+    (:func:`segment_closest_points`)."""
+    c1, c2 = segment_closest_points(p1, q1, p2, q2)
+    return np.sqrt(_dot(c2 - c1, c2 - c1))
+
+
+def _dot(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    return x[0] * y[0] + x[1] * y[1] + x[2] * y[2]

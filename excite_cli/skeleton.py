@@ -7,7 +7,8 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from excite_cli.capsules import Capsule, capsule_placements
+from excite_cli.capsules import Capsule, segment_ends
+from excite_cli.kinematics import BatchKinematics
 from excite_cli.robot import Robot
 
 
@@ -27,6 +28,5 @@ def capsule_segments(robot: Robot, capsules: list[Capsule], q: np.ndarray) -> np
     """(C, 2, 3) world end points [m] of every capsule's segment at the posture q (n,) [rad]."""
     if not capsules:
         return np.zeros((0, 2, 3))
-    rotations, centres = capsule_placements(robot, capsules, q[None, :])
-    half = np.array([np.linalg.norm(c.end - c.start) / 2.0 for c in capsules])[:, None] * rotations[0, :, :, 2]
-    return np.stack([centres[0] - half, centres[0] + half], axis=1)
+    start, end, _, _ = segment_ends(BatchKinematics(robot), capsules, q[None, :])
+    return np.stack([start[:, 0].T, end[:, 0].T], axis=1)

@@ -5,6 +5,7 @@ from pathlib import Path
 
 import coal
 import numpy as np
+import pinocchio as pin
 import pytest
 import yaml
 
@@ -55,14 +56,41 @@ def test_panda_capsule_jacobian_matches_finite_differences(panda):
     assert constraint_jacobian_error(constraint, alpha) < 1e-6
 
 
-def test_screened_distances_equal_coal(panda):
-    constraint = panda.constraints[1]
-    alpha = _lively(panda, 3)
-    rotations, centres = capsule_placements(panda.robot, constraint.capsules, panda.grid_basis.q @ alpha.T)
-    screened = constraint._screen(rotations, centres)
-    for t in range(0, screened.shape[0], 7):
-        for p in range(len(constraint.pairs)):
-            assert screened[t, p] == pytest.approx(constraint._distance(rotations, centres, t, p).min_distance, abs=1e-9)
+@pytest.mark.parametrize("robot", ["panda", "g1"])
+def test_closed_form_distances_and_witness_points_equal_coal(robot, request):
+    excitation = request.getfixturevalue(robot)
+    constraint = excitation.constraints[-1]
+    Q = excitation.grid_basis.q @ _lively(excitation, 3).T
+    d, c1, c2, _, _ = constraint._closest(Q)
+    rotations, centres = capsule_placements(constraint.kinematics, constraint.capsules, Q)
+    radii = np.array([c.radius for c in constraint.capsules])
+    for t in range(0, d.shape[0], 7):
+        for p, (i, j) in enumerate(constraint.pairs):
+            exact = constraint._distance(rotations, centres, t, p)
+            assert d[t, p] == pytest.approx(exact.min_distance, abs=1e-9)
+            normal = (c2[t, p] - c1[t, p]) / np.linalg.norm(c2[t, p] - c1[t, p])
+            np.testing.assert_allclose(c1[t, p] + radii[i] * normal, exact.getNearestPoint1(), atol=1e-6)
+            np.testing.assert_allclose(c2[t, p] - radii[j] * normal, exact.getNearestPoint2(), atol=1e-6)
+
+
+@pytest.mark.parametrize("robot", ["panda", "g1"])
+def test_batched_kinematics_equal_pinocchio(robot, request):
+    excitation = request.getfixturevalue(robot)
+    model, kinematics = excitation.robot.model, excitation.constraints[-1].kinematics
+    data = model.createData()
+    Q = excitation.grid_basis.q @ _lively(excitation, 4).T
+    R, p = kinematics.placements(Q)
+    for t in range(0, Q.shape[0], 5):
+        state = excitation.robot.state(Q[t], 0 * Q[t], 0 * Q[t])[0]
+        pin.computeJointJacobians(model, data, state)
+        for j in range(1, model.njoints):
+            np.testing.assert_allclose(R[t, j], data.oMi[j].rotation, atol=1e-12)
+            np.testing.assert_allclose(p[t, j], data.oMi[j].translation, atol=1e-12)
+        point, normal = p[t, -1] + [0.1, -0.05, 0.2], np.array([0.6, 0.0, 0.8])
+        J = pin.getJointJacobian(model, data, model.njoints - 1, pin.LOCAL_WORLD_ALIGNED)[:, excitation.robot.v_idx]
+        expected = normal @ (J[:3] - pin.skew(point - p[t, -1]) @ J[3:])
+        got = kinematics.distance_rates(R[t:t + 1], p[t:t + 1], point[None, None], normal[None, None])
+        np.testing.assert_allclose(got[0, 0] * kinematics.ancestors[-1], expected, atol=1e-12)
 
 
 def test_segment_distance_closed_forms():
@@ -81,7 +109,7 @@ def test_fitted_capsule_covers_its_points():
     rng = np.random.default_rng(0)
     points = rng.normal(size=(500, 3)) * [0.2, 0.03, 0.02] + [0.1, -0.2, 0.3]
     radius, start, end = fit_capsule(points)
-    assert segment_distances(np.broadcast_to(start, points.shape), np.broadcast_to(end, points.shape), points, points).max() <= radius + 1e-12
+    assert segment_distances(np.broadcast_to(start[:, None], points.T.shape), np.broadcast_to(end[:, None], points.T.shape), points.T, points.T).max() <= radius + 1e-12
     assert np.linalg.norm(end - start) > 0.5  # along the long axis
 
 
@@ -107,9 +135,7 @@ def test_colliding_pair_at_home_is_named(tmp_path):
 def test_capsules_follow_the_links(panda):
     constraint = panda.constraints[1]
     q = panda.home[None]
-    rotations, centres = capsule_placements(panda.robot, constraint.capsules, q)
-    import pinocchio as pin
-
+    rotations, centres = capsule_placements(constraint.kinematics, constraint.capsules, q)
     robot = panda.robot
     pin.forwardKinematics(robot.model, robot.data, robot.state(q[0], 0 * q[0], 0 * q[0])[0])
     pin.updateFramePlacements(robot.model, robot.data)
