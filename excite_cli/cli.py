@@ -30,6 +30,7 @@ from excite_cli.identification.validate import validate_model
 from excite_cli.output import read_last_alpha, read_prior, read_table, write_identification, write_result
 from excite_cli.plots import plot_comparison, plot_identification, plot_result
 from excite_cli.random_baseline import draw_pool, greedy_selection, pool_convergence
+from excite_cli.restarts import Restarts, default_workers
 from excite_cli.sequence import IterationResult, describe, run_sequence
 from excite_cli.verify import check_gradient, constraint_jacobian_error
 
@@ -95,9 +96,12 @@ def _optimize(problem: Problem, excitation: Excitation, target: Path) -> list[It
         }
 
         def progress(k: int):
+            steps: dict[int, int] = {}
+
             def hook(restart: int, it: int, value: float) -> None:
+                steps[restart] = it
                 c = np.exp(value) if opts.objective == "log_cond" else value
-                bar.update(tasks[k], completed=restart * opts.max_iterations + it,
+                bar.update(tasks[k], completed=sum(steps.values()),
                            status=f"restart {restart + 1}/{opts.restarts} · cond {c:.1f}")
             return hook
 
@@ -110,8 +114,10 @@ def _optimize(problem: Problem, excitation: Excitation, target: Path) -> list[It
                 err.print(f"iteration {result.index}: cond(C(i)) {result.cond_own:.1f}, cond(C) {result.cond_stacked:.1f}, "
                           f"{result.wall_time_s:.0f} s", highlight=False)
 
+        workers = min(opts.workers or default_workers(), opts.restarts)
         try:
-            run_sequence(excitation, problem.sequence.iterations, opts.seed, prior, progress, done)
+            with Restarts(excitation, workers, opts.scheduler) as engine:
+                run_sequence(excitation, problem.sequence.iterations, opts.seed, prior, progress, done, engine)
         except KeyboardInterrupt:
             err.print(f"interrupted: kept {len(finished)} finished iteration(s) in {target}")
             raise typer.Exit(130) from None
@@ -125,6 +131,8 @@ def optimize(
     output: Optional[Path] = typer.Option(None, "--output", "-o", help="HDF5 result file (overrides config 'output')."),
     iterations: Optional[int] = typer.Option(None, "--iterations", "-k", min=1, help="Sequential iterations (overrides sequence.iterations)."),
     seed: Optional[int] = typer.Option(None, "--seed", help="Seed of the random starts (overrides optimizer.seed)."),
+    workers: Optional[int] = typer.Option(None, "--workers", min=1, help="Local processes for the restarts (overrides optimizer.workers)."),
+    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="Dask scheduler address, e.g. tcp://host:8786 (overrides optimizer.scheduler)."),
 ) -> None:
     """Optimize Fourier trajectories minimizing cond of the stacked base regressor, sequentially.
 
@@ -136,6 +144,10 @@ def optimize(
         problem.sequence.iterations = iterations
     if seed is not None:
         problem.optimizer.seed = seed
+    if workers is not None:
+        problem.optimizer.workers = workers
+    if scheduler is not None:
+        problem.optimizer.scheduler = scheduler
     target = output if output is not None else Path(problem.output)
     excitation = build_excitation(problem)
     finished = _optimize(problem, excitation, target)

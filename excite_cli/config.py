@@ -105,7 +105,8 @@ class ConstraintsConfig(_Section):
 
 
 class OptimizerConfig(_Section):
-    """SLSQP settings: objective, iterations, tolerance, seed, restarts."""
+    """SLSQP settings: objective, iterations, tolerance, seed, restarts, and where restarts run
+    (``workers`` local processes, default the machine's cores; or a Dask ``scheduler`` address)."""
 
     method: Literal["SLSQP"] = "SLSQP"
     objective: Literal["log_cond", "cond"] = "log_cond"
@@ -113,6 +114,8 @@ class OptimizerConfig(_Section):
     tolerance: float = Field(1e-6, gt=0.0)
     seed: int = 0
     restarts: int = Field(3, ge=1)
+    workers: Optional[int] = Field(None, ge=1)
+    scheduler: Optional[str] = None
 
 
 class RandomBaselineConfig(_Section):

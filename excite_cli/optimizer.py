@@ -24,22 +24,30 @@ ProgressHook = Callable[[int, int, float], None]
 
 
 @dataclass(frozen=True)
-class OptimizationResult:
-    """Best of the restarts.
+class RestartResult:
+    """The best accepted point of one restart.
 
     Attributes:
+        index: the restart's number within its iteration, 0-based.
         alpha: (n, 2N+1) Fourier coefficients.
         objective: criterion value at ``alpha`` (log cond or cond).
-        iterations: SLSQP iterations summed over the restarts.
-        message: SLSQP's message for the best restart.
-        wall_time_s: wall time of all restarts [s].
+        iterations: SLSQP iterations.
+        message: SLSQP's message.
+        wall_time_s: wall time of the restart [s].
     """
 
+    index: int
     alpha: np.ndarray
     objective: float
     iterations: int
     message: str
     wall_time_s: float
+
+
+def best_restart(results: Sequence[RestartResult]) -> RestartResult:
+    """The restart with the lowest objective; ties go to the lower index (so the choice does not
+    depend on the order results arrive in)."""
+    return min(results, key=lambda r: (r.objective, r.index))
 
 
 def _stack(constraints: Sequence[Constraint], alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -77,40 +85,35 @@ def repair(constraints: Sequence[Constraint], alpha: np.ndarray, feasible: np.nd
     return feasible + lo * (alpha - feasible)
 
 
-def optimize_trajectory(
+def optimize_restart(
     criterion: ConditionNumber,
     constraints: Sequence[Constraint],
     options: OptimizerConfig,
-    rng: np.random.Generator,
-    start: Callable[[np.random.Generator], np.ndarray],
+    start: np.ndarray,
     boundary: BoundaryConditions,
+    index: int = 0,
     progress: Optional[ProgressHook] = None,
-    warm_start: Optional[np.ndarray] = None,
-) -> OptimizationResult:
-    """Minimize the criterion over α from ``options.restarts`` random feasible starts.
+) -> RestartResult:
+    """Minimize the criterion over α with SLSQP from one feasible start.
 
     SLSQP works on the variables z of ``boundary`` (α = s ⊙ (w* + Z z): the boundary conditions
     hold exactly, with diagonal preconditioning s, see :mod:`excite_cli.boundary`); everything else
     sees α.
 
-    SQP iterates approach the constraint boundary from outside, so each restart ends with the best
-    of: the best point whose aggregated constraints were all ≤ 0, and the repaired last iterate
-    (:func:`repair`); both are confirmed by every constraint's exact grid check.
+    SQP iterates approach the constraint boundary from outside, so the restart ends with the best
+    of: the start, the best point whose aggregated constraints were all ≤ 0, and the repaired last
+    iterate (:func:`repair`); each is confirmed by every constraint's exact grid check.
 
     Args:
-        criterion: the condition-number criterion (value and gradient).
+        criterion: the criterion (value and gradient).
         constraints: all constraints (values and Jacobians, exact checks, repairs).
-        options: method, iterations, tolerance, restarts.
-        rng: random generator of the starts.
-        start: draws a random α (n, 2N+1) that every constraint and the boundary conditions accept.
+        options: method, iterations, tolerance.
+        start: (n, 2N+1) α that every constraint and the boundary conditions accept.
         boundary: the boundary conditions and the optimizer's coordinates.
+        index: the restart's number (passed to ``progress`` and kept in the result).
         progress: called after every SLSQP iteration.
-        warm_start: an accepted α (n, 2N+1) to start the first restart from instead of a random one
-            (the sequence passes the previous iteration's optimum).
-
-    Returns:
-        The best accepted point over all restarts.
     """
+    begin = time.perf_counter()
     cache: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
 
     def constraint_values(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -132,47 +135,25 @@ def optimize_trajectory(
             inside.update(value=value, x=alpha.copy())
         return value, boundary.chain(grad.ravel())
 
-    begin = time.perf_counter()
-    best: Optional[tuple[float, np.ndarray, str]] = None
-    total_iterations = 0
-    for restart in range(options.restarts):
-        x0 = warm_start.copy() if (restart == 0 and warm_start is not None) else start(rng)
-        inside.clear()
-        counter = [0]
+    counter = [0]
 
-        def callback(xk: np.ndarray, restart: int = restart, counter: list = counter) -> None:
-            counter[0] += 1
-            if progress is not None:
-                progress(restart, counter[0], last_value[0])
+    def callback(xk: np.ndarray) -> None:
+        counter[0] += 1
+        if progress is not None:
+            progress(index, counter[0], last_value[0])
 
-        result = minimize(
-            objective,
-            boundary.to_variables(x0),
-            jac=True,
-            method=options.method,
-            constraints=[{
-                "type": "ineq",
-                "fun": lambda x: -constraint_values(x)[0],
-                "jac": lambda x: -constraint_values(x)[1],
-            }],
-            options={"maxiter": options.max_iterations, "ftol": options.tolerance},
-            callback=callback,
-        )
-        total_iterations += int(result.nit)
-        candidates = [x0, repair(constraints, boundary.to_alpha(result.x), x0, boundary)]
-        if "x" in inside:
-            candidates.append(np.asarray(inside["x"]))
-        for alpha in candidates:
-            if not _accepted(constraints, alpha):
-                continue
-            value = criterion.value(alpha)
-            if best is None or value < best[0]:
-                best = (value, alpha, str(result.message))
-    assert best is not None, "the start of every restart is accepted"
-    return OptimizationResult(
-        alpha=best[1],
-        objective=best[0],
-        iterations=total_iterations,
-        message=best[2],
-        wall_time_s=time.perf_counter() - begin,
+    result = minimize(
+        objective,
+        boundary.to_variables(start),
+        jac=True,
+        method=options.method,
+        constraints=[{"type": "ineq", "fun": lambda x: -constraint_values(x)[0], "jac": lambda x: -constraint_values(x)[1]}],
+        options={"maxiter": options.max_iterations, "ftol": options.tolerance},
+        callback=callback,
     )
+    candidates = [start, repair(constraints, boundary.to_alpha(result.x), start, boundary)]
+    if "x" in inside:
+        candidates.append(np.asarray(inside["x"]))
+    scored = [(criterion.value(alpha), k, alpha) for k, alpha in enumerate(candidates) if k == 0 or _accepted(constraints, alpha)]
+    value, _, alpha = min(scored, key=lambda item: item[:2])
+    return RestartResult(index, alpha, value, int(result.nit), str(result.message), time.perf_counter() - begin)

@@ -11,8 +11,9 @@ import numpy as np
 from excite_cli.criterion import condition_number
 from excite_cli.errors import ExciteError
 from excite_cli.excitation import Excitation
-from excite_cli.optimizer import ProgressHook, optimize_trajectory
+from excite_cli.optimizer import ProgressHook, best_restart
 from excite_cli.playback import check_motion, plan_playback
+from excite_cli.restarts import RestartTask, Restarts
 
 
 @dataclass(frozen=True)
@@ -101,12 +102,13 @@ def run_sequence(
     prior: Optional[np.ndarray] = None,
     progress: Optional[Callable[[int], ProgressHook]] = None,
     on_iteration: Optional[Callable[[IterationResult], None]] = None,
+    restarts: Optional[Restarts] = None,
 ) -> list[IterationResult]:
     """Generate ``iterations`` trajectories, each stacking the regressors of the earlier ones (Eq. 41).
 
     From iteration 2 on, the first restart starts from the previous optimum (repeating earlier data
     keeps cond(C) near cond(C₀), and random starts that satisfy tight balance constraints are far
-    from it); the other restarts are random.
+    from it); the other restarts are random, each from its own seed (:class:`RestartTask`).
 
     Args:
         excitation: the problem.
@@ -115,27 +117,24 @@ def run_sequence(
         prior: optional C_prior (m, b), e.g. from earlier measured data, stacked first.
         progress: ``progress(k)`` gives the SLSQP progress hook of iteration k.
         on_iteration: called with each finished iteration (e.g. to write it to disk at once).
+        restarts: where the restarts run (default: serially in this process).
 
     Returns:
         The K :class:`IterationResult`.
     """
-    rng = np.random.default_rng(seed)
+    if restarts is None:
+        with Restarts(excitation) as serial:
+            return run_sequence(excitation, iterations, seed, prior, progress, on_iteration, serial)
     stacked = np.zeros((0, excitation.base.count)) if prior is None else prior
     results: list[IterationResult] = []
     for k in range(1, iterations + 1):
         start = time.perf_counter()
-        criterion = excitation.criterion(stacked)
-        best = optimize_trajectory(
-            criterion,
-            excitation.constraints,
-            excitation.problem.optimizer,
-            rng,
-            excitation.random_start,
-            excitation.boundary,
-            progress=progress(k) if progress else None,
-            warm_start=results[-1].alpha if results else None,
-        )
-        result = describe(excitation, k, best.alpha, stacked, time.perf_counter() - start, best.iterations, best.message)
+        tasks = [RestartTask(k, r, seed, stacked, results[-1].alpha if (r == 0 and results) else None)
+                 for r in range(excitation.problem.optimizer.restarts)]
+        runs = restarts.run(tasks, progress(k) if progress else None)
+        best = best_restart(runs)
+        result = describe(excitation, k, best.alpha, stacked, time.perf_counter() - start,
+                          sum(r.iterations for r in runs), best.message)
         stacked = np.vstack([stacked, result.regressor])
         results.append(result)
         if on_iteration:

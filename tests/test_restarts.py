@@ -1,0 +1,73 @@
+"""Restarts in parallel: a process pool and a Dask cluster give the serial run's trajectories, bit
+for bit, for the same seed; each restart draws its own start."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import excite_cli.restarts as restarts
+from excite_cli.config import load_problem
+from excite_cli.errors import ExciteError
+from excite_cli.excitation import build_excitation
+from excite_cli.optimizer import RestartResult, best_restart
+from excite_cli.restarts import RestartTask, Restarts
+from excite_cli.sequence import run_sequence
+
+HERE = Path(__file__).resolve().parent
+
+
+@pytest.fixture(scope="module")
+def excitation():
+    """The Panda with capsules (all constraint code runs in the workers), two restarts of 15 SQP iterations."""
+    problem = load_problem(HERE / "panda_capsules.yaml")
+    problem.optimizer.restarts = 2
+    problem.optimizer.max_iterations = 15
+    return build_excitation(problem)
+
+
+@pytest.fixture(scope="module")
+def serial(excitation):
+    return run_sequence(excitation, 2, seed=5)
+
+
+def _same(a, b):
+    for x, y in zip(a, b):
+        np.testing.assert_array_equal(x.alpha, y.alpha)
+        assert x.cond_stacked == y.cond_stacked
+
+
+def test_two_workers_give_the_serial_result(excitation, serial):
+    with Restarts(excitation, workers=2) as engine:
+        parallel = run_sequence(excitation, 2, seed=5, restarts=engine)
+    _same(serial, parallel)
+    assert serial[1].cond_stacked < serial[0].cond_own  # the runs optimized something
+
+
+def test_dask_local_cluster_gives_the_serial_result(excitation, serial):
+    distributed = pytest.importorskip("dask.distributed")
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None) as cluster:
+        with Restarts(excitation, scheduler=cluster.scheduler_address) as engine:
+            on_cluster = run_sequence(excitation, 2, seed=5, restarts=engine)
+    _same(serial, on_cluster)
+
+
+def test_each_restart_draws_its_own_start(excitation):
+    prior = np.zeros((0, excitation.base.count))
+    starts = [excitation.random_start(RestartTask(1, r, 5, prior).rng()) for r in range(3)]
+    assert not np.allclose(starts[0], starts[1]) and not np.allclose(starts[1], starts[2])
+    again = excitation.random_start(RestartTask(1, 1, 5, prior).rng())
+    np.testing.assert_array_equal(again, starts[1])
+    assert not np.allclose(excitation.random_start(RestartTask(2, 1, 5, prior).rng()), starts[1])
+
+
+def test_best_restart_breaks_ties_by_index():
+    results = [RestartResult(i, np.zeros((1, 1)), value, 1, "", 0.0) for i, value in [(2, 1.0), (0, 1.0), (1, 3.0)]]
+    assert best_restart(results).index == 0
+
+
+def test_unreachable_scheduler_is_named(excitation, monkeypatch):
+    monkeypatch.setattr(restarts, "CONNECT_TIMEOUT", "1s")
+    with pytest.raises(ExciteError, match="optimizer.scheduler: cannot reach the Dask scheduler at tcp://127.0.0.1:9"):
+        with Restarts(excitation, scheduler="tcp://127.0.0.1:9"):
+            pass
