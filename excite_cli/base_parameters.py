@@ -32,12 +32,14 @@ class BaseParameters:
     Attributes:
         composition_matrix: X, (p, b): Y_B = Y X (Eq. 2).
         regrouping: K, (b, p): φ_B = K φ.
+        independent: (b,) indices of the standard parameters X selects: Y_B = Y[:, independent].
         names: (b,) readable names, e.g. ``Izz_link2 + 0.09·m_link3``.
     """
 
     composition_matrix: np.ndarray
     regrouping: np.ndarray
     names: list[str]
+    independent: np.ndarray
 
     @property
     def count(self) -> int:
@@ -90,4 +92,4 @@ def compute_base_parameters(robot: Robot, seed: int = 0, samples: int | None = N
     K[:, dependent] = beta
     names = robot.parameter_names
     labels = [_name(K[i], names, independent[i]) for i in range(b)]
-    return BaseParameters(composition_matrix=X, regrouping=K, names=labels)
+    return BaseParameters(composition_matrix=X, regrouping=K, names=labels, independent=independent)

@@ -1,6 +1,7 @@
 """Analytic gradient of cond / log cond (Eqs. 17, 45-49) against central finite differences."""
 
 import numpy as np
+import pinocchio as pin
 import pytest
 
 from conftest import small
@@ -62,3 +63,35 @@ def test_motionless_trajectory_gives_finite_value_and_gradient(panda_problem):
     value, grad = excitation.criterion().value_and_gradient(alpha)
     assert np.isfinite(value) and value > np.log(1e8)
     assert np.all(np.isfinite(grad))
+
+
+@pytest.mark.parametrize("name", ["g1_problem", "panda_problem"])
+def test_mass_shift_changes_no_torque_with_the_motion(name, request):
+    """φ_s (point masses on the joint axes, cancelled on the parents) keeps every body massive and
+    adds nothing to ∂τ/∂(q, q̇, q̈), so the gradient needs no pass of its own."""
+    problem = small(request.getfixturevalue(name), harmonics=3, samples=8)
+    problem.robot.base_wrench_rows = problem.robot.floating_base
+    excitation = build_excitation(problem)
+    criterion = excitation.criterion()
+    models, datas = criterion._virtual_models(np.zeros((excitation.robot.n_parameters, 2)))
+    assert len(models) == 2 and all(models[0].inertias[j].mass > 0.5 for j in range(1, models[0].njoints))
+    robot = excitation.robot
+    for q, qd, qdd in zip(*robot.random_states(5, np.random.default_rng(0))):
+        derivatives = pin.computeRNEADerivatives(models[0], datas[0], *robot.state(q, qd, qdd))
+        for d in derivatives:
+            assert np.abs(d[robot.row_idx][:, robot.v_idx]).max() < 1e-9
+
+
+def test_gradient_with_a_prismatic_joint(panda_problem):
+    """A moving prismatic joint (a finger) takes the shift pass: the gradient still matches."""
+    problem = small(panda_problem, harmonics=3, samples=15)
+    problem.robot.active_joints = [*problem.robot.active_joints[:3], "panda_finger_joint1"]
+    problem.robot.locked_joints.pop("panda_finger_joint1", None)
+    problem.limits.position_margin = 0.002
+    excitation = build_excitation(problem)
+    criterion = excitation.criterion()
+    alpha = _feasible_alpha(excitation)
+    _, analytic = criterion.value_and_gradient(alpha)
+    assert len(criterion._models) == 3
+    fd = finite_difference_gradient(criterion, alpha, step=1e-7, central=True)
+    assert np.linalg.norm(analytic - fd) / np.linalg.norm(fd) < 1e-6
