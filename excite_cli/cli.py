@@ -16,7 +16,7 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
 from excite_cli.config import IdentifyProblem, Problem, SimulationConfig, load_problem
-from excite_cli.criterion import ConditionNumber
+from excite_cli.criterion import OBJECTIVES
 from excite_cli.errors import ExciteError
 from excite_cli.excitation import Excitation, build_excitation
 from excite_cli.export import FORMATS, export_trajectory, write_export
@@ -374,38 +374,50 @@ def verify_gradient(
     result: Optional[Path] = typer.Option(None, "--result", "-r", help="Also check at the last iteration's optimum of this HDF5 result."),
     step: float = typer.Option(1e-6, min=1e-12, help="Finite-difference step on each Fourier coefficient."),
     seed: int = typer.Option(0, help="Seed of the random feasible trajectory."),
+    objective: Optional[list[str]] = typer.Option(None, "--objective", help=f"Criteria to check (repeatable; default all: {', '.join(OBJECTIVES)})."),
+    tolerance: float = typer.Option(1e-6, help="Largest relative error against central differences that passes."),
 ) -> None:
-    """Compare the analytic gradient of cond(C) (Eq. 49) with finite differences: error and speed."""
-    problem = load_problem(config)
-    problem.optimizer.objective = "cond"
-    excitation = build_excitation(problem)
+    """Compare the analytic gradients of the criteria (Eq. 49) with finite differences: error and
+    speed; the constraint Jacobians too. Exit status 1 when an error exceeds the tolerance."""
+    objectives = objective or list(OBJECTIVES)
+    for name in objectives:
+        if name not in OBJECTIVES:
+            raise ExciteError(f"--objective: '{name}' is not a criterion; expected one of {', '.join(OBJECTIVES)}")
+    excitation = build_excitation(load_problem(config))
     alpha = excitation.limits.random_start(excitation.trajectory.n_coefficients, np.random.default_rng(seed), fill=0.7)
-    points = [("random", excitation.criterion(), alpha)]
-    if result is not None:
-        points.append(_optimum(result, excitation))
-    table = Table(title="Analytic gradient vs finite differences (objective: cond)")
-    for column in ("point", "vars", "cond", "err central", "err 1-sided", "analytic [s]", "FD 1-sided [s]", "ratio"):
+    points = [("random", None, alpha)] + ([_optimum(result, excitation)] if result is not None else [])
+    table = Table(title="Analytic gradient vs finite differences")
+    for column in ("point", "objective", "vars", "value", "err central", "err 1-sided", "analytic [s]", "FD 1-sided [s]", "ratio"):
         table.add_column(column, justify="right")
-    for label, criterion, a in points:
-        check = check_gradient(criterion, a, step=step)
-        table.add_row(label, str(check.variables), f"{check.value:.2f}", f"{check.error_central:.2e}",
-                      f"{check.error_forward:.2e}", f"{check.analytic_s:.4f}", f"{check.forward_s:.3f}",
-                      f"{check.speedup:.0f}×")
+    errors = []
+    for label, prior, a in points:
+        for name in objectives:
+            excitation.problem.optimizer.objective = name
+            check = check_gradient(excitation.criterion(prior), a, step=step)
+            errors.append(check.error_central)
+            table.add_row(label, name, str(check.variables), f"{check.value:.4g}", f"{check.error_central:.2e}",
+                          f"{check.error_forward:.2e}", f"{check.analytic_s:.4f}", f"{check.forward_s:.3f}",
+                          f"{check.speedup:.0f}×")
     out.print(table)
     lively = excitation.limits.random_start(excitation.trajectory.n_coefficients, np.random.default_rng(seed), 0.9, excitation.home)
     jacobians = Table(title="Constraint Jacobians vs central differences (random trajectory at 90 % of the limits)")
     for column in ("constraint", "rows", "rel. error"):
         jacobians.add_column(column, justify="right")
     for c in excitation.constraints:
-        jacobians.add_row(c.name, str(c.evaluate(lively)[0].size), f"{constraint_jacobian_error(c, lively):.2e}")
+        errors.append(constraint_jacobian_error(c, lively))
+        jacobians.add_row(c.name, str(c.evaluate(lively)[0].size), f"{errors[-1]:.2e}")
     out.print(jacobians)
+    worst = max(errors)
+    out.print(f"{'PASS' if worst <= tolerance else 'FAIL'}: largest relative error {worst:.2e} (tolerance {tolerance:.0e})")
+    if worst > tolerance:
+        raise typer.Exit(1)
 
 
-def _optimum(path: Path, excitation: Excitation) -> tuple[str, ConditionNumber, np.ndarray]:
-    """The last iteration's α of a result file and its criterion, C₀ = the earlier iterations."""
+def _optimum(path: Path, excitation: Excitation) -> tuple[str, np.ndarray, np.ndarray]:
+    """The last iteration's label, C₀ (the earlier iterations' rows) and α, from a result file."""
     index, alpha = read_last_alpha(path)
     if alpha.shape != (excitation.robot.n_joints, excitation.trajectory.n_coefficients):
         raise ExciteError(f"--result: {path} was made for another problem (alpha shape {alpha.shape})")
     prior = read_prior(path, excitation.base)
     own_rows = excitation.cost_basis.time.size * excitation.robot.n_rows
-    return f"optimum {index}", excitation.criterion(prior[:-own_rows]), alpha
+    return f"optimum {index}", prior[:-own_rows], alpha

@@ -109,7 +109,7 @@ class OptimizerConfig(_Section):
     (``workers`` local processes, default the machine's cores; or a Dask ``scheduler`` address)."""
 
     method: Literal["SLSQP"] = "SLSQP"
-    objective: Literal["log_cond", "cond"] = "log_cond"
+    objective: Literal["log_cond", "cond", "log_det", "sigma_min"] = "log_cond"
     max_iterations: int = Field(200, ge=1)
     tolerance: float = Field(1e-6, gt=0.0)
     seed: int = 0

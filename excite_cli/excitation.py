@@ -18,7 +18,7 @@ from excite_cli.constraints import Constraint, JointLimits, SelfCollision
 from excite_cli.constraints.com_region import com_region_from_config
 from excite_cli.constraints.joint_limits import joint_limit_bounds
 from excite_cli.constraints.lse import GRID_MARGIN
-from excite_cli.criterion import ConditionNumber
+from excite_cli.criterion import Criterion
 from excite_cli.errors import ExciteError
 from excite_cli.robot import Robot, load_robot
 from excite_cli.trajectory import FourierBasis, FourierTrajectory, sample_times
@@ -51,14 +51,14 @@ class Excitation:
     constraints: list[Constraint]
     boundary: BoundaryConditions
 
-    def criterion(self, prior: np.ndarray | None = None) -> ConditionNumber:
-        """The condition-number criterion with C₀ = ``prior`` (m₁, b) (Eq. 41)."""
-        return ConditionNumber(
+    def criterion(self, prior: np.ndarray | None = None) -> Criterion:
+        """The criterion of ``optimizer.objective`` with C₀ = ``prior`` (m₁, b) (Eq. 41)."""
+        return Criterion(
             self.robot,
             self.base,
             self.cost_basis,
             prior=np.zeros((0, self.base.count)) if prior is None else prior,
-            log=self.problem.optimizer.objective == "log_cond",
+            objective=self.problem.optimizer.objective,
         )
 
     @property

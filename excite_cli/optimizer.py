@@ -17,7 +17,7 @@ from scipy.optimize import minimize
 from excite_cli.boundary import BoundaryConditions
 from excite_cli.config import OptimizerConfig
 from excite_cli.constraints import Constraint
-from excite_cli.criterion import ConditionNumber
+from excite_cli.criterion import Criterion
 
 #: Progress hook: (restart index, SLSQP iteration, current objective value).
 ProgressHook = Callable[[int, int, float], None]
@@ -86,7 +86,7 @@ def repair(constraints: Sequence[Constraint], alpha: np.ndarray, feasible: np.nd
 
 
 def optimize_restart(
-    criterion: ConditionNumber,
+    criterion: Criterion,
     constraints: Sequence[Constraint],
     options: OptimizerConfig,
     start: np.ndarray,

@@ -5,8 +5,9 @@ import pinocchio as pin
 import pytest
 
 from conftest import small
-from excite_cli.criterion import ConditionNumber, condition_number
+from excite_cli.criterion import Criterion, condition_number
 from excite_cli.excitation import build_excitation
+from excite_cli.virtual_dynamics import VirtualDynamics
 from excite_cli.verify import check_gradient, finite_difference_gradient
 
 
@@ -15,7 +16,7 @@ def _feasible_alpha(excitation, seed=0):
 
 
 @pytest.mark.parametrize("name", ["g1_problem", "panda_problem", "ur5_problem"])
-@pytest.mark.parametrize("objective", ["cond", "log_cond"])
+@pytest.mark.parametrize("objective", ["cond", "log_cond", "log_det", "sigma_min"])
 def test_gradient_matches_finite_differences(name, objective, request):
     problem = small(request.getfixturevalue(name))
     problem.optimizer.objective = objective
@@ -38,11 +39,24 @@ def test_gradient_with_prior_rows_and_base_wrench_rows(g1_problem):
     assert check.error_central < 1e-6
 
 
+@pytest.mark.parametrize("objective, expected", [
+    ("sigma_min", lambda s: -np.log(s[-1])),
+    ("log_det", lambda s: -np.sum(np.log(s**2)) / s.size),
+])
+def test_d_and_e_optimal_values(panda_problem, objective, expected):
+    excitation = build_excitation(small(panda_problem))
+    criterion = Criterion(excitation.robot, excitation.base, excitation.cost_basis, objective=objective)
+    alpha = _feasible_alpha(excitation, 3)
+    s = np.linalg.svd(criterion.regressor(alpha), compute_uv=False)
+    assert criterion.value(alpha) == pytest.approx(expected(s), rel=1e-12)
+    assert criterion.value_and_gradient(alpha)[0] == pytest.approx(expected(s), rel=1e-9)
+
+
 def test_value_is_the_condition_number_of_the_stacked_regressor(panda_problem):
     excitation = build_excitation(small(panda_problem))
     a, b = _feasible_alpha(excitation, 1), _feasible_alpha(excitation, 2)
     prior = excitation.criterion().regressor(a)
-    criterion = ConditionNumber(excitation.robot, excitation.base, excitation.cost_basis, prior=prior, log=False)
+    criterion = Criterion(excitation.robot, excitation.base, excitation.cost_basis, prior=prior, objective="cond")
     stacked = np.vstack([prior, criterion.regressor(b)])
     s = np.linalg.svd(stacked, compute_uv=False)
     assert criterion.value(b) == pytest.approx(s[0] / s[-1], rel=1e-12)
@@ -65,21 +79,22 @@ def test_motionless_trajectory_gives_finite_value_and_gradient(panda_problem):
     assert np.all(np.isfinite(grad))
 
 
-@pytest.mark.parametrize("name", ["g1_problem", "panda_problem"])
-def test_mass_shift_changes_no_torque_with_the_motion(name, request):
+@pytest.mark.parametrize("name, base_rows", [("g1_problem", False), ("g1_problem", True), ("panda_problem", False)])
+def test_mass_shift_changes_no_torque_with_the_motion(name, base_rows, request):
     """φ_s (point masses on the joint axes, cancelled on the parents) keeps every body massive and
     adds nothing to ∂τ/∂(q, q̇, q̈), so the gradient needs no pass of its own."""
     problem = small(request.getfixturevalue(name), harmonics=3, samples=8)
-    problem.robot.base_wrench_rows = problem.robot.floating_base
-    excitation = build_excitation(problem)
-    criterion = excitation.criterion()
-    models, datas = criterion._virtual_models(np.zeros((excitation.robot.n_parameters, 2)))
-    assert len(models) == 2 and all(models[0].inertias[j].mass > 0.5 for j in range(1, models[0].njoints))
-    robot = excitation.robot
+    problem.robot.base_wrench_rows = base_rows
+    robot = build_excitation(problem).robot
+    dynamics = VirtualDynamics(robot)
+    assert dynamics.model.nv == robot.n_joints + (6 if base_rows else 0)  # the held base is locked unless its wrench is a row
+    models, datas = dynamics._virtual_models(np.zeros((robot.n_parameters, 1)))
+    assert len(models) == 1 and all(models[0].inertias[j].mass > 0.5 for j in range(1, models[0].njoints))
     for q, qd, qdd in zip(*robot.random_states(5, np.random.default_rng(0))):
-        derivatives = pin.computeRNEADerivatives(models[0], datas[0], *robot.state(q, qd, qdd))
-        for d in derivatives:
-            assert np.abs(d[robot.row_idx][:, robot.v_idx]).max() < 1e-9
+        state = np.tile(dynamics.q_reference, 1), np.zeros(dynamics.model.nv), np.zeros(dynamics.model.nv)
+        state[0][dynamics.q_idx], state[1][dynamics.v_idx], state[2][dynamics.v_idx] = q, qd, qdd
+        for d in pin.computeRNEADerivatives(models[0], datas[0], *state):
+            assert np.abs(d[dynamics.row_idx][:, dynamics.v_idx]).max() < 1e-9
 
 
 def test_gradient_with_a_prismatic_joint(panda_problem):
@@ -92,6 +107,6 @@ def test_gradient_with_a_prismatic_joint(panda_problem):
     criterion = excitation.criterion()
     alpha = _feasible_alpha(excitation)
     _, analytic = criterion.value_and_gradient(alpha)
-    assert len(criterion._models) == 3
+    assert not criterion._dynamics.shift_free and len(criterion._dynamics._models) == 3
     fd = finite_difference_gradient(criterion, alpha, step=1e-7, central=True)
     assert np.linalg.norm(analytic - fd) / np.linalg.norm(fd) < 1e-6
