@@ -86,7 +86,8 @@ class BatchKinematics:
 
         Args:
             R, p: joint placements at T instants (:meth:`placements`).
-            points: (T, K, 3) world positions x [m]; normals: (T, K, 3) directions n.
+            points: (3, T, K) world positions x [m]; normals: (3, T, K) directions n (coordinates
+                first, as :func:`~excite_cli.capsules.segment_closest_points` gives them).
 
         Entry k is nᵀ(a_k × (x − o_k)) = a_k·(x × n) − (a_k × o_k)·n for a revolute active joint k
         (a_k its world axis, o_k its origin), nᵀa_k for a prismatic one: the velocity Jacobian of x,
@@ -95,21 +96,17 @@ class BatchKinematics:
         either point gives the same rates (x₂ × n = x₁ × n), so ∂d/∂q_k is the rate times
         ancestors[body₂, k] − ancestors[body₁, k].
         """
-        axes = np.einsum("tkij,kj->tki", R[:, self.joint_of], self.axes)      # (T, n, 3)
-        if not self.revolute.any():
-            return normals @ axes.transpose(0, 2, 1)
-        lines = np.concatenate([axes, _cross(axes, p[:, self.joint_of])], axis=2)          # (T, n, 6)
-        rates = np.concatenate([_cross(points, normals), -normals], axis=2) @ lines.transpose(0, 2, 1)
+        axes = np.einsum("tkij,kj->tik", R[:, self.joint_of], self.axes)      # (T, 3, n)
+        moments = np.cross(axes, p[:, self.joint_of].transpose(0, 2, 1), axis=1)   # a_k × o_k, (T, 3, n)
+        turning = np.concatenate([_cross(points, normals), -normals]).transpose(1, 2, 0) @ np.concatenate([axes, moments], axis=1)
         if self.revolute.all():
-            return rates
-        return np.where(self.revolute, rates, normals @ axes.transpose(0, 2, 1))
+            return turning
+        return np.where(self.revolute, turning, normals.transpose(1, 2, 0) @ axes)
 
 
 def _cross(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """x × y over the last axis (numpy's cross is slower on small last axes)."""
-    return np.stack([x[..., 1] * y[..., 2] - x[..., 2] * y[..., 1],
-                     x[..., 2] * y[..., 0] - x[..., 0] * y[..., 2],
-                     x[..., 0] * y[..., 1] - x[..., 1] * y[..., 0]], axis=-1)
+    """x × y of (3, ...) arrays, coordinates first (contiguous coordinate planes)."""
+    return np.stack([x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]])
 
 
 def axis_rotations(axis: np.ndarray, angles: np.ndarray) -> np.ndarray:

@@ -61,16 +61,15 @@ def test_closed_form_distances_and_witness_points_equal_coal(robot, request):
     excitation = request.getfixturevalue(robot)
     constraint = excitation.constraints[-1]
     Q = excitation.grid_basis.q @ _lively(excitation, 3).T
-    d, c1, c2, _, _ = constraint._closest(Q)
+    d, c1, normal, _, _ = constraint._closest(Q)
     rotations, centres = capsule_placements(constraint.kinematics, constraint.capsules, Q)
     radii = np.array([c.radius for c in constraint.capsules])
     for t in range(0, d.shape[0], 7):
         for p, (i, j) in enumerate(constraint.pairs):
             exact = constraint._distance(rotations, centres, t, p)
             assert d[t, p] == pytest.approx(exact.min_distance, abs=1e-9)
-            normal = (c2[t, p] - c1[t, p]) / np.linalg.norm(c2[t, p] - c1[t, p])
-            np.testing.assert_allclose(c1[t, p] + radii[i] * normal, exact.getNearestPoint1(), atol=1e-6)
-            np.testing.assert_allclose(c2[t, p] - radii[j] * normal, exact.getNearestPoint2(), atol=1e-6)
+            np.testing.assert_allclose(c1[:, t, p] + radii[i] * normal[:, t, p], exact.getNearestPoint1(), atol=1e-6)
+            np.testing.assert_allclose(c1[:, t, p] + (d[t, p] + radii[i]) * normal[:, t, p], exact.getNearestPoint2(), atol=1e-6)
 
 
 @pytest.mark.parametrize("robot", ["panda", "g1"])
@@ -89,7 +88,7 @@ def test_batched_kinematics_equal_pinocchio(robot, request):
         point, normal = p[t, -1] + [0.1, -0.05, 0.2], np.array([0.6, 0.0, 0.8])
         J = pin.getJointJacobian(model, data, model.njoints - 1, pin.LOCAL_WORLD_ALIGNED)[:, excitation.robot.v_idx]
         expected = normal @ (J[:3] - pin.skew(point - p[t, -1]) @ J[3:])
-        got = kinematics.distance_rates(R[t:t + 1], p[t:t + 1], point[None, None], normal[None, None])
+        got = kinematics.distance_rates(R[t:t + 1], p[t:t + 1], point[:, None, None], normal[:, None, None])
         np.testing.assert_allclose(got[0, 0] * kinematics.ancestors[-1], expected, atol=1e-12)
 
 

@@ -65,13 +65,15 @@ class SelfCollision(Constraint):
         return result
 
     def _closest(self, Q: np.ndarray) -> tuple[np.ndarray, ...]:
-        """At the configurations Q (T, n): distances d (T, P) [m], the closest points c₁, c₂ (T, P, 3)
-        of each pair's segments, and the joint placements (:meth:`BatchKinematics.placements`)."""
+        """At the configurations Q (T, n): distances d (T, P) [m], the closest points c₁ (3, T, P) of
+        each pair's first segment, the unit normals (3, T, P) from c₁ to c₂, and the joint placements
+        (:meth:`BatchKinematics.placements`)."""
         start, end, R, p = segment_ends(self.kinematics, self.capsules, Q)
         i, j = self._first, self._second
         c1, c2 = segment_closest_points(start[..., i], end[..., i], start[..., j], end[..., j])
-        gap = np.sqrt(((c2 - c1) ** 2).sum(axis=0))
-        return gap - self._radii[i] - self._radii[j], c1.transpose(1, 2, 0), c2.transpose(1, 2, 0), R, p
+        gap = c2 - c1
+        length = np.sqrt(gap[0] ** 2 + gap[1] ** 2 + gap[2] ** 2)
+        return length - self._radii[i] - self._radii[j], c1, gap / np.maximum(length, 1e-12), R, p
 
     def evaluate(self, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """One aggregated value per pair (P,) and the Jacobian (P, α.size), see :meth:`Constraint.evaluate`."""
@@ -79,12 +81,10 @@ class SelfCollision(Constraint):
         P = len(self.pairs)
         if not P:
             return np.zeros(0), np.zeros((0, n * m))
-        d, c1, c2, R, p = self._closest(self.basis.q @ alpha.T)
+        d, c1, normal, R, p = self._closest(self.basis.q @ alpha.T)
         g, w = smooth_max((self.margin - d) / LENGTH_SCALE, axis=0)  # (P,), (T, P)
-        normal = c2 - c1
-        normal /= np.maximum(np.linalg.norm(normal, axis=-1), 1e-12)[..., None]
         # ∂g/∂q(t) = Σ_p (∂g/∂d) ∂d/∂q, with ∂g/∂d = −w/L folded into the normals
-        rates = self.kinematics.distance_rates(R, p, c1, normal * (-w / LENGTH_SCALE)[..., None])  # (T, P, n)
+        rates = self.kinematics.distance_rates(R, p, c1, normal * (-w / LENGTH_SCALE))  # (T, P, n)
         J = (self.basis.q.T @ rates.reshape(d.shape[0], P * n)).reshape(m, P, n) * self._moves
         return g, J.transpose(1, 2, 0).reshape(P, n * m)
 
