@@ -30,7 +30,7 @@ from excite_cli.identification.validate import validate_model
 from excite_cli.output import read_last_alpha, read_prior, read_table, write_identification, write_result
 from excite_cli.plots import plot_comparison, plot_identification, plot_result
 from excite_cli.random_baseline import draw_pool, greedy_selection, pool_convergence
-from excite_cli.restarts import Restarts, default_workers
+from excite_cli.engine import Engine, default_workers
 from excite_cli.sequence import IterationResult, describe, run_sequence
 from excite_cli.verify import check_gradient, constraint_jacobian_error
 
@@ -74,7 +74,13 @@ def _table(results: list[IterationResult]) -> Table:
     return table
 
 
-def _optimize(problem: Problem, excitation: Excitation, target: Path) -> list[IterationResult]:
+def _engine(problem: Problem, excitation: Excitation) -> Engine:
+    """Where the restarts and random draws run: ``optimizer.scheduler``, else ``optimizer.workers``
+    local processes (default: the machine's cores)."""
+    return Engine(excitation, problem.optimizer.workers or default_workers(), problem.optimizer.scheduler)
+
+
+def _optimize(problem: Problem, excitation: Excitation, target: Path, engine: Engine) -> list[IterationResult]:
     """Run the sequential generation with a progress bar, writing ``target`` after every iteration.
     Ctrl-C keeps the finished iterations and exits with status 130."""
     prior = read_prior(problem.resolve(problem.sequence.prior), excitation.base) if problem.sequence.prior else None
@@ -114,10 +120,8 @@ def _optimize(problem: Problem, excitation: Excitation, target: Path) -> list[It
                 err.print(f"iteration {result.index}: cond(C(i)) {result.cond_own:.1f}, cond(C) {result.cond_stacked:.1f}, "
                           f"{result.wall_time_s:.0f} s", highlight=False)
 
-        workers = min(opts.workers or default_workers(), opts.restarts)
         try:
-            with Restarts(excitation, workers, opts.scheduler) as engine:
-                run_sequence(excitation, problem.sequence.iterations, opts.seed, prior, progress, done, engine)
+            run_sequence(excitation, problem.sequence.iterations, opts.seed, prior, progress, done, engine)
         except KeyboardInterrupt:
             err.print(f"interrupted: kept {len(finished)} finished iteration(s) in {target}")
             raise typer.Exit(130) from None
@@ -131,7 +135,7 @@ def optimize(
     output: Optional[Path] = typer.Option(None, "--output", "-o", help="HDF5 result file (overrides config 'output')."),
     iterations: Optional[int] = typer.Option(None, "--iterations", "-k", min=1, help="Sequential iterations (overrides sequence.iterations)."),
     seed: Optional[int] = typer.Option(None, "--seed", help="Seed of the random starts (overrides optimizer.seed)."),
-    workers: Optional[int] = typer.Option(None, "--workers", min=1, help="Local processes for the restarts (overrides optimizer.workers)."),
+    workers: Optional[int] = typer.Option(None, "--workers", min=1, help="Local processes for the restarts (overrides optimizer.workers; default: the cores)."),
     scheduler: Optional[str] = typer.Option(None, "--scheduler", help="Dask scheduler address, e.g. tcp://host:8786 (overrides optimizer.scheduler)."),
 ) -> None:
     """Optimize Fourier trajectories minimizing cond of the stacked base regressor, sequentially.
@@ -150,7 +154,8 @@ def optimize(
         problem.optimizer.scheduler = scheduler
     target = output if output is not None else Path(problem.output)
     excitation = build_excitation(problem)
-    finished = _optimize(problem, excitation, target)
+    with _engine(problem, excitation) as engine:
+        finished = _optimize(problem, excitation, target, engine)
     out.print(_table(finished))
     plots = plot_result(target, excitation, finished)
     out.print(f"wrote {target} and {', '.join(str(p) for p in plots)}", highlight=False)
@@ -178,18 +183,18 @@ def compare_random(
     base_target = Path(problem.output)
     target = output if output is not None else base_target.with_name(base_target.stem + "_random.h5")
     excitation = build_excitation(problem)
-    if optimized is None:
-        optimized = base_target.with_name(base_target.stem + "_optimized.h5")
-        _optimize(problem, excitation, optimized)
-    optimized_table, optimized_time = read_table(optimized)
-    count = len(optimized_table)
-    budget = optimized_time if equal_effort else None
-    size = 10**9 if equal_effort else max(rcfg.pool_size, count)
-    with Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.fields[status]}"),
-                  TimeElapsedColumn(), console=err) as bar:
-        task = bar.add_task("random candidates", total=None if equal_effort else size, status="")
-        drawn = draw_pool(excitation, size, np.random.default_rng(rcfg.seed), budget,
-                          lambda kept, tried: bar.update(task, completed=kept, status=f"{kept} kept of {tried} drawn"))
+    with _engine(problem, excitation) as engine:
+        if optimized is None:
+            optimized = base_target.with_name(base_target.stem + "_optimized.h5")
+            _optimize(problem, excitation, optimized, engine)
+        optimized_table, optimized_time = read_table(optimized)
+        count = len(optimized_table)
+        size = None if equal_effort else max(rcfg.pool_size, count)
+        with Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.fields[status]}"),
+                      TimeElapsedColumn(), console=err) as bar:
+            task = bar.add_task("random candidates", total=size, status="")
+            drawn = draw_pool(engine, size, rcfg.seed, optimized_time if equal_effort else None,
+                              lambda kept, tried: bar.update(task, completed=kept, status=f"{kept} kept of {tried} drawn"))
     if len(drawn.alphas) < count:
         raise ExciteError(f"random_baseline: only {len(drawn.alphas)} feasible candidates of {drawn.drawn} drawn; "
                           f"{count} are needed (enlarge the pool or the time)")

@@ -17,10 +17,13 @@ from typing import Callable, Optional, Sequence
 import numpy as np
 
 from excite_cli.constraints.lse import GRID_MARGIN
+from excite_cli.engine import Engine
 from excite_cli.excitation import Excitation
 
 #: Bisection steps on the common oscillation scale.
 SCALE_STEPS = 10
+#: Candidates per draw task (each with its own seed).
+DRAWS_PER_TASK = 20
 
 
 @dataclass(frozen=True)
@@ -61,25 +64,67 @@ def random_candidate(excitation: Excitation, rng: np.random.Generator) -> Option
     return alpha
 
 
-def draw_pool(excitation: Excitation, size: int, rng: np.random.Generator, time_budget_s: Optional[float] = None,
+@dataclass(frozen=True)
+class DrawTask:
+    """Draw up to ``count`` candidates, or for ``budget_s`` seconds (a task for
+    :class:`~excite_cli.engine.Engine`), from the seed ``SeedSequence(seed, spawn_key=(index,))``.
+
+    Returns (when called) the kept α (k, n, 2N+1), their regressors (k, T·rows, b) and the draws made.
+    """
+
+    index: int
+    seed: int
+    count: int
+    budget_s: Optional[float] = None
+
+    def __call__(self, excitation: Excitation, progress: Optional[Callable[[int, int], None]] = None) -> tuple[np.ndarray, np.ndarray, int]:
+        rng = np.random.default_rng(np.random.SeedSequence(self.seed, spawn_key=(self.index,)))
+        start = time.perf_counter()
+        alphas, drawn = [], 0
+        while len(alphas) < self.count and (self.budget_s is None or time.perf_counter() - start < self.budget_s):
+            drawn += 1
+            alpha = random_candidate(excitation, rng)
+            if alpha is not None:
+                alphas.append(alpha)
+            if progress:
+                progress(len(alphas), drawn)
+        criterion = excitation.criterion()
+        shape = (excitation.robot.n_joints, excitation.trajectory.n_coefficients)
+        regressors = [criterion.regressor(a) for a in alphas]
+        return np.array(alphas).reshape(-1, *shape), np.array(regressors).reshape(len(alphas), -1, excitation.base.count), drawn
+
+
+def draw_pool(engine: Engine, size: Optional[int], seed: int, budget_s: Optional[float] = None,
               progress: Optional[Callable[[int, int], None]] = None) -> Pool:
-    """Draw feasible candidates until ``size`` are kept (or ``time_budget_s`` [s] is spent, if given).
+    """Draw ``size`` feasible candidates, or as many as ``engine``'s workers find in ``budget_s``
+    seconds each (``size`` None), in tasks of ``DRAWS_PER_TASK`` candidates with their own seeds:
+    the pool does not depend on how many workers draw it.
 
     Args:
-        progress: called with (kept, drawn) after every draw.
+        engine: where the draws run.
+        progress: called with (kept, drawn) as draws finish (after every draw when serial).
     """
     start = time.perf_counter()
-    alphas, drawn = [], 0
-    criterion = excitation.criterion()
-    while len(alphas) < size and (time_budget_s is None or time.perf_counter() - start < time_budget_s):
-        drawn += 1
-        alpha = random_candidate(excitation, rng)
-        if alpha is not None:
-            alphas.append(alpha)
+    if size is None:
+        tasks = [DrawTask(k, seed, 10**9, budget_s) for k in range(max(engine.workers, 1))]
+    else:
+        tasks = [DrawTask(k, seed, min(DRAWS_PER_TASK, size - k * DRAWS_PER_TASK)) for k in range(-(-size // DRAWS_PER_TASK))]
+    done = {"kept": 0, "drawn": 0}
+
+    def finished(result: tuple[np.ndarray, np.ndarray, int]) -> None:
+        done["kept"] += len(result[0])
+        done["drawn"] += result[2]
         if progress:
-            progress(len(alphas), drawn)
-    regressors = np.array([criterion.regressor(a) for a in alphas])
-    return Pool(np.array(alphas), regressors, time.perf_counter() - start, drawn)
+            progress(done["kept"], done["drawn"])
+
+    def serial(kept: int, drawn: int) -> None:
+        if progress:
+            progress(done["kept"] + kept, done["drawn"] + drawn)
+
+    results = engine.run(tasks, serial, finished)
+    alphas = np.concatenate([r[0] for r in results])
+    regressors = np.concatenate([r[1] for r in results])
+    return Pool(alphas, regressors, time.perf_counter() - start, sum(r[2] for r in results))
 
 
 def greedy_selection(regressors: np.ndarray, count: int, prior: Optional[np.ndarray] = None) -> tuple[list[int], list[float]]:

@@ -11,9 +11,9 @@ import numpy as np
 from excite_cli.criterion import condition_number
 from excite_cli.errors import ExciteError
 from excite_cli.excitation import Excitation
-from excite_cli.optimizer import ProgressHook, best_restart
+from excite_cli.engine import Engine
+from excite_cli.optimizer import ProgressHook, RestartResult, best_restart, optimize_restart
 from excite_cli.playback import check_motion, plan_playback
-from excite_cli.restarts import RestartTask, Restarts
 
 
 @dataclass(frozen=True)
@@ -49,6 +49,37 @@ class IterationResult:
     wall_time_s: float = 0.0
     sqp_iterations: int = 0
     message: str = ""
+
+
+@dataclass(frozen=True)
+class RestartTask:
+    """One restart of one iteration (a task for :class:`~excite_cli.engine.Engine`).
+
+    Its random start is drawn from its own seed, ``SeedSequence(seed, spawn_key=(iteration, index))``,
+    so the result does not depend on where or in which order the restarts run.
+
+    Attributes:
+        iteration: k, 1-based; index: the restart's number, 0-based.
+        seed: the run's seed (``optimizer.seed``).
+        prior: C₀ (m, b), the rows stacked above the trajectory's regressor (Eq. 41).
+        warm_start: (n, 2N+1) accepted α to start from instead of a random start, or None.
+    """
+
+    iteration: int
+    index: int
+    seed: int
+    prior: np.ndarray
+    warm_start: Optional[np.ndarray] = None
+
+    def rng(self) -> np.random.Generator:
+        """The restart's own random generator."""
+        return np.random.default_rng(np.random.SeedSequence(self.seed, spawn_key=(self.iteration, self.index)))
+
+    def __call__(self, excitation: Excitation, progress: Optional[ProgressHook] = None) -> RestartResult:
+        """Draw the start (or take the warm start) and optimize from it (:func:`optimize_restart`)."""
+        start = self.warm_start.copy() if self.warm_start is not None else excitation.random_start(self.rng())
+        return optimize_restart(excitation.criterion(self.prior), excitation.constraints, excitation.problem.optimizer,
+                                start, excitation.boundary, self.index, progress)
 
 
 def describe(excitation: Excitation, index: int, alpha: np.ndarray, prior: np.ndarray, wall_time_s: float = 0.0,
@@ -102,7 +133,7 @@ def run_sequence(
     prior: Optional[np.ndarray] = None,
     progress: Optional[Callable[[int], ProgressHook]] = None,
     on_iteration: Optional[Callable[[IterationResult], None]] = None,
-    restarts: Optional[Restarts] = None,
+    engine: Optional[Engine] = None,
 ) -> list[IterationResult]:
     """Generate ``iterations`` trajectories, each stacking the regressors of the earlier ones (Eq. 41).
 
@@ -117,13 +148,13 @@ def run_sequence(
         prior: optional C_prior (m, b), e.g. from earlier measured data, stacked first.
         progress: ``progress(k)`` gives the SLSQP progress hook of iteration k.
         on_iteration: called with each finished iteration (e.g. to write it to disk at once).
-        restarts: where the restarts run (default: serially in this process).
+        engine: where the restarts run (default: serially in this process).
 
     Returns:
         The K :class:`IterationResult`.
     """
-    if restarts is None:
-        with Restarts(excitation) as serial:
+    if engine is None:
+        with Engine(excitation) as serial:
             return run_sequence(excitation, iterations, seed, prior, progress, on_iteration, serial)
     stacked = np.zeros((0, excitation.base.count)) if prior is None else prior
     results: list[IterationResult] = []
@@ -131,7 +162,8 @@ def run_sequence(
         start = time.perf_counter()
         tasks = [RestartTask(k, r, seed, stacked, results[-1].alpha if (r == 0 and results) else None)
                  for r in range(excitation.problem.optimizer.restarts)]
-        runs = restarts.run(tasks, progress(k) if progress else None)
+        hook = progress(k) if progress else None
+        runs = engine.run(tasks, hook, (lambda r: hook(r.index, r.iterations, r.objective)) if hook else None)
         best = best_restart(runs)
         result = describe(excitation, k, best.alpha, stacked, time.perf_counter() - start,
                           sum(r.iterations for r in runs), best.message)

@@ -63,7 +63,7 @@ def check_gradient(criterion: Criterion, alpha: np.ndarray, step: float = 1e-6, 
         step: finite-difference step (the paper used 1e-6).
         repeats: analytic gradients timed; their median is reported (robust to a busy machine).
 
-    Both are timed with one BLAS thread, as the optimizer runs (:mod:`excite_cli.restarts`).
+    Both are timed with one BLAS thread, as the optimizer runs (:mod:`excite_cli.engine`).
     """
     with threadpool_limits(limits=1):
         criterion.value_and_gradient(alpha)  # first call makes the model copies

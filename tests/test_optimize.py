@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-import excite_cli.restarts as restarts
+from excite_cli.engine import Engine
 from conftest import UR5, write_config
 from excite_cli.cli import app
 
@@ -88,7 +88,7 @@ def test_prior_rows_are_stacked_first(result, tmp_path):
 
 
 def test_interrupted_run_keeps_finished_iterations(tmp_path, monkeypatch):
-    real = restarts.Restarts.run
+    real = Engine.run
     calls = []
 
     def interrupt_second(*args, **kwargs):
@@ -97,7 +97,7 @@ def test_interrupted_run_keeps_finished_iterations(tmp_path, monkeypatch):
             raise KeyboardInterrupt
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(restarts.Restarts, "run", interrupt_second)
+    monkeypatch.setattr(Engine, "run", interrupt_second)
     out = tmp_path / "cut.h5"
     run = runner.invoke(app, ["optimize", str(write_config(tmp_path, _data(iterations=3))), "-o", str(out)])
     assert run.exit_code == 130

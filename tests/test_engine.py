@@ -1,18 +1,19 @@
-"""Restarts in parallel: a process pool and a Dask cluster give the serial run's trajectories, bit
-for bit, for the same seed; each restart draws its own start."""
+"""Restarts and random draws in parallel: a process pool and a Dask cluster give the serial run's
+trajectories and candidates, bit for bit, for the same seed; each restart draws its own start."""
 
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-import excite_cli.restarts as restarts
+import excite_cli.engine as engine_module
 from excite_cli.config import load_problem
 from excite_cli.errors import ExciteError
 from excite_cli.excitation import build_excitation
 from excite_cli.optimizer import RestartResult, best_restart
-from excite_cli.restarts import RestartTask, Restarts
-from excite_cli.sequence import run_sequence
+from excite_cli.engine import Engine
+from excite_cli.random_baseline import draw_pool
+from excite_cli.sequence import RestartTask, run_sequence
 
 HERE = Path(__file__).resolve().parent
 
@@ -38,8 +39,8 @@ def _same(a, b):
 
 
 def test_two_workers_give_the_serial_result(excitation, serial):
-    with Restarts(excitation, workers=2) as engine:
-        parallel = run_sequence(excitation, 2, seed=5, restarts=engine)
+    with Engine(excitation, workers=2) as engine:
+        parallel = run_sequence(excitation, 2, seed=5, engine=engine)
     _same(serial, parallel)
     assert serial[1].cond_stacked < serial[0].cond_own  # the runs optimized something
 
@@ -47,8 +48,13 @@ def test_two_workers_give_the_serial_result(excitation, serial):
 def test_dask_local_cluster_gives_the_serial_result(excitation, serial):
     distributed = pytest.importorskip("dask.distributed")
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None) as cluster:
-        with Restarts(excitation, scheduler=cluster.scheduler_address) as engine:
-            on_cluster = run_sequence(excitation, 2, seed=5, restarts=engine)
+        with Engine(excitation, scheduler=cluster.scheduler_address) as engine:
+            on_cluster = run_sequence(excitation, 2, seed=5, engine=engine)
+            pool_on_cluster = draw_pool(engine, 30, seed=2)
+    with Engine(excitation) as engine:
+        pool = draw_pool(engine, 30, seed=2)
+    np.testing.assert_array_equal(pool.alphas, pool_on_cluster.alphas)
+    assert len(pool.alphas) == 30 and pool.regressors.shape[:2] == (30, excitation.cost_basis.time.size * 7)
     _same(serial, on_cluster)
 
 
@@ -67,7 +73,7 @@ def test_best_restart_breaks_ties_by_index():
 
 
 def test_unreachable_scheduler_is_named(excitation, monkeypatch):
-    monkeypatch.setattr(restarts, "CONNECT_TIMEOUT", "1s")
+    monkeypatch.setattr(engine_module, "CONNECT_TIMEOUT", "1s")
     with pytest.raises(ExciteError, match="optimizer.scheduler: cannot reach the Dask scheduler at tcp://127.0.0.1:9"):
-        with Restarts(excitation, scheduler="tcp://127.0.0.1:9"):
+        with Engine(excitation, scheduler="tcp://127.0.0.1:9"):
             pass
