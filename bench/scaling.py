@@ -6,6 +6,9 @@ active joints 7 (left arm), 14 (both arms), 23 (arms, waist and both hips, base 
 and pelvis capsules dropped: they overlap at rest); harmonics 5,
 10, 20; cost samples 40, 100 (same 8 s: the cost period shrinks).
 
+SQP iterations are summed over the restarts; "ms per SQP iteration" is the wall time per iteration of
+one restart (wall × parallel restarts / iterations), the figure that scales with the problem size.
+
 Run: `.venv/bin/python bench/scaling.py`. Prints a table; asserts nothing.
 """
 
@@ -31,7 +34,7 @@ JOINTS = {
 CASES = [(7, 10, 40), (14, 10, 40), (23, 10, 40), (14, 5, 40), (14, 20, 40), (14, 10, 100)]
 
 
-def one_iteration(joints: int, harmonics: int, samples: int) -> tuple[float, float, int]:
+def one_iteration(joints: int, harmonics: int, samples: int) -> tuple[float, float, int, int]:
     problem = load_problem(ROOT / "configs" / "g1_arms.yaml")
     problem.robot.active_joints = JOINTS[joints]
     problem.robot.home_posture = {k: v for k, v in problem.robot.home_posture.items() if k in JOINTS[joints]}
@@ -46,14 +49,16 @@ def one_iteration(joints: int, harmonics: int, samples: int) -> tuple[float, flo
     start = time.perf_counter()
     with Engine(excitation, workers) as engine:
         result = run_sequence(excitation, 1, problem.optimizer.seed, engine=engine)[0]
-    return time.perf_counter() - start, result.cond_stacked, excitation.base.count
+    return time.perf_counter() - start, result.cond_stacked, excitation.base.count, result.sqp_iterations
 
 
 def main() -> None:
-    print(f"{'joints':>6} {'harmonics':>9} {'cost samples':>12} {'base params':>11} {'cond(C)':>8} {'wall [s]':>9}")
+    print(f"{'joints':>6} {'harmonics':>9} {'cost samples':>12} {'base params':>11} {'cond(C)':>8} {'wall [s]':>9} "
+          f"{'SQP iterations':>14} {'ms per SQP iteration':>20}")
     for joints, harmonics, samples in CASES:
-        wall, cond, count = one_iteration(joints, harmonics, samples)
-        print(f"{joints:>6} {harmonics:>9} {samples:>12} {count:>11} {cond:>8.1f} {wall:>9.1f}", flush=True)
+        wall, cond, count, iterations = one_iteration(joints, harmonics, samples)
+        print(f"{joints:>6} {harmonics:>9} {samples:>12} {count:>11} {cond:>8.1f} {wall:>9.1f} {iterations:>14} "
+              f"{1e3 * wall / max(iterations, 1) * min(default_workers(), 2):>20.0f}", flush=True)
 
 
 if __name__ == "__main__":

@@ -180,12 +180,5 @@ def segment_closest_points(p1: np.ndarray, q1: np.ndarray, p2: np.ndarray, q2: n
     return p1 + s * d1, p2 + t * d2
 
 
-def segment_distances(p1: np.ndarray, q1: np.ndarray, p2: np.ndarray, q2: np.ndarray) -> np.ndarray:
-    """Distances [m] between segments [p1, q1] and [p2, q2], coordinates on the first axis (3, ...)
-    (:func:`segment_closest_points`)."""
-    c1, c2 = segment_closest_points(p1, q1, p2, q2)
-    return np.sqrt(_dot(c2 - c1, c2 - c1))
-
-
 def _dot(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     return x[0] * y[0] + x[1] * y[1] + x[2] * y[2]

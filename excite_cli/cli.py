@@ -74,6 +74,14 @@ def _table(results: list[IterationResult]) -> Table:
     return table
 
 
+def _override_engine(problem: Problem, workers: Optional[int], scheduler: Optional[str]) -> None:
+    """Apply ``--workers`` / ``--scheduler`` to the config."""
+    if workers is not None:
+        problem.optimizer.workers = workers
+    if scheduler is not None:
+        problem.optimizer.scheduler = scheduler
+
+
 def _engine(problem: Problem, excitation: Excitation) -> Engine:
     """Where the restarts and random draws run: ``optimizer.scheduler``, else ``optimizer.workers``
     local processes (default: the machine's cores)."""
@@ -148,10 +156,7 @@ def optimize(
         problem.sequence.iterations = iterations
     if seed is not None:
         problem.optimizer.seed = seed
-    if workers is not None:
-        problem.optimizer.workers = workers
-    if scheduler is not None:
-        problem.optimizer.scheduler = scheduler
+    _override_engine(problem, workers, scheduler)
     target = output if output is not None else Path(problem.output)
     excitation = build_excitation(problem)
     with _engine(problem, excitation) as engine:
@@ -170,11 +175,14 @@ def compare_random(
     pool: Optional[int] = typer.Option(None, "--pool", min=1, help="Feasible random candidates to draw (overrides random_baseline.pool_size)."),
     seed: Optional[int] = typer.Option(None, "--seed", help="Seed of the random candidates (overrides random_baseline.seed)."),
     equal_effort: bool = typer.Option(False, "--equal-effort", help="Draw candidates for as long as the optimizer took, instead of a fixed pool."),
+    workers: Optional[int] = typer.Option(None, "--workers", min=1, help="Local processes for restarts and draws (overrides optimizer.workers)."),
+    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="Dask scheduler address (overrides optimizer.scheduler)."),
 ) -> None:
     """The conventional baseline of the paper's ref. [16]: random feasible Fourier trajectories and
     greedy selection (Table II), beside the optimized trajectories (Table I) with the ratio per
     iteration and the wall time of each method."""
     problem = load_problem(config)
+    _override_engine(problem, workers, scheduler)
     rcfg = problem.random_baseline
     if pool is not None:
         rcfg.pool_size = pool

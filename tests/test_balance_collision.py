@@ -10,7 +10,7 @@ import pytest
 import yaml
 
 from conftest import CONFIGS, write_config
-from excite_cli.capsules import capsule_placements, fit_capsule, segment_distances
+from excite_cli.capsules import capsule_placements, fit_capsule, segment_closest_points
 from excite_cli.config import load_problem
 from excite_cli.errors import ExciteError
 from excite_cli.excitation import build_excitation
@@ -90,6 +90,11 @@ def test_batched_kinematics_equal_pinocchio(robot, request):
         expected = normal @ (J[:3] - pin.skew(point - p[t, -1]) @ J[3:])
         got = kinematics.distance_rates(R[t:t + 1], p[t:t + 1], point[:, None, None], normal[:, None, None])
         np.testing.assert_allclose(got[0, 0] * kinematics.ancestors[-1], expected, atol=1e-12)
+
+
+def segment_distances(p1, q1, p2, q2):
+    c1, c2 = segment_closest_points(p1, q1, p2, q2)
+    return np.linalg.norm(c2 - c1, axis=0)
 
 
 def test_segment_distance_closed_forms():
