@@ -15,14 +15,14 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 optimize: $(STAMP)
-	$(VENV)/bin/excite optimize $(CONFIG)
+	$(VENV)/bin/excite optimize $(CONFIG) --force
 
 test: $(STAMP)
 	$(PY) -m pytest -q
 
 smoke: $(STAMP)
-	$(VENV)/bin/excite optimize configs/smoke.yaml --output results/smoke.h5
-	$(VENV)/bin/excite export results/smoke.h5 --rate 1000
+	$(VENV)/bin/excite optimize configs/smoke.yaml --output results/smoke.h5 --force
+	$(VENV)/bin/excite export results/smoke.h5 --rate 1000 --force
 	$(VENV)/bin/excite verify-gradient configs/smoke.yaml
 
 bench: $(STAMP)

@@ -112,7 +112,7 @@ class OptimizerConfig(_Section):
     objective: Literal["log_cond", "cond", "log_det", "sigma_min"] = "log_cond"
     max_iterations: int = Field(200, ge=1)
     tolerance: float = Field(1e-6, gt=0.0)
-    seed: int = 0
+    seed: int = Field(0, ge=0)
     restarts: int = Field(3, ge=1)
     workers: Optional[int] = Field(None, ge=1)
     scheduler: Optional[str] = None
@@ -122,7 +122,7 @@ class RandomBaselineConfig(_Section):
     """``compare-random``: pool size and seed of the random candidates."""
 
     pool_size: int = Field(300, ge=1)
-    seed: int = 1
+    seed: int = Field(1, ge=0)
 
 
 class SequenceConfig(_Section):
@@ -162,6 +162,38 @@ class Problem(_Section):
         if p.is_absolute() or self.source_path is None:
             return p
         return self.source_path.parent / p
+
+
+def with_overrides(config: BaseModel, overrides: dict[str, object]) -> BaseModel:
+    """A validated copy of ``config`` with dotted fields replaced (command-line options), e.g.
+    ``{"sequence.iterations": 2, "optimizer.seed": 5}``; None values are left out. The original is
+    not changed, so what ran is the copy (stored as the effective config).
+
+    Raises:
+        ExciteError: an override is not valid for its field (the message names the field).
+    """
+    data = config.model_dump()
+    for dotted, value in overrides.items():
+        if value is None:
+            continue
+        *parents, last = dotted.split(".")
+        node = data
+        for part in parents:
+            node = node[part]
+        node[last] = value
+    try:
+        copy = type(config).model_validate(data)
+    except ValidationError as error:
+        raise ExciteError(_format_validation_error(Path("command line"), error)) from None
+    for name in ("source_path", "source_text"):
+        if name in type(config).model_fields:
+            setattr(copy, name, getattr(config, name))
+    return copy
+
+
+def effective_yaml(config: BaseModel) -> str:
+    """The validated config as YAML, every default filled in: what a run actually used."""
+    return yaml.safe_dump(config.model_dump(mode="json"), sort_keys=False, allow_unicode=True)
 
 
 def _format_validation_error(path: Path, error: ValidationError) -> str:
@@ -320,7 +352,7 @@ class SimulationConfig(_Section):
     timestamp_jitter: float = Field(0.0, ge=0.0, lt=0.5)
     torque_noise: float = Field(0.0, ge=0.0)
     position_noise: float = Field(0.0, ge=0.0)
-    seed: int = 0
+    seed: int = Field(0, ge=0)
     effects: dict[Effect, dict[str, Union[float, tuple[float, float]]]] = Field(default_factory=dict)
     stribeck_velocity: float = Field(0.1, gt=0.0)
     coulomb_velocity: float = Field(0.01, gt=0.0)

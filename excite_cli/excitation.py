@@ -51,14 +51,14 @@ class Excitation:
     constraints: list[Constraint]
     boundary: BoundaryConditions
 
-    def criterion(self, prior: np.ndarray | None = None) -> Criterion:
-        """The criterion of ``optimizer.objective`` with C₀ = ``prior`` (m₁, b) (Eq. 41)."""
+    def criterion(self, prior: np.ndarray | None = None, objective: str | None = None) -> Criterion:
+        """The criterion of ``objective`` (default ``optimizer.objective``) with C₀ = ``prior`` (m₁, b) (Eq. 41)."""
         return Criterion(
             self.robot,
             self.base,
             self.cost_basis,
             prior=np.zeros((0, self.base.count)) if prior is None else prior,
-            objective=self.problem.optimizer.objective,
+            objective=objective or self.problem.optimizer.objective,
         )
 
     @property

@@ -18,6 +18,7 @@ from excite_cli.errors import ExciteError
 from excite_cli.excitation import build_excitation
 from excite_cli.output import problem_of_result, read_alphas
 from excite_cli.playback import check_motion, plan_playback
+from excite_cli.targets import check_target
 
 #: Highest export rate accepted [Hz] (memory grows with rate × duration).
 MAX_RATE = 100_000.0
@@ -136,3 +137,20 @@ def write_export(path: Path, export: Export, fmt: str = "csv") -> Path:
         tmp.unlink(missing_ok=True)
         raise ExciteError(f"--output: cannot write {path}: {exc}") from None
     return path
+
+
+def export_to_file(result: Path, iteration: int | None = None, rate: float = 1000.0, periods: int = 1, fmt: str = "csv",
+                   output: Path | None = None, force: bool = False) -> tuple[Export, Path]:
+    """:func:`export_trajectory` written by :func:`write_export` to ``output`` (default
+    ``<result>_iteration<K>_<rate>Hz.<fmt>`` beside the result); a given ``output`` is checked first.
+
+    Raises:
+        ExciteError: see both, and a bad or existing (without ``force``) output path.
+    """
+    if fmt not in FORMATS:
+        raise ExciteError(f"--format: must be one of {', '.join(FORMATS)} (got {fmt!r})")
+    if output is not None:
+        check_target(output, "--output", force)
+    export = export_trajectory(result, iteration, rate, periods)
+    target = output or result.with_name(f"{result.stem}_iteration{export.iteration}_{rate:g}Hz.{fmt}")
+    return export, write_export(check_target(target, "--output", force), export, fmt)

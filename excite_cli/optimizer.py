@@ -85,6 +85,39 @@ def repair(constraints: Sequence[Constraint], alpha: np.ndarray, feasible: np.nd
     return feasible + lo * (alpha - feasible)
 
 
+class _Evaluations:
+    """SLSQP's callbacks in its variables z: the objective, and the stacked constraints evaluated once
+    per point; remembers the best point whose aggregated constraints all hold.
+
+    Attributes:
+        best_value: the lowest objective at such a point (``start_value`` until one is seen).
+        best_inside: its α (n, 2N+1), or None.
+    """
+
+    def __init__(self, criterion: Criterion, constraints: Sequence[Constraint], boundary: BoundaryConditions,
+                 start_value: float):
+        self.criterion, self.all, self.boundary = criterion, constraints, boundary
+        self.best_value, self.best_inside = start_value, None
+        self._cache: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
+
+    def constraints(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Stacked values g (m,) and Jacobian in z."""
+        key = z.tobytes()
+        if key not in self._cache:
+            self._cache.clear()
+            g, J = _stack(self.all, self.boundary.to_alpha(z))
+            self._cache[key] = (g, self.boundary.chain(J))
+        return self._cache[key]
+
+    def objective(self, z: np.ndarray) -> tuple[float, np.ndarray]:
+        """The criterion and its gradient in z."""
+        alpha = self.boundary.to_alpha(z)
+        value, grad = self.criterion.value_and_gradient(alpha)
+        if value < (self.best_value if self.best_inside is not None else np.inf) and self.constraints(z)[0].max() <= 0.0:
+            self.best_value, self.best_inside = value, alpha.copy()
+        return value, self.boundary.chain(grad.ravel())
+
+
 def optimize_restart(
     criterion: Criterion,
     constraints: Sequence[Constraint],
@@ -111,49 +144,30 @@ def optimize_restart(
         start: (n, 2N+1) α that every constraint and the boundary conditions accept.
         boundary: the boundary conditions and the optimizer's coordinates.
         index: the restart's number (passed to ``progress`` and kept in the result).
-        progress: called after every SLSQP iteration.
+        progress: called after every SLSQP iteration with the best value whose aggregated
+            constraints all held so far (the start's until one is found).
     """
     begin = time.perf_counter()
-    cache: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
-
-    def constraint_values(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        key = z.tobytes()
-        if key not in cache:
-            cache.clear()
-            g, J = _stack(constraints, boundary.to_alpha(z))
-            cache[key] = (g, boundary.chain(J))
-        return cache[key]
-
-    last_value = [np.nan]
-    inside: dict[str, object] = {}
-
-    def objective(z: np.ndarray) -> tuple[float, np.ndarray]:
-        alpha = boundary.to_alpha(z)
-        value, grad = criterion.value_and_gradient(alpha)
-        last_value[0] = value
-        if value < inside.get("value", np.inf) and constraint_values(z)[0].max() <= 0.0:
-            inside.update(value=value, x=alpha.copy())
-        return value, boundary.chain(grad.ravel())
-
+    problem = _Evaluations(criterion, constraints, boundary, criterion.value(start))
     counter = [0]
 
     def callback(xk: np.ndarray) -> None:
         counter[0] += 1
         if progress is not None:
-            progress(index, counter[0], last_value[0])
+            progress(index, counter[0], problem.best_value)
 
     result = minimize(
-        objective,
+        problem.objective,
         boundary.to_variables(start),
         jac=True,
         method=options.method,
-        constraints=[{"type": "ineq", "fun": lambda x: -constraint_values(x)[0], "jac": lambda x: -constraint_values(x)[1]}],
+        constraints=[{"type": "ineq", "fun": lambda x: -problem.constraints(x)[0], "jac": lambda x: -problem.constraints(x)[1]}],
         options={"maxiter": options.max_iterations, "ftol": options.tolerance},
         callback=callback,
     )
     candidates = [start, repair(constraints, boundary.to_alpha(result.x), start, boundary)]
-    if "x" in inside:
-        candidates.append(np.asarray(inside["x"]))
+    if problem.best_inside is not None:
+        candidates.append(problem.best_inside)
     scored = [(criterion.value(alpha), k, alpha) for k, alpha in enumerate(candidates) if k == 0 or _accepted(constraints, alpha)]
     value, _, alpha = min(scored, key=lambda item: item[:2])
     return RestartResult(index, alpha, value, int(result.nit), str(result.message), time.perf_counter() - begin)

@@ -20,10 +20,10 @@ import yaml
 from pydantic import ValidationError
 
 from excite_cli.base_parameters import BaseParameters
-from excite_cli.config import Problem
+from excite_cli.config import Problem, effective_yaml
 from excite_cli.errors import ExciteError
 from excite_cli.excitation import Excitation
-from excite_cli.sequence import IterationResult
+from excite_cli.sequence import IterationResult, describe
 
 UNITS = {"alpha": "rad", "time": "s", "q": "rad", "qd": "rad/s", "qdd": "rad/s^2", "regressor": "SI (N·m per parameter unit)",
          "com_xy": "m", "min_capsule_distance": "m"}
@@ -92,7 +92,8 @@ def write_result(path: Path, excitation: Excitation, results: Sequence[Iteration
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         with h5py.File(tmp, "w") as f:
-            f.attrs["config"] = excitation.problem.source_text
+            f.attrs["config"] = effective_yaml(excitation.problem)
+            f.attrs["config_original"] = excitation.problem.source_text
             f.attrs["config_path"] = str(excitation.problem.source_path or "")
             f.attrs["seed"] = seed
             f.attrs["objective"] = excitation.problem.optimizer.objective
@@ -195,6 +196,29 @@ def read_last_alpha(path: Path) -> tuple[int, np.ndarray]:
         ExciteError: missing or unreadable file, or no finished iteration in it.
     """
     return read_alphas(path)[-1]
+
+
+def read_iterations(path: Path, excitation: Excitation, prior: np.ndarray | None = None) -> list[IterationResult]:
+    """The finished iterations of a result of the same problem, as :class:`IterationResult` (checks
+    recomputed from the stored α, wall time, SQP iterations and message as stored), to resume it.
+
+    Raises:
+        ExciteError: missing or unreadable file, or a result of another problem.
+    """
+    stacked = np.zeros((0, excitation.base.count)) if prior is None else prior
+    results = []
+    with open_result(path, "--resume") as f:
+        if "iterations" not in f:
+            raise ExciteError(f"--resume: {path} is not an excite optimize result (no /iterations)")
+        for key in sorted(f["iterations"].keys(), key=int):
+            g = f["iterations"][key]
+            alpha = g["alpha"][()]
+            if alpha.shape != (excitation.robot.n_joints, excitation.trajectory.n_coefficients):
+                raise ExciteError(f"--resume: {path} was made for another problem (alpha shape {alpha.shape})")
+            results.append(describe(excitation, int(key), alpha, stacked, float(g.attrs["wall_time_s"]),
+                                    int(g.attrs["sqp_iterations"]), str(g.attrs["optimizer_message"])))
+            stacked = np.vstack([stacked, results[-1].regressor])
+    return results
 
 
 def read_table(path: Path) -> tuple[np.ndarray, float]:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from typing import Callable, Optional
+from typing import Callable, Optional, Sequence
 
 import numpy as np
 
@@ -134,6 +134,7 @@ def run_sequence(
     progress: Optional[Callable[[int], ProgressHook]] = None,
     on_iteration: Optional[Callable[[IterationResult], None]] = None,
     engine: Optional[Engine] = None,
+    finished: Sequence[IterationResult] = (),
 ) -> list[IterationResult]:
     """Generate ``iterations`` trajectories, each stacking the regressors of the earlier ones (Eq. 41).
 
@@ -149,16 +150,19 @@ def run_sequence(
         progress: ``progress(k)`` gives the SLSQP progress hook of iteration k.
         on_iteration: called with each finished iteration (e.g. to write it to disk at once).
         engine: where the restarts run (default: serially in this process).
+        finished: iterations 1..m already done (a resumed run): the sequence continues with m + 1.
+            Each restart's start depends only on (seed, iteration, restart) and the previous
+            optimum, so a resumed run ends as an uninterrupted one.
 
     Returns:
-        The K :class:`IterationResult`.
+        The K :class:`IterationResult` (the finished ones first).
     """
     if engine is None:
         with Engine(excitation) as serial:
-            return run_sequence(excitation, iterations, seed, prior, progress, on_iteration, serial)
-    stacked = np.zeros((0, excitation.base.count)) if prior is None else prior
-    results: list[IterationResult] = []
-    for k in range(1, iterations + 1):
+            return run_sequence(excitation, iterations, seed, prior, progress, on_iteration, serial, finished)
+    stacked = np.vstack([np.zeros((0, excitation.base.count)) if prior is None else prior, *[r.regressor for r in finished]])
+    results: list[IterationResult] = list(finished)
+    for k in range(len(finished) + 1, iterations + 1):
         start = time.perf_counter()
         tasks = [RestartTask(k, r, seed, stacked, results[-1].alpha if (r == 0 and results) else None)
                  for r in range(excitation.problem.optimizer.restarts)]

@@ -16,6 +16,7 @@ from excite_cli.errors import ExciteError
 from excite_cli.identification.effects import COEFFICIENTS, effect_columns
 from excite_cli.output import problem_of_result, read_alphas
 from excite_cli.robot import Robot, load_robot
+from excite_cli.targets import check_folder
 from excite_cli.trajectory import FourierTrajectory
 
 
@@ -42,25 +43,33 @@ def effect_torques(sim: SimulationConfig, robot: Robot, q: np.ndarray, qd: np.nd
     return tau
 
 
-def simulate_runs(result: Path, sim: SimulationConfig, out_dir: Path, prefix: str = "run") -> list[Path]:
-    """Write one CSV per iteration of ``result`` into ``out_dir``.
+def simulate_runs(result: Path, sim: SimulationConfig, out_dir: Path, prefix: str = "run", force: bool = False) -> list[Path]:
+    """Write one CSV per iteration of ``result`` into ``out_dir``; everything is computed (and every
+    error raised) before the first file is written.
 
     Args:
         result: an ``optimize`` (or ``compare-random``) HDF5 result.
         sim: the effects file.
         out_dir: folder for ``<prefix>_<k>.csv``.
+        force: replace existing files.
 
     Returns:
         The written files.
+
+    Raises:
+        ExciteError: not a result, an unknown joint or a wrong coefficient count in the effects,
+            non-finite effect values, files in the way.
     """
     problem = problem_of_result(result)
     problem.robot.base_wrench_rows = False
     robot = load_robot(problem)
     trajectory = FourierTrajectory(problem.trajectory.harmonics, problem.trajectory.base_frequency)
     rng = np.random.default_rng(sim.seed)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    written = []
-    for k, alpha in read_alphas(result):
+    alphas = read_alphas(result)
+    check_folder(out_dir, [f"{prefix}_{k}.csv" for k, _ in alphas], "--output-dir", force)
+    header = ["time"] + [f"q_{j}" for j in robot.joint_names] + [f"tau_{j}" for j in robot.joint_names]
+    tables = {}
+    for k, alpha in alphas:
         count = int(round(sim.periods * trajectory.period * sim.sample_rate)) + 1
         time = np.arange(count) / sim.sample_rate
         time[1:-1] += rng.uniform(-sim.timestamp_jitter, sim.timestamp_jitter, count - 2) / sim.sample_rate
@@ -68,11 +77,15 @@ def simulate_runs(result: Path, sim: SimulationConfig, out_dir: Path, prefix: st
         rigid = np.array([robot.torques(*x) for x in zip(q, qd, qdd)])
         tau = rigid + effect_torques(sim, robot, q, qd, qdd, rigid)
         tau += rng.normal(0.0, sim.torque_noise, tau.shape)
-        q_measured = q + rng.normal(0.0, sim.position_noise, q.shape)
-        header = ["time"] + [f"q_{j}" for j in robot.joint_names] + [f"tau_{j}" for j in robot.joint_names]
+        tables[k] = np.column_stack([time, q + rng.normal(0.0, sim.position_noise, q.shape), tau])
+        if not np.all(np.isfinite(tables[k])):
+            raise ExciteError("effects: a value makes non-finite torques (NaN or inf in the effects file?)")
+    out_dir.mkdir(parents=True, exist_ok=True)
+    written = []
+    for k, table in tables.items():
         path = out_dir / f"{prefix}_{k}.csv"
         tmp = path.with_name(path.name + ".partial")
-        np.savetxt(tmp, np.column_stack([time, q_measured, tau]), delimiter=",", header=",".join(header), comments="", fmt="%.10g")
+        np.savetxt(tmp, table, delimiter=",", header=",".join(header), comments="", fmt="%.10g")
         tmp.replace(path)
         written.append(path)
     return written

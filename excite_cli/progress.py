@@ -1,0 +1,65 @@
+"""Progress of long commands on the terminal: a bar per iteration with the best accepted value, the
+restart, elapsed time and an ETA; a line per finished iteration (with the optimizer's stop reason)
+when the output is a log rather than a terminal; a bar for random draws."""
+
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+from rich.console import Console
+from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+
+from excite_cli.config import Problem
+from excite_cli.optimizer import ProgressHook
+from excite_cli.sequence import IterationResult
+
+
+class Bars:
+    """One live display of bars on ``console`` (a context manager)."""
+
+    def __init__(self, console: Console):
+        self.console = console
+        self.bar = Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.fields[status]}"),
+                            TimeElapsedColumn(), TextColumn("ETA"), TimeRemainingColumn(), console=console)
+
+    def __enter__(self) -> "Bars":
+        self.bar.__enter__()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.bar.__exit__(*exc)
+
+    def iterations(self, problem: Problem) -> tuple[Callable[[int], ProgressHook], Callable[[IterationResult], None]]:
+        """The hooks of :func:`~excite_cli.runs.run_optimize`: ``progress(k)`` per SLSQP iteration
+        (best accepted value so far) and ``done(result)`` per finished iteration."""
+        opts, bar = problem.optimizer, self.bar
+        label = "cond" if opts.objective in ("cond", "log_cond") else opts.objective
+        shown = np.exp if opts.objective == "log_cond" else (lambda v: v)
+        tasks = {k: bar.add_task(f"iteration {k}", total=opts.restarts * opts.max_iterations, status="waiting")
+                 for k in range(1, problem.sequence.iterations + 1)}
+
+        def progress(k: int) -> ProgressHook:
+            steps: dict[int, int] = {}
+            best = [np.inf]
+
+            def hook(restart: int, it: int, value: float) -> None:
+                steps[restart] = it
+                best[0] = min(best[0], value)
+                bar.update(tasks[k], completed=sum(steps.values()),
+                           status=f"restart {restart + 1}/{opts.restarts} · best {label} {shown(best[0]):.4g}")
+            return hook
+
+        def done(result: IterationResult) -> None:
+            bar.update(tasks[result.index], completed=opts.restarts * opts.max_iterations,
+                       status=f"cond(C) {result.cond_stacked:.1f} · {result.message}")
+            if not self.console.is_terminal:
+                self.console.print(f"iteration {result.index}: cond(C(i)) {result.cond_own:.1f}, cond(C) {result.cond_stacked:.1f}, "
+                                   f"{result.wall_time_s:.0f} s, {result.sqp_iterations} SQP iterations, stop: {result.message}",
+                                   highlight=False)
+        return progress, done
+
+    def draws(self, total: int | None) -> Callable[[int, int], None]:
+        """The (kept, drawn) hook of ``compare-random``'s random draws."""
+        task = self.bar.add_task("random candidates", total=total, status="")
+        return lambda kept, drawn: self.bar.update(task, completed=kept, status=f"{kept} kept of {drawn} drawn")
