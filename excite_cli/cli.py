@@ -23,7 +23,7 @@ from excite_cli.simulate import simulate_runs
 app = typer.Typer(add_completion=False, no_args_is_help=True)
 out, err = Console(), Console(stderr=True)
 FORCE = typer.Option(False, "--force", help="Replace existing output files.")
-WORKERS = typer.Option(None, "--workers", min=1, help="Local processes for restarts and draws (optimizer.workers; default: the cores).")
+WORKERS = typer.Option(None, "--workers", help="Local processes for restarts and draws (optimizer.workers; default: the cores).")
 SCHEDULER = typer.Option(None, "--scheduler", help="Dask scheduler address, e.g. tcp://host:8786 (optimizer.scheduler).")
 
 
@@ -96,7 +96,7 @@ def compare_random(config: Path = typer.Argument(..., help="Problem YAML file.")
 @command("verify-gradient")
 def verify_gradient(config: Path = typer.Argument(..., help="Problem YAML file."),
                     result: Optional[Path] = typer.Option(None, "--result", "-r", help="Also check at the last optimum of this result."),
-                    step: float = typer.Option(1e-6, help="Finite-difference step [rad]."), seed: int = typer.Option(0, min=0, help="Seed of the random α."),
+                    step: float = typer.Option(1e-6, help="Finite-difference step [rad]."), seed: int = typer.Option(0, help="Seed of the random α."),
                     objective: Optional[list[str]] = typer.Option(None, "--objective", help=f"Criteria (repeatable; default all: {', '.join(OBJECTIVES)})."),
                     tolerance: float = typer.Option(1e-6, help="Largest relative error against central differences that passes.")) -> None:
     """Analytic gradients (Eq. 49) and constraint Jacobians against finite differences; exit 1 above the tolerance."""

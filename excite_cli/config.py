@@ -18,8 +18,14 @@ from excite_cli.errors import ExciteError
 PerJoint = Union[float, dict[str, float]]
 
 
+#: Largest number of harmonics N (the paper uses 5-10; the memory grows with N × grid instants).
+MAX_HARMONICS = 100
+#: Largest number of cost samples and of constraint-grid instants.
+MAX_GRID = 20000
+
+
 class _Section(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
 
 class RobotConfig(_Section):
@@ -39,9 +45,9 @@ class TrajectoryConfig(_Section):
     constraint grid [s]; boundary conditions (``rest``: q̇ = q̈ = 0 at both ends, ``periodic``: Eq. 50
     as it is) and whether both ends are at the home posture."""
 
-    harmonics: int = Field(10, ge=1)
+    harmonics: int = Field(10, ge=1, le=MAX_HARMONICS)
     base_frequency: float = Field(math.pi / 4, gt=0.0)
-    cost_samples: int = Field(40, ge=1)
+    cost_samples: int = Field(40, ge=1, le=MAX_GRID)
     cost_period: float = Field(0.2, gt=0.0)
     constraint_period: float = Field(0.02, gt=0.0)
     boundary: Literal["rest", "periodic"] = "rest"
@@ -154,6 +160,10 @@ class Problem(_Section):
                 "trajectory.constraint_period must not exceed the trajectory duration "
                 f"cost_samples × cost_period = {self.trajectory.duration:g} s"
             )
+        instants = self.trajectory.duration / self.trajectory.constraint_period
+        if instants > MAX_GRID:
+            raise ValueError(f"trajectory.constraint_period: the constraint grid would have {instants:.0f} instants "
+                             f"(at most {MAX_GRID}; the fine check has {self.limits.check_refinement}× more)")
         return self
 
     def resolve(self, path: str) -> Path:
@@ -211,6 +221,19 @@ def _format_validation_error(path: Path, error: ValidationError) -> str:
     return f"{path}: {field}: {message}{suffix}"
 
 
+class _UniqueKeyLoader(yaml.SafeLoader):
+    """YAML's safe loader, refusing a key given twice in one mapping (YAML lets the last one win silently)."""
+
+    def construct_mapping(self, node, deep=False):
+        seen = set()
+        for key_node, _ in node.value:
+            key = self.construct_object(key_node, deep=deep)
+            if key in seen:
+                raise yaml.constructor.ConstructorError(None, None, f"duplicate key '{key}'", key_node.start_mark)
+            seen.add(key)
+        return super().construct_mapping(node, deep=deep)
+
+
 def load_problem(path: str | Path, kind: type[BaseModel] = Problem):
     """Read and validate a YAML file as a :class:`Problem` (or another config ``kind``).
 
@@ -227,15 +250,20 @@ def load_problem(path: str | Path, kind: type[BaseModel] = Problem):
     path = Path(path)
     if not path.is_file():
         raise ExciteError(f"config file not found: {path}")
-    text = path.read_text()
     try:
-        raw = yaml.safe_load(text)
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError:
+        raise ExciteError(f"{path}: not a text (UTF-8) file; expected a YAML config") from None
+    except OSError as exc:
+        raise ExciteError(f"{path}: cannot read the config: {exc.strerror}") from None
+    try:
+        raw = yaml.load(text, Loader=_UniqueKeyLoader)
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
         raise ExciteError(f"{path}: malformed YAML{where}: {getattr(exc, 'problem', exc)}") from None
     if not isinstance(raw, dict):
-        raise ExciteError(f"{path}: expected a mapping of sections (see README 'Config reference')")
+        raise ExciteError(f"{path}: {'empty file; ' if raw is None else ''}expected a mapping of sections (see README 'Config reference')")
     try:
         problem = kind.model_validate(raw)
     except ValidationError as exc:

@@ -105,6 +105,9 @@ def build_excitation(problem: Problem) -> Excitation:
     robot = load_robot(problem, collision=bool(ccfg.self_collision or (ccfg.com and ccfg.com.support_links)))
     base = compute_base_parameters(robot)
     tcfg = problem.trajectory
+    if tcfg.cost_samples * robot.n_rows < base.count:
+        raise ExciteError(f"trajectory.cost_samples: {tcfg.cost_samples} samples × {robot.n_rows} regressor rows are fewer "
+                          f"than the robot's {base.count} base parameters; cond(C) would be infinite")
     trajectory = FourierTrajectory(tcfg.harmonics, tcfg.base_frequency)
     fine_period = tcfg.constraint_period / problem.limits.check_refinement
     grid_basis = trajectory.basis(sample_times(tcfg.duration, tcfg.constraint_period, include_end=True))

@@ -39,12 +39,12 @@ def links_with_geometry(robot: Robot) -> list[str]:
     return names
 
 
-def link_points(robot: Robot, link: str) -> tuple[np.ndarray, int]:
+def link_points(robot: Robot, link: str, field: str = "constraints.self_collision") -> tuple[np.ndarray, int]:
     """Points of every collision shape of ``link`` in its parent joint's frame [m], (k, 3), and that
     joint's index in the reduced model.
 
     Raises:
-        ExciteError: the link has no collision geometry.
+        ExciteError: the link has no collision geometry (the message names ``field``).
     """
     parts, joint = [], None
     for obj in robot.collision_model.geometryObjects:
@@ -53,13 +53,17 @@ def link_points(robot: Robot, link: str) -> tuple[np.ndarray, int]:
             parts.append(local @ obj.placement.rotation.T + obj.placement.translation)
             joint = obj.parentJoint
     if joint is None:
-        raise ExciteError(f"link '{link}' has no collision geometry in the URDF")
+        raise ExciteError(f"{field}: link '{link}' has no collision geometry in the URDF (or is not a link)")
     return np.vstack(parts), int(joint)
 
 
-def world_points(robot: Robot, link: str, q: np.ndarray) -> np.ndarray:
-    """(k, 3) collision-geometry points of ``link`` in the world frame at active joints ``q`` [m]."""
-    points, joint = link_points(robot, link)
+def world_points(robot: Robot, link: str, q: np.ndarray, field: str = "constraints.com.support_links") -> np.ndarray:
+    """(k, 3) collision-geometry points of ``link`` in the world frame at active joints ``q`` [m].
+
+    Raises:
+        ExciteError: the link has no collision geometry (the message names ``field``).
+    """
+    points, joint = link_points(robot, link, field)
     qf = robot.state(q, np.zeros_like(q), np.zeros_like(q))[0]
     pin.forwardKinematics(robot.model, robot.data, qf)
     placement = robot.data.oMi[joint]

@@ -198,7 +198,7 @@ def read_last_alpha(path: Path) -> tuple[int, np.ndarray]:
     return read_alphas(path)[-1]
 
 
-def read_iterations(path: Path, excitation: Excitation, prior: np.ndarray | None = None) -> list[IterationResult]:
+def read_iterations(path: Path, excitation: Excitation, prior: np.ndarray | None = None, field: str = "--resume") -> list[IterationResult]:
     """The finished iterations of a result of the same problem, as :class:`IterationResult` (checks
     recomputed from the stored α, wall time, SQP iterations and message as stored), to resume it.
 
@@ -207,30 +207,30 @@ def read_iterations(path: Path, excitation: Excitation, prior: np.ndarray | None
     """
     stacked = np.zeros((0, excitation.base.count)) if prior is None else prior
     results = []
-    with open_result(path, "--resume") as f:
+    with open_result(path, field) as f:
         if "iterations" not in f:
-            raise ExciteError(f"--resume: {path} is not an excite optimize result (no /iterations)")
+            raise ExciteError(f"{field}: {path} is not an excite optimize result (no /iterations)")
         for key in sorted(f["iterations"].keys(), key=int):
             g = f["iterations"][key]
             alpha = g["alpha"][()]
             if alpha.shape != (excitation.robot.n_joints, excitation.trajectory.n_coefficients):
-                raise ExciteError(f"--resume: {path} was made for another problem (alpha shape {alpha.shape})")
+                raise ExciteError(f"{field}: {path} was made for another problem (alpha shape {alpha.shape})")
             results.append(describe(excitation, int(key), alpha, stacked, float(g.attrs["wall_time_s"]),
                                     int(g.attrs["sqp_iterations"]), str(g.attrs["optimizer_message"])))
             stacked = np.vstack([stacked, results[-1].regressor])
     return results
 
 
-def read_table(path: Path) -> tuple[np.ndarray, float]:
+def read_table(path: Path, field: str = "") -> tuple[np.ndarray, float]:
     """The condition-number table (iteration, cond_own, cond_stacked) of an excite result and the
     summed wall time of its iterations [s].
 
     Raises:
         ExciteError: missing or unreadable file, or no table in it.
     """
-    with open_result(path) as f:
+    with open_result(path, field) as f:
         if "table" not in f or "iterations" not in f:
-            raise ExciteError(f"{path} is not an excite result (no /table)")
+            raise ExciteError(f"{field + ': ' if field else ''}{path} is not an excite result (no /table)")
         wall = sum(float(g.attrs.get("wall_time_s", 0.0)) for g in f["iterations"].values())
         return f["table"][()], wall
 

@@ -16,19 +16,27 @@ from excite_cli.sequence import IterationResult
 
 
 class Bars:
-    """One live display of bars on ``console`` (a context manager)."""
+    """One live display of bars on ``console`` (a context manager); it appears with the first bar, so
+    an error found before any work is the only thing printed."""
 
     def __init__(self, console: Console):
         self.console = console
         self.bar = Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.fields[status]}"),
                             TimeElapsedColumn(), TextColumn("ETA"), TimeRemainingColumn(), console=console)
+        self._live = False
 
     def __enter__(self) -> "Bars":
-        self.bar.__enter__()
         return self
 
     def __exit__(self, *exc) -> None:
-        self.bar.__exit__(*exc)
+        if self._live:
+            self.bar.__exit__(*exc)
+
+    def _task(self, description: str, total: int | None, status: str) -> int:
+        if not self._live:
+            self.bar.__enter__()
+            self._live = True
+        return self.bar.add_task(description, total=total, status=status)
 
     def iterations(self, problem: Problem) -> tuple[Callable[[int], ProgressHook], Callable[[IterationResult], None]]:
         """The hooks of :func:`~excite_cli.runs.run_optimize`: ``progress(k)`` per SLSQP iteration
@@ -36,10 +44,10 @@ class Bars:
         opts, bar = problem.optimizer, self.bar
         label = "cond" if opts.objective in ("cond", "log_cond") else opts.objective
         shown = np.exp if opts.objective == "log_cond" else (lambda v: v)
-        tasks = {k: bar.add_task(f"iteration {k}", total=opts.restarts * opts.max_iterations, status="waiting")
-                 for k in range(1, problem.sequence.iterations + 1)}
+        tasks: dict[int, int] = {}
 
         def progress(k: int) -> ProgressHook:
+            tasks[k] = self._task(f"iteration {k}", opts.restarts * opts.max_iterations, "starting")
             steps: dict[int, int] = {}
             best = [np.inf]
 
@@ -61,5 +69,10 @@ class Bars:
 
     def draws(self, total: int | None) -> Callable[[int, int], None]:
         """The (kept, drawn) hook of ``compare-random``'s random draws."""
-        task = self.bar.add_task("random candidates", total=total, status="")
-        return lambda kept, drawn: self.bar.update(task, completed=kept, status=f"{kept} kept of {drawn} drawn")
+        task: list[int] = []
+
+        def hook(kept: int, drawn: int) -> None:
+            if not task:
+                task.append(self._task("random candidates", total, ""))
+            self.bar.update(task[0], completed=kept, status=f"{kept} kept of {drawn} drawn")
+        return hook

@@ -64,9 +64,11 @@ def run_optimize(problem: Problem, target: Path, force: bool = False, resume: bo
         Interrupted: Ctrl-C; the finished iterations are in ``target``.
     """
     check_target(target, "--output", force, exists_ok=resume)
+    if resume and not target.is_file():
+        raise ExciteError(f"--resume: no result at {target} to continue")
     excitation = build_excitation(problem)
     prior = read_prior(problem.resolve(problem.sequence.prior), excitation.base) if problem.sequence.prior else None
-    finished = _resumable(target, excitation, prior) if resume and target.exists() else []
+    finished = _resumable(target, excitation, prior) if resume else []
     written = list(finished)
 
     def done(result: IterationResult) -> None:
@@ -148,7 +150,7 @@ def run_compare_random(problem: Problem, optimized: Optional[Path], target: Opti
         if optimized is None:
             optimized = run_optimize(problem, base.with_name(base.stem + "_optimized.h5"), force, progress=progress,
                                      engine=engine).target
-        optimized_table, optimized_time = read_table(optimized)
+        optimized_table, optimized_time = read_table(optimized, "--optimized")
         _check_same_problem(optimized, excitation)
         count = len(optimized_table)
         rcfg = problem.random_baseline
@@ -211,13 +213,15 @@ def run_verify(problem: Problem, result: Optional[Path] = None, objectives: Sequ
     for name in objectives:
         if name not in OBJECTIVES:
             raise ExciteError(f"--objective: '{name}' is not a criterion; expected one of {', '.join(OBJECTIVES)}")
+    if seed < 0:
+        raise ExciteError(f"--seed: must be ≥ 0 (got {seed})")
     if not 1e-12 <= step <= 1e-2:
         raise ExciteError(f"--step: {step:g} is not a finite-difference step for coefficients in rad; use 1e-12 to 1e-2")
     excitation = build_excitation(problem)
     m = excitation.trajectory.n_coefficients
     points = [("random", None, excitation.limits.random_start(m, np.random.default_rng(seed), fill=0.7))]
     if result is not None:
-        finished = read_iterations(result, excitation)
+        finished = read_iterations(result, excitation, field="--result")
         stacked = np.vstack([np.zeros((0, excitation.base.count)), *[r.regressor for r in finished[:-1]]])
         points.append((f"optimum {finished[-1].index}", stacked, finished[-1].alpha))
     gradients = []

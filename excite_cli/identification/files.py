@@ -83,6 +83,8 @@ def _read_text(path: Path, drop: bool) -> Table:
     header = not all(_number(x) or x == "" for x in head)
     names = head if header else [str(k) for k in range(len(head))]
     body = numbered[1:] if header else numbered
+    if not body:
+        raise ExciteError(f"data: {path.name} has a header but no data rows")
     try:  # the fast path: every row complete and numeric
         values = np.loadtxt([line for _, line in body], delimiter=delimiter, ndmin=2, dtype=float)
         if values.shape[1] == len(names) and values.shape[0] == len(body):

@@ -104,6 +104,14 @@ def solve(G: np.ndarray, c: np.ndarray) -> np.ndarray:
     return z / d
 
 
+def excited_rank(G: np.ndarray, tolerance: float = 1e-12) -> int:
+    """Number of unknowns the data determine: the rank of G scaled to unit diagonal (eigenvalues above
+    ``tolerance`` × the largest; a column the data never excite counts as rank loss)."""
+    scaled, _ = _unit_diagonal(G)
+    eig = np.linalg.eigvalsh(scaled)
+    return int(np.sum(eig > tolerance * max(eig[-1], 0.0))) if eig.size and eig[-1] > 0 else 0
+
+
 def sse(G: np.ndarray, c: np.ndarray, s: float, x: np.ndarray) -> float:
     """Residual sum of squares s − 2xᵀc + xᵀGx (≥ 0)."""
     return max(s - 2.0 * x @ c + x @ G @ x, 0.0)

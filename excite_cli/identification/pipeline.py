@@ -14,7 +14,7 @@ from excite_cli.errors import ExciteError
 from excite_cli.identification.effects import COEFFICIENTS
 from excite_cli.identification.dataset import Dataset, build_datasets
 from excite_cli.identification.identify import Selection, design, joint_weights, least_squares, predict, select_effects
-from excite_cli.identification.normal import NormalEquations
+from excite_cli.identification.normal import NormalEquations, excited_rank
 from excite_cli.identification.measurements import load_run
 from excite_cli.identification.physical import ConsistentFit, consistent_fit
 from excite_cli.identification.preprocessing import default_cutoff, preprocess
@@ -126,6 +126,10 @@ def run_identification(problem: IdentifyProblem) -> tuple[Report, Robot, BasePar
     needed = set(cfg.candidates) | {e for e, _ in declared} | {"coulomb"}  # Coulomb: the load column's sign
     fit_data, val_data = build_datasets(robot, base, samples, cfg, problem.data.validation_blocks, needed)
     rigid_only = NormalEquations(fit_data, [])
+    rank = excited_rank(rigid_only.system(None, [])[0])
+    if rank < base.count:
+        raise ExciteError(f"data: the fit runs excite {rank} of the {base.count} base parameters; the robot must move "
+                          "through an exciting trajectory (see `excite optimize`), motionless or small motions cannot identify it")
     first = least_squares(rigid_only, [], joint_weights(rigid_only, cfg.method == "wls"))
     fit_data, val_data = fit_data.with_load_columns(first.x), val_data.with_load_columns(first.x)
     selection = select_effects(fit_data, val_data, cfg, declared, max(1.0, rate / (2.0 * cutoff)))

@@ -134,6 +134,9 @@ def preprocess(run: Run, cfg: PreprocessingConfig, cutoff: float) -> Samples:
     rate = run_rate(run)
     grid = uniform_grid(run)
     q, qd, qdd, tau = (resample(run, x, grid) for x in (run.q, run.qd, run.qdd, run.tau))
+    if cfg.sample_rate > 1.01 * rate:
+        raise ExciteError(f"preprocessing.sample_rate: {cfg.sample_rate:g} Hz is above the {rate:.4g} Hz of {run.name}; "
+                          "resampling cannot add information (use at most the data's rate)")
     target = min(cfg.sample_rate, rate)
     if cutoff >= 0.5 * target:
         raise ExciteError(
