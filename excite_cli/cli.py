@@ -1,7 +1,5 @@
 """Command line: parses options, calls one library function per command, prints what it returns."""
 
-from __future__ import annotations
-
 import functools
 from importlib import metadata
 from pathlib import Path
@@ -12,7 +10,8 @@ from rich.console import Console
 from rich.markup import escape
 
 from excite_cli import runs, tables
-from excite_cli.config import IdentifyProblem, SimulationConfig, load_problem, with_overrides
+from excite_cli.config import load_problem, with_overrides
+from excite_cli.identification.config import IdentifyProblem, SimulationConfig
 from excite_cli.criterion import OBJECTIVES
 from excite_cli.errors import ExciteError, Interrupted
 from excite_cli.export import FORMATS, export_to_file

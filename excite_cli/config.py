@@ -24,11 +24,11 @@ MAX_HARMONICS = 100
 MAX_GRID = 20000
 
 
-class _Section(BaseModel):
+class Section(BaseModel):
     model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
 
-class RobotConfig(_Section):
+class RobotConfig(Section):
     """URDF, floating or fixed base, active and locked joints, home posture (README: `robot`)."""
 
     urdf: str = Field(description="URDF path (relative to the config file) or a path inside example-robot-data")
@@ -40,7 +40,7 @@ class RobotConfig(_Section):
     base_wrench_rows: bool = False
 
 
-class TrajectoryConfig(_Section):
+class TrajectoryConfig(Section):
     """Fourier series (Eq. 50) and sampling: harmonics N, ω [rad/s], cost samples and period [s],
     constraint grid [s]; boundary conditions (``rest``: q̇ = q̈ = 0 at both ends, ``periodic``: Eq. 50
     as it is) and whether both ends are at the home posture."""
@@ -59,7 +59,7 @@ class TrajectoryConfig(_Section):
         return self.cost_samples * self.cost_period
 
 
-class LimitsConfig(_Section):
+class LimitsConfig(Section):
     """Joint limits (Eq. 51): position margin [rad], velocity [rad/s], acceleration [rad/s²], check refinement."""
 
     position_margin: float = Field(0.0, ge=0.0)
@@ -68,7 +68,7 @@ class LimitsConfig(_Section):
     check_refinement: int = Field(10, ge=10)
 
 
-class ComConfig(_Section):
+class ComConfig(Section):
     """Centre-of-mass region (Eq. 52): support links or centre [m], radius [m] or polygon [m]."""
 
     support_links: list[str] = Field(default_factory=list)
@@ -85,7 +85,7 @@ class ComConfig(_Section):
         return self
 
 
-class CapsuleConfig(_Section):
+class CapsuleConfig(Section):
     """One capsule on a link: radius [m], segment end points in the link frame [m]."""
 
     link: str
@@ -94,7 +94,7 @@ class CapsuleConfig(_Section):
     end: tuple[float, float, float]
 
 
-class SelfCollisionConfig(_Section):
+class SelfCollisionConfig(Section):
     """Self-collision (Eq. 53): capsules (``auto`` or given), ignored links, excluded pairs, margin [m]."""
 
     capsules: Union[Literal["auto"], list[CapsuleConfig]] = "auto"
@@ -103,14 +103,14 @@ class SelfCollisionConfig(_Section):
     margin: float = Field(0.01, ge=0.0)
 
 
-class ConstraintsConfig(_Section):
+class ConstraintsConfig(Section):
     """Optional balance and self-collision constraints."""
 
     com: Optional[ComConfig] = None
     self_collision: Optional[SelfCollisionConfig] = None
 
 
-class OptimizerConfig(_Section):
+class OptimizerConfig(Section):
     """SLSQP settings: objective, iterations, tolerance, seed, restarts, and where restarts run
     (``workers`` local processes, default the machine's cores; or a Dask ``scheduler`` address)."""
 
@@ -124,21 +124,21 @@ class OptimizerConfig(_Section):
     scheduler: Optional[str] = None
 
 
-class RandomBaselineConfig(_Section):
+class RandomBaselineConfig(Section):
     """``compare-random``: pool size and seed of the random candidates."""
 
     pool_size: int = Field(300, ge=1)
     seed: int = Field(1, ge=0)
 
 
-class SequenceConfig(_Section):
+class SequenceConfig(Section):
     """Sequential generation (Sec. IV-B): iterations and optional prior data file (Eq. 41)."""
 
     iterations: int = Field(3, ge=1)
     prior: Optional[str] = None
 
 
-class Problem(_Section):
+class Problem(Section):
     """An ``optimize`` problem: the whole YAML file, validated."""
 
     robot: RobotConfig
@@ -272,116 +272,3 @@ def load_problem(path: str | Path, kind: type[BaseModel] = Problem):
         problem.source_path = path.resolve()
         problem.source_text = text
     return problem
-
-
-# --- identification (excite identify) --------------------------------------------------------
-
-EFFECT_NAMES = ("coulomb", "coulomb_asymmetric", "viscous", "stribeck", "offset", "armature", "spring", "gravity_compensator",
-                "position_2", "viscous_asymmetric", "held", "load_coulomb")
-#: The default candidates: adding the last four to them made the greedy selection worse on the real
-#: Panda run (README), so they are opt-in through ``identification.candidates``.
-DEFAULT_CANDIDATES = EFFECT_NAMES[:8]
-Effect = Literal["coulomb", "coulomb_asymmetric", "viscous", "stribeck", "offset", "armature", "spring", "gravity_compensator",
-                 "position_2", "viscous_asymmetric", "held", "load_coulomb"]
-
-
-Column = Union[NonNegativeInt, str]
-
-
-class ColumnsConfig(_Section):
-    """Columns of measured data, in active-joint order, by name or by 0-based position (README:
-    identification config)."""
-
-    time: Column = "time"
-    q: list[Column] = Field(min_length=1)
-    qd: Optional[list[Column]] = None
-    qdd: Optional[list[Column]] = None
-    tau: Optional[list[Column]] = None
-    current: Optional[list[Column]] = None
-
-    @model_validator(mode="after")
-    def _torque_source(self) -> "ColumnsConfig":
-        if (self.tau is None) == (self.current is None):
-            raise ValueError("give exactly one of tau or current columns")
-        return self
-
-
-class RunConfig(_Section):
-    """One measured run: file, optional crop [s], role (fit, validation or time blocks)."""
-
-    file: str
-    crop: Optional[tuple[float, float]] = None
-    role: Literal["fit", "validation", "blocks"] = "blocks"
-
-    @property
-    def label(self) -> str:
-        """The file name with the crop, for tables and reports, e.g. ``run.csv [7.8, 13.2] s``."""
-        return Path(self.file).name + (f" [{self.crop[0]:g}, {self.crop[1]:g}] s" if self.crop else "")
-
-
-class DataConfig(_Section):
-    """Measured runs, their columns, angle unit, torque constants [Nm/A], signs, validation blocks,
-    what to do with rows that cannot be used (stop with an error, or drop and count them)."""
-
-    runs: list[RunConfig] = Field(min_length=1)
-    columns: ColumnsConfig
-    angle_unit: Literal["rad", "deg"] = "rad"
-    torque_constants: Optional[list[float]] = None
-    signs: Optional[list[float]] = None
-    validation_blocks: int = Field(4, ge=2)
-    bad_rows: Literal["error", "drop"] = "error"
-
-
-class PreprocessingConfig(_Section):
-    """Decimated rate [Hz], low-pass cut-off [Hz] (default from the bandwidth), filter order."""
-
-    sample_rate: float = Field(200.0, gt=0.0)
-    cutoff: Optional[float] = Field(None, gt=0.0)
-    filter_order: int = Field(4, ge=1, le=10)
-
-
-class IdentificationConfig(_Section):
-    """LS or WLS, declared and candidate effects, selection thresholds, friction shape constants [rad/s],
-    physically consistent standard parameters and their regularization toward the URDF."""
-
-    method: Literal["wls", "ls"] = "wls"
-    declared_effects: dict[str, list[Effect]] = Field(default_factory=dict)
-    candidates: list[Effect] = Field(default_factory=lambda: list(DEFAULT_CANDIDATES))
-    significance: float = Field(1e-3, gt=0.0, lt=1.0)
-    min_improvement: float = Field(0.01, ge=0.0, lt=1.0)
-    stribeck_velocity: float = Field(0.1, gt=0.0)
-    coulomb_velocity: float = Field(0.01, gt=0.0)
-    held_velocity: float = Field(0.02, gt=0.0)
-    max_effects: int = Field(60, ge=0)
-    physical_consistency: bool = False
-    regularization: float = Field(1e-3, ge=0.0)
-
-
-class IdentifyProblem(_Section):
-    """``excite identify`` config: the robot as for ``optimize``, then data, preprocessing, identification."""
-
-    robot: RobotConfig
-    data: DataConfig
-    preprocessing: PreprocessingConfig = PreprocessingConfig()
-    identification: IdentificationConfig = IdentificationConfig()
-    output: str = "results/identification.h5"
-
-    source_path: Optional[Path] = Field(None, exclude=True)
-    source_text: str = Field("", exclude=True)
-
-    resolve = Problem.resolve
-
-
-class SimulationConfig(_Section):
-    """``excite simulate`` effects file: what the simulated robot has beyond its URDF rigid body."""
-
-    sample_rate: float = Field(1000.0, gt=0.0)
-    periods: int = Field(2, ge=1)
-    timestamp_jitter: float = Field(0.0, ge=0.0, lt=0.5)
-    torque_noise: float = Field(0.0, ge=0.0)
-    position_noise: float = Field(0.0, ge=0.0)
-    seed: int = Field(0, ge=0)
-    effects: dict[Effect, dict[str, Union[float, tuple[float, float]]]] = Field(default_factory=dict)
-    stribeck_velocity: float = Field(0.1, gt=0.0)
-    coulomb_velocity: float = Field(0.01, gt=0.0)
-    held_velocity: float = Field(0.02, gt=0.0)

@@ -25,8 +25,7 @@ from excite_cli.errors import ExciteError
 from excite_cli.excitation import Excitation
 from excite_cli.sequence import IterationResult, describe
 
-UNITS = {"alpha": "rad", "time": "s", "q": "rad", "qd": "rad/s", "qdd": "rad/s^2", "regressor": "SI (N·m per parameter unit)",
-         "com_xy": "m", "min_capsule_distance": "m"}
+UNITS = {"alpha": "rad", "time": "s", "q": "rad", "qd": "rad/s", "qdd": "rad/s^2", "regressor": "SI (N·m per parameter unit)"}
 VERSIONED_PACKAGES = ("excite", "pin", "coal", "numpy", "scipy", "h5py", "example-robot-data")
 
 
@@ -62,7 +61,8 @@ def package_versions() -> dict[str, str]:
     return versions
 
 
-def _strings(group: h5py.Group, name: str, values: Sequence[str]) -> None:
+def write_strings(group: h5py.Group, name: str, values: Sequence[str]) -> None:
+    """A dataset of variable-length strings."""
     group.create_dataset(name, data=np.array(values, dtype=h5py.string_dtype()))
 
 
@@ -71,6 +71,30 @@ def _table(results: Sequence[IterationResult]) -> np.ndarray:
     for row, r in zip(table, results):
         row["iteration"], row["cond_own"], row["cond_stacked"] = r.index, r.cond_own, r.cond_stacked
     return table
+
+
+@contextmanager
+def atomic_h5(path: Path) -> Iterator[h5py.File]:
+    """An HDF5 file written as ``<path>.partial`` and moved onto ``path`` when complete, so a crash or
+    Ctrl-C never leaves a half-written file; creation time and package versions are set.
+
+    Raises:
+        ExciteError: the file cannot be written.
+    """
+    path = Path(path)
+    tmp = path.with_name(path.name + ".partial")
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with h5py.File(tmp, "w") as f:
+            f.attrs["created"] = datetime.now(timezone.utc).isoformat(timespec="seconds")
+            for name, version in package_versions().items():
+                f.attrs[f"version_{name}"] = version
+            yield f
+        os.replace(tmp, path)
+    except OSError as exc:
+        raise ExciteError(f"output: cannot write {path}: {exc}") from None
+    finally:
+        tmp.unlink(missing_ok=True)
 
 
 def write_result(path: Path, excitation: Excitation, results: Sequence[IterationResult], seed: int,
@@ -87,38 +111,27 @@ def write_result(path: Path, excitation: Excitation, results: Sequence[Iteration
     Raises:
         ExciteError: the file cannot be written.
     """
-    path = Path(path)
-    tmp = path.with_name(path.name + ".partial")
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with h5py.File(tmp, "w") as f:
-            f.attrs["config"] = effective_yaml(excitation.problem)
-            f.attrs["config_original"] = excitation.problem.source_text
-            f.attrs["config_path"] = str(excitation.problem.source_path or "")
-            f.attrs["seed"] = seed
-            f.attrs["objective"] = excitation.problem.optimizer.objective
-            f.attrs["created"] = datetime.now(timezone.utc).isoformat(timespec="seconds")
-            for name, version in package_versions().items():
-                f.attrs[f"version_{name}"] = version
-            for name, value in (attributes or {}).items():
-                f.attrs[name] = value
-            _write_robot(f.create_group("robot"), excitation)
-            iterations = f.create_group("iterations")
-            for r in results:
-                _write_iteration(iterations.create_group(str(r.index)), r)
-            table = f.create_dataset("table", data=_table(results))
-            table.attrs["description"] = "Table I: cond of each iteration's regressor and of the stacked regressor"
-        os.replace(tmp, path)
-    except OSError as exc:
-        tmp.unlink(missing_ok=True)
-        raise ExciteError(f"output: cannot write {path}: {exc}") from None
+    with atomic_h5(path) as f:
+        f.attrs["config"] = effective_yaml(excitation.problem)
+        f.attrs["config_original"] = excitation.problem.source_text
+        f.attrs["config_path"] = str(excitation.problem.source_path or "")
+        f.attrs["seed"] = seed
+        f.attrs["objective"] = excitation.problem.optimizer.objective
+        for name, value in (attributes or {}).items():
+            f.attrs[name] = value
+        _write_robot(f.create_group("robot"), excitation)
+        iterations = f.create_group("iterations")
+        for r in results:
+            _write_iteration(iterations.create_group(str(r.index)), r)
+        table = f.create_dataset("table", data=_table(results))
+        table.attrs["description"] = "Table I: cond of each iteration's regressor and of the stacked regressor"
 
 
 def _write_robot(group: h5py.Group, excitation: Excitation) -> None:
     robot, base = excitation.robot, excitation.base
-    _strings(group, "joint_names", robot.joint_names)
-    _strings(group, "parameter_names", robot.parameter_names)
-    _strings(group, "base_parameter_names", base.names)
+    write_strings(group, "joint_names", robot.joint_names)
+    write_strings(group, "parameter_names", robot.parameter_names)
+    write_strings(group, "base_parameter_names", base.names)
     group.create_dataset("composition_matrix", data=base.composition_matrix).attrs["description"] = "X (p x b): Y_B = Y X (Eq. 2)"
     group.create_dataset("regrouping_matrix", data=base.regrouping).attrs["description"] = "K (b x p): phi_B = K phi"
     group.create_dataset("urdf_base_parameters", data=base.from_standard(robot.urdf_parameters()))
@@ -132,7 +145,7 @@ def _write_iteration(group: h5py.Group, r: IterationResult) -> None:
         group.create_dataset(name, data=getattr(r, name)).attrs["unit"] = UNITS[name]
     group["alpha"].attrs["layout"] = "row j: [q0_j, a_j1..a_jN, b_j1..b_jN] (Eq. 50)"
     for name, series in r.tracks.items():
-        group.create_dataset(name, data=series).attrs["unit"] = UNITS[name]
+        group.create_dataset(name, data=series).attrs["unit"] = r.track_units[name]
     group.attrs["cond_own"] = r.cond_own
     group.attrs["cond_stacked"] = r.cond_stacked
     group.attrs["max_violation"] = r.max_violation
@@ -246,113 +259,3 @@ def read_alphas(path: Path) -> list[tuple[int, np.ndarray]]:
         if not keys:
             raise ExciteError(f"{path} has no finished iteration")
         return [(int(k), f["iterations"][k]["alpha"][()]) for k in keys]
-
-
-def _write_consistent(g: h5py.Group, report, robot) -> None:
-    """The physically consistent fit: standard parameters, per-body properties beside the URDF's,
-    active constraints, its validation errors."""
-    from excite_cli.identification.physical import body_properties
-
-    consistent = report.consistent
-    g.create_dataset("standard_parameters", data=consistent.standard).attrs["unit"] = "kg, kg m, kg m^2 (pinocchio order per body)"
-    _strings(g, "standard_parameter_names", robot.parameter_names)
-    g.attrs["solver_status"] = consistent.status
-    _strings(g, "active_constraints", consistent.active)
-    urdf = robot.urdf_parameters()
-    bodies = np.zeros(len(robot.body_names), dtype=[("body", h5py.string_dtype()), ("mass", "f8"), ("com", "f8", 3),
-                                                     ("principal_moments", "f8", 3), ("inertia_com", "f8", (3, 3)),
-                                                     ("urdf_mass", "f8"), ("urdf_com", "f8", 3), ("urdf_principal_moments", "f8", 3),
-                                                     ("pseudo_inertia_min_eigenvalue", "f8")])
-    for i, row in enumerate(bodies):
-        m, c, I, moments = body_properties(consistent.standard[10 * i: 10 * i + 10])
-        um, uc, _, umoments = body_properties(urdf[10 * i: 10 * i + 10])
-        row["body"], row["mass"], row["com"], row["principal_moments"], row["inertia_com"] = robot.body_names[i], m, c, moments, I
-        row["urdf_mass"], row["urdf_com"], row["urdf_principal_moments"] = um, uc, umoments
-        row["pseudo_inertia_min_eigenvalue"] = consistent.min_eigenvalues[i]
-    table = g.create_dataset("bodies", data=bodies)
-    table.attrs["units"] = "mass kg, com m, moments and inertia kg m^2 (about the CoM, body axes)"
-    g.create_dataset("rms_consistent", data=report.rms_consistent).attrs["unit"] = "Nm"
-    g.create_dataset("relative_consistent", data=report.relative_consistent).attrs["unit"] = "%"
-
-
-def write_identification(path: Path, report, robot, base: BaseParameters, source_text: str, regressor: list[np.ndarray],
-                         method: str) -> None:
-    """Write (atomically) an ``identify`` result: ``/identification/...``, plus ``/regressor`` (the
-    base regressor of all preprocessed samples) and ``/robot/base_parameter_names``, so the file can
-    serve as prior data C₀ of ``optimize`` (Eq. 41).
-
-    Args:
-        report: the :class:`~excite_cli.identification.pipeline.Report`.
-        source_text: the identify config's text.
-        regressor: base regressor rows of all samples, in parts ((M_k, b) each, e.g. fit and validation).
-        method: ``wls`` or ``ls``.
-
-    Raises:
-        ExciteError: the file cannot be written.
-    """
-    from excite_cli.identification.pipeline import effect_values
-
-    path = Path(path)
-    tmp = path.with_name(path.name + ".partial")
-    sel = report.selection
-    b = base.count
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with h5py.File(tmp, "w") as f:
-            f.attrs["config"] = source_text
-            f.attrs["created"] = datetime.now(timezone.utc).isoformat(timespec="seconds")
-            for name, version in package_versions().items():
-                f.attrs[f"version_{name}"] = version
-            group = f.create_group("robot")
-            _strings(group, "joint_names", robot.joint_names)
-            _strings(group, "base_parameter_names", base.names)
-            rows = f.create_dataset("regressor", shape=(sum(part.shape[0] for part in regressor), b), dtype="f8")
-            start = 0
-            for part in regressor:
-                rows[start : start + part.shape[0]] = part
-                start += part.shape[0]
-            rows.attrs["description"] = "base regressor of all preprocessed samples, fit then validation (prior data C0, Eq. 41)"
-            g = f.create_group("identification")
-            g.attrs["method"] = method
-            g.attrs["cutoff_Hz"] = report.cutoff
-            g.attrs["fit_samples"] = report.fit_samples
-            g.attrs["validation_samples"] = report.validation_samples
-            g.attrs["dropped_rows"] = "; ".join(f"{name}: {rows}" for name, rows in report.dropped) or "none"
-            _strings(g, "joint_names", report.joints)
-            _strings(g, "base_parameter_names", report.base_names)
-            consistent = report.consistent
-            g.create_dataset("base_parameters", data=sel.fit.x[:b] if consistent is None else consistent.base)
-            g.create_dataset("base_parameters_unconstrained", data=sel.fit.x[:b])
-            g.create_dataset("base_parameters_std", data=sel.fit.std[:b])
-            g.create_dataset("base_parameters_rigid_only", data=sel.rigid.x)
-            g.create_dataset("physically_consistent", data=consistent is not None)
-            if consistent is not None:
-                _write_consistent(g, report, robot)
-            rows = effect_values(report)
-            effects = np.zeros(len(rows), dtype=[("order", "i4"), ("effect", h5py.string_dtype()), ("coefficient", h5py.string_dtype()),
-                                                 ("joint", h5py.string_dtype()), ("value", "f8"), ("std", "f8"), ("declared", "?"),
-                                                 ("value_consistent", "f8")])
-            effects["value_consistent"] = np.nan if report.consistent is None else report.consistent.effects
-            declared = {(e, report.joints[j]) for e, j in sel.effects[: sel.declared]}
-            order = {key: k + 1 for k, key in enumerate((e, report.joints[j]) for e, j in sel.effects)}
-            for row, (effect, coefficient, joint, value, std) in zip(effects, rows):
-                row["order"], row["effect"], row["coefficient"], row["joint"] = order[(effect, joint)], effect, coefficient, joint
-                row["value"], row["std"], row["declared"] = value, std, (effect, joint) in declared
-            g.create_dataset("effects", data=effects)
-            n = len(report.joints)
-            runs = report.per_run()
-            table = np.zeros(len(runs), dtype=[("run", h5py.string_dtype()), ("instants", "i8"), ("rms_before", "f8", n),
-                                                ("rms_after", "f8", n), ("relative_after", "f8", n)])
-            for row, (name, count, before, after, torque) in zip(table, runs):
-                row["run"], row["instants"], row["rms_before"], row["rms_after"] = name, count, before, after
-                row["relative_after"] = 100.0 * after / np.where(torque > 0, torque, 1.0)
-            g.create_dataset("validation_runs", data=table).attrs["units"] = "rms in Nm; relative_after in % of the run's RMS torque"
-            _strings(g, "absorbed_effects", [f"{e}:{report.joints[j]}" for e, j in sel.absorbed])
-            for name, values, unit in (("rms_before", report.rms_before, "Nm"), ("rms_after", report.rms_after, "Nm"),
-                                       ("rms_torque", report.rms_torque, "Nm"), ("relative_before", report.relative_before, "%"),
-                                       ("relative_after", report.relative_after, "%")):
-                g.create_dataset(name, data=values).attrs["unit"] = unit
-        os.replace(tmp, path)
-    except OSError as exc:
-        tmp.unlink(missing_ok=True)
-        raise ExciteError(f"output: cannot write {path}: {exc}") from None

@@ -190,27 +190,13 @@ def _body_name(model: pin.Model, joint_id: int) -> str:
     return model.names[joint_id]
 
 
-def load_robot(problem: Problem, collision: bool = False) -> Robot:
-    """Build the :class:`Robot` of a problem: load the URDF, lock the non-active joints.
-
-    Args:
-        problem: the validated config.
-        collision: also load the URDF's collision geometry (meshes), reduced with the model.
+def _check_joints(cfg: RobotConfig, full: pin.Model) -> list[str]:
+    """The movable joints of the full model, after checking the active and locked joints against them.
 
     Raises:
-        ExciteError: missing URDF, unknown joint name, a joint that is not 1-DoF, a locked value
-            outside the joint's limits.
+        ExciteError: an unknown joint, a joint that is not 1-DoF, a joint listed twice or both active
+            and locked, a locked value outside the joint's limits.
     """
-    cfg: RobotConfig = problem.robot
-    path, package_dirs = resolve_urdf(problem)
-    try:
-        if cfg.floating_base:
-            full = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
-        else:
-            full = pin.buildModelFromUrdf(str(path))
-    except (RuntimeError, ValueError) as exc:
-        raise ExciteError(f"robot.urdf: cannot read {path}: {exc}") from None
-
     movable = [n for j, n in enumerate(full.names) if j > 0 and full.joints[j].shortname() != "JointModelFreeFlyer"]
     for name in cfg.active_joints:
         if name not in movable:
@@ -228,7 +214,28 @@ def load_robot(problem: Problem, collision: bool = False) -> Robot:
         lo, hi = full.lowerPositionLimit[full.idx_qs[j]], full.upperPositionLimit[full.idx_qs[j]]
         if full.joints[j].nq == 1 and not lo <= value <= hi:
             raise ExciteError(f"robot.locked_joints.{name}: {value} rad is outside the joint limits [{lo:g}, {hi:g}]")
+    return movable
 
+
+def load_robot(problem: Problem, collision: bool = False) -> Robot:
+    """Build the :class:`Robot` of a problem: load the URDF, lock the non-active joints.
+
+    Args:
+        problem: the validated config.
+        collision: also load the URDF's collision geometry (meshes), reduced with the model.
+
+    Raises:
+        ExciteError: missing URDF, unknown joint name, a joint that is not 1-DoF, a locked value
+            outside the joint's limits.
+    """
+    cfg: RobotConfig = problem.robot
+    path, package_dirs = resolve_urdf(problem)
+    try:
+        full = pin.buildModelFromUrdf(str(path), *([pin.JointModelFreeFlyer()] if cfg.floating_base else []))
+    except (RuntimeError, ValueError) as exc:
+        raise ExciteError(f"robot.urdf: cannot read {path}: {exc}") from None
+
+    movable = _check_joints(cfg, full)
     q_full = pin.neutral(full)
     for name, value in cfg.locked_joints.items():
         q_full[full.idx_qs[full.getJointId(name)]] = value
@@ -250,11 +257,10 @@ def load_robot(problem: Problem, collision: bool = False) -> Robot:
     if cfg.base_wrench_rows and not cfg.floating_base:
         raise ExciteError("robot.base_wrench_rows: needs robot.floating_base: true")
     lower, upper = model.lowerPositionLimit[q_idx].copy(), model.upperPositionLimit[q_idx].copy()
-    home = np.zeros(len(ids))
-    for name, value in cfg.home_posture.items():
-        if name not in cfg.active_joints:
-            raise _unknown_joint("robot.home_posture", name, list(cfg.active_joints))
-        home[cfg.active_joints.index(name)] = value
+    unknown = [name for name in cfg.home_posture if name not in cfg.active_joints]
+    if unknown:
+        raise _unknown_joint("robot.home_posture", unknown[0], list(cfg.active_joints))
+    home = np.array([cfg.home_posture.get(name, 0.0) for name in cfg.active_joints])
     return Robot(
         model=model,
         joint_names=list(cfg.active_joints),

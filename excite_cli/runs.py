@@ -12,14 +12,16 @@ from typing import Callable, Optional, Sequence
 import numpy as np
 import yaml
 
-from excite_cli.config import IdentifyProblem, Problem, effective_yaml, with_overrides
+from excite_cli.config import Problem, effective_yaml, with_overrides
+from excite_cli.identification.config import IdentifyProblem
 from excite_cli.criterion import OBJECTIVES
 from excite_cli.engine import Engine, default_workers
 from excite_cli.errors import ExciteError, Interrupted
 from excite_cli.excitation import Excitation, build_excitation
 from excite_cli.identification.pipeline import run_identification, write_identified_urdf
 from excite_cli.optimizer import ProgressHook
-from excite_cli.output import open_result, read_iterations, read_prior, read_table, write_identification, write_result
+from excite_cli.identification.report_file import write_identification
+from excite_cli.output import open_result, read_iterations, read_prior, read_table, write_result
 from excite_cli.plots import plot_comparison, plot_identification, plot_result
 from excite_cli.random_baseline import draw_pool, greedy_selection, pool_convergence
 from excite_cli.sequence import IterationResult, describe, run_sequence

@@ -30,7 +30,7 @@ class IterationResult:
         checks: per-constraint figures from the fine grid, units in the names, and those of the
             transitions from and to the home posture (:func:`transition_checks`).
         tracks: per-constraint time series on the constraint grid (``com_xy`` (T_grid, 2) [m],
-            ``min_capsule_distance`` (T_grid,) [m]).
+            ``min_capsule_distance`` (T_grid,) [m]); track_units: their units, from the constraints.
         wall_time_s: optimization wall time [s]; sqp_iterations: SLSQP iterations; message: SLSQP's.
     """
 
@@ -46,6 +46,7 @@ class IterationResult:
     max_violation: float
     checks: dict[str, float | str] = field(default_factory=dict)
     tracks: dict[str, np.ndarray] = field(default_factory=dict)
+    track_units: dict[str, str] = field(default_factory=dict)
     wall_time_s: float = 0.0
     sqp_iterations: int = 0
     message: str = ""
@@ -104,6 +105,7 @@ def describe(excitation: Excitation, index: int, alpha: np.ndarray, prior: np.nd
         max_violation=max(c.max_violation for c in checks),
         checks=details,
         tracks={key: value for c in excitation.constraints for key, value in c.track(alpha, excitation.grid_basis).items()},
+        track_units={key: unit for c in excitation.constraints for key, unit in c.track_units.items()},
         wall_time_s=wall_time_s,
         sqp_iterations=sqp_iterations,
         message=message,

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from excite_cli.config import SimulationConfig
+from excite_cli.identification.config import SimulationConfig
 from excite_cli.errors import ExciteError
 from excite_cli.identification.effects import COEFFICIENTS, effect_columns
 from excite_cli.output import problem_of_result, read_alphas

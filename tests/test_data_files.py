@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 import scipy.io
 
-from excite_cli.config import IdentifyProblem
+from excite_cli.identification.config import IdentifyProblem
 from excite_cli.errors import ExciteError
 from excite_cli.identification.measurements import load_run
 

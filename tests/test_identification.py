@@ -11,7 +11,8 @@ from typer.testing import CliRunner
 
 from conftest import write_config
 from excite_cli.cli import app
-from excite_cli.config import EFFECT_NAMES, IdentifyProblem, load_problem
+from excite_cli.config import load_problem
+from excite_cli.identification.config import EFFECT_NAMES, IdentifyProblem
 from excite_cli.identification.effects import COEFFICIENTS, effect_columns
 from excite_cli.identification.pipeline import effect_values, run_identification
 from excite_cli.identification.preprocessing import Filter, default_cutoff

@@ -14,7 +14,8 @@ from typer.testing import CliRunner
 from conftest import CONFIGS, write_config
 from excite_cli.base_parameters import compute_base_parameters
 from excite_cli.cli import app
-from excite_cli.config import IdentifyProblem, load_problem
+from excite_cli.config import load_problem
+from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.physical import pseudo_inertia
 from excite_cli.identification.pipeline import run_identification
 from excite_cli.output import problem_of_result, read_alphas

@@ -100,6 +100,8 @@ class ComRegion(Constraint):
         dq = np.einsum("tk,tkx,txn->tn", w, ds, J)
         return np.atleast_1d(g), (dq.T @ self.basis.q).reshape(1, -1)
 
+    track_units = {"com_xy": "m"}
+
     def track(self, alpha: np.ndarray, basis: FourierBasis) -> dict[str, np.ndarray]:
         """``com_xy``: (T, 2) ground projection of the CoM [m]."""
         return {"com_xy": self._com(basis.q @ alpha.T)[0]}

@@ -34,11 +34,13 @@ class Constraint(ABC):
         basis: Fourier basis on the constraint grid.
         grid_margin: normalized margin the exact grid samples must keep for α to be accepted; it
             covers the overshoot between grid instants.
+        track_units: the unit of each series :meth:`track` returns, by name.
     """
 
     name: str
     basis: FourierBasis
     grid_margin: float = 0.0
+    track_units: dict[str, str] = {}
 
     @abstractmethod
     def evaluate(self, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -88,6 +88,8 @@ class SelfCollision(Constraint):
         J = (self.basis.q.T @ rates.reshape(d.shape[0], P * n)).reshape(m, P, n) * self._moves
         return g, J.transpose(1, 2, 0).reshape(P, n * m)
 
+    track_units = {"min_capsule_distance": "m"}
+
     def track(self, alpha: np.ndarray, basis: FourierBasis) -> dict[str, np.ndarray]:
         """``min_capsule_distance``: (T,) smallest distance over the pairs at each instant [m]."""
         if not self.pairs:

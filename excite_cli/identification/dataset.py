@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from excite_cli.base_parameters import BaseParameters
-from excite_cli.config import IdentificationConfig
+from excite_cli.identification.config import IdentificationConfig
 from excite_cli.errors import ExciteError
 from excite_cli.identification.effects import COEFFICIENTS, TWO_STAGE, effect_columns
 from excite_cli.identification.preprocessing import Samples

@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import stats
 
-from excite_cli.config import IdentificationConfig
+from excite_cli.identification.config import IdentificationConfig
 from excite_cli.identification.dataset import Dataset
 from excite_cli.identification.effects import REQUIRES
 from excite_cli.identification.normal import ABSORBED, NormalEquations, covariance_diagonal, outside_fraction, solve, sse

@@ -10,7 +10,7 @@ from typing import Optional
 
 import numpy as np
 
-from excite_cli.config import DataConfig, IdentifyProblem, RunConfig
+from excite_cli.identification.config import DataConfig, IdentifyProblem, RunConfig
 from excite_cli.errors import ExciteError
 from excite_cli.identification.files import Table, read_table
 

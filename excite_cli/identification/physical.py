@@ -104,6 +104,23 @@ def body_scales(phi_urdf: np.ndarray) -> np.ndarray:
     return (mass[:, None] * pattern[None, :]).ravel()
 
 
+def _solve(problem: cp.Problem) -> cp.Problem:
+    """Solve with Clarabel; an inaccurate solution is reported in the status, not as a warning.
+
+    Raises:
+        ExciteError: the solver failed or found no (accurate or inaccurate) optimum.
+    """
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)
+            problem.solve(solver=cp.CLARABEL)
+    except cp.SolverError as exc:
+        raise ExciteError(f"identification.physical_consistency: the SDP solver failed: {exc}") from None
+    if problem.status not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE):
+        raise ExciteError(f"identification.physical_consistency: the SDP ended {problem.status}")
+    return problem
+
+
 def consistent_fit(regressor: np.ndarray, effects: np.ndarray, tau: np.ndarray, weights: np.ndarray,
                    regrouping: np.ndarray, phi_urdf: np.ndarray, effect_names: list[str], regularization: float,
                    bodies: list[str]) -> ConsistentFit:
@@ -144,15 +161,7 @@ def consistent_fit(regressor: np.ndarray, effects: np.ndarray, tau: np.ndarray, 
     if k and nonnegative.any():
         constraints.append(theta[np.flatnonzero(nonnegative)] >= 0)
     objective = cp.sum_squares(R @ u - z) / rows + regularization * cp.sum_squares(delta)
-    problem = cp.Problem(cp.Minimize(objective), constraints)
-    try:
-        with warnings.catch_warnings():  # an inaccurate solution is reported in the status instead
-            warnings.simplefilter("ignore", UserWarning)
-            problem.solve(solver=cp.CLARABEL)
-    except cp.SolverError as exc:
-        raise ExciteError(f"identification.physical_consistency: the SDP solver failed: {exc}") from None
-    if problem.status not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE):
-        raise ExciteError(f"identification.physical_consistency: the SDP ended {problem.status}")
+    problem = _solve(cp.Problem(cp.Minimize(objective), constraints))
     standard = phi_urdf + scale * (u.value[: scale.size] / column[: scale.size])
     coefficients = u.value[scale.size:] / column[scale.size:]
     eigen = np.array([np.linalg.eigvalsh(pseudo_inertia(standard[10 * i: 10 * i + 10]))[0] for i in range(len(bodies))])

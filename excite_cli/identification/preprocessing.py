@@ -12,7 +12,7 @@ from typing import Callable, Iterator
 import numpy as np
 from scipy import signal
 
-from excite_cli.config import PreprocessingConfig
+from excite_cli.identification.config import PreprocessingConfig
 from excite_cli.errors import ExciteError
 from excite_cli.identification.measurements import Run
 

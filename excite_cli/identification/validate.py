@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from excite_cli.base_parameters import compute_base_parameters
-from excite_cli.config import IdentifyProblem
+from excite_cli.identification.config import IdentifyProblem
 from excite_cli.errors import ExciteError
 from excite_cli.identification.dataset import build_datasets
 from excite_cli.identification.identify import predict
