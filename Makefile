@@ -24,6 +24,7 @@ smoke: $(STAMP)
 	$(VENV)/bin/excite optimize configs/smoke.yaml --output results/smoke.h5 --force
 	$(VENV)/bin/excite export results/smoke.h5 --rate 1000 --force
 	$(VENV)/bin/excite verify-gradient configs/smoke.yaml
+	$(VENV)/bin/excite identify configs/panda_identify_simulated.yaml --output results/smoke_identify.h5 --force
 
 bench: $(STAMP)
 	$(PY) bench/bench_g1_arms.py

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
+from excite_cli.errors import ExciteError
 from excite_cli.robot import Robot
 
 #: |R_kk| / |R_00| below this is rank loss.
@@ -72,7 +73,7 @@ def compute_base_parameters(robot: Robot, seed: int = 0, samples: int | None = N
         The :class:`BaseParameters`.
 
     Raises:
-        ValueError: no parameter is excited by the regressor rows (b = 0).
+        ExciteError: no parameter is excited by the regressor rows (b = 0).
     """
     rng = np.random.default_rng(seed)
     p = robot.n_parameters
@@ -82,7 +83,7 @@ def compute_base_parameters(robot: Robot, seed: int = 0, samples: int | None = N
     diag = np.abs(np.diag(R))
     b = int(np.sum(diag > RANK_TOLERANCE * diag[0])) if diag.size and diag[0] > 0 else 0
     if b == 0:
-        raise ValueError("no inertial parameter affects the selected regressor rows")
+        raise ExciteError("robot.active_joints: no inertial parameter affects the selected regressor rows")
     independent, dependent = perm[:b], perm[b:]
     beta = scipy.linalg.solve_triangular(R[:b, :b], R[:b, b:])
     X = np.zeros((p, b))

@@ -19,8 +19,10 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+import pinocchio as pin
 
 from excite_cli.base_parameters import BaseParameters
+from excite_cli.errors import ExciteError
 from excite_cli.robot import Robot
 from excite_cli.trajectory import FourierBasis
 from excite_cli.virtual_dynamics import VirtualDynamics
@@ -53,7 +55,7 @@ def objective_terms(objective: str, eigenvalues: np.ndarray) -> tuple[float, np.
         The value, the indices r (R,) of the eigenpairs used, and their coefficients a_r (R,).
 
     Raises:
-        ValueError: an unknown objective.
+        ExciteError: an unknown objective.
     """
     lam = np.maximum(eigenvalues, (RANK_FLOOR**2) * max(eigenvalues[-1], 0.0))
     lam = np.maximum(lam, np.finfo(float).tiny)
@@ -69,7 +71,7 @@ def objective_terms(objective: str, eigenvalues: np.ndarray) -> tuple[float, np.
         return float(-0.5 * np.log(lam[0])), np.array([0]), np.array([-1.0 / lam[0]])
     if objective == "log_det":
         return float(-np.log(lam).sum() / lam.size), np.arange(lam.size), -2.0 / (lam.size * lam)
-    raise ValueError(f"unknown objective '{objective}', expected one of {', '.join(OBJECTIVES)}")
+    raise ExciteError(f"optimizer.objective: unknown '{objective}', expected one of {', '.join(OBJECTIVES)}")
 
 
 @dataclass
@@ -91,21 +93,23 @@ class Criterion:
     prior: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
     objective: str = "log_cond"
     _dynamics: VirtualDynamics = field(init=False, repr=False)
+    _data: pin.Data = field(init=False, repr=False)
     _prior_gram: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         if self.prior.size == 0:
             self.prior = np.zeros((0, self.base.count))
         if self.prior.shape[1] != self.base.count:
-            raise ValueError(f"prior has {self.prior.shape[1]} columns, the robot has {self.base.count} base parameters")
+            raise ExciteError(f"sequence.prior: {self.prior.shape[1]} columns, but the robot has {self.base.count} base parameters")
         objective_terms(self.objective, np.ones(1))  # fail early on an unknown objective
         self._dynamics = VirtualDynamics(self.robot)
+        self._data = self.robot.model.createData()  # this criterion's own, so no result depends on other users
         self._prior_gram = self.prior.T @ self.prior
 
     def regressor(self, alpha: np.ndarray) -> np.ndarray:
         """Ŷ_B of the trajectory α (n, 2N+1): (T·n_rows, b) (Eq. 3 with Y_B = Y X)."""
         Q, QD, QDD = self.basis.evaluate(alpha)
-        return self.robot.regressor_stack(Q, QD, QDD)[:, self.base.independent]  # Y X, X a selection
+        return self.robot.regressor_stack(Q, QD, QDD, self._data)[:, self.base.independent]  # Y X, X a selection
 
     def stacked(self, own: np.ndarray) -> np.ndarray:
         """C = [C₀; Ŷ_B] (Eq. 41)."""

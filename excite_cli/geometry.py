@@ -65,6 +65,7 @@ def world_points(robot: Robot, link: str, q: np.ndarray, field: str = "constrain
     """
     points, joint = link_points(robot, link, field)
     qf = robot.state(q, np.zeros_like(q), np.zeros_like(q))[0]
-    pin.forwardKinematics(robot.model, robot.data, qf)
-    placement = robot.data.oMi[joint]
+    data = robot.model.createData()
+    pin.forwardKinematics(robot.model, data, qf)
+    placement = data.oMi[joint]
     return points @ placement.rotation.T + placement.translation

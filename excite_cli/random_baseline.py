@@ -91,7 +91,8 @@ class DrawTask:
         criterion = excitation.criterion()
         shape = (excitation.robot.n_joints, excitation.trajectory.n_coefficients)
         regressors = [criterion.regressor(a) for a in alphas]
-        return np.array(alphas).reshape(-1, *shape), np.array(regressors).reshape(len(alphas), -1, excitation.base.count), drawn
+        rows = excitation.cost_basis.time.size * excitation.robot.n_rows
+        return np.array(alphas).reshape(-1, *shape), np.array(regressors).reshape(len(alphas), rows, excitation.base.count), drawn
 
 
 def draw_pool(engine: Engine, size: Optional[int], seed: int, budget_s: Optional[float] = None,

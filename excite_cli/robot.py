@@ -136,30 +136,32 @@ class Robot:
         af[self.v_idx] = qdd
         return qf, vf, af
 
-    def regressor(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
+    def regressor(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, data: pin.Data | None = None) -> np.ndarray:
         """Torque regressor Y(q, q̇, q̈) of Eq. 1, rows ``row_idx``: (n_rows, p).
 
         Args:
             q, qd, qdd: (n,) active joints' position [rad], velocity [rad/s], acceleration [rad/s²].
+            data: the caller's pinocchio Data (each consumer keeps its own; default: the robot's).
         """
-        Y = pin.computeJointTorqueRegressor(self.model, self.data, *self.state(q, qd, qdd))
+        Y = pin.computeJointTorqueRegressor(self.model, data or self.data, *self.state(q, qd, qdd))
         return Y[self.row_idx]
 
-    def regressor_stack(self, Q: np.ndarray, QD: np.ndarray, QDD: np.ndarray) -> np.ndarray:
+    def regressor_stack(self, Q: np.ndarray, QD: np.ndarray, QDD: np.ndarray, data: pin.Data | None = None) -> np.ndarray:
         """Regressors at T instants stacked as in Eq. 3: (T·n_rows, p) from (T, n) arrays."""
-        return np.vstack([self.regressor(Q[t], QD[t], QDD[t]) for t in range(Q.shape[0])])
+        return np.vstack([self.regressor(Q[t], QD[t], QDD[t], data) for t in range(Q.shape[0])])
 
-    def torques(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
+    def torques(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, data: pin.Data | None = None) -> np.ndarray:
         """Inverse dynamics τ (RNEA) of the URDF model, rows ``row_idx``: (n_rows,) [Nm, N]."""
-        return pin.rnea(self.model, self.data, *self.state(q, qd, qdd))[self.row_idx].copy()
+        return pin.rnea(self.model, data or self.data, *self.state(q, qd, qdd))[self.row_idx].copy()
 
-    def com(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def com(self, q: np.ndarray, data: pin.Data | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Centre of total mass [m] (3,) in the world frame, of the URDF inertias, and its Jacobian
         (3, n) in the active joints (base held fixed) [m/rad]."""
+        data = data or self.data
         qf = self.q_reference.copy()
         qf[self.q_idx] = q
-        J = pin.jacobianCenterOfMass(self.model, self.data, qf, False)
-        return self.data.com[0].copy(), J[:, self.v_idx]
+        J = pin.jacobianCenterOfMass(self.model, data, qf, False)
+        return data.com[0].copy(), J[:, self.v_idx]
 
     def random_states(self, count: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(count, n) random positions within the limits, and standard-normal velocities and accelerations."""

@@ -5,7 +5,7 @@ import pinocchio as pin
 import pytest
 
 from conftest import small
-from excite_cli.criterion import Criterion, condition_number
+from excite_cli.criterion import Criterion, condition_number, objective_terms
 from excite_cli.excitation import build_excitation
 from excite_cli.virtual_dynamics import VirtualDynamics
 from excite_cli.verify import check_gradient, finite_difference_gradient
@@ -62,11 +62,33 @@ def test_value_is_the_condition_number_of_the_stacked_regressor(panda_problem):
     assert criterion.value(b) == pytest.approx(s[0] / s[-1], rel=1e-12)
 
 
-def test_rank_loss_gives_finite_values():
+def test_condition_number_is_infinite_at_rank_loss():
     C = np.zeros((5, 3))
     C[:, 0] = 1.0
     assert condition_number(C) == float("inf")
     assert condition_number(np.ones((2, 3))) == float("inf")
+
+
+@pytest.mark.parametrize("objective, expected", [("cond", 1e14), ("log_cond", np.log(1e14)), ("sigma_min", -np.log(2e-14))])
+def test_rank_loss_is_floored_to_finite_values_and_gradient_weights(objective, expected):
+    """σ_min = 0 (λ = 0 of CᵀC): σ_min is floored at 1e-14 σ_max = 2e-14, so value and the gradient's
+    coefficients a_r are finite."""
+    value, used, coefficients = objective_terms(objective, np.array([0.0, 1.0, 4.0]))
+    assert value == pytest.approx(expected, rel=1e-12)
+    assert np.all(np.isfinite(coefficients)) and 0 in used
+
+
+def test_gram_value_matches_the_svd_at_high_cond(panda_problem):
+    """value_and_gradient takes σ from the eigenvalues of CᵀC (squared cond); value() from an SVD of C."""
+    excitation = build_excitation(small(panda_problem))
+    criterion = Criterion(excitation.robot, excitation.base, excitation.cost_basis, objective="cond")
+    for scale, largest in ((1.0, 1e-12), (0.1, 1e-6), (0.01, None)):  # smaller motion, worse conditioned
+        alpha = _feasible_alpha(excitation)
+        alpha[:, 1:] *= scale
+        exact = criterion.value(alpha)
+        error = abs(criterion.value_and_gradient(alpha)[0] - exact) / exact
+        assert error <= (largest or 1.0) and error <= np.finfo(float).eps * exact**2  # the Gram matrix squares cond
+    assert exact > 1e8  # the last point is far worse than any optimizer iterate
 
 
 def test_motionless_trajectory_gives_finite_value_and_gradient(panda_problem):

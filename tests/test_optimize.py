@@ -10,6 +10,8 @@ from typer.testing import CliRunner
 from excite_cli.engine import Engine
 from conftest import UR5, write_config
 from excite_cli.cli import app
+from excite_cli.config import load_problem
+from excite_cli.robot import load_robot
 
 runner = CliRunner()
 
@@ -48,8 +50,11 @@ def test_schema(result):
         assert "harmonics" in f.attrs["config"] and f.attrs["seed"] == 3 and "version_pin" in f.attrs
 
 
-def test_table_is_consistent_and_limits_hold(result):
+def test_table_is_consistent_and_limits_hold(result, tmp_path):
     out, output = result
+    data = _data()
+    robot = load_robot(load_problem(write_config(tmp_path, data)))
+    margin, acceleration = data["limits"]["position_margin"], data["limits"]["acceleration"]
     with h5py.File(out) as f:
         blocks = [f[f"iterations/{k}/regressor"][()] for k in "123"]
         table = f["table"][()]
@@ -60,8 +65,11 @@ def test_table_is_consistent_and_limits_hold(result):
             assert table["cond_own"][k] == pytest.approx(s_own[0] / s_own[-1], rel=1e-9)
             attrs = f[f"iterations/{k + 1}"].attrs
             assert attrs["max_violation"] <= 0.0
-            q, qd = f[f"iterations/{k + 1}/q"][()], f[f"iterations/{k + 1}/qd"][()]
-            assert np.all(np.abs(qd) <= 3.2) and np.all(q >= -6.2) and np.all(q <= 6.2)
+            # every sample within the per-joint bounds: URDF position limits minus the margin, the
+            # URDF velocity limits (the config gives none) and the config's acceleration
+            q, qd, qdd = (f[f"iterations/{k + 1}/{name}"][()] for name in ("q", "qd", "qdd"))
+            assert np.all(q >= robot.lower + margin - 1e-9) and np.all(q <= robot.upper - margin + 1e-9)
+            assert np.all(np.abs(qd) <= robot.velocity_limit + 1e-9) and np.all(np.abs(qdd) <= acceleration + 1e-9)
     assert np.all(np.diff(table["cond_stacked"]) <= 0)
     assert "Table I" in output
 

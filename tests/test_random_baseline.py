@@ -14,8 +14,7 @@ from conftest import write_config
 from excite_cli.cli import app
 from excite_cli.config import load_problem
 from excite_cli.excitation import build_excitation
-from excite_cli.engine import Engine
-from excite_cli.random_baseline import draw_pool, greedy_selection, random_candidate
+from excite_cli.random_baseline import greedy_selection, random_candidate
 
 HERE = Path(__file__).resolve().parent
 
@@ -75,11 +74,3 @@ def test_compare_random_command(tmp_path):
         assert f["table"]["cond_stacked"][1] == pytest.approx(_cond(stacked), rel=1e-9)
     assert (tmp_path / "panda_random_comparison.png").stat().st_size > 5000
     assert (tmp_path / "panda_optimized.h5").exists()
-
-
-def test_pool_respects_a_time_budget():
-    excitation = build_excitation(load_problem(HERE / "panda_capsules.yaml"))
-    with Engine(excitation) as engine:
-        pool = draw_pool(engine, None, 3, budget_s=1.0)
-    assert 0 < len(pool.alphas) and pool.generation_time_s < 5.0
-    assert pool.regressors.shape[0] == len(pool.alphas)

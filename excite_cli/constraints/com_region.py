@@ -10,7 +10,7 @@ a log-sum-exp over the constraint grid; the gradient comes from pinocchio's CoM 
 from __future__ import annotations
 
 import numpy as np
-from scipy.spatial import ConvexHull
+from scipy.spatial import ConvexHull, QhullError
 
 from excite_cli.config import ComConfig
 from excite_cli.constraints.constraint import Constraint, FineCheck
@@ -35,7 +35,7 @@ def support_centre(robot: Robot, links: list[str]) -> np.ndarray:
     sole = points[points[:, 2] <= points[:, 2].min() + SOLE_HEIGHT, :2]
     try:
         hull = ConvexHull(sole)
-    except Exception:  # qhull raises its own error type for degenerate input
+    except QhullError:  # degenerate input (collinear or coincident points)
         raise ExciteError("constraints.com.support_links: the soles of these links span no area") from None
     v = sole[hull.vertices]
     cross = v[:, 0] * np.roll(v[:, 1], -1) - np.roll(v[:, 0], -1) * v[:, 1]
@@ -63,6 +63,7 @@ class ComRegion(Constraint):
     def __init__(self, robot: Robot, basis: FourierBasis, centre: np.ndarray, radius: float | None = None,
                  polygon: np.ndarray | None = None):
         self.robot, self.basis, self.centre = robot, basis, np.asarray(centre, dtype=float)
+        self._data = robot.model.createData()  # this constraint's own pinocchio Data
         self.radius = radius
         self.polygon = None if polygon is None else np.asarray(polygon, dtype=float)
         if polygon is not None:
@@ -79,7 +80,7 @@ class ComRegion(Constraint):
 
     def _com(self, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(T, 2) ground projections [m] and (T, 2, n) their Jacobians."""
-        samples = [self.robot.com(q) for q in Q]
+        samples = [self.robot.com(q, self._data) for q in Q]
         return np.array([p[:2] for p, _ in samples]), np.array([J[:2] for _, J in samples])
 
     def _normalized(self, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -116,13 +116,13 @@ def run_identification(problem: IdentifyProblem) -> tuple[Report, Robot, BasePar
     problem.robot.base_wrench_rows = False
     robot = load_robot(problem)
     base = compute_base_parameters(robot)
+    declared = declared_effects(problem, robot)  # before any data is read
     runs = [load_run(r, problem.data, problem, robot.n_joints) for r in problem.data.runs]
     cutoff = problem.preprocessing.cutoff or default_cutoff(runs, problem.preprocessing)
     dropped = [(r.name, r.dropped) for r in runs if r.dropped]
     samples = [preprocess(runs.pop(0), problem.preprocessing, cutoff) for _ in range(len(runs))]
     cfg = problem.identification
     rate = max(s.filter.rate / s.filter.step for s in samples)
-    declared = declared_effects(problem, robot)
     needed = set(cfg.candidates) | {e for e, _ in declared} | {"coulomb"}  # Coulomb: the load column's sign
     fit_data, val_data = build_datasets(robot, base, samples, cfg, problem.data.validation_blocks, needed)
     rigid_only = NormalEquations(fit_data, [])
