@@ -66,7 +66,8 @@ def write_strings(group: h5py.Group, name: str, values: Sequence[str]) -> None:
     group.create_dataset(name, data=np.array(values, dtype=h5py.string_dtype()))
 
 
-def _table(results: Sequence[IterationResult]) -> np.ndarray:
+def results_table(results: Sequence[IterationResult]) -> np.ndarray:
+    """Table I as a structured array: iteration, cond_own, cond_stacked."""
     table = np.zeros(len(results), dtype=[("iteration", "i4"), ("cond_own", "f8"), ("cond_stacked", "f8")])
     for row, r in zip(table, results):
         row["iteration"], row["cond_own"], row["cond_stacked"] = r.index, r.cond_own, r.cond_stacked
@@ -123,7 +124,7 @@ def write_result(path: Path, excitation: Excitation, results: Sequence[Iteration
         iterations = f.create_group("iterations")
         for r in results:
             _write_iteration(iterations.create_group(str(r.index)), r)
-        table = f.create_dataset("table", data=_table(results))
+        table = f.create_dataset("table", data=results_table(results))
         table.attrs["description"] = "Table I: cond of each iteration's regressor and of the stacked regressor"
 
 
@@ -173,11 +174,13 @@ def read_prior(path: Path, base: BaseParameters) -> np.ndarray:
         else:
             raise ExciteError(f"sequence.prior: {path} has neither /iterations nor /regressor")
         names = [n.decode() if isinstance(n, bytes) else n for n in f["robot/base_parameter_names"][()]] if "robot/base_parameter_names" in f else None
-    if prior.ndim != 2 or prior.shape[1] != base.count or (names is not None and names != base.names):
-        raise ExciteError(
-            f"sequence.prior: {path} was made for other base parameters "
-            f"({prior.shape[-1]} columns, the problem has {base.count})"
-        )
+    if prior.ndim != 2 or prior.shape[1] != base.count:
+        raise ExciteError(f"sequence.prior: {path} has {prior.shape[-1]} regressor columns, the problem's robot has "
+                          f"{base.count} base parameters (prior data of another robot or joint set?)")
+    if names is not None and names != base.names:
+        differ = next(k for k, (a, b) in enumerate(zip(names, base.names)) if a != b)
+        raise ExciteError(f"sequence.prior: {path} has the same number of base parameters ({base.count}) but other ones "
+                          f"(number {differ + 1} is '{names[differ]}', the problem's is '{base.names[differ]}')")
     if not np.all(np.isfinite(prior)):
         raise ExciteError(f"sequence.prior: {path} contains NaN or infinite values")
     return prior

@@ -21,7 +21,7 @@ from excite_cli.excitation import Excitation, build_excitation
 from excite_cli.identification.pipeline import run_identification, write_identified_urdf
 from excite_cli.optimizer import ProgressHook
 from excite_cli.identification.report_file import write_identification
-from excite_cli.output import open_result, read_iterations, read_prior, read_table, write_result
+from excite_cli.output import open_result, read_iterations, read_prior, read_table, results_table, write_result
 from excite_cli.plots import plot_comparison, plot_identification, plot_result
 from excite_cli.random_baseline import draw_pool, greedy_selection, pool_convergence
 from excite_cli.sequence import IterationResult, describe, run_sequence
@@ -149,11 +149,12 @@ def run_compare_random(problem: Problem, optimized: Optional[Path], target: Opti
     target = check_target(target or base.with_name(base.stem + "_random.h5"), "--output", force)
     excitation = build_excitation(problem)
     with engine_for(problem, excitation) as engine:
-        if optimized is None:
-            optimized = run_optimize(problem, base.with_name(base.stem + "_optimized.h5"), force, progress=progress,
-                                     engine=engine).target
-        optimized_table, optimized_time = read_table(optimized, "--optimized")
-        _check_same_problem(optimized, excitation)
+        if optimized is None:  # run here: its table is in memory
+            run = run_optimize(problem, base.with_name(base.stem + "_optimized.h5"), force, progress=progress, engine=engine)
+            optimized_table, optimized_time = results_table(run.results), sum(r.wall_time_s for r in run.results)
+        else:
+            optimized_table, optimized_time = read_table(optimized, "--optimized")
+            _check_same_problem(optimized, excitation)
         count = len(optimized_table)
         rcfg = problem.random_baseline
         if not equal_effort and rcfg.pool_size < count:

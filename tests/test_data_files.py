@@ -59,6 +59,13 @@ def test_semicolon_csv_with_header(tmp_path):
     _check(_load(tmp_path, "run.csv", {"q": [f"q{k}" for k in range(7)], "tau": [f"t{k}" for k in range(7)]}))
 
 
+def test_semicolon_csv_with_decimal_commas(tmp_path):
+    header = ";".join(["time"] + [f"q{k}" for k in range(7)] + [f"t{k}" for k in range(7)])
+    rows = [";".join(f"{v:.17g}".replace(".", ",") for v in row) for row in np.column_stack([TIME, Q, TAU])]
+    (tmp_path / "run.csv").write_text("\n".join([header] + rows) + "\n")
+    _check(_load(tmp_path, "run.csv", {"q": [f"q{k}" for k in range(7)], "tau": [f"t{k}" for k in range(7)]}))
+
+
 def _corrupt_csv(tmp_path: Path) -> dict:
     lines = [",".join(["time"] + [f"q{k}" for k in range(7)] + [f"t{k}" for k in range(7)])]
     lines += [",".join(f"{v:.17g}" for v in row) for row in np.column_stack([TIME, Q, TAU])]

@@ -13,6 +13,7 @@ the file and the line, or, with ``bad_rows: drop``, left out and counted.
 from __future__ import annotations
 
 from dataclasses import dataclass
+import re
 from pathlib import Path
 
 import h5py
@@ -22,6 +23,8 @@ import scipy.io
 from excite_cli.errors import ExciteError
 
 DELIMITERS = (",", ";", "\t")
+#: A number written with a decimal comma (semicolon-separated files of European locales).
+DECIMAL_COMMA = re.compile(r"\d,\d")
 
 
 @dataclass(frozen=True)
@@ -79,6 +82,8 @@ def _read_text(path: Path, drop: bool) -> Table:
         raise ExciteError(f"data: {path.name} has no data rows")
     first = numbered[0][1]
     delimiter = max(DELIMITERS, key=first.count) if any(d in first for d in DELIMITERS) else None
+    if delimiter == ";" and any(DECIMAL_COMMA.search(line) for _, line in numbered[1:3]):
+        numbered = [(k, line.replace(",", ".")) for k, line in numbered]  # 1,5;2,25: decimal commas
     head = _split(first, delimiter)
     header = not all(_number(x) or x == "" for x in head)
     names = head if header else [str(k) for k in range(len(head))]
