@@ -18,7 +18,7 @@ optimize: $(STAMP)
 	$(VENV)/bin/excite optimize $(CONFIG) --force
 
 test: $(STAMP)
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q -rs
 
 smoke: $(STAMP)
 	$(VENV)/bin/excite optimize configs/smoke.yaml --output results/smoke.h5 --force

@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from excite_cli.base_parameters import BaseParameters, compute_base_parameters
+from excite_cli.config import with_overrides
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.errors import ExciteError
 from excite_cli.identification.effects import COEFFICIENTS
@@ -113,7 +114,7 @@ def run_identification(problem: IdentifyProblem) -> tuple[Report, Robot, BasePar
     Raises:
         ExciteError: bad data or config (see :func:`load_run`, :func:`preprocess`, :func:`build_datasets`).
     """
-    problem.robot.base_wrench_rows = False
+    problem = with_overrides(problem, {"robot.base_wrench_rows": False})  # a copy: the caller's config is not changed
     robot = load_robot(problem)
     base = compute_base_parameters(robot)
     declared = declared_effects(problem, robot)  # before any data is read

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from excite_cli.base_parameters import compute_base_parameters
+from excite_cli.config import with_overrides
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.errors import ExciteError
 from excite_cli.identification.dataset import build_datasets
@@ -71,7 +72,7 @@ def validate_model(report: Path, problem: IdentifyProblem) -> list[RunError]:
             config (as ``identify``).
     """
     model = read_model(report)
-    problem.robot.base_wrench_rows = False
+    problem = with_overrides(problem, {"robot.base_wrench_rows": False})  # a copy: the caller's config is not changed
     robot = load_robot(problem)
     base = compute_base_parameters(robot)
     if model["joints"] != robot.joint_names or model["base_names"] != base.names:
