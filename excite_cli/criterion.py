@@ -108,7 +108,9 @@ class Criterion:
 
     def regressor(self, alpha: np.ndarray) -> np.ndarray:
         """Ŷ_B of the trajectory α (n, 2N+1): (T·n_rows, b) (Eq. 3 with Y_B = Y X)."""
-        Q, QD, QDD = self.basis.evaluate(alpha)
+        return self._regressor(*self.basis.evaluate(alpha))
+
+    def _regressor(self, Q: np.ndarray, QD: np.ndarray, QDD: np.ndarray) -> np.ndarray:
         return self.robot.regressor_stack(Q, QD, QDD, self._data)[:, self.base.independent]  # Y X, X a selection
 
     def stacked(self, own: np.ndarray) -> np.ndarray:
@@ -130,7 +132,7 @@ class Criterion:
         (``RANK_FLOOR``) so the result is finite.
         """
         Q, QD, QDD = self.basis.evaluate(alpha)
-        own = self.regressor(alpha)
+        own = self._regressor(Q, QD, QDD)
         # eigenpairs of the b×b Gram matrix CᵀC = C₀ᵀC₀ + ŶᵀŶ give σ² and v; C v = σ u (Eqs. 8, 16)
         eig, V = np.linalg.eigh(self._prior_gram + own.T @ own)
         value, used, coefficients = objective_terms(self.objective, eig)

@@ -17,7 +17,7 @@ from __future__ import annotations
 import coal
 import numpy as np
 
-from excite_cli.capsules import Capsule, capsule_placements, segment_closest_points, segment_ends
+from excite_cli.capsules import Capsule, capsule_frames, segment_closest_points, segment_ends
 from excite_cli.constraints.constraint import Constraint, FineCheck
 from excite_cli.constraints.lse import ACCEPT_MARGIN, smooth_max
 from excite_cli.kinematics import BatchKinematics
@@ -101,8 +101,8 @@ class SelfCollision(Constraint):
         gives it (for every sample screened within ``CONFIRM`` of the smallest)."""
         if not self.pairs:
             return FineCheck(max_violation=-np.inf, details={}, where="no capsule pair")
-        screened = self._closest(q)[0]
-        rotations, centres = capsule_placements(self.kinematics, self.capsules, q)
+        screened, _, _, R, p = self._closest(q)
+        rotations, centres = capsule_frames(R, p, self.capsules)
         best, where = np.inf, (0, 0)
         for t, p in zip(*np.nonzero(screened <= screened.min() + CONFIRM)):
             d = self._distance(rotations, centres, t, p).min_distance
