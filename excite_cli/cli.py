@@ -114,10 +114,10 @@ def identify(config: Path = typer.Argument(..., help="Identification YAML: robot
     problem = with_overrides(load_problem(config, IdentifyProblem), {"identification.physical_consistency": physical_consistency or None})
     with err.status("preprocessing, fitting and selecting effects ..."):
         run = runs.run_identify(problem, output or Path(problem.output), urdf_out, force)
-    _say(tables.preprocessing_notes(run.report, problem), console=err)
+    _say(tables.preprocessing_notes(run.report), console=err)
     _say(tables.identification(run.report), [tables.bodies(run.report, run.robot)] if run.report.consistent else [],
          [f"wrote {urdf_out}: its RNEA matches the identified rigid-body torques to {run.urdf_deviation:.1e} Nm"] if urdf_out else [],
-         f"wrote {run.target} and {run.plot}")
+         f"wrote {run.target} and {', '.join(str(p) for p in run.plots)}")
 
 
 @command()

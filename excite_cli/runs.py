@@ -22,7 +22,8 @@ from excite_cli.identification.pipeline import run_identification, write_identif
 from excite_cli.optimizer import ProgressHook
 from excite_cli.identification.report_file import write_identification
 from excite_cli.output import open_result, read_iterations, read_prior, read_table, results_table, write_result
-from excite_cli.plots import plot_comparison, plot_identification, plot_result
+from excite_cli.identification.figures import plot_identification, plot_ladder
+from excite_cli.plots import plot_comparison, plot_result
 from excite_cli.random_baseline import draw_pool, greedy_selection, pool_convergence
 from excite_cli.sequence import IterationResult, describe, run_sequence
 from excite_cli.targets import check_target
@@ -239,12 +240,13 @@ def run_verify(problem: Problem, result: Optional[Path] = None, objectives: Sequ
 
 @dataclass
 class IdentifyRun:
-    """``identify``: the report, the robot, the files written and the URDF round-trip deviation [Nm]."""
+    """``identify``: the report, the robot, the files written (report, plots) and the URDF round-trip
+    deviation [Nm]."""
 
     report: object
     robot: object
     target: Path
-    plot: Path
+    plots: list[Path]
     urdf_deviation: Optional[float]
 
 
@@ -260,7 +262,9 @@ def run_identify(problem: IdentifyProblem, target: Path, urdf_out: Optional[Path
         check_target(urdf_out, "--urdf-out", force)
         problem = with_overrides(problem, {"identification.physical_consistency": True})
     report, robot, base, regressor = run_identification(problem)
-    write_identification(target, report, robot, base, problem.source_text, regressor, problem.identification.method)
+    write_identification(target, report, robot, base, problem, regressor)
     deviation = write_identified_urdf(problem, report, robot, base, urdf_out) if urdf_out is not None else None
-    plot = plot_identification(target.with_suffix("").with_name(target.stem + "_residuals.png"), report)
-    return IdentifyRun(report, robot, target, plot, deviation)
+    stem = target.with_suffix("")
+    plots = [plot_identification(stem.with_name(target.stem + "_residuals.png"), report),
+             plot_ladder(stem.with_name(target.stem + "_ladder.png"), report)]
+    return IdentifyRun(report, robot, target, plots, deviation)

@@ -37,8 +37,8 @@ def effect_torques(sim: SimulationConfig, robot: Robot, q: np.ndarray, qd: np.nd
             if coefficients.size != len(COEFFICIENTS[effect]):
                 raise ExciteError(f"effects.{effect}.{name}: needs {len(COEFFICIENTS[effect])} value(s) {COEFFICIENTS[effect]}")
             for j in (range(robot.n_joints) if name == "*" else [robot.joint_names.index(name)]):
-                cols = effect_columns(effect, q[:, j], qd[:, j], qdd[:, j], sim.coulomb_velocity, sim.stribeck_velocity,
-                                      sim.held_velocity, rigid[:, j])
+                shape = {"stribeck": sim.stribeck_velocity, "held": sim.held_velocity}.get(effect)
+                cols = effect_columns(effect, q[:, j], qd[:, j], qdd[:, j], sim.coulomb_velocity, shape, rigid[:, j])
                 tau[:, j] += cols @ coefficients
     return tau
 

@@ -8,7 +8,7 @@ import numpy as np
 from rich.table import Table
 
 from excite_cli.export import Export
-from excite_cli.identification.effects import UNITS as EFFECT_UNITS
+from excite_cli.identification.effects import COEFFICIENTS, UNITS as EFFECT_UNITS
 from excite_cli.identification.physical import body_properties, pseudo_inertia
 from excite_cli.identification.pipeline import effect_values
 from excite_cli.runs import Comparison, Verification
@@ -84,33 +84,59 @@ def validation(name: str, joints: Sequence[str], errors) -> Table:
                   [(e.name, str(e.instants), *[f"{x:.1f}" for x in e.relative], f"{e.relative.mean():.1f}") for e in errors])
 
 
-def preprocessing_notes(report, problem) -> list[str]:
+def preprocessing_notes(report) -> list[str]:
     """The cut-off used (and where it came from) and the rows dropped per run."""
-    source = "preprocessing.cutoff" if problem.preprocessing.cutoff else "default: 10 × the 99 % power bandwidth of q"
-    return [f"low-pass cut-off {report.cutoff:.3g} Hz ({source}); stored as cutoff_Hz"] + [
+    return [f"low-pass cut-off {report.cutoff:.3g} Hz ({report.cutoff_source}); stored as cutoff_Hz"] + [
         f"data.bad_rows: dropped {rows} unusable row(s) of {name}" for name, rows in report.dropped]
 
 
 def identification(report) -> list[Table | str]:
-    """The before/after error table, the chosen effects, what was absorbed, the base parameters."""
+    """The before/after error table, the ladder, the selection's steps, the chosen effects, what was
+    absorbed, the base parameters."""
     consistent, sel = report.relative_consistent, report.selection
     extra = consistent is not None
-    errors = _table(f"Validation torque error, rigid body only → with the chosen effects ({report.validation_samples} held-out instants)",
+    errors = _table(f"Validation torque error, rigid body only → with the chosen effects ({report.validation_samples} instants "
+                    "that neither the fit nor the selection saw)",
                     ("joint", "RMS τ [Nm]", "before [Nm]", "after [Nm]", "before [%]", "after [%]") + (("consistent [%]",) if extra else ()),
                     [(name, f"{report.rms_torque[j]:.3f}", f"{report.rms_before[j]:.3f}", f"{report.rms_after[j]:.3f}",
                       f"{report.relative_before[j]:.1f}", f"{report.relative_after[j]:.1f}", *((f"{consistent[j]:.1f}",) if extra else ()))
                      for j, name in enumerate(report.joints)],
                     f"mean: before {report.relative_before.mean():.1f} %, after {report.relative_after.mean():.1f} %"
                     + (f", physically consistent {consistent.mean():.1f} %" if extra else ""))
-    order = {key: k + 1 for k, key in enumerate((e, report.joints[j]) for e, j in sel.effects)}
-    effects = _table("Effects, in the order they were added (declared ones first)", ("#", "effect", "joint", "coefficient", "value", "std"),
-                     [(str(order[(effect, joint)]), effect, joint, f"{coefficient} [{EFFECT_UNITS[coefficient]}]", f"{value:.5g}", f"{std:.2g}")
-                      for effect, coefficient, joint, value, std in effect_values(report)])
+    ladder = _table("What each effect bought: mean relative error after each step", ("step", "cross-validated [%]", "validation [%]"),
+                    [(label, f"{cv:.2f}", f"{val:.2f}") for label, cv, val in report.ladder],
+                    f"cross-validated: {sel.folds} blocked folds of the fit data (what the selection minimizes); "
+                    "validation: data it never saw")
+    order = {t: k + 1 for k, t in enumerate(sel.terms)}
+    effects = _table("Effects, in the order they were added (declared ones first)",
+                     ("#", "effect", "joint", "shape [rad/s]", "coefficient", "value", "std"),
+                     [(str(order[t]), t.effect, report.joints[t.joint], "" if t.shape is None else f"{t.shape:g}",
+                       f"{name} [{EFFECT_UNITS[COEFFICIENTS[t.effect][0]]}]", f"{value:.5g}", f"{std:.2g}")
+                      for t, name, value, std in effect_values(report)])
     params = _table("Identified base parameters", ("base parameter", "value", "std"),
                     [(name, f"{value:.5g}", f"{std:.2g}") for name, value, std in zip(report.base_names, sel.fit.x, sel.fit.std)])
     absorbed = ["not separately identifiable (in the span of the base parameters): "
-                + ", ".join(f"{e}:{report.joints[j]}" for e, j in sel.absorbed)] if sel.absorbed else []
-    return [errors, effects, *absorbed, params]
+                + ", ".join(t.label(report.joints) for t in sel.absorbed)] if sel.absorbed else []
+    return [errors, ladder, *search(report), effects, *absorbed, params]
+
+
+def search(report, runners_up: int = 2) -> list[Table | str]:
+    """Each step of the kept search with its gain and the best moves it did not take (every move
+    tried is in the HDF5 report), and the outcome of every start."""
+    sel = report.selection
+    kept = sel.searches[sel.chosen]
+    rows, before = [], kept.initial_error
+    sign = {"add": "+", "remove": "−", "shape": "~"}
+    for k, step in enumerate(sel.steps, start=1):
+        others = sorted((v, m, t) for m, t, v in step.tried if (m, t) != (step.move, step.term))[:runners_up]
+        rows.append((str(k), f"{sign[step.move]} {step.term.label(report.joints)}", f"{100 * (1 - step.cv_error / before):.1f}",
+                     str(len(step.tried)), "; ".join(f"{sign[m]} {t.label(report.joints)} {100 * (1 - v / before):.1f}" for v, m, t in others)))
+        before = step.cv_error
+    steps = _table(f"Selection steps from the start '{kept.start}' (gain: cut of the cross-validated error [%])",
+                   ("step", "move", "gain [%]", "tried", f"next best {runners_up} [gain %]"), rows, f"stopped: {kept.stop}")
+    starts = "; ".join(f"{s.start}: {s.cv_error:.2f} % with {len(s.terms)} effects" + (" (kept)" if k == sel.chosen else "")
+                       for k, s in enumerate(sel.searches))
+    return [steps, f"searches (cross-validated error at their end): {starts}"]
 
 
 def bodies(report, robot) -> Table:

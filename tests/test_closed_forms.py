@@ -13,7 +13,7 @@ from excite_cli.constraints.com_region import ComRegion
 from excite_cli.engine import Engine
 from excite_cli.excitation import build_excitation
 from excite_cli.identification.dataset import Dataset
-from excite_cli.identification.identify import least_squares
+from excite_cli.identification.least_squares import least_squares
 from excite_cli.identification.normal import NormalEquations
 from excite_cli.random_baseline import DrawTask, draw_pool
 from excite_cli.verify import constraint_jacobian_error

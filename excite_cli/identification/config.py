@@ -7,18 +7,16 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Literal, Optional, Union
 
-from pydantic import Field, NonNegativeInt, model_validator
+from pydantic import Field, NonNegativeInt, PositiveFloat, field_validator, model_validator
 
 from excite_cli.config import Problem, RobotConfig, Section
+from excite_cli.identification.effects import EFFECT_NAMES, POSITION, SHAPE_GRID
 
 
-EFFECT_NAMES = ("coulomb", "coulomb_asymmetric", "viscous", "stribeck", "offset", "armature", "spring", "gravity_compensator",
-                "position_2", "viscous_asymmetric", "held", "load_coulomb")
-#: The default candidates: adding the last four to them made the greedy selection worse on the real
-#: Panda run (README), so they are opt-in through ``identification.candidates``.
-DEFAULT_CANDIDATES = EFFECT_NAMES[:8]
-Effect = Literal["coulomb", "coulomb_asymmetric", "viscous", "stribeck", "offset", "armature", "spring", "gravity_compensator",
-                 "position_2", "viscous_asymmetric", "held", "load_coulomb"]
+Effect = Literal[EFFECT_NAMES]
+#: The default candidates: every effect but the position-dependent ones, which fitted the seen phases
+#: of the real Panda run and extrapolated badly to an unseen one (README), so they are opt-in.
+DEFAULT_CANDIDATES = tuple(e for e in EFFECT_NAMES if e not in POSITION)
 
 
 Column = Union[NonNegativeInt, str]
@@ -42,12 +40,23 @@ class ColumnsConfig(Section):
         return self
 
 
+class PayloadConfig(Section):
+    """A known payload of a run: mass [kg], centre of mass [m] and inertia about it [kg·m²]
+    (Ixx, Ixy, Iyy, Ixz, Iyz, Izz) in ``frame`` (default: the link of the last active joint)."""
+
+    mass: float = Field(gt=0.0)
+    com: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    inertia: tuple[float, float, float, float, float, float] = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    frame: Optional[str] = None
+
+
 class RunConfig(Section):
-    """One measured run: file, optional crop [s], role (fit, validation or time blocks)."""
+    """One measured run: file, optional crop [s], role (fit, validation or time blocks), a known payload."""
 
     file: str
     crop: Optional[tuple[float, float]] = None
     role: Literal["fit", "validation", "blocks"] = "blocks"
+    payload: Optional[PayloadConfig] = None
 
     @property
     def label(self) -> str:
@@ -77,20 +86,26 @@ class PreprocessingConfig(Section):
 
 
 class IdentificationConfig(Section):
-    """LS or WLS, declared and candidate effects, selection thresholds, friction shape constants [rad/s],
-    physically consistent standard parameters and their regularization toward the URDF."""
+    """LS or WLS, declared and candidate effects, the selection's cross-validation folds and threshold,
+    friction shape velocities [rad/s] (a Stribeck or held velocity: one value, or a grid the
+    selection searches), physically consistent standard parameters and their regularization."""
 
     method: Literal["wls", "ls"] = "wls"
     declared_effects: dict[str, list[Effect]] = Field(default_factory=dict)
     candidates: list[Effect] = Field(default_factory=lambda: list(DEFAULT_CANDIDATES))
-    significance: float = Field(1e-3, gt=0.0, lt=1.0)
-    min_improvement: float = Field(0.01, ge=0.0, lt=1.0)
-    stribeck_velocity: float = Field(0.1, gt=0.0)
-    coulomb_velocity: float = Field(0.01, gt=0.0)
-    held_velocity: float = Field(0.02, gt=0.0)
+    folds: int = Field(6, ge=3, le=50)
+    min_improvement: float = Field(0.02, ge=0.0, lt=1.0)
+    coulomb_velocity: PositiveFloat = 0.01
+    stribeck_velocity: list[PositiveFloat] = Field(default_factory=lambda: list(SHAPE_GRID), min_length=1)
+    held_velocity: list[PositiveFloat] = Field(default_factory=lambda: list(SHAPE_GRID), min_length=1)
     max_effects: int = Field(60, ge=0)
     physical_consistency: bool = False
     regularization: float = Field(1e-3, ge=0.0)
+
+    @field_validator("stribeck_velocity", "held_velocity", mode="before")
+    @classmethod
+    def _one_or_grid(cls, value):
+        return [value] if isinstance(value, (int, float)) else value
 
 
 class IdentifyProblem(Section):

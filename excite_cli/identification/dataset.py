@@ -8,13 +8,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from excite_cli.base_parameters import BaseParameters
-from excite_cli.identification.config import IdentificationConfig
 from excite_cli.errors import ExciteError
-from excite_cli.identification.effects import COEFFICIENTS, TWO_STAGE, effect_columns
+from excite_cli.identification.effects import COEFFICIENTS, PER_RUN, TWO_STAGE, Term, effect_columns
 from excite_cli.identification.preprocessing import Samples
 from excite_cli.robot import Robot
-
-EFFECTS = tuple(COEFFICIENTS)
 
 
 @dataclass(frozen=True)
@@ -25,14 +22,14 @@ class Dataset:
         regressor: (N·n, b) base regressor Y_B (Eq. 3).
         tau: (N·n,) measured torques [Nm].
         time: (N,) [s]; run: (N,) index of the run of each instant.
-        blocks: effect columns by (effect, joint index), (N, k) each, on that joint's rows.
+        blocks: effect columns by :class:`Term`, (N, k) each, on that term's joint's rows.
     """
 
     regressor: np.ndarray
     tau: np.ndarray
     time: np.ndarray
     run: np.ndarray
-    blocks: dict[tuple[str, int], np.ndarray]
+    blocks: dict[Term, np.ndarray]
 
     @property
     def n(self) -> int:
@@ -44,19 +41,20 @@ class Dataset:
         """(N·n,) joint index of each row."""
         return np.tile(np.arange(self.n), self.time.size)
 
-    def block(self, effect: str, j: int) -> np.ndarray:
-        """(N·n, k) columns of ``effect`` on joint j: nonzero only on joint j's rows."""
-        cols = self.blocks[(effect, j)]
+    def block(self, term: Term) -> np.ndarray:
+        """(N·n, k) columns of ``term``: nonzero only on its joint's rows."""
+        cols = self.blocks[term]
         out = np.zeros((self.tau.size, cols.shape[1]))
-        out[j :: self.n] = cols
+        out[term.joint :: self.n] = cols
         return out
 
-    def with_load_columns(self, base_parameters: np.ndarray) -> "Dataset":
+    def with_load_columns(self, base_parameters: np.ndarray, terms: list[Term]) -> "Dataset":
         """The dataset with the two-stage ``load_coulomb`` blocks: abs(τ_rigid) times the Coulomb
-        block, τ_rigid = Y_B φ_B with the base parameters (b,) of a first, rigid-body fit (the product
-        of the filtered signals stands for the filtered product: both vary slowly at the cut-off)."""
+        block of the same joint, τ_rigid = Y_B φ_B with the base parameters (b,) of a first, rigid-body
+        fit (the product of the filtered signals stands for the filtered product: both vary slowly
+        at the cut-off). ``terms``: the ``load_coulomb`` terms to add."""
         rigid = np.abs(self.regressor @ base_parameters).reshape(-1, self.n)
-        extra = {("load_coulomb", j): rigid[:, j:j + 1] * self.blocks[("coulomb", j)] for j in range(self.n)}
+        extra = {t: rigid[:, t.joint : t.joint + 1] * self.blocks[Term("coulomb", t.joint)] for t in terms}
         return Dataset(self.regressor, self.tau, self.time, self.run, {**self.blocks, **extra})
 
 
@@ -70,28 +68,71 @@ def fit_instants(role: str, count: int, blocks: int) -> np.ndarray:
     return np.minimum((np.arange(count) * blocks) // max(count, 1), blocks - 1) % 2 == 0
 
 
-def build_datasets(robot: Robot, base: BaseParameters, samples: list[Samples], cfg: IdentificationConfig,
-                   blocks: int, effects: set[str] | None = None, split: bool = True) -> tuple[Dataset, Dataset]:
-    """The fit and validation datasets: regressor, candidate effect columns and torques of the
+def run_offset_columns(run: int, fitted: list[int], count: int, columns: int) -> np.ndarray:
+    """(count, columns) offset columns of the instants of ``run``: the indicator of its place among
+    the ``fitted`` runs, or 1/columns in every column for a run the fit never saw (the mean offset)."""
+    row = np.zeros(columns)
+    if run in fitted:
+        row[fitted.index(run)] = 1.0
+    else:
+        row[:] = 1.0 / columns
+    return np.broadcast_to(row, (count, columns))
+
+
+def _run_columns(s: Samples, index: int, terms: list[Term], fitted: list[int], offsets: int, coulomb_velocity: float) -> dict:
+    """Each term's columns of one run, filtered and decimated (offsets: indicator or mean columns)."""
+    kept = s.filter.kept(s.time.size)
+    return {t: run_offset_columns(index, fitted, kept, offsets) if t.effect in PER_RUN else
+            s.filter.decimate(effect_columns(t.effect, s.q[:, t.joint], s.qd[:, t.joint], s.qdd[:, t.joint], coulomb_velocity, t.shape))
+            for t in terms}
+
+
+def _regressor_chunks(robot: Robot, X: np.ndarray, s: Samples, payload: np.ndarray | None):
+    """The run's base regressor rows (k, n·b) and the torque (k, n) [Nm] of a known payload (or None),
+    computed at the run's rate, filtered and decimated chunk by chunk: yields (first kept sample,
+    rows, payload torque)."""
+    n, b = robot.n_joints, X.shape[1]
+
+    def values(lo: int, hi: int) -> np.ndarray:
+        Y = robot.regressor_stack(s.q[lo:hi], s.qd[lo:hi], s.qdd[lo:hi])
+        rows = (Y @ X).reshape(-1, n * b)
+        return rows if payload is None else np.hstack([rows, (Y @ payload).reshape(-1, n)])
+
+    for start, chunk in s.filter.chunks(values, s.time.size):
+        yield start, chunk[:, : n * b], None if payload is None else chunk[:, n * b :]
+
+
+def build_datasets(robot: Robot, base: BaseParameters, samples: list[Samples], terms: list[Term], coulomb_velocity: float,
+                   blocks: int, payloads: list[np.ndarray | None] | None = None, split: bool = True,
+                   offset_runs: int | None = None) -> tuple[Dataset, Dataset, list[int]]:
+    """The fit and validation datasets: regressor, the effect columns of ``terms`` and torques of the
     samples, each low-passed by its run's filter in parallel and decimated (so the filtered τ still
     equals the filtered columns × φ), split by :func:`fit_instants`. Written straight into
     preallocated arrays, the base regressor chunk by chunk: memory is the decimated data once.
-    ``samples`` is emptied as the runs are used. ``effects``: the effects whose blocks to build
-    (default: all that need no first fit). Without ``split`` every instant is validation data (the
-    fit dataset is empty).
+    ``samples`` is emptied as the runs are used. Two-stage terms are left out (see
+    :meth:`Dataset.with_load_columns`). Without ``split`` every instant is validation data (the fit
+    dataset is empty) and offsets are the mean of ``offset_runs`` fitted runs. ``payloads``: per
+    run, the standard parameters (p,) of a known payload (see
+    :func:`~excite_cli.identification.payload.payload_parameters`) or None; its torque Y π is
+    filtered and decimated with the regressor and taken out of τ.
+
+    Returns:
+        fit, validation and the indices of the runs with fit instants (the offsets' columns).
 
     Raises:
         ExciteError: nothing left for fitting or for validation.
     """
     n, b = robot.n_joints, base.count
-    X = base.composition_matrix
     masks = [fit_instants(s.role if split else "validation", s.filter.kept(s.time.size), blocks) for s in samples]
     sizes = {True: sum(int(m.sum()) for m in masks), False: sum(int((~m).sum()) for m in masks)}
     if split and (not sizes[True] or not sizes[False]):
         raise ExciteError("data.runs: need data for fitting and for validation (roles fit/validation, or blocks)")
-    keys = [(e, j) for e in EFFECTS if e not in TWO_STAGE and (effects is None or e in effects) for j in range(n)]
+    fitted = [k for k, m in enumerate(masks) if m.any()] if split else []
+    offsets = len(fitted) if split else max(offset_runs or 1, 1)
+    terms = [t for t in terms if t.effect not in TWO_STAGE]
+    width = {t: offsets if t.effect in PER_RUN else len(COEFFICIENTS[t.effect]) for t in terms}
     out = {side: {"Y": np.empty((size, n * b)), "tau": np.empty((size, n)), "time": np.empty(size),
-                  "run": np.empty(size, dtype=int), "blocks": {key: np.empty((size, len(COEFFICIENTS[key[0]]))) for key in keys}}
+                  "run": np.empty(size, dtype=int), "blocks": {t: np.empty((size, width[t])) for t in terms}}
            for side, size in sizes.items()}
     at = {True: 0, False: 0}
     for index, mask in enumerate(masks):
@@ -100,24 +141,22 @@ def build_datasets(robot: Robot, base: BaseParameters, samples: list[Samples], c
         where = {side: slice(at[side], at[side] + rows[side].size) for side in (True, False)}
         tau = s.filter.decimate(s.tau)
         time = s.time[s.filter.trim : s.time.size - s.filter.trim : s.filter.step]
-        columns = {(e, j): s.filter.decimate(effect_columns(e, s.q[:, j], s.qd[:, j], s.qdd[:, j], cfg.coulomb_velocity,
-                                                            cfg.stribeck_velocity, cfg.held_velocity)) for e, j in keys}
+        columns = _run_columns(s, index, terms, fitted, offsets, coulomb_velocity)
         for side in (True, False):
-            out[side]["tau"][where[side]] = tau[rows[side]]
-            out[side]["time"][where[side]] = time[rows[side]]
+            out[side]["tau"][where[side]], out[side]["time"][where[side]] = tau[rows[side]], time[rows[side]]
             out[side]["run"][where[side]] = index
-            for key in keys:
-                out[side]["blocks"][key][where[side]] = columns[key][rows[side]]
+            for t in terms:
+                out[side]["blocks"][t][where[side]] = columns[t][rows[side]]
         del columns
-        # the base regressor at the run's rate is (T·n, b): computed, filtered and decimated in chunks
-        for start, chunk in s.filter.chunks(lambda lo, hi: (robot.regressor_stack(s.q[lo:hi], s.qd[lo:hi], s.qdd[lo:hi]) @ X)
-                                            .reshape(-1, n * b), s.time.size):
-            part = mask[start : start + chunk.shape[0]]
+        for start, Y, load in _regressor_chunks(robot, base.composition_matrix, s, payloads[index] if payloads else None):
+            part = mask[start : start + Y.shape[0]]
             for side in (True, False):
                 first = at[side] + int(np.searchsorted(rows[side], start))  # this side's rows before the chunk
-                picked = chunk[part == side]
-                out[side]["Y"][first : first + picked.shape[0]] = picked
+                count = int(np.count_nonzero(part == side))
+                out[side]["Y"][first : first + count] = Y[part == side]
+                if load is not None:
+                    out[side]["tau"][first : first + count] -= load[part == side]
         for side in (True, False):
             at[side] += rows[side].size
     fit, val = (Dataset(o["Y"].reshape(-1, b), o["tau"].ravel(), o["time"], o["run"], o["blocks"]) for o in (out[True], out[False]))
-    return fit, val
+    return fit, val, fitted

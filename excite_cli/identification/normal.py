@@ -19,10 +19,13 @@ import numpy as np
 import scipy.linalg
 
 from excite_cli.identification.dataset import Dataset
+from excite_cli.identification.effects import Term
 
 #: A candidate block keeps less than this fraction of its squared norm outside the model's span:
 #: not separately identifiable (above the ~1e-10 rounding floor of squared normal equations).
 ABSORBED = 1e-8
+#: Instants stacked at a time when the normal equations are summed.
+CHUNK = 20_000
 
 
 class NormalEquations:
@@ -30,43 +33,51 @@ class NormalEquations:
 
     Args:
         data: the samples (base regressor, torques, effect blocks).
-        keys: the (effect, joint) blocks that models may contain.
+        keys: the terms (effect blocks) that models may contain.
+        rows: (m,) the instants to use (default all), e.g. one fold of a cross-validation.
     """
 
-    def __init__(self, data: Dataset, keys: list[tuple[str, int]]):
+    def __init__(self, data: Dataset, keys: list[Term], rows: np.ndarray | None = None):
         n, b = data.n, data.regressor.shape[1]
-        self.n, self.b, self.rows = n, b, data.tau.size
-        self.local: list[dict[tuple[str, int], np.ndarray]] = []
+        rows = np.arange(data.time.size) if rows is None else np.asarray(rows)
+        self.n, self.b, self.rows = n, b, rows.size * n
+        self.local: list[dict[Term, np.ndarray]] = []
         self.G, self.c, self.s = [], [], []
         for j in range(n):
-            own = [key for key in keys if key[1] == j]
+            own = [key for key in keys if key.joint == j]
             sizes = [data.blocks[key].shape[1] for key in own]
             starts = b + np.concatenate([[0], np.cumsum(sizes)]).astype(int)
             self.local.append({key: np.arange(starts[k], starts[k + 1]) for k, key in enumerate(own)})
-            L = np.hstack([data.regressor[j::n]] + [data.blocks[key] for key in own])
-            tau = data.tau[j::n]
-            self.G.append(L.T @ L)
-            self.c.append(L.T @ tau)
-            self.s.append(float(tau @ tau))
+            G, c, s = np.zeros((starts[-1], starts[-1])), np.zeros(starts[-1]), 0.0
+            for lo in range(0, rows.size, CHUNK):  # the stacked columns of a chunk only: bounded memory
+                part = rows[lo : lo + CHUNK]
+                L = np.hstack([data.regressor[part * n + j]] + [data.blocks[key][part] for key in own])
+                tau = data.tau[part * n + j]
+                G += L.T @ L
+                c += L.T @ tau
+                s += float(tau @ tau)
+            self.G.append(G)
+            self.c.append(c)
+            self.s.append(s)
 
-    def columns(self, effects: list[tuple[str, int]]) -> int:
+    def columns(self, effects: list[Term]) -> int:
         """Number of unknowns of the model [Y_B, ``effects``]."""
-        return self.b + sum(self.local[j][(e, j)].size for e, j in effects)
+        return self.b + sum(self.local[t.joint][t].size for t in effects)
 
-    def _placement(self, effects: list[tuple[str, int]]) -> list[tuple[np.ndarray, np.ndarray]]:
+    def _placement(self, effects: list[Term]) -> list[tuple[np.ndarray, np.ndarray]]:
         """Per joint j, (indices in j's local pieces, indices among the model's unknowns) of the base
         parameters and of j's effects in the model [Y_B, ``effects``]."""
         base = np.arange(self.b)
         local, glob = [[base] for _ in range(self.n)], [[base] for _ in range(self.n)]
         start = self.b
-        for e, j in effects:
-            columns = self.local[j][(e, j)]
-            local[j].append(columns)
-            glob[j].append(np.arange(start, start + columns.size))
+        for t in effects:
+            columns = self.local[t.joint][t]
+            local[t.joint].append(columns)
+            glob[t.joint].append(np.arange(start, start + columns.size))
             start += columns.size
         return [(np.concatenate(l), np.concatenate(g)) for l, g in zip(local, glob)]
 
-    def system(self, weights: np.ndarray | None, effects: list[tuple[str, int]]) -> tuple[np.ndarray, np.ndarray, float]:
+    def system(self, weights: np.ndarray | None, effects: list[Term]) -> tuple[np.ndarray, np.ndarray, float]:
         """(G, c, s) of the model [Y_B, ``effects``] (unknowns in that order) with joint weights (n,)."""
         m = self.columns(effects)
         G, c, s = np.zeros((m, m)), np.zeros(m), 0.0
@@ -77,7 +88,18 @@ class NormalEquations:
             s += w2 * self.s[j]
         return G, c, s
 
-    def joint_sse(self, x: np.ndarray, effects: list[tuple[str, int]]) -> np.ndarray:
+    def stacked(self, keys: list[Term]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Per-joint pieces placed in the unknowns of the model [Y_B, every one of ``keys``]:
+        G (n, P, P), c (n, P), s (n,) (unweighted), so that any smaller model's system is a
+        weighted sum over joints and a selection of rows and columns."""
+        size = self.columns(keys)
+        G, c = np.zeros((self.n, size, size)), np.zeros((self.n, size))
+        for j, (local, glob) in enumerate(self._placement(keys)):
+            G[j][np.ix_(glob, glob)] = self.G[j][np.ix_(local, local)]
+            c[j, glob] = self.c[j][local]
+        return G, c, np.array(self.s)
+
+    def joint_sse(self, x: np.ndarray, effects: list[Term]) -> np.ndarray:
         """(n,) unweighted residual sum of squares of each joint [Nm²] for coefficients x."""
         out = np.zeros(self.n)
         for j, (local, glob) in enumerate(self._placement(effects)):

@@ -1,5 +1,6 @@
 """``excite identify``: measured runs ─► preprocessing ─► fit / validation split ─► rigid-body fit ─►
-effect selection ─► report of the torque error before and after on the validation data."""
+effect selection (cross-validated on the fit data) ─► report of the torque error before and after on
+the validation data, which neither the fit nor the selection saw."""
 
 from __future__ import annotations
 
@@ -10,15 +11,17 @@ import numpy as np
 
 from excite_cli.base_parameters import BaseParameters, compute_base_parameters
 from excite_cli.config import with_overrides
-from excite_cli.identification.config import IdentifyProblem
 from excite_cli.errors import ExciteError
-from excite_cli.identification.effects import COEFFICIENTS
+from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.dataset import Dataset, build_datasets
-from excite_cli.identification.identify import Selection, design, joint_weights, least_squares, predict, select_effects
-from excite_cli.identification.normal import NormalEquations, excited_rank
+from excite_cli.identification.effects import COEFFICIENTS, PER_RUN, TWO_STAGE, Term
+from excite_cli.identification.least_squares import design, joint_weights, least_squares, predict
 from excite_cli.identification.measurements import load_run
+from excite_cli.identification.normal import NormalEquations, excited_rank
+from excite_cli.identification.payload import payload_parameters
 from excite_cli.identification.physical import ConsistentFit, consistent_fit
-from excite_cli.identification.preprocessing import default_cutoff, preprocess
+from excite_cli.identification.preprocessing import choose_cutoff, preprocess
+from excite_cli.identification.selection import Selection, candidate_terms, select_effects
 from excite_cli.identification.urdf_out import urdf_deviation, write_urdf
 from excite_cli.robot import Robot, load_robot, resolve_urdf
 
@@ -30,14 +33,17 @@ class Report:
     Attributes:
         joints: (n,) active joint names.
         base_names: (b,) base-parameter names.
-        selection: chosen effects, fits and selection steps.
+        selection: chosen effects, fits, the search's steps.
         rms_before, rms_after: (n,) validation torque RMS error [Nm], rigid body only / with effects.
         rms_torque: (n,) RMS of the measured validation torques [Nm].
         validation: the validation samples; predicted_before, predicted_after: (N, n) [Nm] on them.
-        cutoff: low-pass cut-off of every run [Hz].
+        cutoff: low-pass cut-off of every run [Hz]; cutoff_source: how it was chosen, in words.
         fit_samples, validation_samples: instants used for fitting / validation.
         dropped: (file, rows) left out as unusable, per run with ``data.bad_rows: drop``.
-        run_names: (runs,) each configured run's file name (with its crop), indexed by ``Dataset.run``.
+        run_names: (runs,) each configured run's label (file and crop), indexed by ``Dataset.run``.
+        offset_runs: the runs whose offsets the fit has (one column each), as labels.
+        ladder: (step, CV error on the fit data [%], mean relative validation error [%]) for the
+            rigid body, the search's start and after each step of the kept search.
         consistent: the physically consistent fit with the same effects, or None.
         rms_consistent: (n,) its validation torque RMS error [Nm] (None without it).
     """
@@ -52,10 +58,13 @@ class Report:
     predicted_before: np.ndarray
     predicted_after: np.ndarray
     cutoff: float
+    cutoff_source: str
     fit_samples: int
     validation_samples: int
     dropped: list[tuple[str, int]] = field(default_factory=list)
     run_names: list[str] = field(default_factory=list)
+    offset_runs: list[str] = field(default_factory=list)
+    ladder: list[tuple[str, float, float]] = field(default_factory=list)
     consistent: ConsistentFit | None = None
     rms_consistent: np.ndarray | None = None
 
@@ -87,24 +96,101 @@ class Report:
         return None if self.rms_consistent is None else 100.0 * self.rms_consistent / self.rms_torque
 
 
-def declared_effects(problem: IdentifyProblem, robot: Robot) -> list[tuple[str, int]]:
-    """(effect, joint index) pairs of ``identification.declared_effects`` ({joint or "*": [effects]}).
+def declared_terms(problem: IdentifyProblem, robot: Robot) -> list[Term]:
+    """The terms of ``identification.declared_effects`` ({joint or "*": [effects]}); a Stribeck or held
+    term starts at the middle of its velocity grid (the selection may move it along the grid).
 
     Raises:
         ExciteError: a joint that is not active.
     """
-    out = []
-    for name, effects in problem.identification.declared_effects.items():
+    cfg = problem.identification
+    shapes = {"stribeck": cfg.stribeck_velocity, "held": cfg.held_velocity}
+    out: list[Term] = []
+    for name, effects in cfg.declared_effects.items():
         if name != "*" and name not in robot.joint_names:
             raise ExciteError(f"identification.declared_effects: '{name}' is not an active joint")
         joints = range(robot.n_joints) if name == "*" else [robot.joint_names.index(name)]
-        out += [(e, j) for e in effects for j in joints if (e, j) not in out]
+        for e in effects:
+            grid = shapes.get(e)
+            out += [t for j in joints for t in [Term(e, j, grid[len(grid) // 2] if grid else None)]
+                    if all((u.effect, u.joint) != (t.effect, t.joint) for u in out)]
     return out
 
 
+def _relative(measured: np.ndarray, predicted: np.ndarray) -> float:
+    """Mean over joints of RMS(measured − predicted) / RMS(measured) [%]."""
+    torque = np.sqrt(np.mean(measured**2, axis=0))
+    return float(np.mean(100.0 * np.sqrt(np.mean((measured - predicted) ** 2, axis=0)) / np.where(torque > 0, torque, 1.0)))
+
+
+def error_ladder(normal: NormalEquations, val_data: Dataset, selection: Selection, joints: list[str]) -> list[tuple[str, float, float]]:
+    """(step, CV error [%], mean relative validation error [%]) of the rigid body, the kept search's
+    start and each of its steps, every model fitted on all fit data with the selection's weights: what
+    each effect bought."""
+    measured = val_data.tau.reshape(-1, val_data.n)
+    search = selection.searches[selection.chosen]
+    models = [("rigid body", [], selection.cv_rigid)]
+    if search.initial:
+        models.append((f"start: {search.start}", search.initial, search.initial_error))
+    terms = search.initial
+    for step in search.steps:
+        if step.move == "add":
+            terms = terms + [step.term]
+        elif step.move == "remove":
+            terms = [t for t in terms if t != step.term]
+        else:
+            terms = [step.term if (t.effect, t.joint) == (step.term.effect, step.term.joint) else t for t in terms]
+        models.append((f"{ {'add': '+', 'remove': '−', 'shape': '~'}[step.move]} {step.term.label(joints)}", terms, step.cv_error))
+    return [(label, cv, _relative(measured, predict(val_data, least_squares(normal, terms, selection.weights).x, terms)))
+            for label, terms, cv in models]
+
+
+@dataclass
+class Prepared:
+    """The data ``identify`` works on: fit and validation datasets (two-stage columns included), the
+    runs with fit instants, the cut-off [Hz] and its source, rows dropped per run, decimated rate [Hz]."""
+
+    fit: Dataset
+    validation: Dataset
+    fitted: list[int]
+    cutoff: float
+    cutoff_source: str
+    dropped: list[tuple[str, int]]
+    rate: float
+
+
+def prepare_data(problem: IdentifyProblem, robot: Robot, base: BaseParameters, terms: list[Term]) -> Prepared:
+    """Read every run, choose the cut-off, preprocess, build the fit and validation datasets with the
+    columns of ``terms`` (known payloads taken out), check the fit data excite every base parameter,
+    and add the two-stage load columns from a first rigid-body fit. Runs are released as they are
+    decimated.
+
+    Raises:
+        ExciteError: bad data (see :func:`load_run`, :func:`preprocess`, :func:`build_datasets`), or
+            fit runs that do not excite every base parameter.
+    """
+    cfg = problem.identification
+    payloads = [payload_parameters(robot, r.payload, f"data.runs[{k}].payload") if r.payload else None
+                for k, r in enumerate(problem.data.runs)]
+    runs = [load_run(r, problem.data, problem, robot.n_joints) for r in problem.data.runs]
+    cutoff, source = choose_cutoff(runs, problem.preprocessing)
+    dropped = [(r.name, r.dropped) for r in runs if r.dropped]
+    samples = [preprocess(runs.pop(0), problem.preprocessing, cutoff) for _ in range(len(runs))]
+    rate = max(s.filter.rate / s.filter.step for s in samples)
+    coulomb = [Term("coulomb", j) for j in range(robot.n_joints)]  # the load column's sign
+    fit, val, fitted = build_datasets(robot, base, samples, terms + coulomb, cfg.coulomb_velocity, problem.data.validation_blocks, payloads)
+    rigid_only = NormalEquations(fit, [])
+    rank = excited_rank(rigid_only.system(None, [])[0])
+    if rank < base.count:
+        raise ExciteError(f"data: the fit runs excite {rank} of the {base.count} base parameters; the robot must move "
+                          "through an exciting trajectory (see `excite optimize`), motionless or small motions cannot identify it")
+    first = least_squares(rigid_only, [], joint_weights(rigid_only, cfg.method == "wls"))
+    load = [t for t in terms if t.effect in TWO_STAGE]
+    return Prepared(fit.with_load_columns(first.x, load), val.with_load_columns(first.x, load), fitted, cutoff, source, dropped, rate)
+
+
 def run_identification(problem: IdentifyProblem) -> tuple[Report, Robot, BaseParameters, list[np.ndarray]]:
-    """The whole loop on ``problem``'s data. The runs at their own rate are released once they are
-    filtered and decimated, so memory follows the decimated data.
+    """The whole loop on ``problem``'s data; memory follows the decimated data.
 
     Returns:
         The :class:`Report`, the robot, its base parameters and the base regressor rows of all
@@ -112,83 +198,70 @@ def run_identification(problem: IdentifyProblem) -> tuple[Report, Robot, BasePar
         ``optimize`` (Eq. 41).
 
     Raises:
-        ExciteError: bad data or config (see :func:`load_run`, :func:`preprocess`, :func:`build_datasets`).
+        ExciteError: bad data or config (see :func:`prepare_data`).
     """
     problem = with_overrides(problem, {"robot.base_wrench_rows": False})  # a copy: the caller's config is not changed
     robot = load_robot(problem)
     base = compute_base_parameters(robot)
-    declared = declared_effects(problem, robot)  # before any data is read
-    runs = [load_run(r, problem.data, problem, robot.n_joints) for r in problem.data.runs]
-    cutoff = problem.preprocessing.cutoff or default_cutoff(runs, problem.preprocessing)
-    dropped = [(r.name, r.dropped) for r in runs if r.dropped]
-    samples = [preprocess(runs.pop(0), problem.preprocessing, cutoff) for _ in range(len(runs))]
+    declared = declared_terms(problem, robot)  # before any data is read
     cfg = problem.identification
-    rate = max(s.filter.rate / s.filter.step for s in samples)
-    needed = set(cfg.candidates) | {e for e, _ in declared} | {"coulomb"}  # Coulomb: the load column's sign
-    fit_data, val_data = build_datasets(robot, base, samples, cfg, problem.data.validation_blocks, needed)
-    rigid_only = NormalEquations(fit_data, [])
-    rank = excited_rank(rigid_only.system(None, [])[0])
-    if rank < base.count:
-        raise ExciteError(f"data: the fit runs excite {rank} of the {base.count} base parameters; the robot must move "
-                          "through an exciting trajectory (see `excite optimize`), motionless or small motions cannot identify it")
-    first = least_squares(rigid_only, [], joint_weights(rigid_only, cfg.method == "wls"))
-    fit_data, val_data = fit_data.with_load_columns(first.x), val_data.with_load_columns(first.x)
-    selection = select_effects(fit_data, val_data, cfg, declared, max(1.0, rate / (2.0 * cutoff)))
+    data = prepare_data(problem, robot, base, declared + [t for t in candidate_terms(cfg, robot.n_joints) if t not in declared])
+    fit_data, val_data = data.fit, data.validation
+    selection = select_effects(fit_data, cfg, declared, margin=1.0 / data.cutoff,
+                               oversampling=max(1.0, data.rate / (2.0 * data.cutoff)))
     before = predict(val_data, selection.rigid.x, [])
-    after = predict(val_data, selection.fit.x, selection.effects)
+    after = predict(val_data, selection.fit.x, selection.terms)
     measured = val_data.tau.reshape(-1, val_data.n)
-    consistent = fit_consistent(fit_data, selection, robot, base, cfg) if cfg.physical_consistency else None
+    labels = [r.label for r in problem.data.runs]
+    offset_runs = [labels[k] for k in data.fitted]
+    consistent = fit_consistent(fit_data, selection, robot, base, cfg, offset_runs) if cfg.physical_consistency else None
     rms_consistent = None
     if consistent is not None:
-        predicted = predict(val_data, np.concatenate([consistent.base, consistent.effects]), selection.effects)
+        predicted = predict(val_data, np.concatenate([consistent.base, consistent.effects]), selection.terms)
         rms_consistent = np.sqrt(np.mean((measured - predicted) ** 2, axis=0))
     report = Report(
-        joints=robot.joint_names,
-        base_names=base.names,
-        selection=selection,
-        rms_before=np.sqrt(np.mean((measured - before) ** 2, axis=0)),
-        rms_after=np.sqrt(np.mean((measured - after) ** 2, axis=0)),
-        rms_torque=np.sqrt(np.mean(measured**2, axis=0)),
-        validation=val_data,
-        predicted_before=before,
-        predicted_after=after,
-        cutoff=cutoff,
-        fit_samples=fit_data.time.size,
-        validation_samples=val_data.time.size,
-        dropped=dropped,
-        run_names=[r.label for r in problem.data.runs],
-        consistent=consistent,
-        rms_consistent=rms_consistent,
+        joints=robot.joint_names, base_names=base.names, selection=selection,
+        rms_before=np.sqrt(np.mean((measured - before) ** 2, axis=0)), rms_after=np.sqrt(np.mean((measured - after) ** 2, axis=0)),
+        rms_torque=np.sqrt(np.mean(measured**2, axis=0)), validation=val_data, predicted_before=before, predicted_after=after,
+        cutoff=data.cutoff, cutoff_source=data.cutoff_source, fit_samples=fit_data.time.size, validation_samples=val_data.time.size,
+        dropped=data.dropped, run_names=labels, offset_runs=offset_runs,
+        ladder=error_ladder(selection.normal, val_data, selection, robot.joint_names), consistent=consistent, rms_consistent=rms_consistent,
     )
     return report, robot, base, [fit_data.regressor, val_data.regressor]
 
 
-def fit_consistent(fit_data: Dataset, selection: Selection, robot: Robot, base: BaseParameters, cfg) -> ConsistentFit:
+def fit_consistent(fit_data: Dataset, selection: Selection, robot: Robot, base: BaseParameters, cfg,
+                   offset_runs: list[str]) -> ConsistentFit:
     """The physically consistent fit (:mod:`excite_cli.identification.physical`) of the selected model
-    on the fit data, with the selection's per-joint weights (WLS) or none (LS).
+    on the fit data, with the selection's per-joint weights (WLS) or none (LS); ``offset_runs``
+    names the offsets' columns.
 
     Raises:
         ExciteError: the semidefinite program has no solution.
     """
-    b = base.count
     weights = np.ones(fit_data.tau.size) if selection.weights is None else selection.weights[fit_data.joint]
-    names = [f"{c} {robot.joint_names[j]}" for e, j in selection.effects for c in COEFFICIENTS[e]]
-    return consistent_fit(fit_data.regressor, design(fit_data, selection.effects)[:, b:], fit_data.tau, weights,
+    names = [f"{name} {robot.joint_names[t.joint]}" for t in selection.terms for name in coefficient_names(t, offset_runs)]
+    return consistent_fit(fit_data.regressor, design(fit_data, selection.terms)[:, base.count:], fit_data.tau, weights,
                           base.regrouping, robot.urdf_parameters(), names, cfg.regularization, robot.body_names)
 
 
-def effect_values(report: Report, consistent: bool = False) -> list[tuple[str, str, str, float, float]]:
-    """(effect, coefficient, joint, value, std) for every chosen effect coefficient, in order: of the
-    selected least-squares fit, or with ``consistent`` of the physically consistent one (std NaN)."""
+def coefficient_names(term: Term, offset_runs: list[str]) -> list[str]:
+    """Names of a term's coefficients: those of ``COEFFICIENTS``, an offset per run as
+    ``tau0[run label]`` when the fit has several runs (``offset_runs``)."""
+    names = COEFFICIENTS[term.effect]
+    if term.effect in PER_RUN and len(offset_runs) > 1:
+        return [f"{names[0]}[{label}]" for label in offset_runs]
+    return list(names)
+
+
+def effect_values(report: Report, consistent: bool = False) -> list[tuple[Term, str, float, float]]:
+    """(term, coefficient, value, std) for every chosen effect coefficient, in order: of the selected
+    least-squares fit, or with ``consistent`` of the physically consistent one (std NaN)."""
     b = len(report.base_names)
     values = report.consistent.effects if consistent else report.selection.fit.x[b:]
     stds = np.full(values.size, np.nan) if consistent else report.selection.fit.std[b:]
-    rows, k = [], 0
-    for effect, j in report.selection.effects:
-        for coefficient in COEFFICIENTS[effect]:
-            rows.append((effect, coefficient, report.joints[j], float(values[k]), float(stds[k])))
-            k += 1
-    return rows
+    names = [(term, name) for term in report.selection.terms for name in coefficient_names(term, report.offset_runs)]
+    return [(term, name, float(v), float(s)) for (term, name), v, s in zip(names, values, stds)]
 
 
 def write_identified_urdf(problem: IdentifyProblem, report: Report, robot: Robot, base: BaseParameters, target: Path) -> float:
@@ -201,7 +274,7 @@ def write_identified_urdf(problem: IdentifyProblem, report: Report, robot: Robot
     if report.consistent is None:
         raise ExciteError("--urdf-out: needs the physically consistent fit (identification.physical_consistency)")
     source, _ = resolve_urdf(problem)
-    effects = [(e, c, j, v) for e, c, j, v, _ in effect_values(report, consistent=True)]
+    effects = [(t.effect, c, report.joints[t.joint], v) for t, c, v, _ in effect_values(report, consistent=True)]
     write_urdf(source, target, robot, report.consistent.standard, effects,
                f"physically consistent parameters identified from {problem.source_path or 'measured data'}")
     X, phi_base = base.composition_matrix, report.consistent.base

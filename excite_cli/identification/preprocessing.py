@@ -1,8 +1,16 @@
 """Preprocessing of measured runs (scipy.signal): uniform resampling of jittery timestamps, a
 zero-phase low-pass of q before differentiating it into q̇ and q̈ (when they are not measured), and
 the parallel low-pass and decimation that ``Dataset`` applies to the regressor columns and to τ
-alike (Gautier 1997), so filtering never breaks τ = W φ. The default cut-off is ``CUTOFF_FACTOR`` ×
-the trajectory's bandwidth, estimated from the spectrum of q over all runs."""
+alike (Gautier 1997), so filtering never breaks τ = W φ.
+
+The default cut-off is ``CUTOFF_FACTOR`` × the trajectory's bandwidth, the frequency below which
+``POWER_FRACTION`` of the power of q lies, taken from a Hann-windowed, detrended spectrum of the runs
+that are fitted (a validation run of static postures has no bandwidth; an unwindowed spectrum of a
+cropped run leaks its edges' steps to high frequencies: 1.97 Hz instead of 0.53 Hz on the cropped
+real Panda runs), and at least ``MIN_CUTOFF``: measured torques carry the friction's switching at
+velocity reversals, faster than the trajectory itself, and a slow run's 10 × bandwidth (1.6 Hz) lost
+to 5 Hz (issue 10). On the real Panda run cut-offs from 4 to 12 Hz give the same error within about
+a point, above 15 Hz joint 1's structural vibration (10–50 Hz in its torque) biases the fit."""
 
 from __future__ import annotations
 
@@ -19,6 +27,8 @@ from excite_cli.identification.measurements import Run
 #: Default cut-off = this × the frequency below which ``POWER_FRACTION`` of q's power lies ...
 CUTOFF_FACTOR = 10.0
 POWER_FRACTION = 0.99
+#: ... at least this [Hz] ...
+MIN_CUTOFF = 5.0
 #: ... and at most this fraction of the decimated sample rate.
 MAX_CUTOFF_FRACTION = 0.4
 #: Samples trimmed at each end: this many periods of the cut-off frequency.
@@ -29,10 +39,10 @@ CHUNK_MARGIN = 3
 
 
 def bandwidth(q: np.ndarray, rate: float, fraction: float = POWER_FRACTION) -> float:
-    """Frequency [Hz] below which ``fraction`` of the power of the detrended (T, n) signals lies."""
-    power = np.abs(np.fft.rfft(signal.detrend(q, axis=0), axis=0)) ** 2
+    """Frequency [Hz] below which ``fraction`` of the power of the (T, n) signals lies, from their
+    Hann-windowed periodogram after removing a linear trend (scipy.signal.periodogram)."""
+    freqs, power = signal.periodogram(q, fs=rate, window="hann", detrend="linear", axis=0)
     cumulative = np.cumsum(power.sum(axis=1))
-    freqs = np.fft.rfftfreq(q.shape[0], 1.0 / rate)
     return float(freqs[np.searchsorted(cumulative, fraction * cumulative[-1])])
 
 
@@ -113,12 +123,18 @@ def resample(run: Run, x: np.ndarray | None, grid: np.ndarray) -> np.ndarray | N
     return None if x is None else np.column_stack([np.interp(grid, run.time, x[:, j]) for j in range(x.shape[1])])
 
 
-def default_cutoff(runs: list[Run], cfg: PreprocessingConfig) -> float:
-    """``CUTOFF_FACTOR`` × the largest bandwidth of the runs' resampled q, at least 0.5 Hz and at most
-    ``MAX_CUTOFF_FRACTION`` × the decimated rate [Hz]."""
-    widest = max(bandwidth(resample(r, r.q, uniform_grid(r)), run_rate(r)) for r in runs)
+def choose_cutoff(runs: list[Run], cfg: PreprocessingConfig) -> tuple[float, str]:
+    """The low-pass cut-off [Hz] of every run and where it came from, in words: ``cfg.cutoff``, or
+    ``CUTOFF_FACTOR`` × the largest bandwidth of the fitted runs' resampled q (all runs when none
+    is fitted), at least ``MIN_CUTOFF`` and at most ``MAX_CUTOFF_FRACTION`` × the decimated rate."""
+    if cfg.cutoff is not None:
+        return cfg.cutoff, "preprocessing.cutoff"
+    fitted = [r for r in runs if r.role != "validation"] or runs
+    widest = max(bandwidth(resample(r, r.q, uniform_grid(r)), run_rate(r)) for r in fitted)
     top = MAX_CUTOFF_FRACTION * min(cfg.sample_rate, min(run_rate(r) for r in runs))
-    return float(min(max(0.5, CUTOFF_FACTOR * widest), top))
+    cutoff = float(min(max(MIN_CUTOFF, CUTOFF_FACTOR * widest), top))
+    return cutoff, (f"default: {CUTOFF_FACTOR:g} × the {100 * POWER_FRACTION:g} % power bandwidth of q in the fitted runs "
+                    f"({widest:.3g} Hz), at least {MIN_CUTOFF:g} Hz, at most {100 * MAX_CUTOFF_FRACTION:g} % of the rate")
 
 
 def preprocess(run: Run, cfg: PreprocessingConfig, cutoff: float) -> Samples:

@@ -1,6 +1,7 @@
-"""The ``identify`` report as HDF5: ``/identification/...`` (base parameters, effects, validation
-errors, the physically consistent fit), plus ``/regressor`` and ``/robot/base_parameter_names`` so the
-file can serve as prior data C₀ of ``optimize`` (Eq. 41). Units are attributes of each dataset."""
+"""The ``identify`` report as HDF5: ``/identification/...`` (base parameters, effects, the selection's
+steps and every candidate it tried, the error ladder, validation errors and predictions, the
+physically consistent fit), plus ``/regressor`` (compressed) and ``/robot/base_parameter_names`` so
+the file can serve as prior data C₀ of ``optimize`` (Eq. 41). Units are attributes of each dataset."""
 
 from __future__ import annotations
 
@@ -10,37 +11,44 @@ import h5py
 import numpy as np
 
 from excite_cli.base_parameters import BaseParameters
+from excite_cli.config import effective_yaml
+from excite_cli.identification.config import IdentifyProblem
+from excite_cli.identification.effects import COEFFICIENTS, UNITS
 from excite_cli.identification.physical import body_properties
 from excite_cli.identification.pipeline import Report, effect_values
 from excite_cli.output import atomic_h5, write_strings
 from excite_cli.robot import Robot
 
+STR = h5py.string_dtype()
 
-def write_identification(path: Path, report: Report, robot: Robot, base: BaseParameters, source_text: str,
-                         regressor: list[np.ndarray], method: str) -> None:
+
+def write_identification(path: Path, report: Report, robot: Robot, base: BaseParameters, problem: IdentifyProblem,
+                         regressor: list[np.ndarray]) -> None:
     """Write (atomically) an ``identify`` report.
 
     Args:
         report: the :class:`~excite_cli.identification.pipeline.Report`.
-        source_text: the identify config's text.
+        problem: the identify config that ran (stored as the effective config, every default filled
+            in, beside the file's original text).
         regressor: base regressor rows of all samples, in parts ((M_k, b) each, e.g. fit and validation).
-        method: ``wls`` or ``ls``.
 
     Raises:
         ExciteError: the file cannot be written.
     """
     sel, b = report.selection, base.count
     with atomic_h5(path) as f:
-        f.attrs["config"] = source_text
+        f.attrs["config"], f.attrs["config_original"] = effective_yaml(problem), problem.source_text
         group = f.create_group("robot")
         write_strings(group, "joint_names", robot.joint_names)
         write_strings(group, "base_parameter_names", base.names)
-        rows = f.create_dataset("regressor", data=np.vstack(regressor) if regressor else np.zeros((0, b)))
-        rows.attrs["description"] = "base regressor of all preprocessed samples, fit then validation (prior data C0, Eq. 41)"
+        _write_regressor(f, regressor, b)
         g = f.create_group("identification")
-        g.attrs["method"], g.attrs["cutoff_Hz"] = method, report.cutoff
+        g.attrs["method"], g.attrs["cutoff_Hz"], g.attrs["cutoff_source"] = problem.identification.method, report.cutoff, report.cutoff_source
         g.attrs["fit_samples"], g.attrs["validation_samples"] = report.fit_samples, report.validation_samples
         g.attrs["dropped_rows"] = "; ".join(f"{name}: {rows}" for name, rows in report.dropped) or "none"
+        g.attrs["folds"], g.attrs["min_improvement"] = sel.folds, sel.min_improvement
+        g.attrs["cv_error_rigid"], g.attrs["cv_error"] = sel.cv_rigid, sel.cv_error
+        g.attrs["stop_reason"] = sel.searches[sel.chosen].stop
         write_strings(g, "joint_names", report.joints)
         write_strings(g, "base_parameter_names", report.base_names)
         consistent = report.consistent
@@ -52,29 +60,71 @@ def write_identification(path: Path, report: Report, robot: Robot, base: BasePar
         if consistent is not None:
             _write_consistent(g, report, robot)
         _write_effects(g, report)
+        _write_search(g, report)
         _write_validation(g, report)
 
 
+def _write_regressor(f: h5py.File, regressor: list[np.ndarray], b: int) -> None:
+    """``/regressor``: the decimated base regressor rows of every sample, fit then validation, stored
+    once and compressed (gzip with byte shuffling)."""
+    rows = np.vstack(regressor) if regressor else np.zeros((0, b))
+    chunks = (min(max(rows.shape[0], 1), 4096), b) if rows.size else None
+    data = f.create_dataset("regressor", data=rows, compression="gzip" if rows.size else None, shuffle=bool(rows.size), chunks=chunks)
+    data.attrs["description"] = "base regressor of all preprocessed (decimated) samples, fit then validation (prior data C0, Eq. 41)"
+
+
+def _term_fields(term, joints: list[str]) -> tuple[str, str, float]:
+    """(effect, joint, shape velocity [rad/s] or NaN) of a term."""
+    return term.effect, joints[term.joint], np.nan if term.shape is None else term.shape
+
+
 def _write_effects(g: h5py.Group, report: Report) -> None:
-    """The chosen effects in the order they were added, declared ones flagged, and what was absorbed."""
+    """The chosen effects in the order they were added, declared ones flagged, with units, and what
+    was absorbed."""
     sel, rows = report.selection, effect_values(report)
-    effects = np.zeros(len(rows), dtype=[("order", "i4"), ("effect", h5py.string_dtype()), ("coefficient", h5py.string_dtype()),
-                                         ("joint", h5py.string_dtype()), ("value", "f8"), ("std", "f8"), ("declared", "?"),
-                                         ("value_consistent", "f8")])
+    effects = np.zeros(len(rows), dtype=[("order", "i4"), ("effect", STR), ("coefficient", STR), ("joint", STR), ("shape", "f8"),
+                                         ("value", "f8"), ("std", "f8"), ("unit", STR), ("declared", "?"), ("value_consistent", "f8")])
     effects["value_consistent"] = np.nan if report.consistent is None else report.consistent.effects
-    declared = {(e, report.joints[j]) for e, j in sel.effects[: sel.declared]}
-    order = {key: k + 1 for k, key in enumerate((e, report.joints[j]) for e, j in sel.effects)}
-    for row, (effect, coefficient, joint, value, std) in zip(effects, rows):
-        row["order"], row["effect"], row["coefficient"], row["joint"] = order[(effect, joint)], effect, coefficient, joint
-        row["value"], row["std"], row["declared"] = value, std, (effect, joint) in declared
-    g.create_dataset("effects", data=effects)
-    write_strings(g, "absorbed_effects", [f"{e}:{report.joints[j]}" for e, j in sel.absorbed])
+    order = {t: k + 1 for k, t in enumerate(sel.terms)}
+    for row, (term, coefficient, value, std) in zip(effects, rows):
+        row["order"], row["coefficient"], row["value"], row["std"] = order[term], coefficient, value, std
+        row["effect"], row["joint"], row["shape"] = _term_fields(term, report.joints)
+        row["unit"], row["declared"] = UNITS[COEFFICIENTS[term.effect][0]], order[term] <= sel.declared
+    data = g.create_dataset("effects", data=effects)
+    data.attrs["shape_unit"] = "rad/s (Stribeck v_s, held v_h; NaN for other effects)"
+    write_strings(g, "offset_runs", report.offset_runs)
+    write_strings(g, "absorbed_effects", [t.label(report.joints) for t in sel.absorbed])
+    g.create_dataset("cv_error_joint", data=sel.cv_joint).attrs["unit"] = "% (cross-validated on the fit data)"
+
+
+def _write_search(g: h5py.Group, report: Report) -> None:
+    """The selection: the ladder (CV and validation error after each step), the kept search's steps,
+    every move tried at each step with its gain, and the outcome of every start."""
+    ladder = np.array(report.ladder, dtype=[("step", STR), ("cv_error", "f8"), ("validation_error", "f8")])
+    g.create_dataset("ladder", data=ladder).attrs["units"] = "% (mean relative RMS torque error: cross-validated on the fit data, on the validation data)"
+    sel = report.selection
+    move = [("step", "i4"), ("move", STR), ("effect", STR), ("joint", STR), ("shape", "f8"), ("cv_error", "f8"), ("gain", "f8")]
+    steps, tried = [], []
+    before = sel.searches[sel.chosen].initial_error
+    for k, step in enumerate(sel.steps, start=1):
+        steps.append((k, step.move, *_term_fields(step.term, report.joints), step.cv_error, 100.0 * (1.0 - step.cv_error / before)))
+        tried += [(k, m, *_term_fields(t, report.joints), v, 100.0 * (1.0 - v / before)) for m, t, v in step.tried]
+        before = step.cv_error
+    units = "cv_error in %, gain in % of the CV error before the step, shape in rad/s"
+    g.create_dataset("steps", data=np.array(steps, dtype=move)).attrs["units"] = units
+    g.create_dataset("candidates", data=np.array(tried, dtype=move)).attrs["units"] = units + "; every move tried at each step"
+    searches = np.array([(s.start, ", ".join(t.label(report.joints) for t in s.terms), s.cv_error, s.objective, len(s.steps), s.stop,
+                          k == sel.chosen) for k, s in enumerate(sel.searches)],
+                        dtype=[("start", STR), ("effects", STR), ("cv_error", "f8"), ("objective", "f8"), ("steps", "i4"),
+                               ("stop_reason", STR), ("chosen", "?")])
+    g.create_dataset("searches", data=searches).attrs["units"] = "cv_error in %; objective J = log CV + p log(1 + min_improvement)"
 
 
 def _write_validation(g: h5py.Group, report: Report) -> None:
-    """Torque errors on the held-out data: per joint, and per run."""
+    """Torque errors on the validation data (never fitted, never used by the selection): per joint
+    and per run, and the measured and predicted torques."""
     n, runs = len(report.joints), report.per_run()
-    table = np.zeros(len(runs), dtype=[("run", h5py.string_dtype()), ("instants", "i8"), ("rms_before", "f8", n),
+    table = np.zeros(len(runs), dtype=[("run", STR), ("instants", "i8"), ("rms_before", "f8", n),
                                        ("rms_after", "f8", n), ("relative_after", "f8", n)])
     for row, (name, count, before, after, torque) in zip(table, runs):
         row["run"], row["instants"], row["rms_before"], row["rms_after"] = name, count, before, after
@@ -84,6 +134,12 @@ def _write_validation(g: h5py.Group, report: Report) -> None:
                                ("rms_torque", report.rms_torque, "Nm"), ("relative_before", report.relative_before, "%"),
                                ("relative_after", report.relative_after, "%")):
         g.create_dataset(name, data=values).attrs["unit"] = unit
+    val = g.create_group("validation")
+    val.create_dataset("time", data=report.validation.time).attrs["unit"] = "s"
+    val.create_dataset("run", data=report.validation.run).attrs["description"] = "index into the config's data.runs"
+    for name, values in (("measured", report.validation.tau.reshape(-1, n)), ("predicted_before", report.predicted_before),
+                         ("predicted_after", report.predicted_after)):
+        val.create_dataset(name, data=values, compression="gzip").attrs["unit"] = "Nm (filtered and decimated)"
 
 
 def _write_consistent(g: h5py.Group, report: Report, robot: Robot) -> None:
@@ -95,7 +151,7 @@ def _write_consistent(g: h5py.Group, report: Report, robot: Robot) -> None:
     g.attrs["solver_status"] = consistent.status
     write_strings(g, "active_constraints", consistent.active)
     urdf = robot.urdf_parameters()
-    bodies = np.zeros(len(robot.body_names), dtype=[("body", h5py.string_dtype()), ("mass", "f8"), ("com", "f8", 3),
+    bodies = np.zeros(len(robot.body_names), dtype=[("body", STR), ("mass", "f8"), ("com", "f8", 3),
                                                      ("principal_moments", "f8", 3), ("inertia_com", "f8", (3, 3)),
                                                      ("urdf_mass", "f8"), ("urdf_com", "f8", 3), ("urdf_principal_moments", "f8", 3),
                                                      ("pseudo_inertia_min_eigenvalue", "f8")])

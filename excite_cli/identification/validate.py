@@ -3,8 +3,9 @@ neither its fit nor its effect selection saw.
 
 The runs of the config are read and preprocessed as ``identify`` does, with the report's cut-off,
 and all of their instants are predicted by the report's model (base parameters, then its effects
-with their coefficients; the load-dependent Coulomb column from the report's rigid-body
-parameters, as in the fit). Errors per run and joint: RMS [Nm] and RMS relative to the measured
+with their coefficients and shape velocities; the load-dependent Coulomb column from the report's
+rigid-body parameters, as in the fit; offsets the mean of the fitted runs' offsets, since a new
+run's own offset is unknown). Errors per run and joint: RMS [Nm] and RMS relative to the measured
 torque's RMS [%].
 """
 
@@ -14,14 +15,17 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+import yaml
 
 from excite_cli.base_parameters import compute_base_parameters
 from excite_cli.config import with_overrides
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.errors import ExciteError
 from excite_cli.identification.dataset import build_datasets
-from excite_cli.identification.identify import predict
+from excite_cli.identification.effects import TWO_STAGE, Term
+from excite_cli.identification.least_squares import predict
 from excite_cli.identification.measurements import load_run
+from excite_cli.identification.payload import payload_parameters
 from excite_cli.identification.preprocessing import preprocess
 from excite_cli.output import open_result
 from excite_cli.robot import load_robot
@@ -43,29 +47,36 @@ def _strings(values) -> list[str]:
 
 def read_model(path: Path) -> dict:
     """The model of an ``identify`` report: joint and base-parameter names, base parameters, the
-    rigid-body-only ones, effects [(effect, joint name)] in order with their coefficients, cut-off.
+    rigid-body-only ones, effect terms [(effect, joint name, shape)] in order with their
+    coefficients, the number of offset columns (fitted runs), cut-off, Coulomb velocity.
 
     Raises:
         ExciteError: missing or unreadable file, or not an identify report.
     """
     with open_result(path, "REPORT") as f:
-        if "identification" not in f:
-            raise ExciteError(f"REPORT: {path} is not an excite identify report (no /identification)")
+        if "identification" not in f or "effects" not in f["identification"]:
+            raise ExciteError(f"REPORT: {path} is not an excite identify report (no /identification/effects)")
         g = f["identification"]
         rows = g["effects"][()]
         consistent = bool(g["physically_consistent"][()]) if "physically_consistent" in g else False
         values = rows["value_consistent"] if consistent else rows["value"]
-        effects: list[tuple[str, str]] = []
-        for effect, joint in zip(_strings(rows["effect"]), _strings(rows["joint"])):
-            if (effect, joint) not in effects:
-                effects.append((effect, joint))
+        shapes = rows["shape"] if "shape" in rows.dtype.names else np.full(len(rows), np.nan)
+        terms: list[tuple[str, str, float | None]] = []
+        for effect, joint, shape in zip(_strings(rows["effect"]), _strings(rows["joint"]), shapes):
+            term = (effect, joint, None if np.isnan(shape) else float(shape))
+            if term not in terms:
+                terms.append(term)
+        config = yaml.safe_load(f.attrs["config"]) if "config" in f.attrs else {}
         return {"joints": _strings(g["joint_names"][()]), "base_names": _strings(g["base_parameter_names"][()]),
-                "base": g["base_parameters"][()], "rigid": g["base_parameters_rigid_only"][()],
-                "effects": effects, "coefficients": np.asarray(values, dtype=float), "cutoff": float(g.attrs["cutoff_Hz"])}
+                "base": g["base_parameters"][()], "rigid": g["base_parameters_rigid_only"][()], "terms": terms,
+                "coefficients": np.asarray(values, dtype=float), "cutoff": float(g.attrs["cutoff_Hz"]),
+                "offset_runs": max(1, len(g["offset_runs"][()])) if "offset_runs" in g else 1,
+                "coulomb_velocity": float(((config or {}).get("identification") or {}).get("coulomb_velocity", 0.01))}
 
 
 def validate_model(report: Path, problem: IdentifyProblem) -> list[RunError]:
-    """Score the model of ``report`` on every run of ``problem`` (their roles are ignored).
+    """Score the model of ``report`` on every run of ``problem`` (their roles are ignored; a run's
+    offset is the mean of the report's fitted runs' offsets, a run's known payload is taken out).
 
     Raises:
         ExciteError: a report for another robot (joints or base parameters differ), bad data or
@@ -77,15 +88,17 @@ def validate_model(report: Path, problem: IdentifyProblem) -> list[RunError]:
     base = compute_base_parameters(robot)
     if model["joints"] != robot.joint_names or model["base_names"] != base.names:
         raise ExciteError(f"REPORT: {report} was identified for other joints or base parameters than the config's robot")
-    effects = [(e, robot.joint_names.index(j)) for e, j in model["effects"]]
-    needed = {e for e, _ in effects} | {"coulomb"}
+    terms = [Term(e, robot.joint_names.index(j), s) for e, j, s in model["terms"]]
+    needed = terms + [Term("coulomb", j) for j in range(robot.n_joints)]
     errors = []
-    for run in problem.data.runs:
+    for k, run in enumerate(problem.data.runs):
+        payload = [payload_parameters(robot, run.payload, f"data.runs[{k}].payload") if run.payload else None]
         samples = [preprocess(load_run(run.model_copy(update={"role": "validation"}), problem.data, problem, robot.n_joints),
                    problem.preprocessing, model["cutoff"])]
-        _, data = build_datasets(robot, base, samples, problem.identification, problem.data.validation_blocks, needed, split=False)
-        data = data.with_load_columns(model["rigid"])
-        predicted = predict(data, np.concatenate([model["base"], model["coefficients"]]), effects)
+        _, data, _ = build_datasets(robot, base, samples, needed, model["coulomb_velocity"], problem.data.validation_blocks, payload,
+                                    split=False, offset_runs=model["offset_runs"])
+        data = data.with_load_columns(model["rigid"], [t for t in terms if t.effect in TWO_STAGE])
+        predicted = predict(data, np.concatenate([model["base"], model["coefficients"]]), terms)
         measured = data.tau.reshape(-1, data.n)
         rms = np.sqrt(np.mean((measured - predicted) ** 2, axis=0))
         errors.append(RunError(run.label, rms, 100.0 * rms / np.sqrt(np.mean(measured**2, axis=0)), data.time.size))

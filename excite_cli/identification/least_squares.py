@@ -1,0 +1,81 @@
+"""Base parameters and effect coefficients by (weighted) least squares (Eq. 4), and the torques a
+fitted model predicts.
+
+Weighted least squares follows Gautier (1997): each joint's rows are weighted by 1/σ_j, σ_j the
+residual standard deviation of that joint under ordinary least squares of the rigid-body model,
+fixed for every fit of one identification (the effect selection's and the final one), so the
+reported model is the one that was scored. The estimates' standard deviations come from
+σ² (AᵀWA)⁻¹, scaled by √r: after the parallel low-pass at f_c, samples at f_s carry only about
+2 f_c T independent values (r = f_s / (2 f_c), the oversampling). Every fit goes through the
+per-joint normal equations of :mod:`excite_cli.identification.normal` (no design matrix is formed).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from excite_cli.identification.dataset import Dataset
+from excite_cli.identification.effects import Term
+from excite_cli.identification.normal import NormalEquations, covariance_diagonal, solve, sse
+
+
+@dataclass(frozen=True)
+class Fit:
+    """A least-squares fit.
+
+    Attributes:
+        x: (p,) estimates; std: (p,) their standard deviations.
+        sigma: (n,) per-joint residual standard deviation [Nm] of this fit.
+    """
+
+    x: np.ndarray
+    std: np.ndarray
+    sigma: np.ndarray
+
+
+def least_squares(normal: NormalEquations, effects: list[Term], weights: np.ndarray | None = None,
+                  oversampling: float = 1.0) -> Fit:
+    """Ordinary (Eq. 4) or weighted least squares of the model [Y_B, ``effects``] with standard
+    deviations σ² diag((AᵀWA)⁻¹), scaled by √r.
+
+    Args:
+        normal: the data's normal equations.
+        weights: (n,) weight of each joint's rows (WLS, see :func:`joint_weights`), or None (LS).
+        oversampling: samples per independent sample (r ≥ 1).
+    """
+    G, c, s = normal.system(weights, effects)
+    x = solve(G, c)
+    dof = max(1, normal.rows - x.size)
+    s2 = sse(G, c, s, x) / dof
+    std = np.sqrt(oversampling * s2 * np.maximum(covariance_diagonal(G), 0.0))
+    sigma = np.sqrt(normal.joint_sse(x, effects) / (normal.rows / normal.n) / (dof / normal.rows))
+    return Fit(x, std, sigma)
+
+
+def joint_weights(normal: NormalEquations, weighted: bool) -> np.ndarray | None:
+    """(n,) WLS weights 1/σ_j, σ_j the rigid-body least-squares residual of joint j (Gautier 1997),
+    or None for LS. Fixed for the whole selection and the final fit, so the reported model is the
+    one the selection scored."""
+    if not weighted:
+        return None
+    return 1.0 / np.maximum(least_squares(normal, []).sigma, 1e-12)
+
+
+def design(data: Dataset, effects: list[Term]) -> np.ndarray:
+    """[Y_B, effect blocks] (M, b + Σk)."""
+    return np.hstack([data.regressor] + [data.block(t) for t in effects])
+
+
+def predict(data: Dataset, x: np.ndarray, effects: list[Term]) -> np.ndarray:
+    """Predicted torques (N, n) [Nm] of the model [Y_B, effects] with coefficients x (base
+    parameters first), without forming the design."""
+    b = data.regressor.shape[1]
+    out = (data.regressor @ x[:b]).reshape(-1, data.n)
+    k = b
+    for t in effects:
+        cols = data.blocks[t]
+        out[:, t.joint] += cols @ x[k : k + cols.shape[1]]
+        k += cols.shape[1]
+    return out

@@ -1,0 +1,208 @@
+"""Tracing the residual to the effects the rigid-body model lacks: a stepwise search over effect
+terms scored by blocked cross-validation of the fit data (:mod:`~excite_cli.identification.crossval`).
+The validation data (``validation`` runs, odd time blocks) take no part: they stay untouched for
+the reported error.
+
+The search minimizes
+
+    J(M) = log CV(M) + p(M) · log(1 + min_improvement),
+
+p(M) the number of terms the search added: every effect must lower the cross-validated error by
+the fraction ``min_improvement`` (default 1 %) to stay in the model. A move adds a candidate term,
+removes an added term, or changes the shape velocity of a Stribeck or held term (the profile search
+over its grid); the move that lowers J most is taken, and the search stops when none does, so it
+ends in a model no single move improves and cannot cycle. Greedy forward selection alone depends on
+its path: a joint whose Coulomb friction is missing bends the shared base parameters, and adding it
+later can make another joint's error worse first. So the search runs from three starts (the declared
+effects alone, plus Coulomb friction on every joint, plus Coulomb and viscous friction on every
+joint) and keeps the end with the lowest J. Candidates whose columns lie in the span of the
+rigid-body model (e.g. the armature of a joint whose rotor inertia regroups with a link's) are not
+separately identifiable and are skipped. Every fit, in the folds and the final one, uses the same
+per-joint weights (WLS: 1/σ_j of the rigid-body fit, Gautier 1997), so the reported model is exactly
+the one the search scored.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from excite_cli.identification.config import IdentificationConfig
+from excite_cli.identification.crossval import CrossValidation
+from excite_cli.identification.dataset import Dataset
+from excite_cli.identification.effects import REQUIRES, SHAPES, Term
+from excite_cli.identification.least_squares import Fit, joint_weights, least_squares
+from excite_cli.identification.normal import ABSORBED, NormalEquations, outside_fraction
+
+#: Starts of the search beyond the declared effects: friction a real joint is most likely to have.
+STARTS = {"declared effects": (), "Coulomb on every joint": ("coulomb",), "Coulomb and viscous on every joint": ("coulomb", "viscous")}
+
+
+@dataclass(frozen=True)
+class Step:
+    """One move of the search.
+
+    Attributes:
+        move: ``add``, ``remove`` or ``shape`` (a Stribeck or held term's velocity changed).
+        term: the term added, removed, or the new shape's term.
+        cv_error: CV(M) [%] after the move.
+        tried: every move considered at this step: (move, term, CV after [%]).
+    """
+
+    move: str
+    term: Term
+    cv_error: float
+    tried: list[tuple[str, Term, float]]
+
+
+@dataclass
+class Search:
+    """The search from one start: its name, start model and its CV error [%], end model and its CV
+    error [%] and objective J, the steps and why it stopped."""
+
+    start: str
+    initial: list[Term]
+    initial_error: float
+    terms: list[Term]
+    cv_error: float
+    objective: float
+    steps: list[Step] = field(default_factory=list)
+    stop: str = ""
+
+
+@dataclass
+class Selection:
+    """Outcome of the effect selection.
+
+    Attributes:
+        terms: the chosen terms, the declared ones first.
+        declared: how many of ``terms`` were declared in the config.
+        fit: least squares of [Y_B, terms] on all fit data (base parameters first).
+        rigid: least squares of the rigid-body model alone.
+        weights: (n,) the joints' weights (WLS) or None (LS), the same in every fit.
+        cv_rigid, cv_error: CV error [%] of the rigid-body model and of the chosen one.
+        cv_joint: (n,) the chosen model's CV error per joint [%].
+        searches: the search from every start; ``chosen`` indexes the one kept.
+        absorbed: candidates skipped as not separately identifiable.
+        folds: K of the cross-validation; min_improvement: the price of an effect (a fraction).
+        normal: the fit data's normal equations (every candidate), for refitting other models.
+    """
+
+    terms: list[Term]
+    declared: int
+    fit: Fit
+    rigid: Fit
+    weights: np.ndarray | None
+    cv_rigid: float
+    cv_error: float
+    cv_joint: np.ndarray
+    searches: list[Search]
+    chosen: int
+    absorbed: list[Term]
+    folds: int
+    min_improvement: float
+    normal: NormalEquations
+
+    @property
+    def steps(self) -> list[Step]:
+        """The steps of the kept search."""
+        return self.searches[self.chosen].steps
+
+
+def candidate_terms(cfg: IdentificationConfig, n: int) -> list[Term]:
+    """Every candidate term: each candidate effect on each joint, one per shape of ``SHAPES`` effects."""
+    shapes = {"stribeck": cfg.stribeck_velocity, "held": cfg.held_velocity}
+    return [Term(e, j, s) for e in cfg.candidates for j in range(n) for s in (shapes[e] if e in SHAPES else [None])]
+
+
+class _Search:
+    """The moves and the objective J of one selection problem."""
+
+    def __init__(self, cv: CrossValidation, candidates: list[Term], declared: list[Term], cfg: IdentificationConfig):
+        self.cv, self.candidates, self.declared, self.cfg = cv, candidates, declared, cfg
+        self.penalty = np.log1p(cfg.min_improvement)
+        self.cache: dict[frozenset, float] = {}
+
+    def error(self, terms: list[Term]) -> float:
+        key = frozenset(terms)
+        if key not in self.cache:
+            self.cache[key] = self.cv.error(terms)[0]
+        return self.cache[key]
+
+    def objective(self, terms: list[Term], error: float) -> float:
+        return float(np.log(max(error, 1e-12)) + (len(terms) - len(self.declared)) * self.penalty)
+
+    def moves(self, terms: list[Term]) -> list[tuple[str, Term, list[Term]]]:
+        """(move, term, model after) of every allowed move from ``terms``."""
+        family = {(t.effect, t.joint): t for t in terms}
+        out = []
+        if len(terms) - len(self.declared) < self.cfg.max_effects:
+            out += [("add", c, terms + [c]) for c in self.candidates
+                    if (c.effect, c.joint) not in family and (c.effect not in REQUIRES or (REQUIRES[c.effect], c.joint) in family)]
+        for t in terms:
+            needed = any(REQUIRES.get(u.effect) == t.effect and u.joint == t.joint for u in terms)
+            if t not in self.declared and not needed:
+                out.append(("remove", t, [u for u in terms if u != t]))
+            if t.shape is not None:
+                out += [("shape", c, [c if u == t else u for u in terms]) for c in self.candidates
+                        if c.effect == t.effect and c.joint == t.joint and c.shape != t.shape]
+        return out
+
+    def run(self, name: str, start: list[Term]) -> Search:
+        terms = list(start)
+        error = self.error(terms)
+        search = Search(name, list(terms), error, terms, error, self.objective(terms, error))
+        while True:
+            tried = [(move, term, after, self.error(after)) for move, term, after in self.moves(terms)]
+            if not tried:
+                search.stop = "no move left (every candidate is in the model)"
+                break
+            move, term, after, value = min(tried, key=lambda m: self.objective(m[2], m[3]))
+            if self.objective(after, value) >= search.objective - 1e-12:
+                search.stop = (f"no addition, removal or shape change lowers the cross-validated error by "
+                               f"min_improvement ({100 * self.cfg.min_improvement:g} %)")
+                if len(terms) - len(self.declared) >= self.cfg.max_effects:
+                    search.stop = f"max_effects ({self.cfg.max_effects}) reached; no removal or shape change helps"
+                break
+            terms, error = after, value
+            search.objective = self.objective(terms, error)
+            search.steps.append(Step(move, term, value, [(m, t, v) for m, t, _, v in tried]))
+        search.terms, search.cv_error = terms, error
+        return search
+
+
+def select_effects(fit_data: Dataset, cfg: IdentificationConfig, declared: list[Term], margin: float,
+                   oversampling: float = 1.0) -> Selection:
+    """The stepwise search of the module docstring on the fit data.
+
+    Args:
+        fit_data: the fit data, with every candidate's block (two-stage ones included).
+        cfg: candidates, ``min_improvement``, ``max_effects``, ``folds``, ``method``, shape grids.
+        declared: terms in the model from the start, never removed.
+        margin: [s] left out of a fold's fit around its held-out block (correlated samples).
+        oversampling: samples per independent sample r (≥ 1) of the filtered data, for the
+            standard deviations.
+    """
+    n = fit_data.n
+    candidates = [t for t in candidate_terms(cfg, n) if t not in declared and t in fit_data.blocks]
+    total = NormalEquations(fit_data, declared + candidates)
+    weights = joint_weights(total, cfg.method == "wls")
+    model = total.system(weights, declared)[0].shape[0]
+    absorbed = [t for t in candidates if outside_fraction(total.system(weights, declared + [t])[0], model) < ABSORBED]
+    candidates = [t for t in candidates if t not in absorbed]
+    cv = CrossValidation(fit_data, declared + candidates, weights, cfg.folds, margin)
+    search = _Search(cv, candidates, declared, cfg)
+    searches, seen = [], []
+    for name, effects in STARTS.items():
+        start = declared + [t for t in candidates if t.effect in effects and t.shape is None]
+        if any(set(start) == set(s) for s in seen):
+            continue
+        seen.append(start)
+        searches.append(search.run(name, start))
+    chosen = min(range(len(searches)), key=lambda k: searches[k].objective)
+    terms = searches[chosen].terms
+    return Selection(terms=terms, declared=len(declared), fit=least_squares(total, terms, weights, oversampling),
+                     rigid=least_squares(total, [], weights, oversampling), weights=weights, cv_rigid=cv.error([])[0],
+                     cv_error=searches[chosen].cv_error, cv_joint=cv.error(terms)[1], searches=searches, chosen=chosen,
+                     absorbed=absorbed, folds=cfg.folds, min_improvement=cfg.min_improvement, normal=total)

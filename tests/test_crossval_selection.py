@@ -1,0 +1,106 @@
+"""Blocked cross-validation against explicit refits, and the stepwise effect search on a small
+synthetic model with known effects (two joints, a 3-parameter regressor, two runs)."""
+
+import numpy as np
+import pytest
+
+from excite_cli.identification.config import IdentificationConfig
+from excite_cli.identification.crossval import CrossValidation, fold_assignment
+from excite_cli.identification.dataset import Dataset, run_offset_columns
+from excite_cli.identification.effects import Term, effect_columns
+from excite_cli.identification.selection import candidate_terms, select_effects
+
+RATE, N_RUN, B = 200.0, 2400, 3
+PHI = np.array([1.5, -0.7, 0.4])
+
+
+def _smooth(rng, size, cutoff_steps=40):
+    """(size,) a smooth random signal (moving average of noise)."""
+    return np.convolve(rng.normal(0, 1, size + cutoff_steps), np.ones(cutoff_steps) / np.sqrt(cutoff_steps), "valid")[:size]
+
+
+def dataset(effects: dict[Term, float], cfg: IdentificationConfig, noise: float = 0.02, seed: int = 0) -> Dataset:
+    """Two runs of two joints; τ = Y φ + Σ effects + noise; blocks for every candidate of ``cfg``."""
+    rng = np.random.default_rng(seed)
+    n, N = 2, 2 * N_RUN
+    time = np.concatenate([np.arange(N_RUN) / RATE] * 2)
+    run = np.repeat([0, 1], N_RUN)
+    t = np.arange(N) / RATE
+    q = np.column_stack([np.sin(0.7 * t + j) + 0.3 * np.sin(2.3 * t) for j in range(n)])
+    qd = np.gradient(q, 1.0 / RATE, axis=0)
+    qdd = np.gradient(qd, 1.0 / RATE, axis=0)
+    Y = np.stack([np.column_stack([_smooth(rng, N) for _ in range(B)]) for _ in range(n)], axis=1).reshape(-1, B)
+    blocks = {}
+    for term in candidate_terms(cfg, n) + list(effects):
+        if term.effect == "offset":
+            blocks[term] = np.vstack([run_offset_columns(r, [0, 1], N_RUN, 2) for r in (0, 1)])
+        else:
+            blocks[term] = effect_columns(term.effect, q[:, term.joint], qd[:, term.joint], qdd[:, term.joint], 0.01, term.shape)
+    tau = (Y @ PHI).reshape(-1, n) + rng.normal(0, noise, (N, n))
+    for term, value in effects.items():
+        tau[:, term.joint] += blocks[term] @ np.atleast_1d(value)
+    return Dataset(Y, tau.ravel(), time, run, blocks)
+
+
+def test_folds_are_time_blocks_of_every_run_with_margins():
+    time = np.concatenate([np.arange(100) * 0.01, np.arange(60) * 0.01])
+    run = np.repeat([0, 1], [100, 60])
+    fold, margins = fold_assignment(time, run, 4, 0.035)
+    for r, size in ((0, 100), (1, 60)):
+        f = fold[run == r]
+        assert np.all(np.diff(f) >= 0) and np.bincount(f).tolist() == [size // 4] * 4  # contiguous, equal blocks
+    # margin of fold 1 in run 0 (instants 25..49): the 3 instants on each side within 0.035 s
+    assert np.flatnonzero(margins[1][:100]).tolist() == [22, 23, 24, 50, 51, 52]
+    assert not np.any(margins[1] & (fold == 1))
+
+
+def test_fold_errors_equal_explicit_weighted_refits():
+    cfg = IdentificationConfig(candidates=["coulomb", "offset"])
+    terms = [Term("coulomb", 0), Term("offset", 1)]
+    data = dataset({Term("coulomb", 0): 0.5}, cfg)
+    weights = np.array([2.0, 0.5])
+    cv = CrossValidation(data, terms, weights, folds=5, margin=0.05)
+    fold, margins = fold_assignment(data.time, data.run, 5, 0.05)
+    A = np.hstack([data.regressor] + [data.block(t) for t in terms])
+    w = weights[data.joint]
+    expected = np.zeros((5, 2))
+    for k in range(5):
+        train = np.repeat(~(fold == k) & ~margins[k], 2)
+        x = np.linalg.lstsq(w[train, None] * A[train], w[train] * data.tau[train], rcond=None)[0]
+        held = np.repeat(fold == k, 2)
+        residual = (data.tau - A @ x)[held].reshape(-1, 2)
+        expected[k] = (residual**2).sum(axis=0)
+    np.testing.assert_allclose(cv.fold_sse(terms), expected, rtol=1e-8)
+    error, per_joint = cv.error(terms)
+    rms = np.sqrt((data.tau.reshape(-1, 2) ** 2).mean(axis=0))
+    np.testing.assert_allclose(per_joint, 100 * np.sqrt(expected.sum(axis=0) / data.time.size) / rms, rtol=1e-8)
+    assert error == pytest.approx(per_joint.mean())
+
+
+def test_search_finds_the_true_effects_and_shape_and_lowers_its_objective_at_every_step():
+    cfg = IdentificationConfig(candidates=["coulomb", "viscous", "held", "offset", "armature"], held_velocity=[0.05, 0.1, 0.2, 0.4])
+    truth = {Term("coulomb", 0): 0.5, Term("held", 1, 0.2): 0.3, Term("viscous", 1): 0.4}
+    selection = select_effects(dataset(truth, cfg), cfg, [], margin=0.05)
+    assert set(selection.terms) == set(truth)
+    for k, term in enumerate(selection.terms):
+        assert selection.fit.x[B + k] == pytest.approx(truth[term], abs=max(0.03 * truth[term], 3 * selection.fit.std[B + k]))
+    for search in selection.searches:
+        objectives = [np.log(search.initial_error) + (len(search.initial)) * np.log1p(cfg.min_improvement)]
+        terms = list(search.initial)
+        for step in search.steps:
+            terms = terms + [step.term] if step.move == "add" else [u for u in terms if u != step.term] if step.move == "remove" else \
+                [step.term if (u.effect, u.joint) == (step.term.effect, step.term.joint) else u for u in terms]
+            objectives.append(np.log(step.cv_error) + len(terms) * np.log1p(cfg.min_improvement))
+        assert np.all(np.diff(objectives) < 0)  # every move lowers J: the search cannot cycle
+        assert objectives[-1] == pytest.approx(search.objective)
+    assert selection.searches[selection.chosen].objective == min(s.objective for s in selection.searches)
+
+
+def test_no_effect_no_term_and_a_declared_one_stays():
+    cfg = IdentificationConfig(candidates=["coulomb", "viscous", "held", "offset", "armature"])
+    data = dataset({}, cfg)
+    assert select_effects(data, cfg, [], margin=0.05).terms == []
+    declared = [Term("viscous", 0)]
+    selection = select_effects(data, cfg, declared, margin=0.05)
+    assert selection.terms == declared and selection.declared == 1
+    assert abs(selection.fit.x[B]) < 3 * selection.fit.std[B]  # declared but absent: ~0
