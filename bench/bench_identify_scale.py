@@ -43,10 +43,11 @@ def identify(folder: Path, run_file: str, columns: dict) -> tuple[float, float]:
               "output": str(folder / "ident.h5")}
     path = folder / "identify.yaml"
     path.write_text(yaml.safe_dump(config))
-    child = ("import resource, sys\nfrom excite_cli.cli import app\ntry:\n    app(sys.argv[1:], standalone_mode=False)\n"
-             "finally:\n    print('PEAK_KB', resource.getrusage(resource.RUSAGE_SELF).ru_maxrss, file=sys.stderr)")
+    # the app returns its exit status (standalone_mode=False): a refused or failed run must fail the bench
+    child = ("import resource, sys\nfrom excite_cli.cli import app\ntry:\n    code = app(sys.argv[1:], standalone_mode=False)\n"
+             "finally:\n    print('PEAK_KB', resource.getrusage(resource.RUSAGE_SELF).ru_maxrss, file=sys.stderr)\nsys.exit(code or 0)")
     start = time.perf_counter()
-    result = subprocess.run([sys.executable, "-c", child, "identify", str(path)], capture_output=True, text=True)
+    result = subprocess.run([sys.executable, "-c", child, "identify", str(path), "--force"], capture_output=True, text=True)
     wall = time.perf_counter() - start
     peak = [line for line in result.stderr.splitlines() if line.startswith("PEAK_KB")]
     if result.returncode != 0 or not peak:

@@ -20,7 +20,7 @@ import numpy as np
 from threadpoolctl import threadpool_info, threadpool_limits
 
 from excite_cli.config import load_problem
-from excite_cli.engine import keep_freed_memory
+from excite_cli.memory import keep_freed_memory
 from excite_cli.excitation import build_excitation
 from excite_cli.optimizer import optimize_restart
 from excite_cli.verify import finite_difference_gradient

@@ -7,13 +7,11 @@ and its own seed, and is called with the problem's :class:`~excite_cli.excitatio
 its result does not depend on where or in which order it runs. Pool and cluster workers build the
 excitation from the validated problem once and keep it (one per worker thread). Every process that
 runs tasks uses one BLAS thread, since the matrices are small and parallel workers would otherwise
-oversubscribe the cores, and keeps the memory it frees (:func:`keep_freed_memory`).
+oversubscribe the cores, and keeps the memory it frees (:func:`~excite_cli.memory.keep_freed_memory`).
 """
 
 from __future__ import annotations
 
-import ctypes
-import ctypes.util
 import os
 import threading
 from concurrent.futures import Executor, ProcessPoolExecutor, as_completed
@@ -24,9 +22,8 @@ from threadpoolctl import threadpool_limits
 from excite_cli.config import Problem
 from excite_cli.errors import ExciteError
 from excite_cli.excitation import Excitation, build_excitation
+from excite_cli.memory import keep_freed_memory
 
-#: glibc mallopt parameters (malloc.h).
-M_TRIM_THRESHOLD, M_MMAP_THRESHOLD = -1, -3
 #: How long to wait for a Dask scheduler to answer.
 CONNECT_TIMEOUT = "10s"
 
@@ -38,22 +35,6 @@ class Task(Protocol):
     index: int
 
     def __call__(self, excitation: Excitation, progress: Optional[Callable] = None) -> Any: ...
-
-
-def keep_freed_memory() -> None:
-    """Let this process keep freed memory instead of returning it to the OS (glibc ``mallopt``).
-
-    The constraint grid's (instants × pairs) temporaries are megabytes, allocated hundreds of times
-    per second; by default glibc hands blocks above 128 kB back to the OS on free and page-faults
-    them in again on the next allocation, which cost 40 % of a capsule evaluation on the G1 (28 ms
-    → 18 ms with this). Elsewhere than glibc it does nothing.
-    """
-    try:
-        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6")
-        libc.mallopt(M_TRIM_THRESHOLD, 1 << 28)
-        libc.mallopt(M_MMAP_THRESHOLD, 1 << 25)
-    except (OSError, AttributeError):
-        pass
 
 
 _local = threading.local()

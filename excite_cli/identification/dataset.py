@@ -79,12 +79,16 @@ def run_offset_columns(run: int, fitted: list[int], count: int, columns: int) ->
     return np.broadcast_to(row, (count, columns))
 
 
-def _run_columns(s: Samples, index: int, terms: list[Term], fitted: list[int], offsets: int, coulomb_velocity: float) -> dict:
-    """Each term's columns of one run, filtered and decimated (offsets: indicator or mean columns)."""
+def _run_columns(s: Samples, index: int, terms: list[Term], fitted: list[int], offsets: int, coulomb_velocity: float):
+    """Each term's columns of one run, filtered and decimated (offsets: indicator or mean columns),
+    one term at a time, joint by joint: yields (term, columns). A joint's full-rate signals are
+    released once its terms are done (the samples are used up)."""
     kept = s.filter.kept(s.time.size)
-    return {t: run_offset_columns(index, fitted, kept, offsets) if t.effect in PER_RUN else
-            s.filter.decimate(effect_columns(t.effect, s.q[:, t.joint], s.qd[:, t.joint], s.qdd[:, t.joint], coulomb_velocity, t.shape))
-            for t in terms}
+    for j in range(len(s.q)):
+        for t in (t for t in terms if t.joint == j):
+            yield t, (run_offset_columns(index, fitted, kept, offsets) if t.effect in PER_RUN else
+                      s.filter.decimate(effect_columns(t.effect, s.q[j], s.qd[j], s.qdd[j], coulomb_velocity, t.shape)))
+        s.q[j] = s.qd[j] = s.qdd[j] = None
 
 
 def _regressor_chunks(robot: Robot, X: np.ndarray, s: Samples, payload: np.ndarray | None):
@@ -94,7 +98,7 @@ def _regressor_chunks(robot: Robot, X: np.ndarray, s: Samples, payload: np.ndarr
     n, b = robot.n_joints, X.shape[1]
 
     def values(lo: int, hi: int) -> np.ndarray:
-        Y = robot.regressor_stack(s.q[lo:hi], s.qd[lo:hi], s.qdd[lo:hi])
+        Y = robot.regressor_stack(*s.states(lo, hi))
         rows = (Y @ X).reshape(-1, n * b)
         return rows if payload is None else np.hstack([rows, (Y @ payload).reshape(-1, n)])
 
@@ -129,7 +133,7 @@ def build_datasets(robot: Robot, base: BaseParameters, samples: list[Samples], t
         raise ExciteError("data.runs: need data for fitting and for validation (roles fit/validation, or blocks)")
     fitted = [k for k, m in enumerate(masks) if m.any()] if split else []
     offsets = len(fitted) if split else max(offset_runs or 1, 1)
-    terms = [t for t in terms if t.effect not in TWO_STAGE]
+    terms = list(dict.fromkeys(t for t in terms if t.effect not in TWO_STAGE))
     width = {t: offsets if t.effect in PER_RUN else len(COEFFICIENTS[t.effect]) for t in terms}
     out = {side: {"Y": np.empty((size, n * b)), "tau": np.empty((size, n)), "time": np.empty(size),
                   "run": np.empty(size, dtype=int), "blocks": {t: np.empty((size, width[t])) for t in terms}}
@@ -139,15 +143,11 @@ def build_datasets(robot: Robot, base: BaseParameters, samples: list[Samples], t
         s = samples.pop(0)
         rows = {side: np.flatnonzero(mask == side) for side in (True, False)}
         where = {side: slice(at[side], at[side] + rows[side].size) for side in (True, False)}
-        tau = s.filter.decimate(s.tau)
+        tau = s.tau
         time = s.time[s.filter.trim : s.time.size - s.filter.trim : s.filter.step]
-        columns = _run_columns(s, index, terms, fitted, offsets, coulomb_velocity)
         for side in (True, False):
             out[side]["tau"][where[side]], out[side]["time"][where[side]] = tau[rows[side]], time[rows[side]]
             out[side]["run"][where[side]] = index
-            for t in terms:
-                out[side]["blocks"][t][where[side]] = columns[t][rows[side]]
-        del columns
         for start, Y, load in _regressor_chunks(robot, base.composition_matrix, s, payloads[index] if payloads else None):
             part = mask[start : start + Y.shape[0]]
             for side in (True, False):
@@ -156,6 +156,9 @@ def build_datasets(robot: Robot, base: BaseParameters, samples: list[Samples], t
                 out[side]["Y"][first : first + count] = Y[part == side]
                 if load is not None:
                     out[side]["tau"][first : first + count] -= load[part == side]
+        for t, columns in _run_columns(s, index, terms, fitted, offsets, coulomb_velocity):  # releases the run's signals
+            for side in (True, False):
+                out[side]["blocks"][t][where[side]] = columns[rows[side]]
         for side in (True, False):
             at[side] += rows[side].size
     fit, val = (Dataset(o["Y"].reshape(-1, b), o["tau"].ravel(), o["time"], o["run"], o["blocks"]) for o in (out[True], out[False]))

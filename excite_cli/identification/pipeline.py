@@ -23,6 +23,7 @@ from excite_cli.identification.physical import ConsistentFit, consistent_fit
 from excite_cli.identification.preprocessing import choose_cutoff, preprocess
 from excite_cli.identification.selection import Selection, candidate_terms, select_effects
 from excite_cli.identification.urdf_out import urdf_deviation, write_urdf
+from excite_cli.memory import return_freed_memory
 from excite_cli.robot import Robot, load_robot, resolve_urdf
 
 
@@ -200,6 +201,7 @@ def run_identification(problem: IdentifyProblem) -> tuple[Report, Robot, BasePar
     Raises:
         ExciteError: bad data or config (see :func:`prepare_data`).
     """
+    return_freed_memory()  # memory follows the live (decimated) data
     problem = with_overrides(problem, {"robot.base_wrench_rows": False})  # a copy: the caller's config is not changed
     robot = load_robot(problem)
     base = compute_base_parameters(robot)

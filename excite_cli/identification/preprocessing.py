@@ -62,13 +62,25 @@ class Filter:
     step: int
 
     def low_pass(self, x: np.ndarray) -> np.ndarray:
-        """Zero-phase filtered x along time (axis 0)."""
-        return signal.sosfiltfilt(self.sos, x, axis=0)
+        """Zero-phase filtered x along time (axis 0), column by column: the filter's padded
+        temporaries are one column's, not the whole array's (the same values)."""
+        if x.ndim == 1:
+            return signal.sosfiltfilt(self.sos, x)
+        out = np.empty(x.shape)
+        for c in range(x.shape[1]):
+            out[:, c] = signal.sosfiltfilt(self.sos, x[:, c])
+        return out
 
     def decimate(self, x: np.ndarray) -> np.ndarray:
-        """Filtered, trimmed and decimated x (axis 0), a copy (a view would keep the whole filtered
-        signal at the run's rate alive)."""
-        return self.low_pass(x)[self.trim : x.shape[0] - self.trim : self.step].copy()
+        """Filtered, trimmed and decimated x (axis 0), column by column (only the kept samples are
+        held for the whole array)."""
+        kept = slice(self.trim, x.shape[0] - self.trim, self.step)
+        if x.ndim == 1:
+            return signal.sosfiltfilt(self.sos, x)[kept].copy()
+        out = np.empty((self.kept(x.shape[0]), x.shape[1]))
+        for c in range(x.shape[1]):
+            out[:, c] = signal.sosfiltfilt(self.sos, x[:, c])[kept]
+        return out
 
     def kept(self, length: int) -> int:
         """Number of samples :meth:`decimate` keeps of a signal of ``length`` samples."""
@@ -85,7 +97,7 @@ class Filter:
         for start in range(0, kept.size, size):
             idx = kept[start : start + size]
             lo, hi = max(0, idx[0] - margin), min(length, idx[-1] + margin + 1)
-            yield start, self.low_pass(values(lo, hi))[idx - lo]
+            yield start, signal.sosfiltfilt(self.sos, values(lo, hi), axis=0)[idx - lo]  # a chunk: all columns at once
 
 
 @dataclass(frozen=True)
@@ -93,18 +105,25 @@ class Samples:
     """One run on a uniform grid at its own rate, with q̇ and q̈.
 
     Attributes:
-        name, role: from the run; time: (T,) [s]; q, qd, qdd, tau: (T, n) [rad, rad/s, rad/s², Nm]
-        (τ unfiltered: it is filtered in parallel with the regressor); filter: the run's filter.
+        name, role: from the run; time: (T,) [s]; q, qd, qdd: per joint, (T,) [rad, rad/s, rad/s²]
+        each (a list, so that a joint's signals can be released once they are used);
+        tau: (K, n) [Nm] already low-passed and decimated by ``filter`` (the regressor and the
+        effect columns get the same filter and decimation later: the parallel filtering);
+        filter: the run's filter.
     """
 
     name: str
     role: str
     time: np.ndarray
-    q: np.ndarray
-    qd: np.ndarray
-    qdd: np.ndarray
+    q: list[np.ndarray | None]
+    qd: list[np.ndarray | None]
+    qdd: list[np.ndarray | None]
     tau: np.ndarray
     filter: Filter
+
+    def states(self, lo: int, hi: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """q, q̇, q̈ (hi − lo, n) of the samples [lo, hi)."""
+        return tuple(np.column_stack([x[lo:hi] for x in signals]) for signals in (self.q, self.qd, self.qdd))
 
 
 def run_rate(run: Run) -> float:
@@ -118,9 +137,10 @@ def uniform_grid(run: Run) -> np.ndarray:
     return grid[grid <= run.time[-1]]
 
 
-def resample(run: Run, x: np.ndarray | None, grid: np.ndarray) -> np.ndarray | None:
-    """x (T_run, n) linearly interpolated at ``grid`` (removes timestamp jitter)."""
-    return None if x is None else np.column_stack([np.interp(grid, run.time, x[:, j]) for j in range(x.shape[1])])
+def resample(run: Run, x: np.ndarray | None, grid: np.ndarray) -> list[np.ndarray] | None:
+    """The columns of x (T_run, n) linearly interpolated at ``grid`` (removes timestamp jitter): n
+    arrays (T,)."""
+    return None if x is None else [np.interp(grid, run.time, column) for column in x.T]
 
 
 def choose_cutoff(runs: list[Run], cfg: PreprocessingConfig) -> tuple[float, str]:
@@ -130,7 +150,7 @@ def choose_cutoff(runs: list[Run], cfg: PreprocessingConfig) -> tuple[float, str
     if cfg.cutoff is not None:
         return cfg.cutoff, "preprocessing.cutoff"
     fitted = [r for r in runs if r.role != "validation"] or runs
-    widest = max(bandwidth(resample(r, r.q, uniform_grid(r)), run_rate(r)) for r in fitted)
+    widest = max(bandwidth(np.column_stack(resample(r, r.q, uniform_grid(r))), run_rate(r)) for r in fitted)
     top = MAX_CUTOFF_FRACTION * min(cfg.sample_rate, min(run_rate(r) for r in runs))
     cutoff = float(min(max(MIN_CUTOFF, CUTOFF_FACTOR * widest), top))
     return cutoff, (f"default: {CUTOFF_FACTOR:g} × the {100 * POWER_FRACTION:g} % power bandwidth of q in the fitted runs "
@@ -149,7 +169,7 @@ def preprocess(run: Run, cfg: PreprocessingConfig, cutoff: float) -> Samples:
     """
     rate = run_rate(run)
     grid = uniform_grid(run)
-    q, qd, qdd, tau = (resample(run, x, grid) for x in (run.q, run.qd, run.qdd, run.tau))
+    q, qd, qdd = (resample(run, x, grid) for x in (run.q, run.qd, run.qdd))
     if cfg.sample_rate > 1.01 * rate:
         raise ExciteError(f"preprocessing.sample_rate: {cfg.sample_rate:g} Hz is above the {rate:.4g} Hz of {run.name}; "
                           "resampling cannot add information (use at most the data's rate)")
@@ -169,7 +189,8 @@ def preprocess(run: Run, cfg: PreprocessingConfig, cutoff: float) -> Samples:
         )
     filt = Filter(sos, rate, cutoff, trim, max(1, int(round(rate / target))))
     dt = 1.0 / rate
-    q = filt.low_pass(q)
-    qd = filt.low_pass(qd) if qd is not None else np.gradient(q, dt, axis=0)
-    qdd = filt.low_pass(qdd) if qdd is not None else np.gradient(qd, dt, axis=0)
+    q = [filt.low_pass(c) for c in q]
+    qd = [filt.low_pass(c) for c in qd] if qd is not None else [np.gradient(c, dt) for c in q]
+    qdd = [filt.low_pass(c) for c in qdd] if qdd is not None else [np.gradient(c, dt) for c in qd]
+    tau = np.column_stack([filt.decimate(c) for c in resample(run, run.tau, grid)])  # only its kept samples are held
     return Samples(run.name, run.role, grid, q, qd, qdd, tau, filt)

@@ -66,10 +66,14 @@ def write_identification(path: Path, report: Report, robot: Robot, base: BasePar
 
 def _write_regressor(f: h5py.File, regressor: list[np.ndarray], b: int) -> None:
     """``/regressor``: the decimated base regressor rows of every sample, fit then validation, stored
-    once and compressed (gzip with byte shuffling)."""
-    rows = np.vstack(regressor) if regressor else np.zeros((0, b))
-    chunks = (min(max(rows.shape[0], 1), 4096), b) if rows.size else None
-    data = f.create_dataset("regressor", data=rows, compression="gzip" if rows.size else None, shuffle=bool(rows.size), chunks=chunks)
+    once and compressed (gzip with byte shuffling), written part by part (no stacked copy)."""
+    total = sum(part.shape[0] for part in regressor)
+    options = {"compression": "gzip", "shuffle": True, "chunks": (min(total, 4096), b)} if total else {}
+    data = f.create_dataset("regressor", shape=(total, b), dtype="f8", **options)
+    at = 0
+    for part in regressor:
+        data[at : at + part.shape[0]] = part
+        at += part.shape[0]
     data.attrs["description"] = "base regressor of all preprocessed (decimated) samples, fit then validation (prior data C0, Eq. 41)"
 
 

@@ -8,10 +8,11 @@ The search minimizes
     J(M) = log CV(M) + p(M) · log(1 + min_improvement),
 
 p(M) the number of terms the search added: every effect must lower the cross-validated error by
-the fraction ``min_improvement`` (default 1 %) to stay in the model. A move adds a candidate term,
+the fraction ``min_improvement`` (default 2 %) to stay in the model. A move adds a candidate term,
 removes an added term, or changes the shape velocity of a Stribeck or held term (the profile search
-over its grid); the move that lowers J most is taken, and the search stops when none does, so it
-ends in a model no single move improves and cannot cycle. Greedy forward selection alone depends on
+over its grid; such a move must cut the error by ``min_improvement`` too, or it would chase noise
+for free); the move that lowers J most is taken, and the search stops when none does, so it ends in
+a model no single move improves and cannot cycle. Greedy forward selection alone depends on
 its path: a joint whose Coulomb friction is missing bends the shared base parameters, and adding it
 later can make another joint's error worse first. So the search runs from three starts (the declared
 effects alone, plus Coulomb friction on every joint, plus Coulomb and viscous friction on every
@@ -158,8 +159,8 @@ class _Search:
             if not tried:
                 search.stop = "no move left (every candidate is in the model)"
                 break
-            move, term, after, value = min(tried, key=lambda m: self.objective(m[2], m[3]))
-            if self.objective(after, value) >= search.objective - 1e-12:
+            move, term, after, value = min(tried, key=lambda m: self.objective(m[2], m[3]) + (self.penalty if m[0] == "shape" else 0.0))
+            if self.objective(after, value) + (self.penalty if move == "shape" else 0.0) >= search.objective - 1e-12:
                 search.stop = (f"no addition, removal or shape change lowers the cross-validated error by "
                                f"min_improvement ({100 * self.cfg.min_improvement:g} %)")
                 if len(terms) - len(self.declared) >= self.cfg.max_effects:
