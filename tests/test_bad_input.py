@@ -3,11 +3,9 @@ one line naming the field or option, print no traceback, leave no file behind, a
 output untouched."""
 
 import copy
-from pathlib import Path
 
 import h5py
 import numpy as np
-import pinocchio as pin
 import pytest
 import yaml
 from typer.testing import CliRunner
@@ -174,6 +172,15 @@ CASES = [
     ("identify-unknown-key", lambda t, s: ["identify", str(_identify_config(t, **{"identification.methd": "ls"}))], "identification.methd"),
     ("identify-rate-above-data", lambda t, s: ["identify", str((_csv(t / "run.csv"), _identify_config(t, **{"preprocessing.sample_rate": 5000.0}))[1])],
      "preprocessing.sample_rate"),
+    ("identify-payload-frame", lambda t, s: ["identify", str((_csv(t / "run.csv"), _identify_config(t, **{"data.runs": [
+        {"file": "run.csv", "role": "blocks", "payload": {"mass": 1.0, "frame": "gripper"}}]}))[1])], "data.runs[0].payload.frame"),
+    ("identify-payload-mass", lambda t, s: ["identify", str(_identify_config(t, **{"data.runs": [
+        {"file": "run.csv", "payload": {"mass": 0.0}}]}))], "payload.mass"),
+    ("identify-held-velocity", lambda t, s: ["identify", str(_identify_config(t, **{"identification.held_velocity": [0.1, -0.2]}))],
+     "identification.held_velocity"),
+    ("identify-folds", lambda t, s: ["identify", str(_identify_config(t, **{"identification.folds": 2}))], "identification.folds"),
+    ("identify-candidate", lambda t, s: ["identify", str(_identify_config(t, **{"identification.candidates": ["coulomb", "lugre"]}))],
+     "identification.candidates"),
     ("validate-report-missing", lambda t, s: ["validate", str(t / "none.h5"), str(_identify_config(t))], "not found"),
     ("validate-not-report", lambda t, s: ["validate", str(s["result"]), str(_identify_config(t))], "identify report"),
 ]

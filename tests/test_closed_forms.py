@@ -3,7 +3,6 @@ polygon region, the units stored in the HDF5 result, and the random pool's count
 
 import h5py
 import numpy as np
-import pytest
 from typer.testing import CliRunner
 
 from conftest import CONFIGS, UR5, write_config
