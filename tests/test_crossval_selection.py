@@ -8,7 +8,7 @@ from excite_cli.identification.config import IdentificationConfig
 from excite_cli.identification.crossval import CrossValidation, fold_assignment
 from excite_cli.identification.dataset import Dataset, run_offset_columns
 from excite_cli.identification.effects import Term, effect_columns
-from excite_cli.identification.selection import candidate_terms, select_effects
+from excite_cli.identification.selection import _Search, candidate_terms, select_effects
 
 RATE, N_RUN, B = 200.0, 2400, 3
 PHI = np.array([1.5, -0.7, 0.4])
@@ -104,3 +104,15 @@ def test_no_effect_no_term_and_a_declared_one_stays():
     selection = select_effects(data, cfg, declared, margin=0.05)
     assert selection.terms == declared and selection.declared == 1
     assert abs(selection.fit.x[B]) < 3 * selection.fit.std[B]  # declared but absent: ~0
+
+
+def test_a_declared_shape_effect_moves_along_its_grid_and_stays():
+    cfg = IdentificationConfig(candidates=["coulomb", "held"], held_velocity=[0.05, 0.1, 0.2, 0.4])
+    data = dataset({Term("held", 1, 0.2): 0.3}, cfg)
+    selection = select_effects(data, cfg, [Term("held", 1, 0.05)], margin=0.05)
+    assert selection.terms == [Term("held", 1, 0.2)] and selection.declared == 1
+    assert [step.move for step in selection.steps] == ["shape"]
+    # once moved along its grid, the declared effect is still never a removal candidate
+    search = _Search(None, [Term("held", 1, v) for v in cfg.held_velocity], [Term("held", 1, 0.05)], cfg)
+    moves = search.moves([Term("held", 1, 0.2)])
+    assert {m for m, _, _ in moves} == {"shape"}

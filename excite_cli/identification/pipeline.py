@@ -113,8 +113,9 @@ def declared_terms(problem: IdentifyProblem, robot: Robot) -> list[Term]:
         joints = range(robot.n_joints) if name == "*" else [robot.joint_names.index(name)]
         for e in effects:
             grid = shapes.get(e)
-            out += [t for j in joints for t in [Term(e, j, grid[len(grid) // 2] if grid else None)]
-                    if all((u.effect, u.joint) != (t.effect, t.joint) for u in out)]
+            for j in joints:
+                if all((u.effect, u.joint) != (e, j) for u in out):
+                    out.append(Term(e, j, grid[len(grid) // 2] if grid else None))
     return out
 
 

@@ -122,6 +122,7 @@ class _Search:
 
     def __init__(self, cv: CrossValidation, candidates: list[Term], declared: list[Term], cfg: IdentificationConfig):
         self.cv, self.candidates, self.declared, self.cfg = cv, candidates, declared, cfg
+        self.fixed = {(t.effect, t.joint) for t in declared}  # declared: never removed (their shape may move)
         self.penalty = np.log1p(cfg.min_improvement)
         self.cache: dict[frozenset, float] = {}
 
@@ -134,6 +135,10 @@ class _Search:
     def objective(self, terms: list[Term], error: float) -> float:
         return float(np.log(max(error, 1e-12)) + (len(terms) - len(self.declared)) * self.penalty)
 
+    def cost(self, move: str, terms: list[Term], error: float) -> float:
+        """J of the model a move leads to; a shape change pays the price of an effect as well."""
+        return self.objective(terms, error) + (self.penalty if move == "shape" else 0.0)
+
     def moves(self, terms: list[Term]) -> list[tuple[str, Term, list[Term]]]:
         """(move, term, model after) of every allowed move from ``terms``."""
         family = {(t.effect, t.joint): t for t in terms}
@@ -143,7 +148,7 @@ class _Search:
                     if (c.effect, c.joint) not in family and (c.effect not in REQUIRES or (REQUIRES[c.effect], c.joint) in family)]
         for t in terms:
             needed = any(REQUIRES.get(u.effect) == t.effect and u.joint == t.joint for u in terms)
-            if t not in self.declared and not needed:
+            if (t.effect, t.joint) not in self.fixed and not needed:
                 out.append(("remove", t, [u for u in terms if u != t]))
             if t.shape is not None:
                 out += [("shape", c, [c if u == t else u for u in terms]) for c in self.candidates
@@ -159,8 +164,8 @@ class _Search:
             if not tried:
                 search.stop = "no move left (every candidate is in the model)"
                 break
-            move, term, after, value = min(tried, key=lambda m: self.objective(m[2], m[3]) + (self.penalty if m[0] == "shape" else 0.0))
-            if self.objective(after, value) + (self.penalty if move == "shape" else 0.0) >= search.objective - 1e-12:
+            move, term, after, value = min(tried, key=lambda m: self.cost(m[0], m[2], m[3]))
+            if self.cost(move, after, value) >= search.objective - 1e-12:
                 search.stop = (f"no addition, removal or shape change lowers the cross-validated error by "
                                f"min_improvement ({100 * self.cfg.min_improvement:g} %)")
                 if len(terms) - len(self.declared) >= self.cfg.max_effects:
