@@ -42,10 +42,10 @@ def command(name: Optional[str] = None) -> Callable:
 
 
 def _say(*items, console: Console = out) -> None:
-    """Print tables and lines, flattening lists."""
+    """Print tables and lines (as written, not rich markup), flattening lists."""
     for item in items:
         for part in item if isinstance(item, list) else [item]:
-            console.print(part, highlight=False)
+            console.print(escape(part) if isinstance(part, str) else part, highlight=False)
 
 
 def _version(show: bool) -> None:

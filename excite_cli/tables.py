@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import Sequence
 
 import numpy as np
+from rich.markup import escape
 from rich.table import Table
 
 from excite_cli.export import Export
@@ -16,11 +17,13 @@ from excite_cli.sequence import IterationResult
 
 
 def _table(title: str, columns: Sequence[str], rows: Sequence[Sequence[str]], caption: str = "") -> Table:
-    table = Table(title=title, caption=caption or None)
+    """A table whose text is shown as written (brackets such as ``[Nm]`` or ``tau0[run.csv]`` are
+    not rich markup)."""
+    table = Table(title=escape(title), caption=escape(caption) if caption else None)
     for column in columns:
-        table.add_column(column, justify="right")
+        table.add_column(escape(column), justify="right")
     for row in rows:
-        table.add_row(*row)
+        table.add_row(*(escape(cell) for cell in row))
     return table
 
 
