@@ -12,6 +12,7 @@ from excite_cli.export import Export
 from excite_cli.identification.effects import COEFFICIENTS, UNITS as EFFECT_UNITS
 from excite_cli.identification.physical import body_properties, pseudo_inertia
 from excite_cli.identification.pipeline import effect_values
+from excite_cli.identification.selection import MOVE_SIGNS
 from excite_cli.runs import Comparison, Verification
 from excite_cli.sequence import IterationResult
 
@@ -128,13 +129,11 @@ def search(report, runners_up: int = 2) -> list[Table | str]:
     tried is in the HDF5 report), and the outcome of every start."""
     sel = report.selection
     kept = sel.searches[sel.chosen]
-    rows, before = [], kept.initial_error
-    sign = {"add": "+", "remove": "−", "shape": "~"}
+    rows = []
     for k, step in enumerate(sel.steps, start=1):
-        others = sorted((v, m, t) for m, t, v in step.tried if (m, t) != (step.move, step.term))[:runners_up]
-        rows.append((str(k), f"{sign[step.move]} {step.term.label(report.joints)}", f"{100 * (1 - step.cv_error / before):.1f}",
-                     str(len(step.tried)), "; ".join(f"{sign[m]} {t.label(report.joints)} {100 * (1 - v / before):.1f}" for v, m, t in others)))
-        before = step.cv_error
+        others = sorted(((v, m, t) for m, t, v in step.tried if (m, t) != (step.move, step.term)), key=lambda o: o[0])[:runners_up]
+        rows.append((str(k), step.label(report.joints), f"{step.gain:.1f}", str(len(step.tried)),
+                     "; ".join(f"{MOVE_SIGNS[m]} {t.label(report.joints)} {step.gain_of(v):.1f}" for v, m, t in others)))
     steps = _table(f"Selection steps from the start '{kept.start}' (gain: cut of the cross-validated error [%])",
                    ("step", "move", "gain [%]", "tried", f"next best {runners_up} [gain %]"), rows, f"stopped: {kept.stop}")
     starts = "; ".join(f"{s.start}: {s.cv_error:.2f} % with {len(s.terms)} effects" + (" (kept)" if k == sel.chosen else "")

@@ -85,14 +85,14 @@ def test_search_finds_the_true_effects_and_shape_and_lowers_its_objective_at_eve
     for k, term in enumerate(selection.terms):
         assert selection.fit.x[B + k] == pytest.approx(truth[term], abs=max(0.03 * truth[term], 3 * selection.fit.std[B + k]))
     for search in selection.searches:
-        objectives = [np.log(search.initial_error) + (len(search.initial)) * np.log1p(cfg.min_improvement)]
-        terms = list(search.initial)
-        for step in search.steps:
-            terms = terms + [step.term] if step.move == "add" else [u for u in terms if u != step.term] if step.move == "remove" else \
-                [step.term if (u.effect, u.joint) == (step.term.effect, step.term.joint) else u for u in terms]
-            objectives.append(np.log(step.cv_error) + len(terms) * np.log1p(cfg.min_improvement))
+        models = [search.initial] + [step.terms for step in search.steps]
+        errors = [search.initial_error] + [step.cv_error for step in search.steps]
+        objectives = [np.log(e) + len(m) * np.log1p(cfg.min_improvement) for m, e in zip(models, errors)]
         assert np.all(np.diff(objectives) < 0)  # every move lowers J: the search cannot cycle
-        assert objectives[-1] == pytest.approx(search.objective)
+        assert objectives[-1] == pytest.approx(search.objective) and models[-1] == search.terms
+        for step, before, error in zip(search.steps, models, errors):  # each step's model is its move applied
+            assert (step.term in step.terms) != (step.move == "remove") and len(set(step.terms) ^ set(before)) in (1, 2)
+            assert step.before == error and (step.move != "add" or step.gain > 100 * (1 - 1 / (1 + cfg.min_improvement)))
     assert selection.searches[selection.chosen].objective == min(s.objective for s in selection.searches)
 
 

@@ -77,12 +77,10 @@ def plot_ladder(path: Path, report) -> Path:
     top.set_title("what each effect bought", fontsize=9)
     top.legend(fontsize=7)
     top.grid(axis="y", alpha=0.3)
-    before = sel.searches[sel.chosen].initial_error
     for k, step in enumerate(sel.steps, start=1):
-        gains = np.array([100.0 * (1.0 - v / before) for _, _, v in step.tried])
+        gains = np.array([step.gain_of(v) for _, _, v in step.tried])
         bottom.plot(np.full(gains.size, k) + np.linspace(-0.25, 0.25, gains.size), gains, ".", color="0.6", markersize=3)
-        bottom.plot(k, 100.0 * (1.0 - step.cv_error / before), "*", color="C3", markersize=9)
-        before = step.cv_error
+        bottom.plot(k, step.gain, "*", color="C3", markersize=9)
     bottom.axhline(100.0 * (1.0 - 1.0 / (1.0 + sel.min_improvement)), color="k", linewidth=0.8, linestyle="--",
                    label="min_improvement")
     bottom.set_xlabel("step of the search (★ the move taken, dots every move tried)")

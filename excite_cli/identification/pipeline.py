@@ -134,15 +134,7 @@ def error_ladder(normal: NormalEquations, val_data: Dataset, selection: Selectio
     models = [("rigid body", [], selection.cv_rigid)]
     if search.initial:
         models.append((f"start: {search.start}", search.initial, search.initial_error))
-    terms = search.initial
-    for step in search.steps:
-        if step.move == "add":
-            terms = terms + [step.term]
-        elif step.move == "remove":
-            terms = [t for t in terms if t != step.term]
-        else:
-            terms = [step.term if (t.effect, t.joint) == (step.term.effect, step.term.joint) else t for t in terms]
-        models.append((f"{ {'add': '+', 'remove': '−', 'shape': '~'}[step.move]} {step.term.label(joints)}", terms, step.cv_error))
+    models += [(step.label(joints), step.terms, step.cv_error) for step in search.steps]
     return [(label, cv, _relative(measured, predict(val_data, least_squares(normal, terms, selection.weights).x, terms)))
             for label, terms, cv in models]
 

@@ -109,11 +109,9 @@ def _write_search(g: h5py.Group, report: Report) -> None:
     sel = report.selection
     move = [("step", "i4"), ("move", STR), ("effect", STR), ("joint", STR), ("shape", "f8"), ("cv_error", "f8"), ("gain", "f8")]
     steps, tried = [], []
-    before = sel.searches[sel.chosen].initial_error
     for k, step in enumerate(sel.steps, start=1):
-        steps.append((k, step.move, *_term_fields(step.term, report.joints), step.cv_error, 100.0 * (1.0 - step.cv_error / before)))
-        tried += [(k, m, *_term_fields(t, report.joints), v, 100.0 * (1.0 - v / before)) for m, t, v in step.tried]
-        before = step.cv_error
+        steps.append((k, step.move, *_term_fields(step.term, report.joints), step.cv_error, step.gain))
+        tried += [(k, m, *_term_fields(t, report.joints), v, step.gain_of(v)) for m, t, v in step.tried]
     units = "cv_error in %, gain in % of the CV error before the step, shape in rad/s"
     g.create_dataset("steps", data=np.array(steps, dtype=move)).attrs["units"] = units
     g.create_dataset("candidates", data=np.array(tried, dtype=move)).attrs["units"] = units + "; every move tried at each step"

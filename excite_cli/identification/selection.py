@@ -36,6 +36,8 @@ from excite_cli.identification.effects import REQUIRES, SHAPES, Term
 from excite_cli.identification.least_squares import Fit, joint_weights, least_squares
 from excite_cli.identification.normal import ABSORBED, NormalEquations, outside_fraction
 
+#: How a move is written: added, removed, shape changed.
+MOVE_SIGNS = {"add": "+", "remove": "−", "shape": "~"}
 #: Starts of the search beyond the declared effects: friction a real joint is most likely to have.
 STARTS = {"declared effects": (), "Coulomb on every joint": ("coulomb",), "Coulomb and viscous on every joint": ("coulomb", "viscous")}
 
@@ -47,14 +49,30 @@ class Step:
     Attributes:
         move: ``add``, ``remove`` or ``shape`` (a Stribeck or held term's velocity changed).
         term: the term added, removed, or the new shape's term.
-        cv_error: CV(M) [%] after the move.
+        terms: the model after the move.
+        cv_error: CV(M) [%] after the move; before: CV(M) [%] before it.
         tried: every move considered at this step: (move, term, CV after [%]).
     """
 
     move: str
     term: Term
+    terms: list[Term]
     cv_error: float
+    before: float
     tried: list[tuple[str, Term, float]]
+
+    def gain_of(self, cv_error: float) -> float:
+        """The cut [%] of the CV error before this step that a move to ``cv_error`` [%] makes."""
+        return 100.0 * (1.0 - cv_error / self.before)
+
+    @property
+    def gain(self) -> float:
+        """The cut [%] of the CV error this step made."""
+        return self.gain_of(self.cv_error)
+
+    def label(self, joints: list[str]) -> str:
+        """e.g. ``+ held panda_joint7 (v_h 0.1 rad/s)``."""
+        return f"{MOVE_SIGNS[self.move]} {self.term.label(joints)}"
 
 
 @dataclass
@@ -171,9 +189,9 @@ class _Search:
                 if len(terms) - len(self.declared) >= self.cfg.max_effects:
                     search.stop = f"max_effects ({self.cfg.max_effects}) reached; no removal or shape change helps"
                 break
+            search.steps.append(Step(move, term, after, value, error, [(m, t, v) for m, t, _, v in tried]))
             terms, error = after, value
             search.objective = self.objective(terms, error)
-            search.steps.append(Step(move, term, value, [(m, t, v) for m, t, _, v in tried]))
         search.terms, search.cv_error = terms, error
         return search
 
