@@ -13,7 +13,7 @@ import numpy as np
 
 from excite_cli.identification.config import SimulationConfig
 from excite_cli.errors import ExciteError
-from excite_cli.identification.effects import COEFFICIENTS, effect_columns
+from excite_cli.identification.effects import COEFFICIENTS, SHAPE_FIELDS, effect_columns
 from excite_cli.output import problem_of_result, read_alphas
 from excite_cli.robot import Robot, load_robot
 from excite_cli.targets import check_folder
@@ -37,7 +37,7 @@ def effect_torques(sim: SimulationConfig, robot: Robot, q: np.ndarray, qd: np.nd
             if coefficients.size != len(COEFFICIENTS[effect]):
                 raise ExciteError(f"effects.{effect}.{name}: needs {len(COEFFICIENTS[effect])} value(s) {COEFFICIENTS[effect]}")
             for j in (range(robot.n_joints) if name == "*" else [robot.joint_names.index(name)]):
-                shape = {"stribeck": sim.stribeck_velocity, "held": sim.held_velocity}.get(effect)
+                shape = getattr(sim, SHAPE_FIELDS[effect]) if effect in SHAPE_FIELDS else None
                 cols = effect_columns(effect, q[:, j], qd[:, j], qdd[:, j], sim.coulomb_velocity, shape, rigid[:, j])
                 tau[:, j] += cols @ coefficients
     return tau

@@ -16,7 +16,7 @@ from excite_cli.cli import app
 from excite_cli.config import load_problem
 from excite_cli.identification.config import DEFAULT_CANDIDATES, IdentifyProblem, PreprocessingConfig, SimulationConfig
 from excite_cli.identification.dataset import run_offset_columns
-from excite_cli.identification.effects import COEFFICIENTS, EFFECT_NAMES, POSITION, SHAPES, effect_columns
+from excite_cli.identification.effects import COEFFICIENTS, EFFECT_NAMES, POSITION, SHAPE_FIELDS, SHAPES, effect_columns
 from excite_cli.identification.measurements import Run, load_run
 from excite_cli.identification.pipeline import effect_values, run_identification
 from excite_cli.identification.preprocessing import MIN_CUTOFF, Filter, choose_cutoff
@@ -192,7 +192,7 @@ def test_each_undeclared_effect_is_named_with_its_value_and_shape(tmp_path, opti
         expected = truth[(effect, coefficient.split("[")[0], joint)]  # an offset per run: tau0[run] each
         assert abs(value - expected) <= max(0.05 * abs(expected), 3 * std), (effect, joint, value, std)
         if effect in SHAPES:  # the profile search picks the simulated velocity from the grid
-            assert shape == shapes[{"stribeck": "stribeck_velocity", "held": "held_velocity"}[effect]]
+            assert shape == shapes[SHAPE_FIELDS[effect]]
 
 
 def test_offsets_per_run_and_a_known_payload(tmp_path, optimized):

@@ -60,6 +60,8 @@ TWO_STAGE = ("load_coulomb",)
 PER_RUN = ("offset",)
 #: Effects nonlinear in a velocity [rad/s], and the name of that velocity.
 SHAPES = {"stribeck": "v_s", "held": "v_h"}
+#: The config field (identification and simulation) that gives each shape velocity [rad/s].
+SHAPE_FIELDS = {"stribeck": "stribeck_velocity", "held": "held_velocity"}
 #: Default grid of a shape velocity [rad/s]: factors of 2 to 2.5 from 0.02 to 0.5 rad/s.
 SHAPE_GRID = (0.02, 0.05, 0.1, 0.2, 0.5)
 #: Effects whose columns depend on the position (they extrapolate to positions the fit never saw).

@@ -68,6 +68,15 @@ def design(data: Dataset, effects: list[Term]) -> np.ndarray:
     return np.hstack([data.regressor] + [data.block(t) for t in effects])
 
 
+def torque_errors(measured: np.ndarray, predicted: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per joint, of measured and predicted torques (N, n) [Nm]: the RMS error (n,) [Nm], the RMS of
+    the measured torque (n,) [Nm] and their ratio (n,) [%] (relative to 1 Nm where a joint's torque
+    is zero)."""
+    rms = np.sqrt(np.mean((measured - predicted) ** 2, axis=0))
+    torque = np.sqrt(np.mean(measured**2, axis=0))
+    return rms, torque, 100.0 * rms / np.where(torque > 0, torque, 1.0)
+
+
 def predict(data: Dataset, x: np.ndarray, effects: list[Term]) -> np.ndarray:
     """Predicted torques (N, n) [Nm] of the model [Y_B, effects] with coefficients x (base
     parameters first), without forming the design."""

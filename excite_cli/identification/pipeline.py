@@ -14,8 +14,8 @@ from excite_cli.config import with_overrides
 from excite_cli.errors import ExciteError
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.dataset import Dataset, build_datasets
-from excite_cli.identification.effects import COEFFICIENTS, PER_RUN, TWO_STAGE, Term
-from excite_cli.identification.least_squares import design, joint_weights, least_squares, predict
+from excite_cli.identification.effects import COEFFICIENTS, PER_RUN, SHAPE_FIELDS, TWO_STAGE, Term
+from excite_cli.identification.least_squares import design, joint_weights, least_squares, predict, torque_errors
 from excite_cli.identification.measurements import load_run
 from excite_cli.identification.normal import NormalEquations, excited_rank
 from excite_cli.identification.payload import payload_parameters
@@ -86,9 +86,8 @@ class Report:
         out = []
         for r in np.unique(self.validation.run):
             rows = self.validation.run == r
-            rms = [np.sqrt(np.mean((measured[rows] - p[rows]) ** 2, axis=0)) for p in (self.predicted_before, self.predicted_after)]
-            torque = np.sqrt(np.mean(measured[rows] ** 2, axis=0))
-            out.append((self.run_names[r] if r < len(self.run_names) else str(r), int(rows.sum()), *rms, torque))
+            (before, torque, _), (after, _, _) = (torque_errors(measured[rows], p[rows]) for p in (self.predicted_before, self.predicted_after))
+            out.append((self.run_names[r] if r < len(self.run_names) else str(r), int(rows.sum()), before, after, torque))
         return out
 
     @property
@@ -105,27 +104,20 @@ def declared_terms(problem: IdentifyProblem, robot: Robot) -> list[Term]:
         ExciteError: a joint that is not active.
     """
     cfg = problem.identification
-    shapes = {"stribeck": cfg.stribeck_velocity, "held": cfg.held_velocity}
     out: list[Term] = []
     for name, effects in cfg.declared_effects.items():
         if name != "*" and name not in robot.joint_names:
             raise ExciteError(f"identification.declared_effects: '{name}' is not an active joint")
         joints = range(robot.n_joints) if name == "*" else [robot.joint_names.index(name)]
         for e in effects:
-            grid = shapes.get(e)
+            grid = getattr(cfg, SHAPE_FIELDS[e]) if e in SHAPE_FIELDS else None
             for j in joints:
                 if all((u.effect, u.joint) != (e, j) for u in out):
                     out.append(Term(e, j, grid[len(grid) // 2] if grid else None))
     return out
 
 
-def _relative(measured: np.ndarray, predicted: np.ndarray) -> float:
-    """Mean over joints of RMS(measured − predicted) / RMS(measured) [%]."""
-    torque = np.sqrt(np.mean(measured**2, axis=0))
-    return float(np.mean(100.0 * np.sqrt(np.mean((measured - predicted) ** 2, axis=0)) / np.where(torque > 0, torque, 1.0)))
-
-
-def error_ladder(normal: NormalEquations, val_data: Dataset, selection: Selection, joints: list[str]) -> list[tuple[str, float, float]]:
+def error_ladder(val_data: Dataset, selection: Selection, joints: list[str]) -> list[tuple[str, float, float]]:
     """(step, CV error [%], mean relative validation error [%]) of the rigid body, the kept search's
     start and each of its steps, every model fitted on all fit data with the selection's weights: what
     each effect bought."""
@@ -135,8 +127,8 @@ def error_ladder(normal: NormalEquations, val_data: Dataset, selection: Selectio
     if search.initial:
         models.append((f"start: {search.start}", search.initial, search.initial_error))
     models += [(step.label(joints), step.terms, step.cv_error) for step in search.steps]
-    return [(label, cv, _relative(measured, predict(val_data, least_squares(normal, terms, selection.weights).x, terms)))
-            for label, terms, cv in models]
+    fitted = ((label, cv, predict(val_data, least_squares(selection.normal, terms, selection.weights).x, terms)) for label, terms, cv in models)
+    return [(label, cv, float(torque_errors(measured, predicted)[2].mean())) for label, cv, predicted in fitted]
 
 
 @dataclass
@@ -213,14 +205,14 @@ def run_identification(problem: IdentifyProblem) -> tuple[Report, Robot, BasePar
     rms_consistent = None
     if consistent is not None:
         predicted = predict(val_data, np.concatenate([consistent.base, consistent.effects]), selection.terms)
-        rms_consistent = np.sqrt(np.mean((measured - predicted) ** 2, axis=0))
+        rms_consistent = torque_errors(measured, predicted)[0]
     report = Report(
         joints=robot.joint_names, base_names=base.names, selection=selection,
-        rms_before=np.sqrt(np.mean((measured - before) ** 2, axis=0)), rms_after=np.sqrt(np.mean((measured - after) ** 2, axis=0)),
-        rms_torque=np.sqrt(np.mean(measured**2, axis=0)), validation=val_data, predicted_before=before, predicted_after=after,
+        rms_before=torque_errors(measured, before)[0], rms_after=torque_errors(measured, after)[0],
+        rms_torque=torque_errors(measured, after)[1], validation=val_data, predicted_before=before, predicted_after=after,
         cutoff=data.cutoff, cutoff_source=data.cutoff_source, fit_samples=fit_data.time.size, validation_samples=val_data.time.size,
         dropped=data.dropped, run_names=labels, offset_runs=offset_runs,
-        ladder=error_ladder(selection.normal, val_data, selection, robot.joint_names), consistent=consistent, rms_consistent=rms_consistent,
+        ladder=error_ladder(val_data, selection, robot.joint_names), consistent=consistent, rms_consistent=rms_consistent,
     )
     return report, robot, base, [fit_data.regressor, val_data.regressor]
 

@@ -66,21 +66,15 @@ class Filter:
         temporaries are one column's, not the whole array's (the same values)."""
         if x.ndim == 1:
             return signal.sosfiltfilt(self.sos, x)
-        out = np.empty(x.shape)
-        for c in range(x.shape[1]):
-            out[:, c] = signal.sosfiltfilt(self.sos, x[:, c])
-        return out
+        return np.column_stack([signal.sosfiltfilt(self.sos, column) for column in x.T])
 
     def decimate(self, x: np.ndarray) -> np.ndarray:
         """Filtered, trimmed and decimated x (axis 0), column by column (only the kept samples are
         held for the whole array)."""
         kept = slice(self.trim, x.shape[0] - self.trim, self.step)
         if x.ndim == 1:
-            return signal.sosfiltfilt(self.sos, x)[kept].copy()
-        out = np.empty((self.kept(x.shape[0]), x.shape[1]))
-        for c in range(x.shape[1]):
-            out[:, c] = signal.sosfiltfilt(self.sos, x[:, c])[kept]
-        return out
+            return self.low_pass(x)[kept].copy()
+        return np.column_stack([self.low_pass(column)[kept] for column in x.T])
 
     def kept(self, length: int) -> int:
         """Number of samples :meth:`decimate` keeps of a signal of ``length`` samples."""

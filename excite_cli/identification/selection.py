@@ -32,7 +32,7 @@ import numpy as np
 from excite_cli.identification.config import IdentificationConfig
 from excite_cli.identification.crossval import CrossValidation
 from excite_cli.identification.dataset import Dataset
-from excite_cli.identification.effects import REQUIRES, SHAPES, Term
+from excite_cli.identification.effects import REQUIRES, SHAPE_FIELDS, Term
 from excite_cli.identification.least_squares import Fit, joint_weights, least_squares
 from excite_cli.identification.normal import ABSORBED, NormalEquations, outside_fraction
 
@@ -131,8 +131,7 @@ class Selection:
 
 def candidate_terms(cfg: IdentificationConfig, n: int) -> list[Term]:
     """Every candidate term: each candidate effect on each joint, one per shape of ``SHAPES`` effects."""
-    shapes = {"stribeck": cfg.stribeck_velocity, "held": cfg.held_velocity}
-    return [Term(e, j, s) for e in cfg.candidates for j in range(n) for s in (shapes[e] if e in SHAPES else [None])]
+    return [Term(e, j, s) for e in cfg.candidates for j in range(n) for s in (getattr(cfg, SHAPE_FIELDS[e]) if e in SHAPE_FIELDS else [None])]
 
 
 class _Search:

@@ -15,7 +15,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import yaml
 
 from excite_cli.base_parameters import compute_base_parameters
 from excite_cli.config import with_overrides
@@ -23,7 +22,7 @@ from excite_cli.identification.config import IdentifyProblem
 from excite_cli.errors import ExciteError
 from excite_cli.identification.dataset import build_datasets
 from excite_cli.identification.effects import TWO_STAGE, Term
-from excite_cli.identification.least_squares import predict
+from excite_cli.identification.least_squares import predict, torque_errors
 from excite_cli.identification.measurements import load_run
 from excite_cli.identification.payload import payload_parameters
 from excite_cli.identification.preprocessing import preprocess
@@ -66,12 +65,11 @@ def read_model(path: Path) -> dict:
             term = (effect, joint, None if np.isnan(shape) else float(shape))
             if term not in terms:
                 terms.append(term)
-        config = yaml.safe_load(f.attrs["config"]) if "config" in f.attrs else {}
         return {"joints": _strings(g["joint_names"][()]), "base_names": _strings(g["base_parameter_names"][()]),
                 "base": g["base_parameters"][()], "rigid": g["base_parameters_rigid_only"][()], "terms": terms,
                 "coefficients": np.asarray(values, dtype=float), "cutoff": float(g.attrs["cutoff_Hz"]),
                 "offset_runs": max(1, len(g["offset_runs"][()])) if "offset_runs" in g else 1,
-                "coulomb_velocity": float(((config or {}).get("identification") or {}).get("coulomb_velocity", 0.01))}
+                "coulomb_velocity": float(g.attrs.get("coulomb_velocity_rad_s", 0.01))}
 
 
 def validate_model(report: Path, problem: IdentifyProblem) -> list[RunError]:
@@ -99,7 +97,6 @@ def validate_model(report: Path, problem: IdentifyProblem) -> list[RunError]:
                                     split=False, offset_runs=model["offset_runs"])
         data = data.with_load_columns(model["rigid"], [t for t in terms if t.effect in TWO_STAGE])
         predicted = predict(data, np.concatenate([model["base"], model["coefficients"]]), terms)
-        measured = data.tau.reshape(-1, data.n)
-        rms = np.sqrt(np.mean((measured - predicted) ** 2, axis=0))
-        errors.append(RunError(run.label, rms, 100.0 * rms / np.sqrt(np.mean(measured**2, axis=0)), data.time.size))
+        rms, _, relative = torque_errors(data.tau.reshape(-1, data.n), predicted)
+        errors.append(RunError(run.label, rms, relative, data.time.size))
     return errors
