@@ -4,7 +4,7 @@ PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 CONFIG ?= configs/g1_arms.yaml
 
-.PHONY: install optimize test smoke bench clean
+.PHONY: install ipopt optimize test smoke bench clean
 
 install: $(STAMP)
 
@@ -12,7 +12,18 @@ $(STAMP): pyproject.toml
 	python3 -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -e ".[test]"
+	$(MAKE) --no-print-directory ipopt
 	touch $(STAMP)
+
+# IPOPT for optimizer.method: ipopt. cyipopt has no Linux wheel on PyPI, so it is built against
+# Debian's coinor-libipopt-dev, installed here when missing (as root with apt-get, as on this
+# project's machines); elsewhere install IPOPT yourself, or the method says it is missing.
+ipopt:
+	@pkg-config --exists ipopt 2>/dev/null || { [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null && \
+	  apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq \
+	  coinor-libipopt-dev liblapack-dev libblas-dev pkg-config >/dev/null; } || true
+	@if pkg-config --exists ipopt 2>/dev/null; then $(PY) -m pip install --quiet -e ".[ipopt]"; \
+	  else echo "IPOPT not found: optimizer.method 'ipopt' is unavailable (SLSQP, the default, works)"; fi
 
 optimize: $(STAMP)
 	$(VENV)/bin/excite optimize $(CONFIG) --force

@@ -16,11 +16,11 @@ from excite_cli.criterion import OBJECTIVES
 from excite_cli.errors import ExciteError, Interrupted
 from excite_cli.export import FORMATS, export_to_file
 from excite_cli.identification.validate import validate_model
-from excite_cli.progress import Bars
+from excite_cli.progress import Bars, wide_console
 from excite_cli.simulate import simulate_runs
 
 app = typer.Typer(add_completion=False, no_args_is_help=True)
-out, err = Console(), Console(stderr=True)
+out, err = wide_console(), wide_console(stderr=True)
 FORCE = typer.Option(False, "--force", help="Replace existing output files.")
 WORKERS = typer.Option(None, "--workers", help="Local processes for restarts and draws (optimizer.workers; default: the cores).")
 SCHEDULER = typer.Option(None, "--scheduler", help="Dask scheduler address, e.g. tcp://host:8786 (optimizer.scheduler).")
@@ -71,7 +71,7 @@ def optimize(config: Path = typer.Argument(..., help="Problem YAML file (see REA
                                                     "optimizer.workers": workers, "optimizer.scheduler": scheduler})
     with Bars(err) as bars:
         run = runs.run_optimize(problem, output or Path(problem.output), force, resume, *bars.iterations(problem))
-    _say(tables.iterations(run.results), f"wrote {run.target} and {', '.join(str(p) for p in run.plots)}")
+    _say(tables.iterations(run.results, problem.optimizer.objective), f"wrote {run.target} and {', '.join(str(p) for p in run.plots)}")
 
 
 @command("compare-random")

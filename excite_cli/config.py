@@ -111,13 +111,16 @@ class ConstraintsConfig(Section):
 
 
 class OptimizerConfig(Section):
-    """SLSQP settings: objective, iterations, tolerance, seed, restarts, and where restarts run
-    (``workers`` local processes, default the machine's cores; or a Dask ``scheduler`` address)."""
+    """Solver settings: method (:mod:`excite_cli.solvers`), objective, iterations, the solver's own
+    tolerance and the first-order optimality tolerance a restart must meet to count as converged
+    (:mod:`excite_cli.optimality`), seed, restarts, and where restarts run (``workers`` local
+    processes, default the machine's cores; or a Dask ``scheduler`` address)."""
 
-    method: Literal["SLSQP"] = "SLSQP"
+    method: Literal["SLSQP", "trust-constr", "ipopt"] = "SLSQP"
     objective: Literal["log_cond", "cond", "log_det", "sigma_min"] = "log_cond"
     max_iterations: int = Field(200, ge=1)
     tolerance: float = Field(1e-6, gt=0.0)
+    optimality_tolerance: float = Field(1e-3, gt=0.0)
     seed: int = Field(0, ge=0)
     restarts: int = Field(3, ge=1)
     workers: Optional[int] = Field(None, ge=1)

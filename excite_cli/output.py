@@ -23,6 +23,8 @@ from excite_cli.base_parameters import BaseParameters
 from excite_cli.config import Problem, effective_yaml
 from excite_cli.errors import ExciteError
 from excite_cli.excitation import Excitation
+from excite_cli.optimality import Optimality
+from excite_cli.optimizer import RestartResult
 from excite_cli.sequence import IterationResult, describe
 
 UNITS = {"alpha": "rad", "time": "s", "q": "rad", "qd": "rad/s", "qdd": "rad/s^2", "regressor": "SI (N·m per parameter unit)"}
@@ -67,10 +69,14 @@ def write_strings(group: h5py.Group, name: str, values: Sequence[str]) -> None:
 
 
 def results_table(results: Sequence[IterationResult]) -> np.ndarray:
-    """Table I as a structured array: iteration, cond_own, cond_stacked."""
-    table = np.zeros(len(results), dtype=[("iteration", "i4"), ("cond_own", "f8"), ("cond_stacked", "f8")])
+    """Table I as a structured array: iteration, cond_own, cond_stacked, excitation_own,
+    excitation_stacked (ē [N·m], :mod:`excite_cli.information`)."""
+    fields = ("cond_own", "cond_stacked", "excitation_own", "excitation_stacked")
+    table = np.zeros(len(results), dtype=[("iteration", "i4")] + [(name, "f8") for name in fields])
     for row, r in zip(table, results):
-        row["iteration"], row["cond_own"], row["cond_stacked"] = r.index, r.cond_own, r.cond_stacked
+        row["iteration"] = r.index
+        for name in fields:
+            row[name] = getattr(r, name)
     return table
 
 
@@ -125,7 +131,8 @@ def write_result(path: Path, excitation: Excitation, results: Sequence[Iteration
         for r in results:
             _write_iteration(iterations.create_group(str(r.index)), r)
         table = f.create_dataset("table", data=results_table(results))
-        table.attrs["description"] = "Table I: cond of each iteration's regressor and of the stacked regressor"
+        table.attrs["description"] = ("Table I: cond of each iteration's regressor and of the stacked regressor, and their "
+                                      "base-independent excitation e [N m] (README 'Output')")
 
 
 def _write_robot(group: h5py.Group, excitation: Excitation) -> None:
@@ -149,12 +156,39 @@ def _write_iteration(group: h5py.Group, r: IterationResult) -> None:
         group.create_dataset(name, data=series).attrs["unit"] = r.track_units[name]
     group.attrs["cond_own"] = r.cond_own
     group.attrs["cond_stacked"] = r.cond_stacked
+    group.attrs["excitation_own_Nm"] = r.excitation_own
+    group.attrs["excitation_stacked_Nm"] = r.excitation_stacked
     group.attrs["max_violation"] = r.max_violation
     group.attrs["wall_time_s"] = r.wall_time_s
     group.attrs["sqp_iterations"] = r.sqp_iterations
-    group.attrs["optimizer_message"] = r.message
+    group.attrs["stop"] = r.stop
+    group.attrs["optimizer_message"] = r.best.message if r.best else ""
     for key, value in r.checks.items():
         group.attrs[key] = value
+    restarts = group.create_group("restarts")
+    restarts.attrs["kept"] = r.best.index if r.best else -1
+    for restart in r.restarts:
+        _write_restart(restarts.create_group(str(restart.index)), restart)
+
+
+def _write_restart(group: h5py.Group, r: RestartResult) -> None:
+    group.create_dataset("alpha", data=r.alpha).attrs["unit"] = UNITS["alpha"]
+    history = group.create_dataset("history", data=r.history)
+    history.attrs["columns"] = "objective, largest constraint value g (normalized, > 0 outside)"
+    history.attrs["description"] = "one row per solver iteration, at its accepted iterate"
+    for name in ("objective", "start_objective", "iterations", "message", "wall_time_s", "stop", "end"):
+        group.attrs[name] = getattr(r, name)
+    o = r.optimality
+    group.attrs.update(kkt_residual=o.residual, active_constraints=o.active, gradient_norm=o.gradient_norm,
+                       max_constraint=o.max_constraint)
+
+
+def _read_restart(group: h5py.Group, index: int) -> RestartResult:
+    a = group.attrs
+    optimality = Optimality(float(a["kkt_residual"]), int(a["active_constraints"]), float(a["gradient_norm"]), float(a["max_constraint"]))
+    return RestartResult(index, group["alpha"][()], float(a["objective"]), int(a["iterations"]), str(a["message"]),
+                         float(a["wall_time_s"]), float(a["start_objective"]), group["history"][()], optimality,
+                         str(a["stop"]), str(a["end"]))
 
 
 def read_prior(path: Path, base: BaseParameters) -> np.ndarray:
@@ -231,8 +265,8 @@ def read_iterations(path: Path, excitation: Excitation, prior: np.ndarray | None
             alpha = g["alpha"][()]
             if alpha.shape != (excitation.robot.n_joints, excitation.trajectory.n_coefficients):
                 raise ExciteError(f"{field}: {path} was made for another problem (alpha shape {alpha.shape})")
-            results.append(describe(excitation, int(key), alpha, stacked, float(g.attrs["wall_time_s"]),
-                                    int(g.attrs["sqp_iterations"]), str(g.attrs["optimizer_message"])))
+            restarts = [_read_restart(g["restarts"][r], int(r)) for r in sorted(g["restarts"].keys(), key=int)] if "restarts" in g else []
+            results.append(describe(excitation, int(key), alpha, stacked, float(g.attrs["wall_time_s"]), restarts))
             stacked = np.vstack([stacked, results[-1].regressor])
     return results
 

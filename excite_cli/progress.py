@@ -1,9 +1,10 @@
-"""Progress of long commands on the terminal: a bar per iteration with the best accepted value, the
-restart, elapsed time and an ETA; a line per finished iteration (with the optimizer's stop reason)
+"""Progress of long commands on the terminal: a bar per iteration with the objective at the current
+iterate, the restart, elapsed time and an ETA; a line per finished iteration (with the optimizer's stop reason)
 when the output is a log rather than a terminal; a bar for random draws."""
 
 from __future__ import annotations
 
+import sys
 from typing import Callable
 
 import numpy as np
@@ -13,6 +14,17 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, Ti
 from excite_cli.config import Problem
 from excite_cli.optimizer import ProgressHook
 from excite_cli.sequence import IterationResult
+
+
+#: Width of printed tables where the output is not a terminal (a log, a pipe): rich's default of 80
+#: columns would cut their numbers.
+LOG_WIDTH = 200
+
+
+def wide_console(stderr: bool = False) -> Console:
+    """A console on stdout (or stderr) as wide as the terminal, or ``LOG_WIDTH`` where it is not one."""
+    stream = sys.stderr if stderr else sys.stdout
+    return Console(stderr=stderr, width=None if stream.isatty() else LOG_WIDTH)
 
 
 class Bars:
@@ -40,7 +52,7 @@ class Bars:
 
     def iterations(self, problem: Problem) -> tuple[Callable[[int], ProgressHook], Callable[[IterationResult], None]]:
         """The hooks of :func:`~excite_cli.runs.run_optimize`: ``progress(k)`` per SLSQP iteration
-        (best accepted value so far) and ``done(result)`` per finished iteration."""
+        (the objective at the current iterate) and ``done(result)`` per finished iteration."""
         opts, bar = problem.optimizer, self.bar
         label = "cond" if opts.objective in ("cond", "log_cond") else opts.objective
         shown = np.exp if opts.objective == "log_cond" else (lambda v: v)
@@ -49,21 +61,19 @@ class Bars:
         def progress(k: int) -> ProgressHook:
             tasks[k] = self._task(f"iteration {k}", opts.restarts * opts.max_iterations, "starting")
             steps: dict[int, int] = {}
-            best = [np.inf]
 
             def hook(restart: int, it: int, value: float) -> None:
                 steps[restart] = it
-                best[0] = min(best[0], value)
                 bar.update(tasks[k], completed=sum(steps.values()),
-                           status=f"restart {restart + 1}/{opts.restarts} · best {label} {shown(best[0]):.4g}")
+                           status=f"restart {restart + 1}/{opts.restarts} · {label} {shown(value):.4g}")
             return hook
 
         def done(result: IterationResult) -> None:
             bar.update(tasks[result.index], completed=opts.restarts * opts.max_iterations,
-                       status=f"cond(C) {result.cond_stacked:.1f} · {result.message}")
+                       status=f"cond(C) {result.cond_stacked:.1f} · {result.stop}")
             if not self.console.is_terminal:
                 self.console.print(f"iteration {result.index}: cond(C(i)) {result.cond_own:.1f}, cond(C) {result.cond_stacked:.1f}, "
-                                   f"{result.wall_time_s:.0f} s, {result.sqp_iterations} SQP iterations, stop: {result.message}",
+                                   f"{result.wall_time_s:.0f} s, {result.sqp_iterations} solver iterations, stop: {result.stop}",
                                    highlight=False)
         return progress, done
 

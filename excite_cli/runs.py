@@ -176,7 +176,7 @@ def run_compare_random(problem: Problem, optimized: Optional[Path], target: Opti
     write_result(target, excitation, results, rcfg.seed, {"method": "random_selection", "pool_size": len(drawn.alphas),
                                                           "drawn": drawn.drawn, "generation_time_s": drawn.generation_time_s,
                                                           "selection_time_s": selection_s})
-    random_table = np.array([(r.index, r.cond_own, r.cond_stacked) for r in results], dtype=optimized_table.dtype)
+    random_table = results_table(results)
     sizes = sorted({s for s in (count, 10, 30, 100, 300, 1000, 3000, len(drawn.alphas)) if count <= s <= len(drawn.alphas)})
     plot = plot_comparison(target.with_suffix("").with_name(target.stem + "_comparison.png"), random_table, optimized_table)
     return Comparison(random_table, optimized_table, drawn.generation_time_s + selection_s, optimized_time, len(drawn.alphas),

@@ -26,12 +26,16 @@ class IterationResult:
         time: (T_grid,) constraint grid [s]; q, qd, qdd: (T_grid, n) [rad, rad/s, rad/s²] on it.
         regressor: C⁽ᵏ⁾, (T·n_rows, b) base regressor at the cost samples.
         cond_own: cond(C⁽ᵏ⁾); cond_stacked: cond([C₀; C⁽ᵏ⁾]) (Table I).
+        excitation_own, excitation_stacked: ē of the same [N·m], the excitation figure that does
+            not depend on the choice of base columns (:mod:`excite_cli.information`).
         max_violation: largest normalized constraint violation on the fine grid (≤ 0: satisfied).
         checks: per-constraint figures from the fine grid, units in the names, and those of the
             transitions from and to the home posture (:func:`transition_checks`).
         tracks: per-constraint time series on the constraint grid (``com_xy`` (T_grid, 2) [m],
             ``min_capsule_distance`` (T_grid,) [m]); track_units: their units, from the constraints.
-        wall_time_s: optimization wall time [s]; sqp_iterations: SLSQP iterations; message: SLSQP's.
+        wall_time_s: optimization wall time [s].
+        restarts: every restart of the iteration (:class:`~excite_cli.optimizer.RestartResult`:
+            start and end value, solver iterations, first-order optimality, stop reason), in order.
     """
 
     index: int
@@ -44,12 +48,28 @@ class IterationResult:
     cond_own: float
     cond_stacked: float
     max_violation: float
+    excitation_own: float = 0.0
+    excitation_stacked: float = 0.0
     checks: dict[str, float | str] = field(default_factory=dict)
     tracks: dict[str, np.ndarray] = field(default_factory=dict)
     track_units: dict[str, str] = field(default_factory=dict)
     wall_time_s: float = 0.0
-    sqp_iterations: int = 0
-    message: str = ""
+    restarts: tuple[RestartResult, ...] = ()
+
+    @property
+    def sqp_iterations(self) -> int:
+        """Solver iterations of all restarts."""
+        return sum(r.iterations for r in self.restarts)
+
+    @property
+    def best(self) -> Optional[RestartResult]:
+        """The restart whose end point this iteration kept."""
+        return best_restart(self.restarts) if self.restarts else None
+
+    @property
+    def stop(self) -> str:
+        """Why the kept restart ended (:func:`~excite_cli.optimality.stop_reason`), or ``-``."""
+        return self.best.stop if self.best else "-"
 
 
 @dataclass(frozen=True)
@@ -84,7 +104,7 @@ class RestartTask:
 
 
 def describe(excitation: Excitation, index: int, alpha: np.ndarray, prior: np.ndarray, wall_time_s: float = 0.0,
-             sqp_iterations: int = 0, message: str = "") -> IterationResult:
+             restarts: Sequence[RestartResult] = ()) -> IterationResult:
     """The :class:`IterationResult` of trajectory α (n, 2N+1) stacked under ``prior`` (m, b): its
     regressor, condition numbers, samples on the constraint grid and every constraint's fine check."""
     own = excitation.criterion().regressor(alpha)
@@ -102,13 +122,14 @@ def describe(excitation: Excitation, index: int, alpha: np.ndarray, prior: np.nd
         regressor=own,
         cond_own=condition_number(own),
         cond_stacked=condition_number(np.vstack([prior, own])),
+        excitation_own=excitation.excitation_level(own),
+        excitation_stacked=excitation.excitation_level(np.vstack([prior, own])),
         max_violation=max(c.max_violation for c in checks),
         checks=details,
         tracks={key: value for c in excitation.constraints for key, value in c.track(alpha, excitation.grid_basis).items()},
         track_units={key: unit for c in excitation.constraints for key, unit in c.track_units.items()},
         wall_time_s=wall_time_s,
-        sqp_iterations=sqp_iterations,
-        message=message,
+        restarts=tuple(restarts),
     )
 
 
@@ -171,8 +192,7 @@ def run_sequence(
         hook = progress(k) if progress else None
         runs = engine.run(tasks, hook, (lambda r: hook(r.index, r.iterations, r.objective)) if hook else None)
         best = best_restart(runs)
-        result = describe(excitation, k, best.alpha, stacked, time.perf_counter() - start,
-                          sum(r.iterations for r in runs), best.message)
+        result = describe(excitation, k, best.alpha, stacked, time.perf_counter() - start, runs)
         stacked = np.vstack([stacked, result.regressor])
         results.append(result)
         if on_iteration:

@@ -28,26 +28,33 @@ def _table(title: str, columns: Sequence[str], rows: Sequence[Sequence[str]], ca
     return table
 
 
-def iterations(results: Sequence[IterationResult]) -> Table:
-    """Table I: cond per iteration, violations, CoM and capsule figures, transitions, time, stop reason."""
+def iterations(results: Sequence[IterationResult], objective: str = "log_cond") -> list[Table]:
+    """Table I (cond per iteration, violations, CoM and capsule figures, transitions, time, stop
+    reason of the kept restart) and every restart's convergence (start and end value, first-order
+    optimality, active constraints, solver iterations, stop reason)."""
     extra = [(key, label) for key, label in (("com_max_excursion_m", "CoM [cm]"), ("min_capsule_distance_m", "dist [cm]"))
              if results and key in results[0].checks]
     rows = []
     for r in results:
         ok = float(r.checks.get("transition_max_violation", -np.inf)) <= 0.0
         moves = f"{r.checks.get('transition_in_s', 0.0):.1f}/{r.checks.get('transition_out_s', 0.0):.1f}" if ok else "violated"
-        rows.append((str(r.index), f"{r.cond_own:.1f}", f"{r.cond_stacked:.1f}", f"{r.max_violation:+.1e}",
-                     *[f"{100 * float(r.checks[key]):.2f}" for key, _ in extra], moves, f"{r.wall_time_s:.0f}", _stop(r.message)))
-    return _table("Condition numbers (Table I)",
-                  ("iter", "cond(C(i))", "cond(C)", "max viol.", *[label for _, label in extra], "in/out [s]", "time [s]", "stop"),
-                  rows, "in/out: quintic transitions from and to the home posture at rest (checked on the fine grid); "
-                        "stop: why SLSQP ended for the best restart")
-
-
-def _stop(message: str) -> str:
-    """SLSQP's message, short."""
-    known = {"Optimization terminated successfully": "converged", "Iteration limit reached": "iteration limit"}
-    return next((short for text, short in known.items() if message.startswith(text)), message[:30] or "-")
+        rows.append((str(r.index), f"{r.cond_own:.1f}", f"{r.cond_stacked:.1f}", f"{r.excitation_stacked:.3g}", f"{r.max_violation:+.1e}",
+                     *[f"{100 * float(r.checks[key]):.2f}" for key, _ in extra], moves, f"{r.wall_time_s:.0f}", r.stop))
+    table = _table("Condition numbers (Table I)",
+                   ("iter", "cond(C(i))", "cond(C)", "ē(C) [Nm]", "max viol.", *[label for _, label in extra], "in/out [s]", "time [s]", "stop"),
+                   rows, "ē: excitation that does not depend on the choice of base columns (geometric mean of the singular "
+                         "values of the URDF-scaled regressor); in/out: quintic transitions from and to the home posture at "
+                         "rest (checked on the fine grid); stop: why the kept restart ended")
+    shown, label = (np.exp, "cond(C)") if objective == "log_cond" else ((lambda v: v), objective)
+    restarts = [(str(r.index), str(s.index) + ("*" if s is r.best else ""), f"{shown(s.start_objective):.4g}", f"{shown(s.objective):.4g}",
+                 f"{s.optimality.residual:.1e}", str(s.optimality.active), str(s.iterations), s.end, s.stop)
+                for r in results for s in r.restarts]
+    convergence = _table("Restarts", ("iter", "restart", f"start {label}", f"end {label}", "KKT residual", "active", "iterations",
+                                      "end point", "stop"), restarts,
+                         "*: kept; KKT residual: first-order optimality at the end point (0 at a local optimum); "
+                         "end point: the feasible point nearest the solver's last iterate (projected), the best iterate "
+                         "inside (inside), towards the start (bisection) or the start")
+    return [table, convergence] if restarts else [table]
 
 
 def comparison(c: Comparison) -> list[Table]:
