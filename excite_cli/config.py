@@ -113,8 +113,22 @@ class ConstraintsConfig(Section):
 class OptimizerConfig(Section):
     """Solver settings: method (:mod:`excite_cli.solvers`), objective, iterations, the solver's own
     tolerance and the first-order optimality tolerance a restart must meet to count as converged
-    (:mod:`excite_cli.optimality`), seed, restarts, and where restarts run (``workers`` local
-    processes, default the machine's cores; or a Dask ``scheduler`` address)."""
+    (:mod:`excite_cli.optimality`), seed, restarts, the random starts screened for
+    ``screen_iterations`` before the best ``restarts`` continue (``starts``, default: no
+    screening), and where restarts run (``workers`` local processes, default the machine's cores;
+    or a Dask ``scheduler`` address)."""
+
+    @property
+    def screened(self) -> int:
+        """Starts screened before the best ``restarts`` continue; 0 without screening."""
+        return self.starts if self.starts is not None and self.starts > self.restarts else 0
+
+    @property
+    def planned_iterations(self) -> int:
+        """Solver iterations one sequential iteration runs at most (all starts and restarts)."""
+        screen = min(self.screen_iterations, self.max_iterations)
+        return (self.screened * screen + self.restarts * (self.max_iterations - screen) if self.screened
+                else self.restarts * self.max_iterations)
 
     method: Literal["SLSQP", "trust-constr", "ipopt"] = "SLSQP"
     objective: Literal["log_cond", "cond", "log_det", "sigma_min"] = "log_cond"
@@ -123,6 +137,8 @@ class OptimizerConfig(Section):
     optimality_tolerance: float = Field(1e-3, gt=0.0)
     seed: int = Field(0, ge=0)
     restarts: int = Field(3, ge=1)
+    starts: Optional[int] = Field(None, ge=1)
+    screen_iterations: int = Field(30, ge=1)
     workers: Optional[int] = Field(None, ge=1)
     scheduler: Optional[str] = None
 

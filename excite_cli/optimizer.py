@@ -173,6 +173,7 @@ def optimize_restart(
     boundary: BoundaryConditions,
     index: int = 0,
     progress: Optional[ProgressHook] = None,
+    max_iterations: Optional[int] = None,
 ) -> RestartResult:
     """Minimize the criterion over α with ``options.method`` from one feasible start.
 
@@ -190,6 +191,7 @@ def optimize_restart(
         boundary: the boundary conditions and the optimizer's coordinates.
         index: the restart's number (passed to ``progress`` and kept in the result).
         progress: called after every solver iteration with the objective at the iterate.
+        max_iterations: solver iterations (default ``options.max_iterations``).
     """
     begin = time.perf_counter()
     start_value = criterion.value(start)
@@ -201,7 +203,8 @@ def optimize_restart(
         if progress is not None:
             progress(index, len(history), history[-1][0])
 
-    run = solve(options.method, problem, boundary.to_variables(start), options.max_iterations, options.tolerance, on_iterate)
+    run = solve(options.method, problem, boundary.to_variables(start), max_iterations or options.max_iterations,
+                options.tolerance, on_iterate)
     projected = project(problem, run.z)
     ends = [("start", start), ("projected" if projected is not None else "bisection",
                                 projected if projected is not None else repair(constraints, boundary.to_alpha(run.z), start, boundary))]

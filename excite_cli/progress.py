@@ -59,17 +59,18 @@ class Bars:
         tasks: dict[int, int] = {}
 
         def progress(k: int) -> ProgressHook:
-            tasks[k] = self._task(f"iteration {k}", opts.restarts * opts.max_iterations, "starting")
+            tasks[k] = self._task(f"iteration {k}", opts.planned_iterations, "starting")
             steps: dict[int, int] = {}
 
             def hook(restart: int, it: int, value: float) -> None:
                 steps[restart] = it
                 bar.update(tasks[k], completed=sum(steps.values()),
-                           status=f"restart {restart + 1}/{opts.restarts} · {label} {shown(value):.4g}")
+                           status=f"run {restart + 1}/{opts.screened + opts.restarts if opts.screened else opts.restarts} · "
+                                  f"{label} {shown(value):.4g}")
             return hook
 
         def done(result: IterationResult) -> None:
-            bar.update(tasks[result.index], completed=opts.restarts * opts.max_iterations,
+            bar.update(tasks[result.index], completed=opts.planned_iterations,
                        status=f"cond(C) {result.cond_stacked:.1f} · {result.stop}")
             if not self.console.is_terminal:
                 self.console.print(f"iteration {result.index}: cond(C(i)) {result.cond_own:.1f}, cond(C) {result.cond_stacked:.1f}, "

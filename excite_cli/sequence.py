@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Callable, Optional, Sequence
 
 import numpy as np
@@ -84,6 +84,7 @@ class RestartTask:
         seed: the run's seed (``optimizer.seed``).
         prior: C₀ (m, b), the rows stacked above the trajectory's regressor (Eq. 41).
         warm_start: (n, 2N+1) accepted α to start from instead of a random start, or None.
+        iterations: solver iterations (default ``optimizer.max_iterations``).
     """
 
     iteration: int
@@ -91,6 +92,7 @@ class RestartTask:
     seed: int
     prior: np.ndarray
     warm_start: Optional[np.ndarray] = None
+    iterations: Optional[int] = None
 
     def rng(self) -> np.random.Generator:
         """The restart's own random generator."""
@@ -100,7 +102,7 @@ class RestartTask:
         """Draw the start (or take the warm start) and optimize from it (:func:`optimize_restart`)."""
         start = self.warm_start.copy() if self.warm_start is not None else excitation.random_start(self.rng())
         return optimize_restart(excitation.criterion(self.prior), excitation.constraints, excitation.problem.optimizer,
-                                start, excitation.boundary, self.index, progress)
+                                start, excitation.boundary, self.index, progress, self.iterations)
 
 
 def describe(excitation: Excitation, index: int, alpha: np.ndarray, prior: np.ndarray, wall_time_s: float = 0.0,
@@ -131,6 +133,41 @@ def describe(excitation: Excitation, index: int, alpha: np.ndarray, prior: np.nd
         wall_time_s=wall_time_s,
         restarts=tuple(restarts),
     )
+
+
+def run_restarts(excitation: Excitation, engine: Engine, k: int, seed: int, prior: np.ndarray,
+                 warm_start: Optional[np.ndarray], hook: Optional[ProgressHook] = None) -> list[RestartResult]:
+    """The restarts of iteration k: ``optimizer.restarts`` solver runs of ``max_iterations``, the
+    first from ``warm_start`` (n, 2N+1) when given, the others from random starts.
+
+    With screening (``optimizer.starts`` > ``restarts``), ``starts`` runs of ``screen_iterations``
+    first, then the ``restarts`` with the lowest objective continue from their end points for the
+    remaining iterations; the others are kept with the stop reason ``screened out``. Which ones
+    continue depends only on the screened results, so it does not depend on where they ran.
+
+    Returns:
+        Every start's :class:`RestartResult`, by index (a continued one with its screening's start
+        value, iterations and history included).
+    """
+    opts = excitation.problem.optimizer
+    count, iterations = (opts.screened, min(opts.screen_iterations, opts.max_iterations)) if opts.screened else (opts.restarts, None)
+    tasks = [RestartTask(k, r, seed, prior, warm_start if r == 0 else None, iterations) for r in range(count)]
+    runs = engine.run(tasks, hook, (lambda r: hook(r.index, r.iterations, r.objective)) if hook else None)
+    if not opts.screened or iterations >= opts.max_iterations:
+        return runs
+    chosen = sorted(runs, key=lambda r: (r.objective, r.index))[:opts.restarts]
+    more = [RestartTask(k, r.index, seed, prior, r.alpha, opts.max_iterations - iterations) for r in chosen]
+    shifted = (lambda r, it, value: hook(count + r, it, value)) if hook else None  # continuations count on their own
+    continued = {c.index: c for c in engine.run(more, shifted, (lambda c: shifted(c.index, c.iterations, c.objective)) if hook else None)}
+    screened = {r.index: r for r in chosen}
+    return [_joined(screened[r.index], continued[r.index]) if r.index in continued else replace(r, stop="screened out")
+            for r in runs]
+
+
+def _joined(screen: RestartResult, more: RestartResult) -> RestartResult:
+    """One restart of a screening and its continuation."""
+    return replace(more, iterations=screen.iterations + more.iterations, start_objective=screen.start_objective,
+                   wall_time_s=screen.wall_time_s + more.wall_time_s, history=np.vstack([screen.history, more.history]))
 
 
 def transition_checks(excitation: Excitation, alpha: np.ndarray) -> dict[str, float | str]:
@@ -187,12 +224,9 @@ def run_sequence(
     results: list[IterationResult] = list(finished)
     for k in range(len(finished) + 1, iterations + 1):
         start = time.perf_counter()
-        tasks = [RestartTask(k, r, seed, stacked, results[-1].alpha if (r == 0 and results) else None)
-                 for r in range(excitation.problem.optimizer.restarts)]
-        hook = progress(k) if progress else None
-        runs = engine.run(tasks, hook, (lambda r: hook(r.index, r.iterations, r.objective)) if hook else None)
-        best = best_restart(runs)
-        result = describe(excitation, k, best.alpha, stacked, time.perf_counter() - start, runs)
+        runs = run_restarts(excitation, engine, k, seed, stacked, results[-1].alpha if results else None,
+                            progress(k) if progress else None)
+        result = describe(excitation, k, best_restart(runs).alpha, stacked, time.perf_counter() - start, runs)
         stacked = np.vstack([stacked, result.regressor])
         results.append(result)
         if on_iteration:

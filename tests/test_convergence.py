@@ -148,3 +148,27 @@ def test_excitation_level_is_the_scaled_standard_regressor_and_does_not_depend_o
     other = dataclasses.replace(base, regrouping=np.linalg.solve(T, base.regrouping))
     assert excitation_level(C @ T, other, d) == pytest.approx(truth, rel=1e-8)
     assert excitation_level(C[:, :-1] @ np.ones((base.count - 1, base.count)), base, d) == 0.0  # rank-deficient
+
+
+def test_screening_continues_the_best_starts_wherever_they_run(ur5_problem):
+    from excite_cli.engine import Engine
+    from excite_cli.sequence import run_restarts
+
+    opts = ur5_problem.optimizer
+    opts.restarts, opts.starts, opts.screen_iterations, opts.max_iterations = 2, 5, 8, 30
+    excitation = build_excitation(ur5_problem)
+    prior = np.zeros((0, excitation.base.count))
+    with Engine(excitation) as serial:
+        runs = run_restarts(excitation, serial, 1, 3, prior, None)
+    with Engine(excitation, workers=2) as pool:
+        again = run_restarts(excitation, pool, 1, 3, prior, None)
+    assert [r.alpha.tobytes() for r in runs] == [r.alpha.tobytes() for r in again]
+    assert [r.index for r in runs] == list(range(5))
+    out = [r for r in runs if r.stop == "screened out"]
+    kept = [r for r in runs if r.stop != "screened out"]
+    assert len(out) == 3 and len(kept) == 2
+    assert all(r.iterations == 8 for r in out) and all(8 < r.iterations <= 30 for r in kept)
+    assert all(r.history.shape == (r.iterations, 2) for r in runs)
+    # the continued ones were the best two of the screening, and continuing never makes a point worse
+    assert max(r.objective for r in kept) <= min(r.objective for r in out)
+    assert all(_accepted(excitation.constraints, r.alpha) for r in runs)
