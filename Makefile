@@ -29,7 +29,7 @@ optimize: $(STAMP)
 	$(VENV)/bin/excite optimize $(CONFIG) --force
 
 test: $(STAMP)
-	$(PY) -m pytest -q -rs
+	$(PY) -m pytest -q -rs -n auto
 
 smoke: $(STAMP)
 	$(VENV)/bin/excite optimize configs/smoke.yaml --output results/smoke.h5 --force

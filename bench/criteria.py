@@ -4,7 +4,8 @@ configs/panda.yaml, first iteration), then identified on simulated measurements.
 
 Simulation: one period sampled at 200 Hz, torques from pinocchio's RNEA with the URDF inertias plus
 white noise (0.05 Nm); base parameters by least squares with the base regressor; 200 noise draws.
-Printed per criterion: cond(C), and over the base parameters the median and largest standard
+Printed per criterion: cond(C), the excitation ē that does not depend on the base columns
+(:mod:`excite_cli.information`; log ē is the D-optimal criterion up to a constant), and over the base parameters the median and largest standard
 deviation of the estimates, and the median relative standard deviation (std / |φ_B|, parameters with
 |φ_B| > 1e-3), with the largest bias (mean estimate − truth) as a check that the estimates are unbiased.
 
@@ -44,7 +45,7 @@ def identification_spread(excitation, alpha: np.ndarray, rng: np.random.Generato
 
 
 def main(config: Path) -> None:
-    print(f"{'objective':<10} {'cond(C)':>8} {'median std':>11} {'largest std':>12} {'median rel. std':>16} {'largest bias':>13}")
+    print(f"{'objective':<10} {'cond(C)':>8} {'e [Nm]':>8} {'median std':>11} {'largest std':>12} {'median rel. std':>16} {'largest bias':>13}")
     for objective in OBJECTIVES:
         problem = load_problem(config)
         problem.optimizer.objective = objective
@@ -53,7 +54,7 @@ def main(config: Path) -> None:
             result = run_sequence(excitation, 1, problem.optimizer.seed, engine=engine)[0]
         std, bias, truth = identification_spread(excitation, result.alpha, np.random.default_rng(0))
         relevant = np.abs(truth) > 1e-3
-        print(f"{objective:<10} {condition_number(result.regressor):>8.1f} {np.median(std):>11.2e} {std.max():>12.2e} "
+        print(f"{objective:<10} {condition_number(result.regressor):>8.1f} {result.excitation_own:>8.4g} {np.median(std):>11.2e} {std.max():>12.2e} "
               f"{np.median(std[relevant] / np.abs(truth[relevant])):>16.2%} {np.abs(bias).max():>13.1e}", flush=True)
 
 
