@@ -205,12 +205,16 @@ def optimize_restart(
 
     run = solve(options.method, problem, boundary.to_variables(start), max_iterations or options.max_iterations,
                 options.tolerance, on_iterate)
+    ends = [("start", start)]
     projected = project(problem, run.z)
-    ends = [("start", start), ("projected" if projected is not None else "bisection",
-                                projected if projected is not None else repair(constraints, boundary.to_alpha(run.z), start, boundary))]
+    if projected is not None:
+        ends.append(("projected", projected))
+    else:
+        ends.append(("bisection", repair(constraints, boundary.to_alpha(run.z), start, boundary)))
     if problem.best_inside is not None:
         ends.append(("inside", problem.best_inside))
-    scored = [(criterion.value(alpha), k, name, alpha) for k, (name, alpha) in enumerate(ends) if k == 0 or _accepted(constraints, alpha)]
+    scored = [(criterion.value(alpha), k, name, alpha) for k, (name, alpha) in enumerate(ends)
+              if name in ("start", "projected") or _accepted(constraints, alpha)]  # both already accepted
     value, _, end, alpha = min(scored, key=lambda item: item[:2])
     optimality = problem.optimality(alpha)
     stop = stop_reason(optimality, [f for f, _ in history], run.limit, run.failed, options.optimality_tolerance)
