@@ -15,8 +15,8 @@ from pathlib import Path
 import numpy as np
 
 from excite_cli.config import load_problem
-from excite_cli.excitation import build_excitation
-from excite_cli.verify import check_gradient
+from excite_cli.optimization.excitation import build_excitation
+from excite_cli.optimization.verify import check_gradient
 
 ROOT = Path(__file__).resolve().parent.parent
 

@@ -16,7 +16,7 @@ import numpy as np
 import yaml
 
 from excite_cli.config import load_problem
-from excite_cli.robot import load_robot
+from excite_cli.dynamics.robot import load_robot
 
 ROOT = Path(__file__).resolve().parent.parent
 JOINTS = [f"panda_joint{k}" for k in range(1, 8)]

@@ -14,9 +14,9 @@ from pathlib import Path
 import numpy as np
 
 from excite_cli.config import ConstraintsConfig, load_problem
-from excite_cli.criterion import condition_number
-from excite_cli.excitation import build_excitation
-from excite_cli.sequence import run_sequence
+from excite_cli.optimization.criterion import condition_number
+from excite_cli.optimization.excitation import build_excitation
+from excite_cli.optimization.sequence import run_sequence
 
 ROOT = Path(__file__).resolve().parent.parent
 

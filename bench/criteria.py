@@ -5,7 +5,7 @@ configs/panda.yaml, first iteration), then identified on simulated measurements.
 Simulation: one period sampled at 200 Hz, torques from pinocchio's RNEA with the URDF inertias plus
 white noise (0.05 Nm); base parameters by least squares with the base regressor; 200 noise draws.
 Printed per criterion: cond(C), the excitation ē that does not depend on the base columns
-(:mod:`excite_cli.information`; log ē is the D-optimal criterion up to a constant), and over the base parameters the median and largest standard
+(:mod:`excite_cli.optimization.information`; log ē is the D-optimal criterion up to a constant), and over the base parameters the median and largest standard
 deviation of the estimates, and the median relative standard deviation (std / |φ_B|, parameters with
 |φ_B| > 1e-3), with the largest bias (mean estimate − truth) as a check that the estimates are unbiased.
 
@@ -20,10 +20,10 @@ from pathlib import Path
 import numpy as np
 
 from excite_cli.config import load_problem
-from excite_cli.criterion import OBJECTIVES, condition_number
-from excite_cli.excitation import build_excitation
-from excite_cli.engine import Engine, default_workers
-from excite_cli.sequence import run_sequence
+from excite_cli.optimization.criterion import OBJECTIVES, condition_number
+from excite_cli.optimization.excitation import build_excitation
+from excite_cli.optimization.engine import Engine, default_workers
+from excite_cli.optimization.sequence import run_sequence
 
 ROOT = Path(__file__).resolve().parent.parent
 NOISE = 0.05  # Nm

@@ -21,9 +21,9 @@ from threadpoolctl import threadpool_info, threadpool_limits
 
 from excite_cli.config import load_problem
 from excite_cli.memory import keep_freed_memory
-from excite_cli.excitation import build_excitation
-from excite_cli.optimizer import optimize_restart
-from excite_cli.verify import finite_difference_gradient
+from excite_cli.optimization.excitation import build_excitation
+from excite_cli.optimization.optimizer import optimize_restart
+from excite_cli.optimization.verify import finite_difference_gradient
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -56,7 +56,7 @@ def profile(config: Path, iterations: int) -> None:
         timed(c, "evaluate", f"{c.name}: values + Jacobian", spent, calls)
         timed(c, "check_samples", f"{c.name}: exact checks", spent, calls)
     start_alpha = excitation.random_start(np.random.default_rng(0))
-    keep_freed_memory()  # as every process that runs restarts (excite_cli.engine)
+    keep_freed_memory()  # as every process that runs restarts (excite_cli.optimization.engine)
     with threadpool_limits(limits=1):
         start = time.perf_counter()
         result = optimize_restart(criterion, excitation.constraints, problem.optimizer, start_alpha, excitation.boundary)

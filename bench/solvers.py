@@ -16,10 +16,10 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from excite_cli.config import load_problem, with_overrides
-from excite_cli.excitation import build_excitation
+from excite_cli.optimization.excitation import build_excitation
 from excite_cli.memory import keep_freed_memory
-from excite_cli.sequence import RestartTask
-from excite_cli.solvers import METHODS
+from excite_cli.optimization.sequence import RestartTask
+from excite_cli.optimization.solvers import METHODS
 
 
 def main() -> None:

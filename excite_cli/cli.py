@@ -9,15 +9,15 @@ import typer
 from rich.console import Console
 from rich.markup import escape
 
-from excite_cli import runs, tables
+from excite_cli.console import tables
 from excite_cli.config import load_problem, with_overrides
 from excite_cli.identification.config import IdentifyProblem, SimulationConfig
-from excite_cli.criterion import OBJECTIVES
+from excite_cli.optimization.criterion import OBJECTIVES
 from excite_cli.errors import ExciteError, Interrupted
-from excite_cli.export import FORMATS, export_to_file
+from excite_cli.storage.export import FORMATS, export_to_file
 from excite_cli.identification.validate import validate_model
-from excite_cli.progress import Bars, wide_console
-from excite_cli.simulate import simulate_runs
+from excite_cli.console.progress import Bars, wide_console
+from excite_cli.workflows import run_compare_random, run_identify, run_optimize, run_verify, simulate_runs
 
 app = typer.Typer(add_completion=False, no_args_is_help=True)
 out, err = wide_console(), wide_console(stderr=True)
@@ -70,7 +70,7 @@ def optimize(config: Path = typer.Argument(..., help="Problem YAML file (see REA
     problem = with_overrides(load_problem(config), {"sequence.iterations": iterations, "optimizer.seed": seed,
                                                     "optimizer.workers": workers, "optimizer.scheduler": scheduler})
     with Bars(err) as bars:
-        run = runs.run_optimize(problem, output or Path(problem.output), force, resume, *bars.iterations(problem))
+        run = run_optimize(problem, output or Path(problem.output), force, resume, *bars.iterations(problem))
     _say(tables.iterations(run.results, problem.optimizer.objective), f"wrote {run.target} and {', '.join(str(p) for p in run.plots)}")
 
 
@@ -87,7 +87,7 @@ def compare_random(config: Path = typer.Argument(..., help="Problem YAML file.")
                                                     "optimizer.workers": workers, "optimizer.scheduler": scheduler})
     with Bars(err) as bars:
         progress = bars.iterations(problem)[0] if optimized is None else None
-        comparison = runs.run_compare_random(problem, optimized, output, equal_effort, force, progress,
+        comparison = run_compare_random(problem, optimized, output, equal_effort, force, progress,
                                              bars.draws(None if equal_effort else problem.random_baseline.pool_size))
     _say(tables.comparison(comparison), f"wrote {comparison.target} and {comparison.plot}")
 
@@ -99,7 +99,7 @@ def verify_gradient(config: Path = typer.Argument(..., help="Problem YAML file."
                     objective: Optional[list[str]] = typer.Option(None, "--objective", help=f"Criteria (repeatable; default all: {', '.join(OBJECTIVES)})."),
                     tolerance: float = typer.Option(1e-6, help="Largest relative error against central differences that passes.")) -> None:
     """Analytic gradients (Eq. 49) and constraint Jacobians against finite differences; exit 1 above the tolerance."""
-    verification = runs.run_verify(load_problem(config), result, objective or OBJECTIVES, step, seed)
+    verification = run_verify(load_problem(config), result, objective or OBJECTIVES, step, seed)
     _say(tables.verification(verification, tolerance))
     if verification.worst > tolerance:
         raise typer.Exit(1)
@@ -113,7 +113,7 @@ def identify(config: Path = typer.Argument(..., help="Identification YAML: robot
     """Identify base parameters (Eq. 4), trace the residual to missing effects, report the error before/after."""
     problem = with_overrides(load_problem(config, IdentifyProblem), {"identification.physical_consistency": physical_consistency or None})
     with err.status("preprocessing, fitting and selecting effects ..."):
-        run = runs.run_identify(problem, output or Path(problem.output), urdf_out, force)
+        run = run_identify(problem, output or Path(problem.output), urdf_out, force)
     _say(tables.preprocessing_notes(run.report), console=err)
     _say(tables.identification(run.report), [tables.bodies(run.report, run.robot)] if run.report.consistent else [],
          [f"wrote {urdf_out}: its RNEA matches the identified rigid-body torques to {run.urdf_deviation:.1e} Nm"] if urdf_out else [],

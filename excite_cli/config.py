@@ -111,9 +111,9 @@ class ConstraintsConfig(Section):
 
 
 class OptimizerConfig(Section):
-    """Solver settings: method (:mod:`excite_cli.solvers`), objective, iterations, the solver's own
+    """Solver settings: method (:mod:`excite_cli.optimization.solvers`), objective, iterations, the solver's own
     tolerance and the first-order optimality tolerance a restart must meet to count as converged
-    (:mod:`excite_cli.optimality`), seed, restarts, the random starts screened for
+    (:mod:`excite_cli.optimization.optimality`), seed, restarts, the random starts screened for
     ``screen_iterations`` before the best ``restarts`` continue (``starts``, default: no
     screening), and where restarts run (``workers`` local processes, default the machine's cores;
     or a Dask ``scheduler`` address)."""

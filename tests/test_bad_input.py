@@ -13,7 +13,7 @@ from typer.testing import CliRunner
 from conftest import UR5
 from excite_cli.cli import app
 from excite_cli.config import load_problem
-from excite_cli.robot import load_robot
+from excite_cli.dynamics.robot import load_robot
 
 runner = CliRunner()
 JOINTS = UR5["robot"]["active_joints"]

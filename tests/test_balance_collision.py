@@ -10,11 +10,11 @@ import pytest
 import yaml
 
 from conftest import CONFIGS, write_config
-from excite_cli.capsules import capsule_placements, fit_capsule, segment_closest_points
+from excite_cli.collision.capsules import capsule_placements, fit_capsule, segment_closest_points
 from excite_cli.config import load_problem
 from excite_cli.errors import ExciteError
-from excite_cli.excitation import build_excitation
-from excite_cli.verify import constraint_jacobian_error
+from excite_cli.optimization.excitation import build_excitation
+from excite_cli.optimization.verify import constraint_jacobian_error
 
 HERE = Path(__file__).resolve().parent
 

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from excite_cli.base_parameters import compute_base_parameters
-from excite_cli.robot import load_robot
+from excite_cli.dynamics.base_parameters import compute_base_parameters
+from excite_cli.dynamics.robot import load_robot
 
 
 @pytest.mark.parametrize("name", ["g1_problem", "panda_problem", "ur5_problem"])

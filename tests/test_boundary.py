@@ -6,7 +6,7 @@ import pytest
 from conftest import CONFIGS, small
 from excite_cli.config import load_problem
 from excite_cli.errors import ExciteError
-from excite_cli.excitation import build_excitation
+from excite_cli.optimization.excitation import build_excitation
 
 
 def _excitation(boundary="rest", ends_at_home=False, duration=None, harmonics=4):

@@ -9,13 +9,13 @@ from conftest import CONFIGS, UR5, write_config
 from excite_cli.cli import app
 from excite_cli.config import load_problem
 from excite_cli.constraints.com_region import ComRegion
-from excite_cli.engine import Engine
-from excite_cli.excitation import build_excitation
+from excite_cli.optimization.engine import Engine
+from excite_cli.optimization.excitation import build_excitation
 from excite_cli.identification.dataset import Dataset
 from excite_cli.identification.least_squares import least_squares
 from excite_cli.identification.normal import NormalEquations
-from excite_cli.random_baseline import DrawTask, draw_pool
-from excite_cli.verify import constraint_jacobian_error
+from excite_cli.optimization.random_baseline import DrawTask, draw_pool
+from excite_cli.optimization.verify import constraint_jacobian_error
 
 
 def test_weighted_least_squares_and_standard_deviations_match_the_closed_form():

@@ -14,10 +14,10 @@ from typer.testing import CliRunner
 from conftest import UR5, write_config
 from excite_cli.cli import app
 from excite_cli.config import load_problem
-from excite_cli.excitation import build_excitation
-from excite_cli.optimality import (ACTIVE_TOLERANCE, CONVERGED, SOLVER_FAILED, STALLED, STILL_IMPROVING, Optimality,
+from excite_cli.optimization.excitation import build_excitation
+from excite_cli.optimization.optimality import (ACTIVE_TOLERANCE, CONVERGED, SOLVER_FAILED, STALLED, STILL_IMPROVING, Optimality,
                                    kkt_optimality, stop_reason)
-from excite_cli.optimizer import _Evaluations, _accepted, project, repair
+from excite_cli.optimization.optimizer import _Evaluations, _accepted, project, repair
 
 runner = CliRunner()
 
@@ -122,7 +122,7 @@ def test_every_method_ends_feasible_and_below_its_start(ur5_problem, method):
     ur5_problem.optimizer.method = method
     ur5_problem.optimizer.max_iterations = 40
     excitation = build_excitation(ur5_problem)
-    from excite_cli.sequence import RestartTask
+    from excite_cli.optimization.sequence import RestartTask
 
     result = RestartTask(1, 0, 2, np.zeros((0, excitation.base.count)))(excitation)
     assert _accepted(excitation.constraints, result.alpha)
@@ -133,7 +133,7 @@ def test_every_method_ends_feasible_and_below_its_start(ur5_problem, method):
 def test_excitation_level_is_the_scaled_standard_regressor_and_does_not_depend_on_the_base(panda_problem):
     import dataclasses
 
-    from excite_cli.information import excitation_level, parameter_magnitudes
+    from excite_cli.optimization.information import excitation_level, parameter_magnitudes
 
     excitation = build_excitation(panda_problem)
     robot, base = excitation.robot, excitation.base
@@ -151,8 +151,8 @@ def test_excitation_level_is_the_scaled_standard_regressor_and_does_not_depend_o
 
 
 def test_screening_continues_the_best_starts_wherever_they_run(ur5_problem):
-    from excite_cli.engine import Engine
-    from excite_cli.sequence import run_restarts
+    from excite_cli.optimization.engine import Engine
+    from excite_cli.optimization.sequence import run_restarts
 
     opts = ur5_problem.optimizer
     opts.restarts, opts.starts, opts.screen_iterations, opts.max_iterations = 2, 5, 8, 30

@@ -6,14 +6,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import excite_cli.engine as engine_module
+import excite_cli.optimization.engine as engine_module
 from excite_cli.config import load_problem
 from excite_cli.errors import ExciteError
-from excite_cli.excitation import build_excitation
-from excite_cli.optimizer import RestartResult, best_restart
-from excite_cli.engine import Engine
-from excite_cli.random_baseline import draw_pool
-from excite_cli.sequence import RestartTask, run_sequence
+from excite_cli.optimization.excitation import build_excitation
+from excite_cli.optimization.optimizer import RestartResult, best_restart
+from excite_cli.optimization.engine import Engine
+from excite_cli.optimization.random_baseline import draw_pool
+from excite_cli.optimization.sequence import RestartTask, run_sequence
 
 HERE = Path(__file__).resolve().parent
 

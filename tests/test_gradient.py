@@ -5,10 +5,10 @@ import pinocchio as pin
 import pytest
 
 from conftest import small
-from excite_cli.criterion import Criterion, condition_number, objective_terms
-from excite_cli.excitation import build_excitation
-from excite_cli.virtual_dynamics import VirtualDynamics
-from excite_cli.verify import check_gradient, finite_difference_gradient
+from excite_cli.optimization.criterion import Criterion, condition_number, objective_terms
+from excite_cli.optimization.excitation import build_excitation
+from excite_cli.dynamics.virtual_dynamics import VirtualDynamics
+from excite_cli.optimization.verify import check_gradient, finite_difference_gradient
 
 
 def _feasible_alpha(excitation, seed=0):

@@ -6,7 +6,7 @@ import ast
 from pathlib import Path
 
 PACKAGE = Path(__file__).resolve().parent.parent / "excite_cli"
-PRINTING = {"excite_cli.cli", "excite_cli.tables", "excite_cli.progress"}
+PRINTING = {"excite_cli.cli", "excite_cli.console.tables", "excite_cli.console.progress"}
 
 
 def _modules() -> dict[str, ast.Module]:

@@ -21,9 +21,9 @@ from excite_cli.identification.measurements import Run, load_run
 from excite_cli.identification.pipeline import effect_values, run_identification
 from excite_cli.identification.preprocessing import MIN_CUTOFF, Filter, choose_cutoff
 from excite_cli.identification.validate import validate_model
-from excite_cli.robot import load_robot
-from excite_cli.simulate import simulate_runs
-from excite_cli.trajectory import FourierTrajectory
+from excite_cli.dynamics.robot import load_robot
+from excite_cli.workflows.simulate import simulate_runs
+from excite_cli.trajectory.fourier import FourierTrajectory
 
 runner = CliRunner()
 HERE = Path(__file__).resolve().parent

@@ -6,8 +6,8 @@ import pytest
 from conftest import small
 from excite_cli.constraints.joint_limits import JointLimits
 from excite_cli.constraints.lse import GRID_MARGIN, SHARPNESS
-from excite_cli.excitation import build_excitation
-from excite_cli.verify import constraint_jacobian_error
+from excite_cli.optimization.excitation import build_excitation
+from excite_cli.optimization.verify import constraint_jacobian_error
 
 
 @pytest.fixture
@@ -41,7 +41,7 @@ def test_random_start_fills_the_requested_fraction(panda):
 
 def test_fine_check_reports_physical_violation():
     basis_times = np.linspace(0, 2 * np.pi, 2001)
-    from excite_cli.trajectory import FourierTrajectory
+    from excite_cli.trajectory.fourier import FourierTrajectory
 
     basis = FourierTrajectory(1, 1.0).basis(basis_times)
     lower = np.array([[-1.0], [-1.0], [-1.0]])

@@ -12,15 +12,15 @@ import yaml
 from typer.testing import CliRunner
 
 from conftest import CONFIGS, write_config
-from excite_cli.base_parameters import compute_base_parameters
+from excite_cli.dynamics.base_parameters import compute_base_parameters
 from excite_cli.cli import app
 from excite_cli.config import load_problem
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.physical import pseudo_inertia
 from excite_cli.identification.pipeline import run_identification
-from excite_cli.output import problem_of_result, read_alphas
-from excite_cli.robot import load_robot
-from excite_cli.trajectory import FourierTrajectory
+from excite_cli.storage.results import problem_of_result, read_alphas
+from excite_cli.dynamics.robot import load_robot
+from excite_cli.trajectory.fourier import FourierTrajectory
 from test_identification import JOINTS, SHARED, optimized  # noqa: F401  (module fixture)
 
 runner = CliRunner()

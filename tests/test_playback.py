@@ -11,9 +11,9 @@ from conftest import CONFIGS
 from excite_cli.cli import app
 from excite_cli.constraints import JointLimits
 from excite_cli.constraints.lse import GRID_MARGIN
-from excite_cli.playback import RESOLUTION, Transition, plan_transition
-from excite_cli.robot import example_robot_data_root
-from excite_cli.skeleton import skeleton
+from excite_cli.optimization.playback import RESOLUTION, Transition, plan_transition
+from excite_cli.dynamics.robot import example_robot_data_root
+from excite_cli.plots.skeleton import skeleton
 
 runner = CliRunner()
 PANDA_URDF = "example-robot-data/robots/panda_description/urdf/panda.urdf"
@@ -146,7 +146,7 @@ def test_quintic_meets_both_end_states_and_is_smooth():
 
 def test_rest_to_rest_transition_is_as_short_as_the_velocity_limit_allows():
     basis_time = np.linspace(0.0, 1.0, 3)
-    from excite_cli.trajectory import FourierTrajectory
+    from excite_cli.trajectory.fourier import FourierTrajectory
 
     limits = JointLimits(np.array([[-3.0], [-1.0], [-100.0]]), np.array([[3.0], [1.0], [100.0]]),
                          FourierTrajectory(1, 1.0).basis(basis_time))
@@ -162,7 +162,7 @@ def test_rest_to_rest_transition_is_as_short_as_the_velocity_limit_allows():
 
 def test_skeleton_of_the_panda_at_zero_reaches_the_flange():
     from excite_cli.config import load_problem
-    from excite_cli.robot import load_robot
+    from excite_cli.dynamics.robot import load_robot
 
     robot = load_robot(load_problem(CONFIGS / "panda.yaml"))
     points = skeleton(robot, np.zeros(7)).reshape(-1, 3)
@@ -172,7 +172,7 @@ def test_skeleton_of_the_panda_at_zero_reaches_the_flange():
 
 
 def test_skeleton_of_the_g1_has_its_locked_legs(g1_problem):
-    from excite_cli.robot import load_robot
+    from excite_cli.dynamics.robot import load_robot
 
     robot = load_robot(g1_problem)
     points = skeleton(robot, robot.home).reshape(-1, 3)

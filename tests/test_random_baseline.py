@@ -13,8 +13,8 @@ from typer.testing import CliRunner
 from conftest import write_config
 from excite_cli.cli import app
 from excite_cli.config import load_problem
-from excite_cli.excitation import build_excitation
-from excite_cli.random_baseline import greedy_selection, random_candidate
+from excite_cli.optimization.excitation import build_excitation
+from excite_cli.optimization.random_baseline import greedy_selection, random_candidate
 
 HERE = Path(__file__).resolve().parent
 

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from excite_cli.trajectory import FourierTrajectory, sample_times
+from excite_cli.trajectory.fourier import FourierTrajectory, sample_times
 
 
 def test_velocity_and_acceleration_match_time_differences():

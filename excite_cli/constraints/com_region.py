@@ -16,9 +16,9 @@ from excite_cli.config import ComConfig
 from excite_cli.constraints.constraint import Constraint, FineCheck
 from excite_cli.constraints.lse import ACCEPT_MARGIN, smooth_max
 from excite_cli.errors import ExciteError
-from excite_cli.geometry import world_points
-from excite_cli.robot import Robot
-from excite_cli.trajectory import FourierBasis
+from excite_cli.collision.geometry import world_points
+from excite_cli.dynamics.robot import Robot
+from excite_cli.trajectory.fourier import FourierBasis
 
 #: Points of the support links within this height of their lowest point form the soles [m].
 SOLE_HEIGHT = 0.005

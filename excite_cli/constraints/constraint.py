@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from excite_cli.trajectory import FourierBasis
+from excite_cli.trajectory.fourier import FourierBasis
 
 
 @dataclass(frozen=True)

@@ -17,8 +17,8 @@ from excite_cli.config import LimitsConfig, PerJoint
 from excite_cli.constraints.constraint import Constraint, FineCheck
 from excite_cli.constraints.lse import ACCEPT_MARGIN, GRID_MARGIN, smooth_max
 from excite_cli.errors import ExciteError
-from excite_cli.robot import Robot
-from excite_cli.trajectory import FourierBasis
+from excite_cli.dynamics.robot import Robot
+from excite_cli.trajectory.fourier import FourierBasis
 
 ORDERS = ("position_rad", "velocity_rad_s", "acceleration_rad_s2")
 

@@ -2,7 +2,7 @@
 safety margin over the constraint grid.
 
 In the optimizer, every (instant, pair) distance is computed at once in vectorized numpy: the joint
-placements at all grid instants (:class:`~excite_cli.kinematics.BatchKinematics`), each capsule's
+placements at all grid instants (:class:`~excite_cli.dynamics.kinematics.BatchKinematics`), each capsule's
 segment, and the closest points of the two segments in closed form (``segment_closest_points``);
 the capsule distance is d = |c₂ − c₁| − r₁ − r₂ with normal n = (c₂ − c₁)/|c₂ − c₁|. It varies as
 ∂d = nᵀ(J_{c₂} − J_{c₁}) ∂q, J_c the velocity Jacobian of the closest point fixed to its body
@@ -17,12 +17,12 @@ from __future__ import annotations
 import coal
 import numpy as np
 
-from excite_cli.capsules import Capsule, capsule_frames, segment_closest_points, segment_ends
+from excite_cli.collision.capsules import Capsule, capsule_frames, segment_closest_points, segment_ends
 from excite_cli.constraints.constraint import Constraint, FineCheck
 from excite_cli.constraints.lse import ACCEPT_MARGIN, smooth_max
-from excite_cli.kinematics import BatchKinematics
-from excite_cli.robot import Robot
-from excite_cli.trajectory import FourierBasis
+from excite_cli.dynamics.kinematics import BatchKinematics
+from excite_cli.dynamics.robot import Robot
+from excite_cli.trajectory.fourier import FourierBasis
 
 #: Distances are normalized by this length [m].
 LENGTH_SCALE = 0.05

@@ -7,11 +7,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from excite_cli.base_parameters import BaseParameters
+from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.errors import ExciteError
 from excite_cli.identification.effects import COEFFICIENTS, PER_RUN, TWO_STAGE, Term, effect_columns
 from excite_cli.identification.preprocessing import Samples
-from excite_cli.robot import Robot
+from excite_cli.dynamics.robot import Robot
 
 
 @dataclass(frozen=True)

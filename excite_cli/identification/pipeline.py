@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from excite_cli.base_parameters import BaseParameters, compute_base_parameters
+from excite_cli.dynamics.base_parameters import BaseParameters, compute_base_parameters
 from excite_cli.config import with_overrides
 from excite_cli.errors import ExciteError
 from excite_cli.identification.config import IdentifyProblem
@@ -24,7 +24,7 @@ from excite_cli.identification.preprocessing import choose_cutoff, preprocess
 from excite_cli.identification.selection import Selection, candidate_terms, select_effects
 from excite_cli.identification.urdf_out import urdf_deviation, write_urdf
 from excite_cli.memory import return_freed_memory
-from excite_cli.robot import Robot, load_robot, resolve_urdf
+from excite_cli.dynamics.robot import Robot, load_robot, resolve_urdf
 
 
 @dataclass

@@ -10,14 +10,14 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from excite_cli.base_parameters import BaseParameters
+from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.config import effective_yaml
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.effects import COEFFICIENTS, UNITS
 from excite_cli.identification.physical import body_properties
 from excite_cli.identification.pipeline import Report, effect_values
-from excite_cli.output import atomic_h5, write_strings
-from excite_cli.robot import Robot
+from excite_cli.storage.results import atomic_h5, write_strings
+from excite_cli.dynamics.robot import Robot
 
 STR = h5py.string_dtype()
 

@@ -20,7 +20,7 @@ import numpy as np
 import pinocchio as pin
 
 from excite_cli.errors import ExciteError
-from excite_cli.robot import Robot, load_robot
+from excite_cli.dynamics.robot import Robot, load_robot
 
 #: Friction coefficients that URDF's <dynamics> carries: coefficient → attribute.
 DYNAMICS = {"Fc": "friction", "Fv": "damping"}

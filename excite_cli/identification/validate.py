@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from excite_cli.base_parameters import compute_base_parameters
+from excite_cli.dynamics.base_parameters import compute_base_parameters
 from excite_cli.config import with_overrides
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.errors import ExciteError
@@ -26,8 +26,8 @@ from excite_cli.identification.least_squares import predict, torque_errors
 from excite_cli.identification.measurements import load_run
 from excite_cli.identification.payload import payload_parameters
 from excite_cli.identification.preprocessing import preprocess
-from excite_cli.output import open_result
-from excite_cli.robot import load_robot
+from excite_cli.storage.results import open_result
+from excite_cli.dynamics.robot import load_robot
 
 
 @dataclass(frozen=True)

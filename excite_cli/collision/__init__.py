@@ -1,0 +1,1 @@
+"""Collision geometry: the URDF's shapes and the capsules fitted to them (Eq. 53)."""

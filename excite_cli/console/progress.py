@@ -1,0 +1,89 @@
+"""Progress of long commands on the terminal: a bar per iteration with the objective at the current
+iterate, the restart, elapsed time and an ETA; a line per finished iteration (with the optimizer's stop reason)
+when the output is a log rather than a terminal; a bar for random draws."""
+
+from __future__ import annotations
+
+import sys
+from typing import Callable
+
+import numpy as np
+from rich.console import Console
+from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+
+from excite_cli.config import Problem
+from excite_cli.optimization.optimizer import ProgressHook
+from excite_cli.optimization.sequence import IterationResult
+
+
+#: Width of printed tables where the output is not a terminal (a log, a pipe): rich's default of 80
+#: columns would cut their numbers.
+LOG_WIDTH = 200
+
+
+def wide_console(stderr: bool = False) -> Console:
+    """A console on stdout (or stderr) as wide as the terminal, or ``LOG_WIDTH`` where it is not one."""
+    stream = sys.stderr if stderr else sys.stdout
+    return Console(stderr=stderr, width=None if stream.isatty() else LOG_WIDTH)
+
+
+class Bars:
+    """One live display of bars on ``console`` (a context manager); it appears with the first bar, so
+    an error found before any work is the only thing printed."""
+
+    def __init__(self, console: Console):
+        self.console = console
+        self.bar = Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.fields[status]}"),
+                            TimeElapsedColumn(), TextColumn("ETA"), TimeRemainingColumn(), console=console)
+        self._live = False
+
+    def __enter__(self) -> "Bars":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if self._live:
+            self.bar.__exit__(*exc)
+
+    def _task(self, description: str, total: int | None, status: str) -> int:
+        if not self._live:
+            self.bar.__enter__()
+            self._live = True
+        return self.bar.add_task(description, total=total, status=status)
+
+    def iterations(self, problem: Problem) -> tuple[Callable[[int], ProgressHook], Callable[[IterationResult], None]]:
+        """The hooks of :func:`~excite_cli.runs.run_optimize`: ``progress(k)`` per SLSQP iteration
+        (the objective at the current iterate) and ``done(result)`` per finished iteration."""
+        opts, bar = problem.optimizer, self.bar
+        label = "cond" if opts.objective in ("cond", "log_cond") else opts.objective
+        shown = np.exp if opts.objective == "log_cond" else (lambda v: v)
+        tasks: dict[int, int] = {}
+
+        def progress(k: int) -> ProgressHook:
+            tasks[k] = self._task(f"iteration {k}", opts.planned_iterations, "starting")
+            steps: dict[int, int] = {}
+
+            def hook(restart: int, it: int, value: float) -> None:
+                steps[restart] = it
+                bar.update(tasks[k], completed=sum(steps.values()),
+                           status=f"run {restart + 1}/{opts.screened + opts.restarts if opts.screened else opts.restarts} · "
+                                  f"{label} {shown(value):.4g}")
+            return hook
+
+        def done(result: IterationResult) -> None:
+            bar.update(tasks[result.index], completed=opts.planned_iterations,
+                       status=f"cond(C) {result.cond_stacked:.1f} · {result.stop}")
+            if not self.console.is_terminal:
+                self.console.print(f"iteration {result.index}: cond(C(i)) {result.cond_own:.1f}, cond(C) {result.cond_stacked:.1f}, "
+                                   f"{result.wall_time_s:.0f} s, {result.sqp_iterations} solver iterations, stop: {result.stop}",
+                                   highlight=False)
+        return progress, done
+
+    def draws(self, total: int | None) -> Callable[[int, int], None]:
+        """The (kept, drawn) hook of ``compare-random``'s random draws."""
+        task: list[int] = []
+
+        def hook(kept: int, drawn: int) -> None:
+            if not task:
+                task.append(self._task("random candidates", total, ""))
+            self.bar.update(task[0], completed=kept, status=f"{kept} kept of {drawn} drawn")
+        return hook

@@ -1,0 +1,116 @@
+"""Forward kinematics of the reduced model at many configurations at once, in vectorized numpy.
+
+pinocchio computes one configuration per call; the self-collision constraint needs every joint's
+placement at every instant of the constraint grid (hundreds) in each optimizer evaluation, where the
+Python loop over instants costs more than the kinematics. The chain is the model's: each joint's
+placement in its parent (``model.jointPlacements``) followed by its motion, a rotation about (or
+translation along) the joint's axis for the active 1-DoF joints; every other joint (the held
+floating base) keeps its motion at the reference configuration. pinocchio stays the reference
+(tests compare both to 1e-12).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+from excite_cli.dynamics.robot import Robot
+
+
+class BatchKinematics:
+    """Joint placements of ``robot``'s reduced model at T configurations of the active joints.
+
+    Args:
+        robot: the robot (active joints revolute or prismatic, as :func:`load_robot` ensures).
+
+    Attributes:
+        ancestors: (njoints, n) bool, whether active joint k moves joint j (k is j or above it).
+        axes: (n, 3) each active joint's axis in its own frame; revolute: (n,) bool.
+    """
+
+    def __init__(self, robot: Robot):
+        model = robot.model
+        data = model.createData()
+        pin.computeJointJacobians(model, data, robot.q_reference)
+        self.robot = robot
+        self.parents = list(model.parents)
+        self._column = {j: robot.v_idx.tolist().index(model.joints[j].idx_v)
+                        for j in range(1, model.njoints) if model.joints[j].idx_v in robot.v_idx}
+        self.joint_of = [0] * robot.n_joints
+        self.axes = np.zeros((robot.n_joints, 3))
+        self.revolute = np.zeros(robot.n_joints, dtype=bool)
+        # fixed part of each joint's placement in its parent: jointPlacement for active joints, the
+        # whole liMi at the reference configuration for held joints
+        self.fixed_R = np.zeros((model.njoints, 3, 3))
+        self.fixed_p = np.zeros((model.njoints, 3))
+        for j in range(1, model.njoints):
+            if j in self._column:
+                k = self._column[j]
+                S = pin.getJointJacobian(model, data, j, pin.LOCAL)[:, model.joints[j].idx_v]
+                self.joint_of[k] = j
+                self.revolute[k] = np.linalg.norm(S[3:]) > 0.0
+                self.axes[k] = S[3:] if self.revolute[k] else S[:3]
+                placement = model.jointPlacements[j]
+            else:
+                placement = data.liMi[j]
+            self.fixed_R[j], self.fixed_p[j] = placement.rotation, placement.translation
+        self.ancestors = np.zeros((model.njoints, robot.n_joints), dtype=bool)
+        for j in range(1, model.njoints):
+            self.ancestors[j] = self.ancestors[self.parents[j]]
+            if j in self._column:
+                self.ancestors[j, self._column[j]] = True
+
+    def placements(self, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """World rotations (T, njoints, 3, 3) and origins (T, njoints, 3) [m] of every joint frame
+        (``data.oMi``) at the active joints' configurations Q (T, n) [rad or m]."""
+        T, J = Q.shape[0], len(self.parents)
+        R = np.zeros((T, J, 3, 3))
+        p = np.zeros((T, J, 3))
+        R[:, 0] = np.eye(3)
+        for j in range(1, J):
+            parent = self.parents[j]
+            Rj = R[:, parent] @ self.fixed_R[j]
+            p[:, j] = p[:, parent] + R[:, parent] @ self.fixed_p[j]
+            k = self._column.get(j)
+            if k is None:
+                R[:, j] = Rj
+            elif self.revolute[k]:
+                R[:, j] = Rj @ axis_rotations(self.axes[k], Q[:, k])
+            else:
+                R[:, j] = Rj
+                p[:, j] += (Rj @ self.axes[k]) * Q[:, k, None]
+        return R, p
+
+    def distance_rates(self, R: np.ndarray, p: np.ndarray, points: np.ndarray, normals: np.ndarray) -> np.ndarray:
+        """Rates (T, K, n) at which each active joint alone moves K world points along directions n.
+
+        Args:
+            R, p: joint placements at T instants (:meth:`placements`).
+            points: (3, T, K) world positions x [m]; normals: (3, T, K) directions n (coordinates
+                first, as :func:`~excite_cli.collision.capsules.segment_closest_points` gives them).
+
+        Entry k is nᵀ(a_k × (x − o_k)) = a_k·(x × n) − (a_k × o_k)·n for a revolute active joint k
+        (a_k its world axis, o_k its origin), nᵀa_k for a prismatic one: the velocity Jacobian of x,
+        projected on n, as if x were fixed to a body below every joint. For a body, keep the columns
+        of its :attr:`ancestors`. For the distance of two closest points x₁, x₂ along n ∥ x₂ − x₁,
+        either point gives the same rates (x₂ × n = x₁ × n), so ∂d/∂q_k is the rate times
+        ancestors[body₂, k] − ancestors[body₁, k].
+        """
+        axes = np.einsum("tkij,kj->tik", R[:, self.joint_of], self.axes)      # (T, 3, n)
+        moments = np.cross(axes, p[:, self.joint_of].transpose(0, 2, 1), axis=1)   # a_k × o_k, (T, 3, n)
+        turning = np.concatenate([_cross(points, normals), -normals]).transpose(1, 2, 0) @ np.concatenate([axes, moments], axis=1)
+        if self.revolute.all():
+            return turning
+        return np.where(self.revolute, turning, normals.transpose(1, 2, 0) @ axes)
+
+
+def _cross(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """x × y of (3, ...) arrays, coordinates first (contiguous coordinate planes)."""
+    return np.stack([x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]])
+
+
+def axis_rotations(axis: np.ndarray, angles: np.ndarray) -> np.ndarray:
+    """(T, 3, 3) rotations by ``angles`` (T,) [rad] about the unit ``axis`` (3,) (Rodrigues' formula)."""
+    K = pin.skew(np.asarray(axis, dtype=float))
+    s, c = np.sin(angles)[:, None, None], np.cos(angles)[:, None, None]
+    return np.eye(3) + s * K + (1.0 - c) * (K @ K)

@@ -1,0 +1,143 @@
+"""Condition number (or D-, E-optimality) of the stacked base regressor C = [C₀; Ŷ_B] (Eqs. 5, 41)
+and its analytic gradient.
+
+With C = U Σ Vᵀ, Eq. 17 gives ∂c/∂C = (1/σ_b) u₁v₁ᵀ − (σ₁/σ_b²) u_b v_bᵀ. The rows of C at instant t are
+Y(x_t) X, and Y(x_t) φ = τ(x_t; φ) is inverse dynamics, so (Eqs. 45–47)
+
+    ∂c/∂x_t = Σ_{r∈{1,b}} w_r u_{r,t}ᵀ ∂τ(x_t; φ = X v_r)/∂x_t,   w₁ = 1/σ_b,  w_b = −σ₁/σ_b².
+
+∂τ/∂x_t comes from pinocchio's analytic RNEA derivatives evaluated with the "virtual" inertial
+parameters X v_r (:mod:`excite_cli.dynamics.virtual_dynamics`). The result is chained with the constant
+Fourier basis (Eq. 49).
+
+D- and E-optimality have gradients of the same form, Σ_r a_r (C v_r) v_rᵀ over eigenvectors v_r of
+CᵀC (:func:`objective_terms`): −log σ_min needs one pass, −log det(CᵀC)/b all b.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import pinocchio as pin
+
+from excite_cli.dynamics.base_parameters import BaseParameters
+from excite_cli.errors import ExciteError
+from excite_cli.dynamics.robot import Robot
+from excite_cli.trajectory.fourier import FourierBasis
+from excite_cli.dynamics.virtual_dynamics import VirtualDynamics
+
+#: σ_b is floored at this fraction of σ₁, so rank loss gives a large finite value, never NaN.
+RANK_FLOOR = 1e-14
+
+
+def condition_number(C: np.ndarray) -> float:
+    """cond(C) = σ_max / σ_min (Eq. 5) of an (M, b) matrix; ``inf`` if C has fewer rows than columns or is zero."""
+    if C.shape[0] < C.shape[1]:
+        return float("inf")
+    s = np.linalg.svd(C, compute_uv=False)
+    return float(s[0] / s[-1]) if s[-1] > 0 else float("inf")
+
+
+#: The criteria of ``optimizer.objective``: the condition number (Eq. 5) or its log, D-optimality
+#: (−log det(CᵀC) / b, the mean log eigenvalue of the information matrix, maximized) and
+#: E-optimality (−log σ_min(C), the smallest singular value maximized), after the paper's ref. [20].
+OBJECTIVES = ("cond", "log_cond", "log_det", "sigma_min")
+
+
+def objective_terms(objective: str, eigenvalues: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
+    """A criterion of C from the eigenvalues λ (b,) of CᵀC (ascending), and its gradient in C as
+    Σ_r a_r (C v_r) v_rᵀ over the eigenvectors v_r it needs (Eq. 17 and its D-, E-optimal analogues).
+
+    λ_min is floored at (``RANK_FLOOR`` σ_max)² so rank loss gives a large finite value.
+
+    Returns:
+        The value, the indices r (R,) of the eigenpairs used, and their coefficients a_r (R,).
+
+    Raises:
+        ExciteError: an unknown objective.
+    """
+    lam = np.maximum(eigenvalues, (RANK_FLOOR**2) * max(eigenvalues[-1], 0.0))
+    lam = np.maximum(lam, np.finfo(float).tiny)
+    last = lam.size - 1
+    if objective in ("cond", "log_cond"):
+        s_max, s_min = np.sqrt(lam[-1]), np.sqrt(lam[0])
+        c = s_max / s_min
+        coefficients = np.array([1.0 / (s_min * s_max), -s_max / s_min**3])
+        if objective == "cond":
+            return float(c), np.array([last, 0]), coefficients
+        return float(np.log(c)), np.array([last, 0]), coefficients / c
+    if objective == "sigma_min":
+        return float(-0.5 * np.log(lam[0])), np.array([0]), np.array([-1.0 / lam[0]])
+    if objective == "log_det":
+        return float(-np.log(lam).sum() / lam.size), np.arange(lam.size), -2.0 / (lam.size * lam)
+    raise ExciteError(f"optimizer.objective: unknown '{objective}', expected one of {', '.join(OBJECTIVES)}")
+
+
+@dataclass
+class Criterion:
+    """The criterion f(α) of the stacked base regressor C = [C₀; Ŷ_B(α)] (``objective``: cond, log
+    cond, D- or E-optimality, see :func:`objective_terms`) with its gradient in the Fourier coefficients.
+
+    Attributes:
+        robot: the robot.
+        base: its base parameters (composition matrix X).
+        basis: Fourier basis at the T cost samples.
+        prior: C₀, (m₁, b) rows stacked above the trajectory's regressor (Eq. 41), or an empty array.
+        objective: one of ``OBJECTIVES``.
+    """
+
+    robot: Robot
+    base: BaseParameters
+    basis: FourierBasis
+    prior: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    objective: str = "log_cond"
+    _dynamics: VirtualDynamics = field(init=False, repr=False)
+    _data: pin.Data = field(init=False, repr=False)
+    _prior_gram: np.ndarray = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        if self.prior.size == 0:
+            self.prior = np.zeros((0, self.base.count))
+        if self.prior.shape[1] != self.base.count:
+            raise ExciteError(f"sequence.prior: {self.prior.shape[1]} columns, but the robot has {self.base.count} base parameters")
+        objective_terms(self.objective, np.ones(1))  # fail early on an unknown objective
+        self._dynamics = VirtualDynamics(self.robot)
+        self._data = self.robot.model.createData()  # this criterion's own, so no result depends on other users
+        self._prior_gram = self.prior.T @ self.prior
+
+    def regressor(self, alpha: np.ndarray) -> np.ndarray:
+        """Ŷ_B of the trajectory α (n, 2N+1): (T·n_rows, b) (Eq. 3 with Y_B = Y X)."""
+        return self._regressor(*self.basis.evaluate(alpha))
+
+    def _regressor(self, Q: np.ndarray, QD: np.ndarray, QDD: np.ndarray) -> np.ndarray:
+        return self.robot.regressor_stack(Q, QD, QDD, self._data)[:, self.base.independent]  # Y X, X a selection
+
+    def stacked(self, own: np.ndarray) -> np.ndarray:
+        """C = [C₀; Ŷ_B] (Eq. 41)."""
+        return np.vstack([self.prior, own])
+
+    def value(self, alpha: np.ndarray) -> float:
+        """f(α), from the singular values of C (accurate also where CᵀC is not)."""
+        C = self.stacked(self.regressor(alpha))
+        if C.shape[0] < C.shape[1]:
+            return float("inf")
+        s = np.linalg.svd(C, compute_uv=False)
+        return objective_terms(self.objective, s[::-1] ** 2)[0]
+
+    def value_and_gradient(self, alpha: np.ndarray) -> tuple[float, np.ndarray]:
+        """f(α) and its gradient, shaped like α (n, 2N+1) (Eqs. 17, 45–49).
+
+        Ties σ₁ = σ₂ give one valid subgradient (that of the eigenbasis); rank loss is floored
+        (``RANK_FLOOR``) so the result is finite.
+        """
+        Q, QD, QDD = self.basis.evaluate(alpha)
+        own = self._regressor(Q, QD, QDD)
+        # eigenpairs of the b×b Gram matrix CᵀC = C₀ᵀC₀ + ŶᵀŶ give σ² and v; C v = σ u (Eqs. 8, 16)
+        eig, V = np.linalg.eigh(self._prior_gram + own.T @ own)
+        value, used, coefficients = objective_terms(self.objective, eig)
+        phis = np.zeros((self.robot.n_parameters, used.size))
+        phis[self.base.independent] = V[:, used]  # X v_r
+        # row weights a_r (Ŷ_B v_r) at each instant
+        weights = ((own @ V[:, used]) * coefficients).T.reshape(used.size, Q.shape[0], self.robot.n_rows)
+        return value, self.basis.chain(*self._dynamics.weighted_derivatives(phis, weights, Q, QD, QDD))

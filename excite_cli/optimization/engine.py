@@ -1,0 +1,140 @@
+"""Where independent pieces of work run: in this process, in a local process pool, or on a Dask
+distributed cluster.
+
+The restarts of an iteration (:class:`~excite_cli.optimization.sequence.RestartTask`) and the random candidates
+of ``compare-random`` (:class:`~excite_cli.optimization.random_baseline.DrawTask`) are tasks: each has an index
+and its own seed, and is called with the problem's :class:`~excite_cli.optimization.excitation.Excitation`, so
+its result does not depend on where or in which order it runs. Pool and cluster workers build the
+excitation from the validated problem once and keep it (one per worker thread). Every process that
+runs tasks uses one BLAS thread, since the matrices are small and parallel workers would otherwise
+oversubscribe the cores, and keeps the memory it frees (:func:`~excite_cli.memory.keep_freed_memory`).
+"""
+
+from __future__ import annotations
+
+import os
+import threading
+from concurrent.futures import Executor, ProcessPoolExecutor, as_completed
+from typing import Any, Callable, Iterator, Optional, Protocol, Sequence
+
+from threadpoolctl import threadpool_limits
+
+from excite_cli.config import Problem
+from excite_cli.errors import ExciteError
+from excite_cli.optimization.excitation import Excitation, build_excitation
+from excite_cli.memory import keep_freed_memory
+
+#: How long to wait for a Dask scheduler to answer.
+CONNECT_TIMEOUT = "10s"
+
+
+class Task(Protocol):
+    """A piece of work: ``task(excitation, progress)`` returns its result; ``progress`` (serial runs
+    only) is the caller's hook for what the task reports while it runs."""
+
+    index: int
+
+    def __call__(self, excitation: Excitation, progress: Optional[Callable] = None) -> Any: ...
+
+
+_local = threading.local()
+
+
+def _worker_excitation(problem: Problem) -> Excitation:
+    """The excitation of ``problem`` in this worker (thread), built on first use."""
+    key = (str(problem.source_path), problem.model_dump_json())
+    cache = getattr(_local, "cache", None)
+    if cache is None or cache[0] != key:
+        _local.cache = cache = (key, build_excitation(problem))
+    return cache[1]
+
+
+def run_on_worker(problem: Problem, task: Task) -> Any:
+    """``task`` in a pool or cluster worker, with the worker's own excitation and, from then on, one
+    BLAS thread in the worker's process (a worker is there to run tasks)."""
+    threadpool_limits(limits=1)
+    keep_freed_memory()
+    return task(_worker_excitation(problem))
+
+
+class Engine:
+    """Runs tasks serially (``workers`` 1), in a local process pool of ``workers`` processes, or on
+    the Dask scheduler at ``scheduler``.
+
+    Use as a context manager: this process runs with one BLAS thread inside it (and keeps freed
+    memory), and the pool or client is closed on exit.
+
+    Raises:
+        ExciteError: the scheduler cannot be reached.
+    """
+
+    def __init__(self, excitation: Excitation, workers: int = 1, scheduler: Optional[str] = None):
+        self.excitation, self.workers, self.scheduler = excitation, workers, scheduler
+        self._pool: Optional[Executor] = None
+        self._client = None
+        self._limits: Optional[threadpool_limits] = None
+
+    def __enter__(self) -> "Engine":
+        self._limits = threadpool_limits(limits=1)
+        keep_freed_memory()
+        if self.scheduler:
+            from dask.distributed import Client
+
+            try:
+                self._client = Client(self.scheduler, timeout=CONNECT_TIMEOUT)
+            except (OSError, TimeoutError) as exc:
+                raise ExciteError(f"optimizer.scheduler: cannot reach the Dask scheduler at {self.scheduler}: {exc}") from None
+        elif self.workers > 1:
+            self._pool = ProcessPoolExecutor(max_workers=self.workers)
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if self._pool is not None:
+            self._pool.shutdown(cancel_futures=True)
+        if self._client is not None:
+            self._client.close()
+        if self._limits is not None:
+            self._limits.restore_original_limits()
+
+    @property
+    def parallel(self) -> bool:
+        """Whether tasks run in other processes (a pool or a cluster)."""
+        return self._pool is not None or self._client is not None
+
+    def run(self, tasks: Sequence[Task], progress: Optional[Callable] = None,
+            on_result: Optional[Callable[[Any], None]] = None) -> list[Any]:
+        """Results of all ``tasks``, in task order.
+
+        Args:
+            tasks: the tasks (distinct indices).
+            progress: passed to each task when it runs in this process.
+            on_result: called with each result as it arrives.
+        """
+        results = {}
+        for task, result in self._completed(tasks, progress):
+            results[task.index] = result
+            if on_result is not None:
+                on_result(result)
+        return [results[task.index] for task in tasks]
+
+    def _completed(self, tasks: Sequence[Task], progress: Optional[Callable]) -> Iterator[tuple[Task, Any]]:
+        if not self.parallel or len(tasks) == 1:  # one task gains nothing from another process
+            for task in tasks:
+                yield task, task(self.excitation, progress)
+            return
+        problem = self.excitation.problem
+        if self._client is not None:
+            from dask.distributed import as_completed as dask_completed
+
+            futures = {self._client.submit(run_on_worker, problem, task, pure=False): task for task in tasks}
+            for future in dask_completed(list(futures)):
+                yield futures[future], future.result()
+            return
+        pool_futures = {self._pool.submit(run_on_worker, problem, task): task for task in tasks}
+        for future in as_completed(pool_futures):
+            yield pool_futures[future], future.result()
+
+
+def default_workers() -> int:
+    """The cores this process may use."""
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)

@@ -1,0 +1,193 @@
+"""Everything one excitation design needs, built once from a validated :class:`~excite_cli.config.Problem`.
+
+config ─► robot, base parameters, Fourier bases (cost samples, constraint grid, fine check grid),
+constraints ─► the optimizer and the sequential generation use these, never the config.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from excite_cli.dynamics.base_parameters import BaseParameters, compute_base_parameters
+from excite_cli.trajectory.boundary import BoundaryConditions, boundary_rows
+from excite_cli.config import Problem
+from excite_cli.collision.capsules import capsule_pairs, capsules_from_config
+from excite_cli.constraints import Constraint, JointLimits, SelfCollision
+from excite_cli.constraints.com_region import com_region_from_config
+from excite_cli.constraints.joint_limits import joint_limit_bounds
+from excite_cli.constraints.lse import GRID_MARGIN
+from excite_cli.optimization.criterion import Criterion
+from excite_cli.errors import ExciteError
+from excite_cli.optimization.information import excitation_level, parameter_magnitudes
+from excite_cli.dynamics.robot import Robot, load_robot
+from excite_cli.trajectory.fourier import FourierBasis, FourierTrajectory, sample_times
+
+#: Decimals [rad] random starts are rounded to (see :meth:`Excitation.random_start`).
+START_DECIMALS = 9
+
+
+@dataclass
+class Excitation:
+    """A ready-to-optimize excitation problem.
+
+    Attributes:
+        problem: the validated config.
+        robot, base: the robot and its base parameters (Eq. 2).
+        trajectory: the Fourier parameterization (Eq. 50).
+        cost_basis: basis at the T cost samples (regressor rows, Eq. 3).
+        grid_basis: basis on the constraint grid (every ``constraint_period``, end included).
+        fine_basis: basis on the check grid, ``check_refinement`` times finer.
+        limits: joint limits (Eq. 51).
+        constraints: all constraints handed to the optimizer (joint limits first).
+        boundary: boundary conditions (rest or periodic) and the optimizer's coordinates.
+    """
+
+    problem: Problem
+    robot: Robot
+    base: BaseParameters
+    trajectory: FourierTrajectory
+    cost_basis: FourierBasis
+    grid_basis: FourierBasis
+    fine_basis: FourierBasis
+    limits: JointLimits
+    constraints: list[Constraint]
+    boundary: BoundaryConditions
+
+    def criterion(self, prior: np.ndarray | None = None, objective: str | None = None) -> Criterion:
+        """The criterion of ``objective`` (default ``optimizer.objective``) with C₀ = ``prior`` (m₁, b) (Eq. 41)."""
+        return Criterion(
+            self.robot,
+            self.base,
+            self.cost_basis,
+            prior=np.zeros((0, self.base.count)) if prior is None else prior,
+            objective=objective or self.problem.optimizer.objective,
+        )
+
+    def excitation_level(self, C: np.ndarray) -> float:
+        """ē(C) [N·m] of base-regressor rows C (M, b), the excitation figure that does not depend on
+        the choice of base columns (:mod:`excite_cli.optimization.information`)."""
+        return excitation_level(C, self.base, parameter_magnitudes(self.robot))
+
+    @property
+    def home(self) -> np.ndarray:
+        """(n,) the robot's home posture [rad] moved inside the position bounds by their margin."""
+        return home_posture(self.robot, self.limits)
+
+    def static(self) -> np.ndarray:
+        """α (n, 2N+1) of standing still at the home posture."""
+        alpha = np.zeros((self.robot.n_joints, self.trajectory.n_coefficients))
+        alpha[:, 0] = self.home
+        return alpha
+
+    def random_motion(self, rng: np.random.Generator, fill: float) -> np.ndarray:
+        """Random α (n, 2N+1) about the home posture that meets the boundary conditions and fills the
+        fraction ``fill`` of each joint's position, velocity and acceleration room on the grid."""
+        return self.limits.random_start(self.trajectory.n_coefficients, rng, fill, self.home, self.boundary.wave_space)
+
+    def random_start(self, rng: np.random.Generator) -> np.ndarray:
+        """Random α (n, 2N+1) about the home posture that every constraint and the boundary
+        conditions accept: random Fourier coefficients filling 50-90 % of the joint limits, shrunk
+        until the other constraints hold.
+
+        The drawn oscillation coefficients are rounded to ``START_DECIMALS`` decimals [rad] and moved
+        back into the oscillations that meet the boundary conditions (by loops that do not depend on
+        BLAS threads), so that the rounding of the matrix products that scaled them, which depends on
+        the BLAS library, its threads and the processor, does not reach the start: one seed gives the
+        same start with any thread setting, unless a coefficient falls within rounding of a decimal's
+        edge (a chance of about 10⁻⁴ per start on the G1 problem's 294 coefficients)."""
+        alpha = self.random_motion(rng, rng.uniform(0.5, 0.9))
+        waves = self.boundary.wave_space
+        alpha[:, 1:] = np.einsum("jm,mr,kr->jk", np.round(alpha[:, 1:], START_DECIMALS), waves, waves, optimize=False)
+        for _ in range(40):
+            if all(c.accepts(alpha) for c in self.constraints):
+                return alpha
+            alpha[:, 1:] *= 0.7
+        return self.static()
+
+
+def home_posture(robot: Robot, limits: JointLimits) -> np.ndarray:
+    """(n,) the robot's home posture [rad] moved inside the position bounds by their margin."""
+    inner = (1.0 - GRID_MARGIN) * limits.half[0]
+    return np.clip(robot.home, limits.centre[0] - inner, limits.centre[0] + inner)
+
+
+def build_excitation(problem: Problem) -> Excitation:
+    """Load the robot and set up bases and constraints for ``problem``.
+
+    Raises:
+        ExciteError: bad robot or limits input (see :func:`load_robot`, :func:`joint_limit_bounds`).
+    """
+    ccfg = problem.constraints
+    robot = load_robot(problem, collision=bool(ccfg.self_collision or (ccfg.com and ccfg.com.support_links)))
+    base = compute_base_parameters(robot)
+    tcfg = problem.trajectory
+    if tcfg.cost_samples * robot.n_rows < base.count:
+        raise ExciteError(f"trajectory.cost_samples: {tcfg.cost_samples} samples × {robot.n_rows} regressor rows are fewer "
+                          f"than the robot's {base.count} base parameters; cond(C) would be infinite")
+    trajectory = FourierTrajectory(tcfg.harmonics, tcfg.base_frequency)
+    fine_period = tcfg.constraint_period / problem.limits.check_refinement
+    grid_basis = trajectory.basis(sample_times(tcfg.duration, tcfg.constraint_period, include_end=True))
+    limits = JointLimits(*joint_limit_bounds(problem.limits, robot), grid_basis)
+    boundary = _boundary_conditions(problem, trajectory, limits, home_posture(robot, limits))
+    constraints: list[Constraint] = [limits]
+    if ccfg.com is not None:
+        constraints.append(com_region_from_config(ccfg.com, robot, grid_basis))
+    if ccfg.self_collision is not None:
+        capsules = capsules_from_config(ccfg.self_collision, robot)
+        pairs = capsule_pairs(ccfg.self_collision, robot, capsules)
+        constraints.append(SelfCollision(robot, grid_basis, capsules, pairs, ccfg.self_collision.margin))
+    excitation = Excitation(
+        problem=problem,
+        robot=robot,
+        base=base,
+        trajectory=trajectory,
+        cost_basis=trajectory.basis(sample_times(tcfg.duration, tcfg.cost_period)),
+        grid_basis=grid_basis,
+        fine_basis=trajectory.basis(sample_times(tcfg.duration, fine_period, include_end=True)),
+        limits=limits,
+        constraints=constraints,
+        boundary=boundary,
+    )
+    _check_home_posture(excitation)
+    return excitation
+
+
+def _boundary_conditions(problem: Problem, trajectory: FourierTrajectory, limits: JointLimits,
+                         home: np.ndarray) -> BoundaryConditions:
+    """The boundary conditions of ``trajectory.boundary`` / ``ends_at_home`` (see :mod:`excite_cli.trajectory.boundary`).
+
+    Raises:
+        ExciteError: the conditions leave the joints no oscillation (too few harmonics).
+    """
+    tcfg = problem.trajectory
+    rows = boundary_rows(trajectory, tcfg.duration, tcfg.boundary == "rest", tcfg.ends_at_home)
+    targets = np.zeros((home.size, rows.shape[0]))
+    if tcfg.ends_at_home:
+        targets[:, -2:] = home[:, None]
+    boundary = BoundaryConditions(rows, targets, limits.coefficient_scale())
+    if boundary.wave_space.shape[1] == 0:
+        raise ExciteError(
+            f"trajectory.harmonics: {tcfg.harmonics} harmonic(s) leave no free oscillation under "
+            f"boundary '{tcfg.boundary}'{' with ends_at_home' if tcfg.ends_at_home else ''}; use more harmonics"
+        )
+    return boundary
+
+
+def _check_home_posture(excitation: Excitation) -> None:
+    """Stop before optimizing when standing still at the home posture already violates a constraint.
+
+    Raises:
+        ExciteError: naming the constraint and where it fails (the capsule pair, the CoM distance).
+    """
+    static = excitation.static()
+    fields = {"joint_limits": "robot.home_posture", "com_region": "constraints.com",
+              "self_collision": "constraints.self_collision"}
+    for c in excitation.constraints:
+        check = c.check(static, excitation.grid_basis)
+        if check.max_violation > -c.grid_margin:
+            raise ExciteError(
+                f"{fields[c.name]}: violated before optimization, at the home posture with the locked "
+                f"joints: {check.where or 'joint limits'}"
+            )

@@ -1,0 +1,53 @@
+"""Excitation that does not depend on the choice of base columns.
+
+cond(C) depends on which standard-parameter columns form the base (Eq. 2) and on their units, so
+two trajectories can rank differently under two choices of base. The standard regressor Y does not
+depend on that choice: Y = Y_B K with K (b, p) the regrouping (φ_B = K φ). With Y's columns scaled
+by the URDF's parameter magnitudes D = diag(d) (p, p), the b nonzero singular values of Y D have the
+product det(C_BᵀC_B)^½ · det(K D² Kᵀ)^½, and another base Y_B T, K' = T⁻¹ K gives the same product.
+Their geometric mean
+
+    ē(C) = (det(CᵀC) · det(K D² Kᵀ))^(1 / 2b)   [N·m]
+
+is the torque a trajectory's samples carry per relative change of a parameter, on average over
+the b directions the data can identify: a larger ē is more excitation, whichever base columns the
+optimizer worked with. log ē is the D-optimal criterion (``optimizer.objective: log_det``, the
+paper's ref. [20]) up to a constant.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from excite_cli.dynamics.base_parameters import BaseParameters
+from excite_cli.dynamics.robot import Robot
+
+
+def parameter_magnitudes(robot: Robot) -> np.ndarray:
+    """(p,) the URDF's magnitude d of each standard parameter, per body of mass m: m [kg] for the
+    mass, m·ℓ [kg·m] for the first moments, m·ℓ² [kg·m²] for the inertia entries, with ℓ [m] the
+    body's radius of gyration about its frame origin, √(tr I_o / 2m). Bodies without mass get 1."""
+    blocks = robot.urdf_parameters().reshape(-1, 10)
+    d = np.ones_like(blocks)
+    for block, row in zip(blocks, d):
+        m = block[0]
+        if m > 0:
+            trace = block[4] + block[6] + block[9]
+            length = np.sqrt(max(trace, 0.0) / (2.0 * m))
+            row[0], row[1:4], row[4:] = m, m * length, m * length**2
+    return np.where(d > 0, d, 1.0).ravel()
+
+
+def excitation_level(C: np.ndarray, base: BaseParameters, magnitudes: np.ndarray) -> float:
+    """ē(C) [N·m] (module docstring) of a stacked base regressor C (M, b); 0 when C is rank-deficient.
+
+    Args:
+        C: base-regressor rows (M, b) [SI].
+        base: the base parameters C's columns belong to (regrouping K).
+        magnitudes: (p,) parameter magnitudes d (:func:`parameter_magnitudes`).
+    """
+    sign, logdet = np.linalg.slogdet(C.T @ C) if C.shape[0] >= C.shape[1] else (0.0, -np.inf)
+    if sign <= 0:
+        return 0.0
+    K = base.regrouping * magnitudes
+    return float(np.exp((logdet + np.linalg.slogdet(K @ K.T)[1]) / (2 * base.count)))

@@ -1,0 +1,222 @@
+"""One trajectory optimization (Eq. 7 under the constraints) from one feasible start.
+
+The solver (``optimizer.method``, :mod:`excite_cli.optimization.solvers`) works on the optimizer's variables z
+(boundary conditions met exactly, preconditioned); the criterion and every constraint supply
+analytic gradients. Quasi-Newton iterates of this problem approach the constraint boundary from
+outside (on the G1 problem SLSQP's iterates stay up to 3 cm outside the CoM region for most of
+the run), so a restart ends at the feasible point nearest to the solver's last iterate
+(:func:`project`): what the restart found is then judged by a point every constraint accepts, with
+its first-order optimality (:mod:`excite_cli.optimization.optimality`) and an honest stop reason.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Callable, Optional, Sequence
+
+import numpy as np
+from scipy.optimize import minimize
+
+from excite_cli.trajectory.boundary import BoundaryConditions
+from excite_cli.config import OptimizerConfig
+from excite_cli.constraints import Constraint
+from excite_cli.optimization.criterion import Criterion
+from excite_cli.optimization.optimality import Optimality, kkt_optimality, stop_reason
+from excite_cli.optimization.solvers import solve
+
+#: Progress hook: (restart index, solver iteration, objective at the current iterate).
+ProgressHook = Callable[[int, int, float], None]
+#: SLSQP iterations of the projection onto the feasible set (it converges in 10-50 on the G1 problem).
+PROJECTION_ITERATIONS = 60
+
+
+@dataclass(frozen=True)
+class RestartResult:
+    """The end of one restart: the best point every constraint accepts, and how the solver got there.
+
+    Attributes:
+        index: the restart's number within its iteration, 0-based.
+        alpha: (n, 2N+1) Fourier coefficients of the end point.
+        objective: criterion value at ``alpha`` (log cond, cond, ...).
+        iterations: solver iterations.
+        message: the solver's own message.
+        wall_time_s: wall time of the restart [s].
+        start_objective: criterion value at the start.
+        history: (iterations, 2) objective and largest constraint value g (normalized, > 0 outside)
+            at each accepted iterate of the solver.
+        optimality: first-order optimality at ``alpha`` (:func:`~excite_cli.optimization.optimality.kkt_optimality`).
+        stop: why it ended (:func:`~excite_cli.optimization.optimality.stop_reason`).
+        end: which point was kept: ``projected`` (the feasible point nearest the last iterate),
+            ``inside`` (the best iterate inside every constraint), ``bisection`` (towards the start),
+            or ``start``.
+    """
+
+    index: int
+    alpha: np.ndarray
+    objective: float
+    iterations: int
+    message: str
+    wall_time_s: float
+    start_objective: float = np.nan
+    history: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    optimality: Optimality = Optimality(np.nan, 0, np.nan, np.nan)
+    stop: str = ""
+    end: str = ""
+
+
+def best_restart(results: Sequence[RestartResult]) -> RestartResult:
+    """The restart with the lowest objective; ties go to the lower index (so the choice does not
+    depend on the order results arrive in)."""
+    return min(results, key=lambda r: (r.objective, r.index))
+
+
+def _accepted(constraints: Sequence[Constraint], alpha: np.ndarray) -> bool:
+    return all(c.accepts(alpha) for c in constraints)
+
+
+def repair(constraints: Sequence[Constraint], alpha: np.ndarray, feasible: np.ndarray,
+           boundary: Optional[BoundaryConditions] = None, steps: int = 12) -> np.ndarray:
+    """A feasible point near α: the constraints' own exact repairs, moved back onto the boundary
+    conditions, then, if some constraint still rejects it, the farthest point towards it from
+    ``feasible`` (bisection on the segment, which keeps the boundary conditions: they are affine).
+
+    Args:
+        constraints: all constraints.
+        alpha: (n, 2N+1) point to repair, typically the last SQP iterate.
+        feasible: (n, 2N+1) point every constraint accepts (the restart's start).
+        boundary: the boundary conditions both points meet, if any.
+        steps: bisection steps.
+    """
+    for c in constraints:
+        alpha = c.restore(alpha)
+    if boundary is not None:
+        alpha = boundary.project(alpha)
+    if _accepted(constraints, alpha):
+        return alpha
+    lo, hi = 0.0, 1.0
+    for _ in range(steps):
+        mid = (lo + hi) / 2.0
+        lo, hi = (mid, hi) if _accepted(constraints, feasible + mid * (alpha - feasible)) else (lo, mid)
+    return feasible + lo * (alpha - feasible)
+
+
+class _Evaluations:
+    """The solver's callbacks in its variables z: the objective and the stacked constraints, each
+    evaluated once per point; remembers the best point whose aggregated constraints all hold.
+
+    Attributes:
+        best_value: the lowest objective at such a point (``start_value`` until one is seen).
+        best_inside: its α (n, 2N+1), or None.
+    """
+
+    def __init__(self, criterion: Criterion, constraints: Sequence[Constraint], boundary: BoundaryConditions,
+                 start_value: float):
+        self.criterion, self.all, self.boundary = criterion, constraints, boundary
+        self.best_value, self.best_inside = start_value, None
+        self._constraints: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
+        self._objective: dict[bytes, tuple[float, np.ndarray]] = {}
+
+    def constraints(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Stacked values g (m,) and Jacobian in z."""
+        key = z.tobytes()
+        if key not in self._constraints:
+            self._constraints.clear()
+            g, J = _stack(self.all, self.boundary.to_alpha(z))
+            self._constraints[key] = (g, self.boundary.chain(J))
+        return self._constraints[key]
+
+    def objective(self, z: np.ndarray) -> tuple[float, np.ndarray]:
+        """The criterion and its gradient in z."""
+        key = z.tobytes()
+        if key not in self._objective:
+            self._objective.clear()
+            alpha = self.boundary.to_alpha(z)
+            value, grad = self.criterion.value_and_gradient(alpha)
+            if value < (self.best_value if self.best_inside is not None else np.inf) and self.constraints(z)[0].max() <= 0.0:
+                self.best_value, self.best_inside = value, alpha.copy()
+            self._objective[key] = (value, self.boundary.chain(grad.ravel()))
+        return self._objective[key]
+
+    def optimality(self, alpha: np.ndarray) -> Optimality:
+        """First-order optimality at α (n, 2N+1), in the variables z."""
+        z = self.boundary.to_variables(alpha)
+        return kkt_optimality(self.objective(z)[1], *self.constraints(z))
+
+
+def _stack(constraints: Sequence[Constraint], alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    parts = [c.evaluate(alpha) for c in constraints]
+    return np.concatenate([g for g, _ in parts]), np.vstack([J for _, J in parts])
+
+
+def project(problem: _Evaluations, z: np.ndarray, iterations: int = PROJECTION_ITERATIONS) -> Optional[np.ndarray]:
+    """The feasible point nearest to z (n_z,) in the optimizer's (preconditioned) variables:
+    argmin ½‖y − z‖² s.t. g(y) ≤ 0, by SLSQP from z (a convex objective: it converges where the
+    criterion's problem does not), then the constraints' own exact repairs. Returns its α (n, 2N+1)
+    if every constraint accepts it, else None."""
+    result = minimize(lambda y: (0.5 * float((y - z) @ (y - z)), y - z), z, jac=True, method="SLSQP",
+                      constraints=[{"type": "ineq", "fun": lambda y: -problem.constraints(y)[0],
+                                    "jac": lambda y: -problem.constraints(y)[1]}],
+                      options={"maxiter": iterations, "ftol": 1e-12})
+    alpha = problem.boundary.to_alpha(result.x)
+    for c in problem.all:
+        alpha = c.restore(alpha)
+    alpha = problem.boundary.project(alpha)
+    return alpha if _accepted(problem.all, alpha) else None
+
+
+def optimize_restart(
+    criterion: Criterion,
+    constraints: Sequence[Constraint],
+    options: OptimizerConfig,
+    start: np.ndarray,
+    boundary: BoundaryConditions,
+    index: int = 0,
+    progress: Optional[ProgressHook] = None,
+    max_iterations: Optional[int] = None,
+) -> RestartResult:
+    """Minimize the criterion over α with ``options.method`` from one feasible start.
+
+    The solver works on the variables z of ``boundary`` (α = s ⊙ (w* + Z z): the boundary conditions
+    hold exactly, with diagonal preconditioning s, see :mod:`excite_cli.trajectory.boundary`); everything else
+    sees α. The restart ends with the best of: the start, the best iterate whose aggregated
+    constraints were all ≤ 0, and the feasible point nearest to the last iterate (:func:`project`;
+    if the projection fails, :func:`repair`); each is confirmed by every constraint's exact grid check.
+
+    Args:
+        criterion: the criterion (value and gradient).
+        constraints: all constraints (values and Jacobians, exact checks, repairs).
+        options: method, iterations, tolerances.
+        start: (n, 2N+1) α that every constraint and the boundary conditions accept.
+        boundary: the boundary conditions and the optimizer's coordinates.
+        index: the restart's number (passed to ``progress`` and kept in the result).
+        progress: called after every solver iteration with the objective at the iterate.
+        max_iterations: solver iterations (default ``options.max_iterations``).
+    """
+    begin = time.perf_counter()
+    start_value = criterion.value(start)
+    problem = _Evaluations(criterion, constraints, boundary, start_value)
+    history: list[tuple[float, float]] = []
+
+    def on_iterate(z: np.ndarray) -> None:
+        history.append((problem.objective(z)[0], float(problem.constraints(z)[0].max())))
+        if progress is not None:
+            progress(index, len(history), history[-1][0])
+
+    run = solve(options.method, problem, boundary.to_variables(start), max_iterations or options.max_iterations,
+                options.tolerance, on_iterate)
+    ends = [("start", start)]
+    projected = project(problem, run.z)
+    if projected is not None:
+        ends.append(("projected", projected))
+    else:
+        ends.append(("bisection", repair(constraints, boundary.to_alpha(run.z), start, boundary)))
+    if problem.best_inside is not None:
+        ends.append(("inside", problem.best_inside))
+    scored = [(criterion.value(alpha), k, name, alpha) for k, (name, alpha) in enumerate(ends)
+              if name in ("start", "projected") or _accepted(constraints, alpha)]  # both already accepted
+    value, _, end, alpha = min(scored, key=lambda item: item[:2])
+    optimality = problem.optimality(alpha)
+    stop = stop_reason(optimality, [f for f, _ in history], run.limit, run.failed, options.optimality_tolerance)
+    return RestartResult(index, alpha, value, run.iterations, run.message, time.perf_counter() - begin, start_value,
+                         np.array(history, dtype=float).reshape(-1, 2), optimality, stop, end)

@@ -1,0 +1,134 @@
+"""The nonlinear programming solvers behind ``optimizer.method``, one interface for all:
+
+    minimize f(z) subject to g(z) ≤ 0,
+
+z the optimizer's variables (:mod:`excite_cli.trajectory.boundary`), f the criterion (Eqs. 5, 16) and g the
+stacked constraints, both with analytic gradients.
+
+- ``SLSQP``: scipy's sequential quadratic programming with a BFGS Hessian (the paper's quasi-Newton
+  method with constraints, Section IV-A);
+- ``trust-constr``: scipy's trust-region interior point method with BFGS Hessians;
+- ``ipopt``: IPOPT's interior point method with a limited-memory BFGS Hessian, through cyipopt (the
+  solver of FIGAROH, RAPTOR and FloBaRoID for this problem).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable, Protocol
+
+import numpy as np
+from scipy.optimize import BFGS, NonlinearConstraint, minimize
+
+from excite_cli.errors import ExciteError
+
+#: The methods of ``optimizer.method``.
+METHODS = ("SLSQP", "trust-constr", "ipopt")
+
+#: Called with each accepted iterate z of the solver.
+IterateHook = Callable[[np.ndarray], None]
+
+
+class NLP(Protocol):
+    """The problem a solver sees: f(z) with its gradient, g(z) (m,) with its Jacobian (m, z.size)."""
+
+    def objective(self, z: np.ndarray) -> tuple[float, np.ndarray]: ...
+
+    def constraints(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]: ...
+
+
+@dataclass(frozen=True)
+class SolverRun:
+    """How a solver ended.
+
+    Attributes:
+        z: its last iterate (may violate g ≤ 0).
+        iterations: its iterations.
+        message: its own message.
+        limit: it stopped at its iteration limit.
+        failed: it stopped on a failure of its own (line search, incompatible subproblem,
+            restoration), not at a limit and not on its convergence test.
+    """
+
+    z: np.ndarray
+    iterations: int
+    message: str
+    limit: bool
+    failed: bool
+
+
+def solve(method: str, nlp: NLP, z0: np.ndarray, max_iterations: int, tolerance: float, on_iterate: IterateHook) -> SolverRun:
+    """Run ``method`` (one of ``METHODS``) from z0 (n_z,) for at most ``max_iterations`` iterations.
+
+    Args:
+        tolerance: the solver's own convergence tolerance (SLSQP ``ftol``, trust-constr ``gtol``,
+            IPOPT ``tol``).
+        on_iterate: called with every accepted iterate.
+
+    Raises:
+        ExciteError: an unknown method, or ``ipopt`` without cyipopt installed.
+    """
+    if method == "SLSQP":
+        return _slsqp(nlp, z0, max_iterations, tolerance, on_iterate)
+    if method == "trust-constr":
+        return _trust_constr(nlp, z0, max_iterations, tolerance, on_iterate)
+    if method == "ipopt":
+        return _ipopt(nlp, z0, max_iterations, tolerance, on_iterate)
+    raise ExciteError(f"optimizer.method: unknown '{method}', expected one of {', '.join(METHODS)}")
+
+
+def _slsqp(nlp: NLP, z0: np.ndarray, max_iterations: int, tolerance: float, on_iterate: IterateHook) -> SolverRun:
+    result = minimize(nlp.objective, z0, jac=True, method="SLSQP",
+                      constraints=[{"type": "ineq", "fun": lambda z: -nlp.constraints(z)[0], "jac": lambda z: -nlp.constraints(z)[1]}],
+                      options={"maxiter": max_iterations, "ftol": tolerance}, callback=lambda z, *_: on_iterate(z))
+    # scipy's SLSQP exit modes: 0 converged (ftol), 9 iteration limit, anything else a failure
+    return SolverRun(result.x, int(result.nit), str(result.message), result.status == 9, result.status not in (0, 9))
+
+
+def _trust_constr(nlp: NLP, z0: np.ndarray, max_iterations: int, tolerance: float, on_iterate: IterateHook) -> SolverRun:
+    constraint = NonlinearConstraint(lambda z: nlp.constraints(z)[0], -np.inf, 0.0, jac=lambda z: nlp.constraints(z)[1], hess=BFGS())
+    result = minimize(nlp.objective, z0, jac=True, hess=BFGS(), method="trust-constr", constraints=[constraint],
+                      options={"maxiter": max_iterations, "gtol": tolerance, "xtol": 1e-10},
+                      callback=lambda z, *_: on_iterate(z))
+    # trust-constr's status: 0 iteration limit, 1 gtol met, 2 xtol met (steps too small)
+    return SolverRun(result.x, int(result.nit), str(result.message), result.status == 0, False)
+
+
+def _ipopt(nlp: NLP, z0: np.ndarray, max_iterations: int, tolerance: float, on_iterate: IterateHook) -> SolverRun:
+    try:
+        import cyipopt
+    except ImportError:
+        raise ExciteError("optimizer.method: 'ipopt' needs cyipopt, which `make install` builds against Debian's "
+                          "coinor-libipopt-dev (see README 'Quick start')") from None
+    last, count = [z0], [0]
+
+    class _Callbacks:
+        def objective(self, z):
+            last[0] = z
+            return nlp.objective(z)[0]
+
+        def gradient(self, z):
+            return nlp.objective(z)[1]
+
+        def constraints(self, z):
+            return nlp.constraints(z)[0]
+
+        def jacobian(self, z):
+            return nlp.constraints(z)[1].ravel()
+
+        def intermediate(self, _mode, iteration, *_):
+            if iteration > 0:  # IPOPT evaluates f last at the trial point it accepts
+                count[0] = iteration
+                on_iterate(last[0])
+            return True
+
+    m = nlp.constraints(z0)[0].size
+    problem = cyipopt.Problem(n=z0.size, m=m, problem_obj=_Callbacks(), lb=None, ub=None, cl=np.full(m, -1e20), cu=np.zeros(m))
+    for option, value in (("hessian_approximation", "limited-memory"), ("max_iter", max_iterations), ("tol", tolerance),
+                          ("print_level", 0), ("sb", "yes")):
+        problem.add_option(option, value)
+    z, info = problem.solve(z0)
+    status = int(info["status"])
+    message = info["status_msg"].decode() if isinstance(info["status_msg"], bytes) else str(info["status_msg"])
+    # IPOPT's status: 0 solved, 1 solved to an acceptable level, -1 iteration limit, others failures
+    return SolverRun(np.asarray(z), count[0], message, status == -1, status not in (0, 1, -1))

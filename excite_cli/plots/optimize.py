@@ -1,0 +1,219 @@
+"""PNG figures: joint trajectories with their limits, the condition-number table, constraint tracks,
+posture strips, the random-baseline comparison and identification residuals."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Sequence
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+from excite_cli.constraints import ComRegion, SelfCollision  # noqa: E402
+from excite_cli.optimization.excitation import Excitation  # noqa: E402
+from excite_cli.optimization.sequence import IterationResult  # noqa: E402
+from excite_cli.plots.skeleton import capsule_segments, skeleton  # noqa: E402
+
+
+def plot_result(target: Path, excitation: Excitation, results: Sequence[IterationResult]) -> list[Path]:
+    """The PNG figures of an ``optimize`` result beside ``target`` (``<stem>_trajectories.png``,
+    ``_cond.png``, ``_postures.png`` and, with balance or collision constraints, ``_constraints.png``)."""
+    stem = target.with_suffix("")
+    com = next((c for c in excitation.constraints if isinstance(c, ComRegion)), None)
+    collision = next((c for c in excitation.constraints if isinstance(c, SelfCollision)), None)
+    capsules = collision.capsules if collision else []
+    limits = excitation.limits
+    plots = [
+        plot_trajectories(stem.with_name(stem.name + "_trajectories.png"), excitation.robot.joint_names, results,
+                          limits.lower, limits.upper),
+        plot_condition_numbers(stem.with_name(stem.name + "_cond.png"), results),
+        plot_postures(stem.with_name(stem.name + "_postures.png"), results,
+                      lambda q: (skeleton(excitation.robot, q), capsule_segments(excitation.robot, capsules, q)),
+                      [c.radius for c in capsules], excitation.home),
+    ]
+    if any(r.tracks for r in results):
+        plots.append(plot_constraint_tracks(
+            stem.with_name(stem.name + "_constraints.png"), results,
+            centre=com.centre if com else None, radius=com.radius if com else None,
+            polygon=com.polygon if com else None, margin=collision.margin if collision else None,
+        ))
+    return plots
+
+
+def _joint_colours(count: int) -> list:
+    """``count`` distinguishable colours (tab10, then tab20's light shades; 20 before repeating)."""
+    palette = list(plt.get_cmap("tab10").colors) + list(plt.get_cmap("tab20").colors[1::2])
+    return [palette[j % len(palette)] for j in range(count)]
+
+
+def plot_trajectories(path: Path, joint_names: Sequence[str], results: Sequence[IterationResult],
+                      lower: np.ndarray | None = None, upper: np.ndarray | None = None) -> Path:
+    """q, q̇, q̈ of every iteration over time, one column per iteration, each joint in its own colour,
+    with the joint limits (Eq. 51) as dashed lines in the joint's colour; written to ``path`` (PNG).
+
+    Args:
+        lower, upper: (3, n) bounds of q [rad], q̇ [rad/s], q̈ [rad/s²], or None.
+    """
+    colours = _joint_colours(len(joint_names))
+    fig, axes = plt.subplots(3, len(results), figsize=(4.5 * len(results) + 2.5, 8), sharex=True, squeeze=False)
+    for col, r in enumerate(results):
+        for row, (name, unit) in enumerate((("q", "rad"), ("qd", "rad/s"), ("qdd", "rad/s²"))):
+            ax = axes[row, col]
+            for j, colour in enumerate(colours):
+                ax.plot(r.time, getattr(r, name)[:, j], color=colour, linewidth=0.8, label=joint_names[j])
+                if lower is not None and upper is not None:
+                    for bound in (lower[row, j], upper[row, j]):
+                        ax.axhline(bound, color=colour, linestyle="--", linewidth=0.6, alpha=0.6)
+            ax.set_ylabel(f"{name} [{unit}]")
+            ax.grid(alpha=0.3)
+        axes[0, col].set_title(f"iteration {r.index}: cond {r.cond_own:.1f}")
+        axes[-1, col].set_xlabel("time [s]")
+    handles, labels = axes[0, -1].get_legend_handles_labels()
+    handles.append(plt.Line2D([], [], color="grey", linestyle="--", linewidth=0.8))
+    labels.append("limits (dashed)")
+    axes[0, -1].legend(handles, labels, fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def plot_condition_numbers(path: Path, results: Sequence[IterationResult]) -> Path:
+    """cond(C⁽ⁱ⁾) and cond(C) per iteration (the paper's Table I as a chart, log axis); written to
+    ``path`` (PNG)."""
+    fig, ax = plt.subplots(figsize=(5, 3.5))
+    k = [r.index for r in results]
+    ax.plot(k, [r.cond_own for r in results], "o-", label="cond(C⁽ⁱ⁾) own")
+    ax.plot(k, [r.cond_stacked for r in results], "s-", label="cond(C) stacked")
+    for r in results:
+        ax.annotate(f"{r.cond_stacked:.1f}", (r.index, r.cond_stacked), textcoords="offset points", xytext=(4, -10), fontsize=7)
+    ax.set_yscale("log")
+    ax.margins(x=0.12)
+    ax.set_xlabel("iteration")
+    ax.set_ylabel("condition number (log)")
+    ax.set_xticks(k)
+    ax.grid(alpha=0.3, which="both")
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def _stadium(a: np.ndarray, b: np.ndarray, radius: float, points: int = 12) -> np.ndarray:
+    """(2·points + 2, 2) outline of the 2-D capsule around the segment [a, b] (its projection)."""
+    d = b - a
+    angle = np.arctan2(d[1], d[0]) if np.linalg.norm(d) > 1e-12 else 0.0
+    arc = np.linspace(-np.pi / 2, np.pi / 2, points)
+    ends = [b + radius * np.column_stack([np.cos(angle + arc), np.sin(angle + arc)]),
+            a + radius * np.column_stack([np.cos(angle + np.pi + arc), np.sin(angle + np.pi + arc)])]
+    return np.vstack(ends)
+
+
+def plot_postures(path: Path, results: Sequence[IterationResult], draw, radii: Sequence[float], home: np.ndarray,
+                  columns: int = 6) -> Path:
+    """A strip of postures over one period per iteration, front view (from +x, the robot's left on the
+    right) and side view (from −y, forward to the right), like the paper's Fig. 2; the home posture
+    in grey behind every one. Written to ``path`` (PNG).
+
+    Args:
+        draw: ``draw(q)`` → (skeleton (L, 2, 3), capsule segments (C, 2, 3)) [m] at the posture q (n,) [rad].
+        radii: (C,) capsule radii [m].
+        home: (n,) home posture [rad].
+        columns: postures per iteration, at t = kT/columns.
+    """
+    views = (("front", 1, -1.0), ("side", 0, 1.0))  # horizontal world axis, its sign
+    home_bones, _ = draw(home)
+    picks = [np.linspace(0, len(r.time) - 1, columns, endpoint=False).astype(int) for r in results]
+    poses = [[draw(r.q[t]) for t in ts] for r, ts in zip(results, picks)]
+    points = np.concatenate([home_bones.reshape(-1, 3)] + [b.reshape(-1, 3) for row in poses for b, _ in row])
+    pad = max(radii, default=0.0) + 0.05
+    fig, axes = plt.subplots(2 * len(results), columns, figsize=(2.2 * columns, 2.4 * 2 * len(results)), squeeze=False)
+    for i, r in enumerate(results):
+        for c, (bones, capsules) in enumerate(poses[i]):
+            t = r.time[picks[i][c]]
+            for v, (view, axis, sign) in enumerate(views):
+                ax = axes[2 * i + v, c]
+                for a, b in home_bones:
+                    ax.plot([sign * a[axis], sign * b[axis]], [a[2], b[2]], color="0.8", linewidth=1.0)
+                for (a, b), radius in zip(capsules, radii):
+                    outline = _stadium(np.array([sign * a[axis], a[2]]), np.array([sign * b[axis], b[2]]), radius)
+                    ax.fill(outline[:, 0], outline[:, 1], color="tab:blue", alpha=0.15, linewidth=0)
+                for a, b in bones:
+                    ax.plot([sign * a[axis], sign * b[axis]], [a[2], b[2]], color="k", linewidth=1.2, marker="o", markersize=1.5)
+                horizontal = sign * points[:, axis]
+                ax.set_xlim(horizontal.min() - pad, horizontal.max() + pad)
+                ax.set_ylim(points[:, 2].min() - pad, points[:, 2].max() + pad)
+                ax.set_aspect("equal")
+                ax.set_xticks([])
+                ax.set_yticks([])
+                ax.set_title(f"iteration {r.index}, {view}, t = {t:.1f} s", fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return path
+
+
+def plot_constraint_tracks(path: Path, results: Sequence[IterationResult], centre=None, radius: float | None = None,
+                           polygon=None, margin: float | None = None) -> Path:
+    """Per iteration: the CoM ground track against its region (Eq. 52) and the smallest capsule
+    distance over time against the margin (Eq. 53), in cm; written to ``path`` (PNG).
+
+    Args:
+        centre: (2,) region centre [m]; radius [m] or polygon (K, 2) relative to it [m].
+        margin: capsule safety margin [m].
+    """
+    fig, axes = plt.subplots(2, len(results), figsize=(4.2 * len(results), 7.5), squeeze=False)
+    for col, r in enumerate(results):
+        ax = axes[0, col]
+        if "com_xy" in r.tracks and centre is not None:
+            xy = (r.tracks["com_xy"] - centre) * 100
+            ax.plot(xy[:, 0], xy[:, 1], linewidth=0.8, label="CoM track")
+            if radius is not None:
+                ax.add_patch(plt.Circle((0, 0), radius * 100, fill=False, color="r", label="region"))
+            if polygon is not None:
+                ax.add_patch(plt.Polygon(polygon * 100, fill=False, color="r", label="region"))
+            ax.set_aspect("equal")
+            ax.set_xlabel("x − centre [cm]")
+            ax.set_ylabel("y − centre [cm]")
+            ax.legend(fontsize=7)
+        ax.set_title(f"iteration {r.index}")
+        ax = axes[1, col]
+        if "min_capsule_distance" in r.tracks:
+            ax.plot(r.time, r.tracks["min_capsule_distance"] * 100, linewidth=0.8, label="smallest distance")
+            if margin is not None:
+                ax.axhline(margin * 100, color="r", linestyle="--", label="margin")
+            ax.set_xlabel("time [s]")
+            ax.set_ylabel("capsule distance [cm]")
+            ax.legend(fontsize=7)
+        for a in axes[:, col]:
+            a.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def plot_comparison(path: Path, random_table, optimized_table) -> Path:
+    """Bars of cond(C⁽ⁱ⁾) and cond(C) per motion index, random selection (Table II) beside the
+    optimized trajectories (Table I); log scale; written to ``path`` (PNG)."""
+    fig, axes = plt.subplots(1, 2, figsize=(9, 3.8))
+    for ax, column, title in zip(axes, ("cond_own", "cond_stacked"), ("cond(C⁽ⁱ⁾)", "cond(C) stacked")):
+        k = np.asarray(random_table["iteration"])
+        ax.bar(k - 0.2, random_table[column], width=0.4, label="random + selection")
+        if optimized_table is not None:
+            ax.bar(np.asarray(optimized_table["iteration"]) + 0.2, optimized_table[column], width=0.4, label="optimized")
+        ax.set_yscale("log")
+        ax.set_xticks(k)
+        ax.set_xlabel("motion index")
+        ax.set_title(title)
+        ax.grid(alpha=0.3, axis="y")
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path

@@ -1,0 +1,1 @@
+"""Files the optimizer writes and reads: optimize results, exports, output paths."""

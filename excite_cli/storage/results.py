@@ -1,0 +1,298 @@
+"""HDF5 result files (h5py), readable without excite. Schema in README.md ("Output").
+
+The file is rewritten whole after every finished iteration into a temporary file that then replaces
+the target (``os.replace`` is atomic), so an interrupted run leaves a valid file with the finished
+iterations and never a half-written one.
+"""
+
+from __future__ import annotations
+
+import os
+from contextlib import contextmanager
+from datetime import datetime, timezone
+from importlib import metadata
+from pathlib import Path
+from typing import Iterator, Sequence
+
+import h5py
+import numpy as np
+import yaml
+from pydantic import ValidationError
+
+from excite_cli.dynamics.base_parameters import BaseParameters
+from excite_cli.config import Problem, effective_yaml
+from excite_cli.errors import ExciteError
+from excite_cli.optimization.excitation import Excitation
+from excite_cli.optimization.optimality import Optimality
+from excite_cli.optimization.optimizer import RestartResult
+from excite_cli.optimization.sequence import IterationResult, describe
+
+UNITS = {"alpha": "rad", "time": "s", "q": "rad", "qd": "rad/s", "qdd": "rad/s^2", "regressor": "SI (N·m per parameter unit)"}
+VERSIONED_PACKAGES = ("excite", "pin", "coal", "numpy", "scipy", "h5py", "example-robot-data")
+
+
+@contextmanager
+def open_result(path: Path, field: str = "") -> Iterator[h5py.File]:
+    """An HDF5 file opened for reading, with one clear message when it is missing or unreadable.
+
+    Args:
+        field: config field or option named in the messages (e.g. ``sequence.prior``).
+
+    Raises:
+        ExciteError: the file does not exist or is not HDF5.
+    """
+    prefix = f"{field}: " if field else ""
+    path = Path(path)
+    if not path.is_file():
+        raise ExciteError(f"{prefix}file not found: {path}")
+    try:
+        with h5py.File(path, "r") as f:
+            yield f
+    except OSError as exc:
+        raise ExciteError(f"{prefix}cannot read {path} as HDF5: {exc}") from None
+
+
+def package_versions() -> dict[str, str]:
+    """Installed versions of the packages a result depends on."""
+    versions = {}
+    for name in VERSIONED_PACKAGES:
+        try:
+            versions[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            versions[name] = "not installed"
+    return versions
+
+
+def write_strings(group: h5py.Group, name: str, values: Sequence[str]) -> None:
+    """A dataset of variable-length strings."""
+    group.create_dataset(name, data=np.array(values, dtype=h5py.string_dtype()))
+
+
+def results_table(results: Sequence[IterationResult]) -> np.ndarray:
+    """Table I as a structured array: iteration, cond_own, cond_stacked, excitation_own,
+    excitation_stacked (ē [N·m], :mod:`excite_cli.optimization.information`)."""
+    fields = ("cond_own", "cond_stacked", "excitation_own", "excitation_stacked")
+    table = np.zeros(len(results), dtype=[("iteration", "i4")] + [(name, "f8") for name in fields])
+    for row, r in zip(table, results):
+        row["iteration"] = r.index
+        for name in fields:
+            row[name] = getattr(r, name)
+    return table
+
+
+@contextmanager
+def atomic_h5(path: Path) -> Iterator[h5py.File]:
+    """An HDF5 file written as ``<path>.partial`` and moved onto ``path`` when complete, so a crash or
+    Ctrl-C never leaves a half-written file; creation time and package versions are set.
+
+    Raises:
+        ExciteError: the file cannot be written.
+    """
+    path = Path(path)
+    tmp = path.with_name(path.name + ".partial")
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with h5py.File(tmp, "w") as f:
+            f.attrs["created"] = datetime.now(timezone.utc).isoformat(timespec="seconds")
+            for name, version in package_versions().items():
+                f.attrs[f"version_{name}"] = version
+            yield f
+        os.replace(tmp, path)
+    except OSError as exc:
+        raise ExciteError(f"output: cannot write {path}: {exc}") from None
+    finally:
+        tmp.unlink(missing_ok=True)
+
+
+def write_result(path: Path, excitation: Excitation, results: Sequence[IterationResult], seed: int,
+                 attributes: dict | None = None) -> None:
+    """Write (or replace atomically) the result file of a sequential generation.
+
+    Args:
+        path: target ``.h5`` file; its folder is created.
+        excitation: the problem (robot names, composition matrix, config text).
+        results: finished iterations, in order.
+        seed: the seed the run used.
+        attributes: extra root attributes (e.g. ``method``, ``pool_size``).
+
+    Raises:
+        ExciteError: the file cannot be written.
+    """
+    with atomic_h5(path) as f:
+        f.attrs["config"] = effective_yaml(excitation.problem)
+        f.attrs["config_original"] = excitation.problem.source_text
+        f.attrs["config_path"] = str(excitation.problem.source_path or "")
+        f.attrs["seed"] = seed
+        f.attrs["objective"] = excitation.problem.optimizer.objective
+        for name, value in (attributes or {}).items():
+            f.attrs[name] = value
+        _write_robot(f.create_group("robot"), excitation)
+        iterations = f.create_group("iterations")
+        for r in results:
+            _write_iteration(iterations.create_group(str(r.index)), r)
+        table = f.create_dataset("table", data=results_table(results))
+        table.attrs["description"] = ("Table I: cond of each iteration's regressor and of the stacked regressor, and their "
+                                      "base-independent excitation e [N m] (README 'Output')")
+
+
+def _write_robot(group: h5py.Group, excitation: Excitation) -> None:
+    robot, base = excitation.robot, excitation.base
+    write_strings(group, "joint_names", robot.joint_names)
+    write_strings(group, "parameter_names", robot.parameter_names)
+    write_strings(group, "base_parameter_names", base.names)
+    group.create_dataset("composition_matrix", data=base.composition_matrix).attrs["description"] = "X (p x b): Y_B = Y X (Eq. 2)"
+    group.create_dataset("regrouping_matrix", data=base.regrouping).attrs["description"] = "K (b x p): phi_B = K phi"
+    group.create_dataset("urdf_base_parameters", data=base.from_standard(robot.urdf_parameters()))
+    group.attrs["urdf"] = excitation.problem.robot.urdf
+    group.attrs["floating_base"] = excitation.problem.robot.floating_base
+    group.attrs["regressor_rows_per_instant"] = robot.n_rows
+
+
+def _write_iteration(group: h5py.Group, r: IterationResult) -> None:
+    for name in ("alpha", "time", "q", "qd", "qdd", "regressor"):
+        group.create_dataset(name, data=getattr(r, name)).attrs["unit"] = UNITS[name]
+    group["alpha"].attrs["layout"] = "row j: [q0_j, a_j1..a_jN, b_j1..b_jN] (Eq. 50)"
+    for name, series in r.tracks.items():
+        group.create_dataset(name, data=series).attrs["unit"] = r.track_units[name]
+    group.attrs["cond_own"] = r.cond_own
+    group.attrs["cond_stacked"] = r.cond_stacked
+    group.attrs["excitation_own_Nm"] = r.excitation_own
+    group.attrs["excitation_stacked_Nm"] = r.excitation_stacked
+    group.attrs["max_violation"] = r.max_violation
+    group.attrs["wall_time_s"] = r.wall_time_s
+    group.attrs["sqp_iterations"] = r.sqp_iterations
+    group.attrs["stop"] = r.stop
+    group.attrs["optimizer_message"] = r.best.message if r.best else ""
+    for key, value in r.checks.items():
+        group.attrs[key] = value
+    restarts = group.create_group("restarts")
+    restarts.attrs["kept"] = r.best.index if r.best else -1
+    for restart in r.restarts:
+        _write_restart(restarts.create_group(str(restart.index)), restart)
+
+
+def _write_restart(group: h5py.Group, r: RestartResult) -> None:
+    group.create_dataset("alpha", data=r.alpha).attrs["unit"] = UNITS["alpha"]
+    history = group.create_dataset("history", data=r.history)
+    history.attrs["columns"] = "objective, largest constraint value g (normalized, > 0 outside)"
+    history.attrs["description"] = "one row per solver iteration, at its accepted iterate"
+    for name in ("objective", "start_objective", "iterations", "message", "wall_time_s", "stop", "end"):
+        group.attrs[name] = getattr(r, name)
+    o = r.optimality
+    group.attrs.update(kkt_residual=o.residual, active_constraints=o.active, gradient_norm=o.gradient_norm,
+                       max_constraint=o.max_constraint)
+
+
+def _read_restart(group: h5py.Group, index: int) -> RestartResult:
+    a = group.attrs
+    optimality = Optimality(float(a["kkt_residual"]), int(a["active_constraints"]), float(a["gradient_norm"]), float(a["max_constraint"]))
+    return RestartResult(index, group["alpha"][()], float(a["objective"]), int(a["iterations"]), str(a["message"]),
+                         float(a["wall_time_s"]), float(a["start_objective"]), group["history"][()], optimality,
+                         str(a["stop"]), str(a["end"]))
+
+
+def read_prior(path: Path, base: BaseParameters) -> np.ndarray:
+    """Prior data C₀ (m, b) for Eq. 41 from an excite result (all iterations' regressors stacked) or
+    an HDF5 file with a dataset ``regressor`` of base-regressor rows.
+
+    Raises:
+        ExciteError: missing or unreadable file, no regressor inside, or base parameters that differ.
+    """
+    with open_result(path, "sequence.prior") as f:
+        if "iterations" in f:
+            keys = sorted(f["iterations"].keys(), key=int)
+            blocks = [f["iterations"][k]["regressor"][()] for k in keys]
+            prior = np.vstack(blocks) if blocks else np.zeros((0, base.count))
+        elif "regressor" in f:
+            prior = np.asarray(f["regressor"][()], dtype=float)
+        else:
+            raise ExciteError(f"sequence.prior: {path} has neither /iterations nor /regressor")
+        names = [n.decode() if isinstance(n, bytes) else n for n in f["robot/base_parameter_names"][()]] if "robot/base_parameter_names" in f else None
+    if prior.ndim != 2 or prior.shape[1] != base.count:
+        raise ExciteError(f"sequence.prior: {path} has {prior.shape[-1]} regressor columns, the problem's robot has "
+                          f"{base.count} base parameters (prior data of another robot or joint set?)")
+    if names is not None and names != base.names:
+        differ = next(k for k, (a, b) in enumerate(zip(names, base.names)) if a != b)
+        raise ExciteError(f"sequence.prior: {path} has the same number of base parameters ({base.count}) but other ones "
+                          f"(number {differ + 1} is '{names[differ]}', the problem's is '{base.names[differ]}')")
+    if not np.all(np.isfinite(prior)):
+        raise ExciteError(f"sequence.prior: {path} contains NaN or infinite values")
+    return prior
+
+
+def problem_of_result(path: Path) -> Problem:
+    """The optimize config stored in a result file (relative paths resolved from its original place).
+
+    Raises:
+        ExciteError: missing or unreadable file, or no valid stored config (not an excite result).
+    """
+    with open_result(path) as f:
+        if "config" not in f.attrs or "iterations" not in f:
+            raise ExciteError(f"{path}: not an excite optimize result (no stored config or /iterations)")
+        text, origin = str(f.attrs["config"]), str(f.attrs.get("config_path", ""))
+    try:
+        problem = Problem.model_validate(yaml.safe_load(text))
+    except (yaml.YAMLError, ValidationError):
+        raise ExciteError(f"{path}: its stored config is not a valid optimize problem (not an excite optimize result?)") from None
+    problem.source_path = Path(origin) if origin else None
+    problem.source_text = text
+    return problem
+
+
+def read_last_alpha(path: Path) -> tuple[int, np.ndarray]:
+    """Index k and Fourier coefficients α (n, 2N+1) of the last iteration of an excite result.
+
+    Raises:
+        ExciteError: missing or unreadable file, or no finished iteration in it.
+    """
+    return read_alphas(path)[-1]
+
+
+def read_iterations(path: Path, excitation: Excitation, prior: np.ndarray | None = None, field: str = "--resume") -> list[IterationResult]:
+    """The finished iterations of a result of the same problem, as :class:`IterationResult` (checks
+    recomputed from the stored α, wall time, SQP iterations and message as stored), to resume it.
+
+    Raises:
+        ExciteError: missing or unreadable file, or a result of another problem.
+    """
+    stacked = np.zeros((0, excitation.base.count)) if prior is None else prior
+    results = []
+    with open_result(path, field) as f:
+        if "iterations" not in f:
+            raise ExciteError(f"{field}: {path} is not an excite optimize result (no /iterations)")
+        for key in sorted(f["iterations"].keys(), key=int):
+            g = f["iterations"][key]
+            alpha = g["alpha"][()]
+            if alpha.shape != (excitation.robot.n_joints, excitation.trajectory.n_coefficients):
+                raise ExciteError(f"{field}: {path} was made for another problem (alpha shape {alpha.shape})")
+            restarts = [_read_restart(g["restarts"][r], int(r)) for r in sorted(g["restarts"].keys(), key=int)] if "restarts" in g else []
+            results.append(describe(excitation, int(key), alpha, stacked, float(g.attrs["wall_time_s"]), restarts))
+            stacked = np.vstack([stacked, results[-1].regressor])
+    return results
+
+
+def read_table(path: Path, field: str = "") -> tuple[np.ndarray, float]:
+    """The condition-number table (iteration, cond_own, cond_stacked) of an excite result and the
+    summed wall time of its iterations [s].
+
+    Raises:
+        ExciteError: missing or unreadable file, or no table in it.
+    """
+    with open_result(path, field) as f:
+        if "table" not in f or "iterations" not in f:
+            raise ExciteError(f"{field + ': ' if field else ''}{path} is not an excite result (no /table)")
+        wall = sum(float(g.attrs.get("wall_time_s", 0.0)) for g in f["iterations"].values())
+        return f["table"][()], wall
+
+
+def read_alphas(path: Path) -> list[tuple[int, np.ndarray]]:
+    """(k, α (n, 2N+1)) of every iteration of an excite result, in order.
+
+    Raises:
+        ExciteError: missing or unreadable file, or no iteration in it.
+    """
+    with open_result(path) as f:
+        keys = sorted(f["iterations"].keys(), key=int) if "iterations" in f else []
+        if not keys:
+            raise ExciteError(f"{path} has no finished iteration")
+        return [(int(k), f["iterations"][k]["alpha"][()]) for k in keys]

@@ -1,0 +1,99 @@
+"""``optimize``: the sequential generation, its result written after every iteration (resumable), then plots."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable, Optional
+
+import numpy as np
+import yaml
+
+from excite_cli.config import Problem, effective_yaml
+from excite_cli.errors import ExciteError, Interrupted
+from excite_cli.optimization.engine import Engine, default_workers
+from excite_cli.optimization.excitation import Excitation, build_excitation
+from excite_cli.optimization.optimizer import ProgressHook
+from excite_cli.optimization.sequence import IterationResult, run_sequence
+from excite_cli.plots.optimize import plot_result
+from excite_cli.storage.paths import check_target
+from excite_cli.storage.results import open_result, read_iterations, read_prior, write_result
+
+
+RESUMABLE_CHANGES = ("sequence.iterations", "optimizer.workers", "optimizer.scheduler")
+
+
+def engine_for(problem: Problem, excitation: Excitation) -> Engine:
+    """Where restarts and draws run: ``optimizer.scheduler``, else ``optimizer.workers`` local
+    processes (default: the machine's cores)."""
+    return Engine(excitation, problem.optimizer.workers or default_workers(), problem.optimizer.scheduler)
+
+
+@dataclass
+class OptimizeRun:
+    """A finished ``optimize``: the problem, its iterations, the result file and the plots."""
+
+    excitation: Excitation
+    results: list[IterationResult]
+    target: Path
+    plots: list[Path]
+
+
+def run_optimize(problem: Problem, target: Path, force: bool = False, resume: bool = False,
+                 progress: Optional[Callable[[int], ProgressHook]] = None,
+                 on_iteration: Optional[Callable[[IterationResult], None]] = None,
+                 engine: Optional[Engine] = None) -> OptimizeRun:
+    """The sequential generation of ``problem``, writing ``target`` after every iteration, then plots.
+
+    Args:
+        force: replace an existing ``target``.
+        resume: continue the iterations already in ``target`` (made with the same config, up to
+            ``RESUMABLE_CHANGES``); the end result is that of an uninterrupted run.
+        progress, on_iteration: see :func:`run_sequence`.
+        engine: where restarts run (default: :func:`engine_for`).
+
+    Raises:
+        ExciteError: bad target, prior data or problem; a result to resume made with another config.
+        Interrupted: Ctrl-C; the finished iterations are in ``target``.
+    """
+    check_target(target, "--output", force, exists_ok=resume)
+    if resume and not target.is_file():
+        raise ExciteError(f"--resume: no result at {target} to continue")
+    excitation = build_excitation(problem)
+    prior = read_prior(problem.resolve(problem.sequence.prior), excitation.base) if problem.sequence.prior else None
+    finished = _resumable(target, excitation, prior) if resume else []
+    written = list(finished)
+
+    def done(result: IterationResult) -> None:
+        written.append(result)
+        write_result(target, excitation, written, problem.optimizer.seed, {"method": "optimized"})
+        if on_iteration:
+            on_iteration(result)
+
+    try:
+        with engine or engine_for(problem, excitation) as active:
+            results = run_sequence(excitation, problem.sequence.iterations, problem.optimizer.seed, prior, progress,
+                                   done, active, finished)
+    except KeyboardInterrupt:
+        raise Interrupted(target, len(written)) from None
+    return OptimizeRun(excitation, results, target, plot_result(target, excitation, results))
+
+
+def _resumable(target: Path, excitation: Excitation, prior: Optional[np.ndarray]) -> list[IterationResult]:
+    """The iterations of ``target`` if it was made with the same config (see ``RESUMABLE_CHANGES``)."""
+    with open_result(target, "--resume") as f:
+        stored = yaml.safe_load(str(f.attrs.get("config", ""))) or {}
+    current = yaml.safe_load(effective_yaml(excitation.problem))
+    for dotted in RESUMABLE_CHANGES:
+        section, name = dotted.split(".")
+        for config in (stored, current):
+            config.get(section, {}).pop(name, None)
+    if stored != current:
+        differing = sorted(k for k in set(stored) | set(current) if stored.get(k) != current.get(k))
+        raise ExciteError(f"--resume: {target} was made with another config ({', '.join(differing) or 'the whole file'} differ)")
+    finished = read_iterations(target, excitation, prior)
+    if len(finished) > excitation.problem.sequence.iterations:
+        raise ExciteError(f"--resume: {target} has {len(finished)} iterations, more than the {excitation.problem.sequence.iterations} asked for")
+    return finished
+
+

@@ -1,0 +1,91 @@
+"""``excite simulate``: measured-like runs from a trajectory result and the URDF model, with effects and
+noise from a separate effects file, written as CSV in the format ``identify`` reads.
+
+τ = RNEA(q, q̇, q̈; URDF inertias) + Σ effects + N(0, σ_τ²); q is written with N(0, σ_q²) added and
+timestamps with uniform jitter. Columns: ``time, q_<joint>..., tau_<joint>...``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from excite_cli.identification.config import SimulationConfig
+from excite_cli.errors import ExciteError
+from excite_cli.identification.effects import COEFFICIENTS, SHAPE_FIELDS, effect_columns
+from excite_cli.storage.results import problem_of_result, read_alphas
+from excite_cli.dynamics.robot import Robot, load_robot
+from excite_cli.storage.paths import check_folder
+from excite_cli.trajectory.fourier import FourierTrajectory
+
+
+def effect_torques(sim: SimulationConfig, robot: Robot, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray,
+                   rigid: np.ndarray) -> np.ndarray:
+    """(T, n) torques [Nm] of the effects in ``sim.effects`` ({effect: {joint or "*": value}}) at the
+    samples q, q̇, q̈ (T, n) in time order, ``rigid`` (T, n) the rigid-body torques [Nm].
+
+    Raises:
+        ExciteError: an unknown joint or a value with the wrong number of coefficients.
+    """
+    tau = np.zeros_like(q)
+    for effect, per_joint in sim.effects.items():
+        for name, value in per_joint.items():
+            if name != "*" and name not in robot.joint_names:
+                raise ExciteError(f"effects.{effect}: '{name}' is not an active joint")
+            coefficients = np.atleast_1d(np.asarray(value, dtype=float))
+            if coefficients.size != len(COEFFICIENTS[effect]):
+                raise ExciteError(f"effects.{effect}.{name}: needs {len(COEFFICIENTS[effect])} value(s) {COEFFICIENTS[effect]}")
+            for j in (range(robot.n_joints) if name == "*" else [robot.joint_names.index(name)]):
+                shape = getattr(sim, SHAPE_FIELDS[effect]) if effect in SHAPE_FIELDS else None
+                cols = effect_columns(effect, q[:, j], qd[:, j], qdd[:, j], sim.coulomb_velocity, shape, rigid[:, j])
+                tau[:, j] += cols @ coefficients
+    return tau
+
+
+def simulate_runs(result: Path, sim: SimulationConfig, out_dir: Path, prefix: str = "run", force: bool = False) -> list[Path]:
+    """Write one CSV per iteration of ``result`` into ``out_dir``; everything is computed (and every
+    error raised) before the first file is written.
+
+    Args:
+        result: an ``optimize`` (or ``compare-random``) HDF5 result.
+        sim: the effects file.
+        out_dir: folder for ``<prefix>_<k>.csv``.
+        force: replace existing files.
+
+    Returns:
+        The written files.
+
+    Raises:
+        ExciteError: not a result, an unknown joint or a wrong coefficient count in the effects,
+            non-finite effect values, files in the way.
+    """
+    problem = problem_of_result(result)
+    problem.robot.base_wrench_rows = False
+    robot = load_robot(problem)
+    trajectory = FourierTrajectory(problem.trajectory.harmonics, problem.trajectory.base_frequency)
+    rng = np.random.default_rng(sim.seed)
+    alphas = read_alphas(result)
+    check_folder(out_dir, [f"{prefix}_{k}.csv" for k, _ in alphas], "--output-dir", force)
+    header = ["time"] + [f"q_{j}" for j in robot.joint_names] + [f"tau_{j}" for j in robot.joint_names]
+    tables = {}
+    for k, alpha in alphas:
+        count = int(round(sim.periods * trajectory.period * sim.sample_rate)) + 1
+        time = np.arange(count) / sim.sample_rate
+        time[1:-1] += rng.uniform(-sim.timestamp_jitter, sim.timestamp_jitter, count - 2) / sim.sample_rate
+        q, qd, qdd = trajectory.basis(time).evaluate(alpha)
+        rigid = np.array([robot.torques(*x) for x in zip(q, qd, qdd)])
+        tau = rigid + effect_torques(sim, robot, q, qd, qdd, rigid)
+        tau += rng.normal(0.0, sim.torque_noise, tau.shape)
+        tables[k] = np.column_stack([time, q + rng.normal(0.0, sim.position_noise, q.shape), tau])
+        if not np.all(np.isfinite(tables[k])):
+            raise ExciteError("effects: a value makes non-finite torques (NaN or inf in the effects file?)")
+    out_dir.mkdir(parents=True, exist_ok=True)
+    written = []
+    for k, table in tables.items():
+        path = out_dir / f"{prefix}_{k}.csv"
+        tmp = path.with_name(path.name + ".partial")
+        np.savetxt(tmp, table, delimiter=",", header=",".join(header), comments="", fmt="%.10g")
+        tmp.replace(path)
+        written.append(path)
+    return written
