@@ -4,7 +4,7 @@ PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 CONFIG ?= configs/g1_arms.yaml
 
-.PHONY: install ipopt optimize test smoke bench clean
+.PHONY: install ipopt optimize test lint smoke bench clean
 
 install: $(STAMP)
 
@@ -30,6 +30,10 @@ optimize: $(STAMP)
 
 test: $(STAMP)
 	$(PY) -m pytest -q -rs -n auto
+
+lint: $(STAMP)
+	$(VENV)/bin/ruff check .
+	$(VENV)/bin/ruff format --check .
 
 smoke: $(STAMP)
 	$(VENV)/bin/excite optimize configs/smoke.yaml --output results/smoke.h5 --force

@@ -36,8 +36,12 @@ def main(config: Path) -> None:
     print(f"relative error (one-sided FD)  {check.error_forward:.1e}")
     target = ROOT / "results" / f"bench_{config.stem}.h5"
     start = time.perf_counter()
-    run = subprocess.run([sys.executable, "-m", "excite_cli", "optimize", str(config), "-o", str(target)],
-                         check=True, capture_output=True, text=True)
+    run = subprocess.run(
+        [sys.executable, "-m", "excite_cli", "optimize", str(config), "-o", str(target)],
+        check=True,
+        capture_output=True,
+        text=True,
+    )
     print(f"full optimize wall time        {time.perf_counter() - start:.1f} s  ({target})")
     print(run.stdout)
 

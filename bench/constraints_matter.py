@@ -27,17 +27,27 @@ def main(config: Path) -> None:
     free_problem = copy.deepcopy(problem)
     free_problem.constraints = ConstraintsConfig()
     free = build_excitation(free_problem)
-    print(f"{'constraints':<12} {'cond':>7} {'CoM excursion [cm]':>19} {'smallest capsule distance [cm] (pair)':>40} {'time [s]':>9}")
+    print(
+        f"{'constraints':<12} {'cond':>7} {'CoM excursion [cm]':>19} {'smallest capsule distance [cm] (pair)':>40} {'time [s]':>9}"
+    )
     for label, excitation in (("off", free), ("on", constrained)):
         result = run_sequence(excitation, 1, problem.optimizer.seed)[0]
-        checks = {k: v for c in constrained.constraints for k, v in c.check(result.alpha, constrained.fine_basis).details.items()}
+        checks = {
+            k: v
+            for c in constrained.constraints
+            for k, v in c.check(result.alpha, constrained.fine_basis).details.items()
+        }
         cond = condition_number(result.regressor)
-        print(f"{label:<12} {cond:7.1f} {100 * checks.get('com_max_excursion_m', np.nan):19.2f} "
-              f"{100 * checks.get('min_capsule_distance_m', np.nan):10.2f} ({checks.get('min_capsule_pair', '-')})"
-              f"{result.wall_time_s:9.0f}")
+        print(
+            f"{label:<12} {cond:7.1f} {100 * checks.get('com_max_excursion_m', np.nan):19.2f} "
+            f"{100 * checks.get('min_capsule_distance_m', np.nan):10.2f} ({checks.get('min_capsule_pair', '-')})"
+            f"{result.wall_time_s:9.0f}"
+        )
     region = next(c for c in constrained.constraints if c.name == "com_region")
-    print(f"CoM region radius {100 * region.radius:.1f} cm; capsule margin "
-          f"{100 * next(c for c in constrained.constraints if c.name == 'self_collision').margin:.1f} cm")
+    print(
+        f"CoM region radius {100 * region.radius:.1f} cm; capsule margin "
+        f"{100 * next(c for c in constrained.constraints if c.name == 'self_collision').margin:.1f} cm"
+    )
 
 
 if __name__ == "__main__":

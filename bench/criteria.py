@@ -21,8 +21,8 @@ import numpy as np
 
 from excite_cli.config import load_problem
 from excite_cli.optimization.criterion import OBJECTIVES, condition_number
-from excite_cli.optimization.excitation import build_excitation
 from excite_cli.optimization.engine import Engine, default_workers
+from excite_cli.optimization.excitation import build_excitation
 from excite_cli.optimization.sequence import run_sequence
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -31,7 +31,9 @@ RATE = 200.0  # Hz
 DRAWS = 200
 
 
-def identification_spread(excitation, alpha: np.ndarray, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def identification_spread(
+    excitation, alpha: np.ndarray, rng: np.random.Generator
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Estimates' standard deviation and bias (b,), and the true base parameters (b,)."""
     robot = excitation.robot
     basis = excitation.trajectory.basis(np.arange(0.0, excitation.problem.trajectory.duration, 1.0 / RATE))
@@ -45,7 +47,9 @@ def identification_spread(excitation, alpha: np.ndarray, rng: np.random.Generato
 
 
 def main(config: Path) -> None:
-    print(f"{'objective':<10} {'cond(C)':>8} {'e [Nm]':>8} {'median std':>11} {'largest std':>12} {'median rel. std':>16} {'largest bias':>13}")
+    print(
+        f"{'objective':<10} {'cond(C)':>8} {'e [Nm]':>8} {'median std':>11} {'largest std':>12} {'median rel. std':>16} {'largest bias':>13}"
+    )
     for objective in OBJECTIVES:
         problem = load_problem(config)
         problem.optimizer.objective = objective
@@ -54,8 +58,11 @@ def main(config: Path) -> None:
             result = run_sequence(excitation, 1, problem.optimizer.seed, engine=engine)[0]
         std, bias, truth = identification_spread(excitation, result.alpha, np.random.default_rng(0))
         relevant = np.abs(truth) > 1e-3
-        print(f"{objective:<10} {condition_number(result.regressor):>8.1f} {result.excitation_own:>8.4g} {np.median(std):>11.2e} {std.max():>12.2e} "
-              f"{np.median(std[relevant] / np.abs(truth[relevant])):>16.2%} {np.abs(bias).max():>13.1e}", flush=True)
+        print(
+            f"{objective:<10} {condition_number(result.regressor):>8.1f} {result.excitation_own:>8.4g} {np.median(std):>11.2e} {std.max():>12.2e} "
+            f"{np.median(std[relevant] / np.abs(truth[relevant])):>16.2%} {np.abs(bias).max():>13.1e}",
+            flush=True,
+        )
 
 
 if __name__ == "__main__":

@@ -59,14 +59,20 @@ def profile(config: Path, iterations: int) -> None:
     keep_freed_memory()  # as every process that runs restarts (excite_cli.optimization.engine)
     with threadpool_limits(limits=1):
         start = time.perf_counter()
-        result = optimize_restart(criterion, excitation.constraints, problem.optimizer, start_alpha, excitation.boundary)
+        result = optimize_restart(
+            criterion, excitation.constraints, problem.optimizer, start_alpha, excitation.boundary
+        )
         wall = time.perf_counter() - start
     its = max(result.iterations, 1)
-    print(f"{config.name}: {result.iterations} SLSQP iterations, {calls['criterion + gradient']} evaluations, "
-          f"{wall:.1f} s wall, {1e3 * wall / its:.1f} ms per iteration")
+    print(
+        f"{config.name}: {result.iterations} SLSQP iterations, {calls['criterion + gradient']} evaluations, "
+        f"{wall:.1f} s wall, {1e3 * wall / its:.1f} ms per iteration"
+    )
     print(f"{'part':<36} {'calls':>6} {'ms/call':>8} {'ms/iteration':>13} {'share':>6}")
     for label, seconds in sorted(spent.items(), key=lambda item: -item[1]):
-        print(f"{label:<36} {calls[label]:>6} {1e3 * seconds / calls[label]:>8.2f} {1e3 * seconds / its:>13.2f} {seconds / wall:>6.0%}")
+        print(
+            f"{label:<36} {calls[label]:>6} {1e3 * seconds / calls[label]:>8.2f} {1e3 * seconds / its:>13.2f} {seconds / wall:>6.0%}"
+        )
     rest = wall - sum(spent.values())
     print(f"{'SLSQP itself (QP, line search)':<36} {'':>6} {'':>8} {1e3 * rest / its:>13.2f} {rest / wall:>6.0%}")
 

@@ -18,8 +18,8 @@ import time
 from pathlib import Path
 
 from excite_cli.config import load_problem
-from excite_cli.optimization.excitation import build_excitation
 from excite_cli.optimization.engine import Engine, default_workers
+from excite_cli.optimization.excitation import build_excitation
 from excite_cli.optimization.sequence import run_sequence
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -28,8 +28,8 @@ JOINTS = {
     7: [f"left_{j}_joint" for j in ARM],
     14: [f"{side}_{j}_joint" for side in ("left", "right") for j in ARM],
     23: [f"{side}_{j}_joint" for side in ("left", "right") for j in ARM]
-        + ["waist_yaw_joint", "waist_roll_joint", "waist_pitch_joint"]
-        + [f"{side}_hip_{axis}_joint" for side in ("left", "right") for axis in ("pitch", "roll", "yaw")],
+    + ["waist_yaw_joint", "waist_roll_joint", "waist_pitch_joint"]
+    + [f"{side}_hip_{axis}_joint" for side in ("left", "right") for axis in ("pitch", "roll", "yaw")],
 }
 CASES = [(7, 10, 40), (14, 10, 40), (23, 10, 40), (14, 5, 40), (14, 20, 40), (14, 10, 100)]
 
@@ -39,8 +39,10 @@ def one_iteration(joints: int, harmonics: int, samples: int) -> tuple[float, flo
     problem.robot.active_joints = JOINTS[joints]
     problem.robot.home_posture = {k: v for k, v in problem.robot.home_posture.items() if k in JOINTS[joints]}
     if joints == 23:  # the hip links sit in the pelvis's capsule and each other's at rest
-        problem.constraints.self_collision.ignore_links += ["pelvis_contour_link", *[
-            f"{side}_hip_{axis}_link" for side in ("left", "right") for axis in ("pitch", "roll", "yaw")]]
+        problem.constraints.self_collision.ignore_links += [
+            "pelvis_contour_link",
+            *[f"{side}_hip_{axis}_link" for side in ("left", "right") for axis in ("pitch", "roll", "yaw")],
+        ]
     problem.trajectory.harmonics = harmonics
     problem.trajectory.cost_samples = samples
     problem.trajectory.cost_period = 8.0 / samples
@@ -53,12 +55,17 @@ def one_iteration(joints: int, harmonics: int, samples: int) -> tuple[float, flo
 
 
 def main() -> None:
-    print(f"{'joints':>6} {'harmonics':>9} {'cost samples':>12} {'base params':>11} {'cond(C)':>8} {'wall [s]':>9} "
-          f"{'SQP iterations':>14} {'ms per SQP iteration':>20}")
+    print(
+        f"{'joints':>6} {'harmonics':>9} {'cost samples':>12} {'base params':>11} {'cond(C)':>8} {'wall [s]':>9} "
+        f"{'SQP iterations':>14} {'ms per SQP iteration':>20}"
+    )
     for joints, harmonics, samples in CASES:
         wall, cond, count, iterations = one_iteration(joints, harmonics, samples)
-        print(f"{joints:>6} {harmonics:>9} {samples:>12} {count:>11} {cond:>8.1f} {wall:>9.1f} {iterations:>14} "
-              f"{1e3 * wall / max(iterations, 1) * min(default_workers(), 2):>20.0f}", flush=True)
+        print(
+            f"{joints:>6} {harmonics:>9} {samples:>12} {count:>11} {cond:>8.1f} {wall:>9.1f} {iterations:>14} "
+            f"{1e3 * wall / max(iterations, 1) * min(default_workers(), 2):>20.0f}",
+            flush=True,
+        )
 
 
 if __name__ == "__main__":

@@ -29,7 +29,9 @@ EXCITE = Path(sys.executable).with_name("excite")
 def run(config: Path, seed: int, threads: str, iterations: int | None, folder: Path) -> dict:
     """One `excite optimize` run; its figures from the result file."""
     out = folder / f"seed{seed}_{threads}.h5"
-    env = {k: v for k, v in os.environ.items() if k not in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")}
+    env = {
+        k: v for k, v in os.environ.items() if k not in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
+    }
     if threads != "default":
         env.update(OPENBLAS_NUM_THREADS=threads, OMP_NUM_THREADS=threads, MKL_NUM_THREADS=threads)
     argv = [str(EXCITE), "optimize", str(config), "--seed", str(seed), "--output", str(out), "--force"]
@@ -42,10 +44,15 @@ def run(config: Path, seed: int, threads: str, iterations: int | None, folder: P
         table = f["table"][()]
         groups = [f["iterations"][str(k)] for k in table["iteration"]]
         kept = [g["restarts"][str(g["restarts"].attrs["kept"])].attrs for g in groups]
-        return {"cond": list(table["cond_stacked"]), "excitation": float(table["excitation_stacked"][-1]),
-                "stop": [str(a["stop"]) for a in kept], "kkt": [float(a["kkt_residual"]) for a in kept],
-                "max_violation": max(float(g.attrs["max_violation"]) for g in groups),
-                "transitions": max(float(g.attrs.get("transition_max_violation", -np.inf)) for g in groups), "wall": wall}
+        return {
+            "cond": list(table["cond_stacked"]),
+            "excitation": float(table["excitation_stacked"][-1]),
+            "stop": [str(a["stop"]) for a in kept],
+            "kkt": [float(a["kkt_residual"]) for a in kept],
+            "max_violation": max(float(g.attrs["max_violation"]) for g in groups),
+            "transitions": max(float(g.attrs.get("transition_max_violation", -np.inf)) for g in groups),
+            "wall": wall,
+        }
 
 
 def main() -> None:
@@ -57,21 +64,28 @@ def main() -> None:
     args = parser.parse_args()
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
-        print("| seed | BLAS threads | cond(C) after each iteration | ē [Nm] | stop (kept restart) | KKT residual | max violation "
-              "(grid / transitions) | wall [s] |")
+        print(
+            "| seed | BLAS threads | cond(C) after each iteration | ē [Nm] | stop (kept restart) | KKT residual | max violation "
+            "(grid / transitions) | wall [s] |"
+        )
         print("|---|---|---|---|---|---|---|---|")
         for seed in args.seeds:
             for threads in args.threads:
                 r = run(args.config.resolve(), seed, threads, args.iterations, Path(tmp))
                 rows.append(r)
-                print(f"| {seed} | {threads} | {' / '.join(f'{c:.2f}' for c in r['cond'])} | {r['excitation']:.4g} | "
-                      f"{'; '.join(r['stop'])} | {' / '.join(f'{k:.1e}' for k in r['kkt'])} | "
-                      f"{r['max_violation']:+.1e} / {r['transitions']:+.1e} | {r['wall']:.1f} |", flush=True)
+                print(
+                    f"| {seed} | {threads} | {' / '.join(f'{c:.2f}' for c in r['cond'])} | {r['excitation']:.4g} | "
+                    f"{'; '.join(r['stop'])} | {' / '.join(f'{k:.1e}' for k in r['kkt'])} | "
+                    f"{r['max_violation']:+.1e} / {r['transitions']:+.1e} | {r['wall']:.1f} |",
+                    flush=True,
+                )
     last = np.array([r["cond"][-1] for r in rows])
     walls = np.array([r["wall"] for r in rows])
-    print(f"\nlast cond(C): median {np.median(last):.2f}, worst {last.max():.2f}, best {last.min():.2f} "
-          f"(worst within {100 * (last.max() / last.min() - 1):.1f} % of the best); wall: median {np.median(walls):.1f} s, "
-          f"worst {walls.max():.1f} s")
+    print(
+        f"\nlast cond(C): median {np.median(last):.2f}, worst {last.max():.2f}, best {last.min():.2f} "
+        f"(worst within {100 * (last.max() / last.min() - 1):.1f} % of the best); wall: median {np.median(walls):.1f} s, "
+        f"worst {walls.max():.1f} s"
+    )
 
 
 if __name__ == "__main__":

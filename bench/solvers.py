@@ -16,8 +16,8 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from excite_cli.config import load_problem, with_overrides
-from excite_cli.optimization.excitation import build_excitation
 from excite_cli.memory import keep_freed_memory
+from excite_cli.optimization.excitation import build_excitation
 from excite_cli.optimization.sequence import RestartTask
 from excite_cli.optimization.solvers import METHODS
 
@@ -34,14 +34,23 @@ def main() -> None:
     print("| method | seed | start cond | end cond | KKT residual | stop | end point | iterations | wall [s] |")
     print("|---|---|---|---|---|---|---|---|---|")
     for method in args.methods:
-        problem = with_overrides(load_problem(args.config), {"optimizer.method": method, "optimizer.max_iterations": args.iterations,
-                                                             "optimizer.objective": "log_cond"})
+        problem = with_overrides(
+            load_problem(args.config),
+            {
+                "optimizer.method": method,
+                "optimizer.max_iterations": args.iterations,
+                "optimizer.objective": "log_cond",
+            },
+        )
         excitation = build_excitation(problem)
         for seed in args.seeds:
             begin = time.perf_counter()
             r = RestartTask(1, 0, seed, np.zeros((0, excitation.base.count)))(excitation)
-            print(f"| {method} | {seed} | {np.exp(r.start_objective):.1f} | {np.exp(r.objective):.2f} | {r.optimality.residual:.1e} | "
-                  f"{r.stop} | {r.end} | {r.iterations} | {time.perf_counter() - begin:.1f} |", flush=True)
+            print(
+                f"| {method} | {seed} | {np.exp(r.start_objective):.1f} | {np.exp(r.objective):.2f} | {r.optimality.residual:.1e} | "
+                f"{r.stop} | {r.end} | {r.iterations} | {time.perf_counter() - begin:.1f} |",
+                flush=True,
+            )
 
 
 if __name__ == "__main__":

@@ -9,35 +9,47 @@ import typer
 from rich.console import Console
 from rich.markup import escape
 
-from excite_cli.console import tables
 from excite_cli.config import load_problem, with_overrides
-from excite_cli.identification.config import IdentifyProblem, SimulationConfig
-from excite_cli.optimization.criterion import OBJECTIVES
-from excite_cli.errors import ExciteError, Interrupted
-from excite_cli.storage.export import FORMATS, export_to_file
-from excite_cli.identification.validate import validate_model
+from excite_cli.console import identification as identify_tables
+from excite_cli.console import tables
+from excite_cli.console.errors import spellings, word
 from excite_cli.console.progress import Bars, wide_console
+from excite_cli.errors import ExciteError, Interrupted
+from excite_cli.identification.config import IdentifyProblem, SimulationConfig
+from excite_cli.identification.validate import validate_model
+from excite_cli.optimization.criterion import OBJECTIVES
+from excite_cli.storage.export import FORMATS, export_to_file
 from excite_cli.workflows import run_compare_random, run_identify, run_optimize, run_verify, simulate_runs
 
 app = typer.Typer(add_completion=False, no_args_is_help=True)
 out, err = wide_console(), wide_console(stderr=True)
 FORCE = typer.Option(False, "--force", help="Replace existing output files.")
-WORKERS = typer.Option(None, "--workers", help="Local processes for restarts and draws (optimizer.workers; default: the cores).")
-SCHEDULER = typer.Option(None, "--scheduler", help="Dask scheduler address, e.g. tcp://host:8786 (optimizer.scheduler).")
+WORKERS = typer.Option(
+    None, "--workers", help="Local processes for restarts and draws (optimizer.workers; default: the cores)."
+)
+SCHEDULER = typer.Option(
+    None, "--scheduler", help="Dask scheduler address, e.g. tcp://host:8786 (optimizer.scheduler)."
+)
 
 
 def command(name: Optional[str] = None) -> Callable:
     """A command of ``app``: ExciteError → one line, exit 2 (no traceback); Ctrl-C → what was kept, exit 130."""
+
     def register(function: Callable) -> Callable:
         @functools.wraps(function)
         def guarded(*args, **kwargs):
             try:
                 return function(*args, **kwargs)
-            except (ExciteError, Interrupted) as exc:
-                user = isinstance(exc, ExciteError)
-                err.print(f"[bold red]error:[/] {escape(str(exc))}" if user else str(exc), highlight=False, soft_wrap=True)
-                raise typer.Exit(2 if user else 130) from None
+            except ExciteError as exc:
+                err.print(f"[bold red]error:[/] {escape(word(exc, spelled))}", highlight=False, soft_wrap=True)
+                raise typer.Exit(2) from None
+            except Interrupted as exc:
+                err.print(str(exc), highlight=False, soft_wrap=True)
+                raise typer.Exit(130) from None
+
+        spelled = spellings(function)
         return app.command(name)(guarded)
+
     return register
 
 
@@ -55,49 +67,98 @@ def _version(show: bool) -> None:
 
 
 @app.callback()
-def main(version: bool = typer.Option(False, "--version", callback=_version, is_eager=True, help="Print the version and exit.")) -> None:
+def main(
+    version: bool = typer.Option(
+        False, "--version", callback=_version, is_eager=True, help="Print the version and exit."
+    ),
+) -> None:
     """Persistently exciting trajectories for robot dynamic identification (Ayusawa et al. 2017)."""
 
 
 @command()
-def optimize(config: Path = typer.Argument(..., help="Problem YAML file (see README 'Config reference')."),
-             output: Optional[Path] = typer.Option(None, "--output", "-o", help="HDF5 result file (overrides config 'output')."),
-             iterations: Optional[int] = typer.Option(None, "--iterations", "-k", help="Sequential iterations (sequence.iterations)."),
-             seed: Optional[int] = typer.Option(None, "--seed", help="Seed of the random starts (optimizer.seed)."),
-             workers: Optional[int] = WORKERS, scheduler: Optional[str] = SCHEDULER, force: bool = FORCE,
-             resume: bool = typer.Option(False, "--resume", help="Continue the iterations already in the output file.")) -> None:
+def optimize(
+    config: Path = typer.Argument(..., help="Problem YAML file (see README 'Config reference')."),
+    output: Optional[Path] = typer.Option(None, "--output", "-o", help="HDF5 result file (overrides config 'output')."),
+    iterations: Optional[int] = typer.Option(
+        None, "--iterations", "-k", help="Sequential iterations (sequence.iterations)."
+    ),
+    seed: Optional[int] = typer.Option(None, "--seed", help="Seed of the random starts (optimizer.seed)."),
+    workers: Optional[int] = WORKERS,
+    scheduler: Optional[str] = SCHEDULER,
+    force: bool = FORCE,
+    resume: bool = typer.Option(False, "--resume", help="Continue the iterations already in the output file."),
+) -> None:
     """Optimize Fourier trajectories minimizing cond(C), sequentially; the result is rewritten after every iteration."""
-    problem = with_overrides(load_problem(config), {"sequence.iterations": iterations, "optimizer.seed": seed,
-                                                    "optimizer.workers": workers, "optimizer.scheduler": scheduler})
+    problem = with_overrides(
+        load_problem(config),
+        {
+            "sequence.iterations": iterations,
+            "optimizer.seed": seed,
+            "optimizer.workers": workers,
+            "optimizer.scheduler": scheduler,
+        },
+    )
     with Bars(err) as bars:
         run = run_optimize(problem, output or Path(problem.output), force, resume, *bars.iterations(problem))
-    _say(tables.iterations(run.results, problem.optimizer.objective), f"wrote {run.target} and {', '.join(str(p) for p in run.plots)}")
+    _say(
+        tables.iterations(run.results, problem.optimizer.objective),
+        f"wrote {run.target} and {', '.join(str(p) for p in run.plots)}",
+    )
 
 
 @command("compare-random")
-def compare_random(config: Path = typer.Argument(..., help="Problem YAML file."),
-                   optimized: Optional[Path] = typer.Option(None, "--optimized", help="Optimized result to compare with; computed when not given."),
-                   output: Optional[Path] = typer.Option(None, "--output", "-o", help="Random selection HDF5 (default: <output>_random.h5)."),
-                   pool: Optional[int] = typer.Option(None, "--pool", help="Feasible random candidates (random_baseline.pool_size)."),
-                   seed: Optional[int] = typer.Option(None, "--seed", help="Seed of the candidates (random_baseline.seed)."),
-                   equal_effort: bool = typer.Option(False, "--equal-effort", help="Draw for as long as the optimizer took."),
-                   workers: Optional[int] = WORKERS, scheduler: Optional[str] = SCHEDULER, force: bool = FORCE) -> None:
-    """The conventional baseline (ref. [16]): random feasible trajectories, greedy selection, beside the optimized ones."""
-    problem = with_overrides(load_problem(config), {"random_baseline.pool_size": pool, "random_baseline.seed": seed,
-                                                    "optimizer.workers": workers, "optimizer.scheduler": scheduler})
+def compare_random(
+    config: Path = typer.Argument(..., help="Problem YAML file."),
+    optimized: Optional[Path] = typer.Option(
+        None, "--optimized", help="Optimized result to compare with; computed when not given."
+    ),
+    output: Optional[Path] = typer.Option(
+        None, "--output", "-o", help="Random selection HDF5 (default: <output>_random.h5)."
+    ),
+    pool: Optional[int] = typer.Option(None, "--pool", help="Feasible random candidates (random_baseline.pool_size)."),
+    seed: Optional[int] = typer.Option(None, "--seed", help="Seed of the candidates (random_baseline.seed)."),
+    equal_effort: bool = typer.Option(False, "--equal-effort", help="Draw for as long as the optimizer took."),
+    workers: Optional[int] = WORKERS,
+    scheduler: Optional[str] = SCHEDULER,
+    force: bool = FORCE,
+) -> None:
+    """The conventional baseline (ref. [16]): random feasible trajectories, greedy selection, beside the optimum."""
+    problem = with_overrides(
+        load_problem(config),
+        {
+            "random_baseline.pool_size": pool,
+            "random_baseline.seed": seed,
+            "optimizer.workers": workers,
+            "optimizer.scheduler": scheduler,
+        },
+    )
     with Bars(err) as bars:
         progress = bars.iterations(problem)[0] if optimized is None else None
-        comparison = run_compare_random(problem, optimized, output, equal_effort, force, progress,
-                                             bars.draws(None if equal_effort else problem.random_baseline.pool_size))
+        comparison = run_compare_random(
+            problem,
+            optimized,
+            output,
+            equal_effort,
+            force,
+            progress,
+            bars.draws(None if equal_effort else problem.random_baseline.pool_size),
+        )
     _say(tables.comparison(comparison), f"wrote {comparison.target} and {comparison.plot}")
 
 
 @command("verify-gradient")
-def verify_gradient(config: Path = typer.Argument(..., help="Problem YAML file."),
-                    result: Optional[Path] = typer.Option(None, "--result", "-r", help="Also check at the last optimum of this result."),
-                    step: float = typer.Option(1e-6, help="Finite-difference step [rad]."), seed: int = typer.Option(0, help="Seed of the random α."),
-                    objective: Optional[list[str]] = typer.Option(None, "--objective", help=f"Criteria (repeatable; default all: {', '.join(OBJECTIVES)})."),
-                    tolerance: float = typer.Option(1e-6, help="Largest relative error against central differences that passes.")) -> None:
+def verify_gradient(
+    config: Path = typer.Argument(..., help="Problem YAML file."),
+    result: Optional[Path] = typer.Option(
+        None, "--result", "-r", help="Also check at the last optimum of this result."
+    ),
+    step: float = typer.Option(1e-6, help="Finite-difference step [rad]."),
+    seed: int = typer.Option(0, help="Seed of the random α."),
+    objective: Optional[list[str]] = typer.Option(
+        None, "--objective", help=f"Criteria (repeatable; default all: {', '.join(OBJECTIVES)})."
+    ),
+    tolerance: float = typer.Option(1e-6, help="Largest relative error against central differences that passes."),
+) -> None:
     """Analytic gradients (Eq. 49) and constraint Jacobians against finite differences; exit 1 above the tolerance."""
     verification = run_verify(load_problem(config), result, objective or OBJECTIVES, step, seed)
     _say(tables.verification(verification, tolerance))
@@ -106,44 +167,67 @@ def verify_gradient(config: Path = typer.Argument(..., help="Problem YAML file."
 
 
 @command()
-def identify(config: Path = typer.Argument(..., help="Identification YAML: robot, data, preprocessing, identification."),
-             output: Optional[Path] = typer.Option(None, "--output", "-o", help="HDF5 report (overrides config 'output')."),
-             physical_consistency: bool = typer.Option(False, "--physical-consistency", help="Also fit physically consistent parameters."),
-             urdf_out: Optional[Path] = typer.Option(None, "--urdf-out", help="Write the identified URDF (implies --physical-consistency)."), force: bool = FORCE) -> None:
+def identify(
+    config: Path = typer.Argument(..., help="Identification YAML: robot, data, preprocessing, identification."),
+    output: Optional[Path] = typer.Option(None, "--output", "-o", help="HDF5 report (overrides config 'output')."),
+    physical_consistency: bool = typer.Option(
+        False, "--physical-consistency", help="Also fit physically consistent parameters."
+    ),
+    urdf_out: Optional[Path] = typer.Option(
+        None, "--urdf-out", help="Write the identified URDF (implies --physical-consistency)."
+    ),
+    force: bool = FORCE,
+) -> None:
     """Identify base parameters (Eq. 4), trace the residual to missing effects, report the error before/after."""
-    problem = with_overrides(load_problem(config, IdentifyProblem), {"identification.physical_consistency": physical_consistency or None})
+    problem = with_overrides(
+        load_problem(config, IdentifyProblem), {"identification.physical_consistency": physical_consistency or None}
+    )
     with err.status("preprocessing, fitting and selecting effects ..."):
         run = run_identify(problem, output or Path(problem.output), urdf_out, force)
-    _say(tables.preprocessing_notes(run.report), console=err)
-    _say(tables.identification(run.report), [tables.bodies(run.report, run.robot)] if run.report.consistent else [],
-         [f"wrote {urdf_out}: its RNEA matches the identified rigid-body torques to {run.urdf_deviation:.1e} Nm"] if urdf_out else [],
-         f"wrote {run.target} and {', '.join(str(p) for p in run.plots)}")
+    _say(identify_tables.preprocessing_notes(run.report), console=err)
+    _say(
+        identify_tables.identification(run.report),
+        [identify_tables.bodies(run.report, run.robot)] if run.report.consistent else [],
+        [f"wrote {urdf_out}: its RNEA matches the identified rigid-body torques to {run.urdf_deviation:.1e} Nm"]
+        if urdf_out
+        else [],
+        f"wrote {run.target} and {', '.join(str(p) for p in run.plots)}",
+    )
 
 
 @command()
-def export(result: Path = typer.Argument(..., help="An optimize (or compare-random) HDF5 result."),
-           iteration: Optional[int] = typer.Option(None, "--iteration", "-k", help="Iteration (default: the last)."),
-           rate: float = typer.Option(1000.0, "--rate", help="Controller rate [Hz]."), periods: int = typer.Option(1, "--periods", help="Periods to play."),
-           fmt: str = typer.Option("csv", "--format", help=f"File format: {' or '.join(FORMATS)}."),
-           force: bool = FORCE, output: Optional[Path] = typer.Option(None, "--output", "-o", help="File to write (default: beside the result).")) -> None:
+def export(
+    result: Path = typer.Argument(..., help="An optimize (or compare-random) HDF5 result."),
+    iteration: Optional[int] = typer.Option(None, "--iteration", "-k", help="Iteration (default: the last)."),
+    rate: float = typer.Option(1000.0, "--rate", help="Controller rate [Hz]."),
+    periods: int = typer.Option(1, "--periods", help="Periods to play."),
+    fmt: str = typer.Option("csv", "--format", help=f"File format: {' or '.join(FORMATS)}."),
+    force: bool = FORCE,
+    output: Optional[Path] = typer.Option(None, "--output", "-o", help="File to write (default: beside the result)."),
+) -> None:
     """Write a trajectory as a robot plays it: home → P periods → home, at the controller's rate, with torques."""
     exported, target = export_to_file(result, iteration, rate, periods, fmt, output, force)
     _say(tables.export_lines(exported, rate), f"wrote {target}")
 
 
 @command()
-def validate(report: Path = typer.Argument(..., help="An identify report (HDF5)."),
-             config: Path = typer.Argument(..., help="Identification YAML whose data.runs are scored (roles ignored).")) -> None:
+def validate(
+    report: Path = typer.Argument(..., help="An identify report (HDF5)."),
+    config: Path = typer.Argument(..., help="Identification YAML whose data.runs are scored (roles ignored)."),
+) -> None:
     """Score an identified model on other runs: torque error per run and joint, on data its fit never saw."""
     problem = load_problem(config, IdentifyProblem)
     with err.status("preprocessing and predicting ..."):
-        _say(tables.validation(report.name, problem.robot.active_joints, validate_model(report, problem)))
+        _say(identify_tables.validation(report.name, problem.robot.active_joints, validate_model(report, problem)))
 
 
 @command()
-def simulate(result: Path = typer.Argument(..., help="An optimize (or compare-random) result: its trajectories are simulated."),
-             effects: Path = typer.Argument(..., help="Effects file (YAML): effects, noise, sample rate, jitter."),
-             output_dir: Path = typer.Option(Path("results/simulated"), "--output-dir", "-o", help="Folder for the CSV runs."), force: bool = FORCE) -> None:
+def simulate(
+    result: Path = typer.Argument(..., help="An optimize (or compare-random) result: its trajectories are simulated."),
+    effects: Path = typer.Argument(..., help="Effects file (YAML): effects, noise, sample rate, jitter."),
+    output_dir: Path = typer.Option(Path("results/simulated"), "--output-dir", "-o", help="Folder for the CSV runs."),
+    force: bool = FORCE,
+) -> None:
     """Measured-like CSV runs (one per iteration) of a result, with the effects and noise of an effects file."""
     files = simulate_runs(result, load_problem(effects, SimulationConfig), output_dir, force=force)
     _say("wrote " + ", ".join(str(f) for f in files))

@@ -6,6 +6,7 @@ Every field is documented in README.md ("Config reference") with its unit and de
 
 from __future__ import annotations
 
+import functools
 import math
 from pathlib import Path
 from typing import Literal, Optional, Union
@@ -13,10 +14,9 @@ from typing import Literal, Optional, Union
 import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
-from excite_cli.errors import ExciteError
+from excite_cli.errors import ExciteError, FileNotFound
 
 PerJoint = Union[float, dict[str, float]]
-
 
 #: Largest number of harmonics N (the paper uses 5-10; the memory grows with N × grid instants).
 MAX_HARMONICS = 100
@@ -127,8 +127,11 @@ class OptimizerConfig(Section):
     def planned_iterations(self) -> int:
         """Solver iterations one sequential iteration runs at most (all starts and restarts)."""
         screen = min(self.screen_iterations, self.max_iterations)
-        return (self.screened * screen + self.restarts * (self.max_iterations - screen) if self.screened
-                else self.restarts * self.max_iterations)
+        return (
+            self.screened * screen + self.restarts * (self.max_iterations - screen)
+            if self.screened
+            else self.restarts * self.max_iterations
+        )
 
     method: Literal["SLSQP", "trust-constr", "ipopt"] = "SLSQP"
     objective: Literal["log_cond", "cond", "log_det", "sigma_min"] = "log_cond"
@@ -181,8 +184,10 @@ class Problem(Section):
             )
         instants = self.trajectory.duration / self.trajectory.constraint_period
         if instants > MAX_GRID:
-            raise ValueError(f"trajectory.constraint_period: the constraint grid would have {instants:.0f} instants "
-                             f"(at most {MAX_GRID}; the fine check has {self.limits.check_refinement}× more)")
+            raise ValueError(
+                f"trajectory.constraint_period: the constraint grid would have {instants:.0f} instants "
+                f"(at most {MAX_GRID}; the fine check has {self.limits.check_refinement}× more)"
+            )
         return self
 
     def resolve(self, path: str) -> Path:
@@ -206,14 +211,11 @@ def with_overrides(config: BaseModel, overrides: dict[str, object]) -> BaseModel
         if value is None:
             continue
         *parents, last = dotted.split(".")
-        node = data
-        for part in parents:
-            node = node[part]
-        node[last] = value
+        functools.reduce(dict.__getitem__, parents, data)[last] = value
     try:
         copy = type(config).model_validate(data)
     except ValidationError as error:
-        raise ExciteError(_format_validation_error(Path("command line"), error)) from None
+        raise _validation_error(Path("command line"), error) from None
     for name in ("source_path", "source_text"):
         if name in type(config).model_fields:
             setattr(copy, name, getattr(config, name))
@@ -225,7 +227,7 @@ def effective_yaml(config: BaseModel) -> str:
     return yaml.safe_dump(config.model_dump(mode="json"), sort_keys=False, allow_unicode=True)
 
 
-def _format_validation_error(path: Path, error: ValidationError) -> str:
+def _validation_error(path: Path, error: ValidationError) -> ExciteError:
     first = error.errors()[0]
     field = ".".join(str(part) for part in first["loc"]) or "(top level)"
     message = first["msg"].removeprefix("Value error, ")
@@ -237,7 +239,7 @@ def _format_validation_error(path: Path, error: ValidationError) -> str:
         message = f"{message} (got {first.get('input')!r})"
     more = len(error.errors()) - 1
     suffix = f" (+{more} more problem{'s' if more > 1 else ''})" if more else ""
-    return f"{path}: {field}: {message}{suffix}"
+    return ExciteError(field, f"{message}{suffix}", first.get("input"), source=path)
 
 
 class _UniqueKeyLoader(yaml.SafeLoader):
@@ -268,25 +270,30 @@ def load_problem(path: str | Path, kind: type[BaseModel] = Problem):
     """
     path = Path(path)
     if not path.is_file():
-        raise ExciteError(f"config file not found: {path}")
+        raise FileNotFound("config", path, "config file")
     try:
         text = path.read_text(encoding="utf-8")
     except UnicodeDecodeError:
-        raise ExciteError(f"{path}: not a text (UTF-8) file; expected a YAML config") from None
+        raise ExciteError("config", f"{path} is not a text (UTF-8) file", path, "a YAML config") from None
     except OSError as exc:
-        raise ExciteError(f"{path}: cannot read the config: {exc.strerror}") from None
+        raise ExciteError("config", f"cannot read {path}: {exc.strerror}", path) from None
     try:
         raw = yaml.load(text, Loader=_UniqueKeyLoader)
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        raise ExciteError(f"{path}: malformed YAML{where}: {getattr(exc, 'problem', exc)}") from None
+        raise ExciteError("config", f"{path}: malformed YAML{where}: {getattr(exc, 'problem', exc)}", path) from None
     if not isinstance(raw, dict):
-        raise ExciteError(f"{path}: {'empty file; ' if raw is None else ''}expected a mapping of sections (see README 'Config reference')")
+        raise ExciteError(
+            "config",
+            f"{path}: {'empty file' if raw is None else 'not a mapping'}",
+            path,
+            "a mapping of sections (see README 'Config reference')",
+        )
     try:
         problem = kind.model_validate(raw)
     except ValidationError as exc:
-        raise ExciteError(_format_validation_error(path, exc)) from None
+        raise _validation_error(path, exc) from None
     if hasattr(problem, "source_path"):
         problem.source_path = path.resolve()
         problem.source_text = text

@@ -15,11 +15,22 @@ UR5 = {
     "robot": {
         "urdf": "ur_description/urdf/ur5_robot.urdf",
         "source": "example-robot-data",
-        "active_joints": ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint",
-                          "wrist_1_joint", "wrist_2_joint", "wrist_3_joint"],
+        "active_joints": [
+            "shoulder_pan_joint",
+            "shoulder_lift_joint",
+            "elbow_joint",
+            "wrist_1_joint",
+            "wrist_2_joint",
+            "wrist_3_joint",
+        ],
     },
-    "trajectory": {"harmonics": 4, "base_frequency": 0.5, "cost_samples": 30, "cost_period": 0.3,
-                   "constraint_period": 0.05},
+    "trajectory": {
+        "harmonics": 4,
+        "base_frequency": 0.5,
+        "cost_samples": 30,
+        "cost_period": 0.3,
+        "constraint_period": 0.05,
+    },
     "limits": {"position_margin": 0.1, "acceleration": 4.0},
 }
 

@@ -8,8 +8,8 @@ import numpy as np
 import pinocchio as pin
 import pytest
 import yaml
-
 from conftest import CONFIGS, write_config
+
 from excite_cli.collision.capsules import capsule_placements, fit_capsule, segment_closest_points
 from excite_cli.config import load_problem
 from excite_cli.errors import ExciteError
@@ -39,7 +39,9 @@ def panda():
 
 def _lively(excitation, seed):
     """A start that moves a lot: the joint-limit start at 90 % fill, not shrunk for the others."""
-    return excitation.limits.random_start(excitation.trajectory.n_coefficients, np.random.default_rng(seed), 0.9, excitation.home)
+    return excitation.limits.random_start(
+        excitation.trajectory.n_coefficients, np.random.default_rng(seed), 0.9, excitation.home
+    )
 
 
 @pytest.mark.parametrize("name", ["com_region", "self_collision"])
@@ -69,7 +71,9 @@ def test_closed_form_distances_and_witness_points_equal_coal(robot, request):
             exact = constraint._distance(rotations, centres, t, p)
             assert d[t, p] == pytest.approx(exact.min_distance, abs=1e-9)
             np.testing.assert_allclose(c1[:, t, p] + radii[i] * normal[:, t, p], exact.getNearestPoint1(), atol=1e-6)
-            np.testing.assert_allclose(c1[:, t, p] + (d[t, p] + radii[i]) * normal[:, t, p], exact.getNearestPoint2(), atol=1e-6)
+            np.testing.assert_allclose(
+                c1[:, t, p] + (d[t, p] + radii[i]) * normal[:, t, p], exact.getNearestPoint2(), atol=1e-6
+            )
 
 
 @pytest.mark.parametrize("robot", ["panda", "g1"])
@@ -88,7 +92,7 @@ def test_batched_kinematics_equal_pinocchio(robot, request):
         point, normal = p[t, -1] + [0.1, -0.05, 0.2], np.array([0.6, 0.0, 0.8])
         J = pin.getJointJacobian(model, data, model.njoints - 1, pin.LOCAL_WORLD_ALIGNED)[:, excitation.robot.v_idx]
         expected = normal @ (J[:3] - pin.skew(point - p[t, -1]) @ J[3:])
-        got = kinematics.distance_rates(R[t:t + 1], p[t:t + 1], point[:, None, None], normal[:, None, None])
+        got = kinematics.distance_rates(R[t : t + 1], p[t : t + 1], point[:, None, None], normal[:, None, None])
         np.testing.assert_allclose(got[0, 0] * kinematics.ancestors[-1], expected, atol=1e-12)
 
 
@@ -99,13 +103,19 @@ def segment_distances(p1, q1, p2, q2):
 
 def test_segment_distance_closed_forms():
     z = np.zeros(3)
-    assert segment_distances(z, np.array([1.0, 0, 0]), np.array([0.5, 1, 0]), np.array([0.5, 2, 0])) == pytest.approx(1.0)
-    assert segment_distances(z, np.array([1.0, 0, 0]), np.array([2.0, 0, 0]), np.array([3.0, 0, 0])) == pytest.approx(1.0)
+    assert segment_distances(z, np.array([1.0, 0, 0]), np.array([0.5, 1, 0]), np.array([0.5, 2, 0])) == pytest.approx(
+        1.0
+    )
+    assert segment_distances(z, np.array([1.0, 0, 0]), np.array([2.0, 0, 0]), np.array([3.0, 0, 0])) == pytest.approx(
+        1.0
+    )
     assert segment_distances(z, z, np.array([0, 3.0, 4.0]), np.array([0, 3.0, 4.0])) == pytest.approx(5.0)
     point = np.array([0.5, 2.0, 0.0])
     assert segment_distances(z, np.array([1.0, 0, 0]), point, point) == pytest.approx(2.0)
     assert segment_distances(point, point, z, np.array([1.0, 0, 0])) == pytest.approx(2.0)
-    skew = segment_distances(np.array([-1.0, 0, 0]), np.array([1.0, 0, 0]), np.array([0, -1.0, 2]), np.array([0, 1.0, 2]))
+    skew = segment_distances(
+        np.array([-1.0, 0, 0]), np.array([1.0, 0, 0]), np.array([0, -1.0, 2]), np.array([0, 1.0, 2])
+    )
     assert skew == pytest.approx(2.0)
 
 
@@ -113,7 +123,15 @@ def test_fitted_capsule_covers_its_points():
     rng = np.random.default_rng(0)
     points = rng.normal(size=(500, 3)) * [0.2, 0.03, 0.02] + [0.1, -0.2, 0.3]
     radius, start, end = fit_capsule(points)
-    assert segment_distances(np.broadcast_to(start[:, None], points.T.shape), np.broadcast_to(end[:, None], points.T.shape), points.T, points.T).max() <= radius + 1e-12
+    assert (
+        segment_distances(
+            np.broadcast_to(start[:, None], points.T.shape),
+            np.broadcast_to(end[:, None], points.T.shape),
+            points.T,
+            points.T,
+        ).max()
+        <= radius + 1e-12
+    )
     assert np.linalg.norm(end - start) > 0.5  # along the long axis
 
 

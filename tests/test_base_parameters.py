@@ -15,8 +15,12 @@ def test_base_regressor_reproduces_rnea(name, request):
     Q, QD, QDD = robot.random_states(15, np.random.default_rng(123))
     for q, qd, qdd in zip(Q, QD, QDD):
         tau = robot.torques(q, qd, qdd)
-        np.testing.assert_allclose(robot.regressor(q, qd, qdd) @ base.composition_matrix @ phi_b, tau,
-                                   rtol=1e-8, atol=1e-8 * (1 + np.abs(tau).max()))
+        np.testing.assert_allclose(
+            robot.regressor(q, qd, qdd) @ base.composition_matrix @ phi_b,
+            tau,
+            rtol=1e-8,
+            atol=1e-8 * (1 + np.abs(tau).max()),
+        )
 
 
 @pytest.mark.parametrize("name", ["panda_problem", "ur5_problem"])

@@ -2,8 +2,8 @@
 
 import numpy as np
 import pytest
-
 from conftest import CONFIGS, small
+
 from excite_cli.config import load_problem
 from excite_cli.errors import ExciteError
 from excite_cli.optimization.excitation import build_excitation
@@ -69,8 +69,12 @@ def test_chained_gradient_matches_finite_differences_in_the_coordinates():
     _, grad = criterion.value_and_gradient(boundary.to_alpha(z))
     analytic = boundary.chain(grad.ravel())
     h = 1e-6
-    numeric = np.array([(criterion.value(boundary.to_alpha(z + h * e)) - criterion.value(boundary.to_alpha(z - h * e))) / (2 * h)
-                        for e in np.eye(z.size)])
+    numeric = np.array(
+        [
+            (criterion.value(boundary.to_alpha(z + h * e)) - criterion.value(boundary.to_alpha(z - h * e))) / (2 * h)
+            for e in np.eye(z.size)
+        ]
+    )
     assert np.linalg.norm(analytic - numeric) / np.linalg.norm(numeric) < 1e-6
 
 

@@ -3,17 +3,17 @@ polygon region, the units stored in the HDF5 result, and the random pool's count
 
 import h5py
 import numpy as np
+from conftest import CONFIGS, UR5, write_config
 from typer.testing import CliRunner
 
-from conftest import CONFIGS, UR5, write_config
 from excite_cli.cli import app
 from excite_cli.config import load_problem
 from excite_cli.constraints.com_region import ComRegion
-from excite_cli.optimization.engine import Engine
-from excite_cli.optimization.excitation import build_excitation
 from excite_cli.identification.dataset import Dataset
 from excite_cli.identification.least_squares import least_squares
 from excite_cli.identification.normal import NormalEquations
+from excite_cli.optimization.engine import Engine
+from excite_cli.optimization.excitation import build_excitation
 from excite_cli.optimization.random_baseline import DrawTask, draw_pool
 from excite_cli.optimization.verify import constraint_jacobian_error
 
@@ -41,17 +41,27 @@ def test_com_polygon_region():
     robot = excitation.robot
     com = robot.com(excitation.home)[0][:2]
     square = lambda half: com + half * np.array([[1, 1], [-1, 1], [-1, -1], [1, -1]])  # noqa: E731
-    alpha = excitation.limits.random_start(excitation.trajectory.n_coefficients, np.random.default_rng(1), 0.5, excitation.home)
+    alpha = excitation.limits.random_start(
+        excitation.trajectory.n_coefficients, np.random.default_rng(1), 0.5, excitation.home
+    )
     excursion = np.abs(np.array([robot.com(q)[0][:2] for q in excitation.grid_basis.evaluate(alpha)[0]]) - com).max()
     wide = ComRegion(robot, excitation.grid_basis, com, polygon=square(2.0 * excursion))
     narrow = ComRegion(robot, excitation.grid_basis, com, polygon=square(0.5 * excursion))
-    assert wide.check(alpha, excitation.grid_basis).max_violation < 0 < narrow.check(alpha, excitation.grid_basis).max_violation
+    assert (
+        wide.check(alpha, excitation.grid_basis).max_violation
+        < 0
+        < narrow.check(alpha, excitation.grid_basis).max_violation
+    )
     assert constraint_jacobian_error(narrow, alpha) < 1e-6
 
 
 def test_result_datasets_carry_their_units(tmp_path):
-    data = {**UR5, "trajectory": {**UR5["trajectory"], "harmonics": 3, "cost_samples": 20, "cost_period": 0.4},
-            "optimizer": {"max_iterations": 5, "restarts": 1}, "sequence": {"iterations": 1}}
+    data = {
+        **UR5,
+        "trajectory": {**UR5["trajectory"], "harmonics": 3, "cost_samples": 20, "cost_period": 0.4},
+        "optimizer": {"max_iterations": 5, "restarts": 1},
+        "sequence": {"iterations": 1},
+    }
     out = tmp_path / "u.h5"
     assert CliRunner().invoke(app, ["optimize", str(write_config(tmp_path, data)), "-o", str(out)]).exit_code == 0
     with h5py.File(out) as f:

@@ -3,9 +3,9 @@
 import copy
 
 import pytest
+from conftest import UR5, write_config
 from typer.testing import CliRunner
 
-from conftest import UR5, write_config
 from excite_cli.cli import app
 from excite_cli.config import load_problem
 from excite_cli.errors import ExciteError
@@ -48,7 +48,14 @@ def test_negative_period_names_the_field(tmp_path):
         (lambda d: d["limits"].update(acceleration=-1.0), "limits.acceleration"),
         (lambda d: d["robot"].update(urdf="nowhere/robot.urdf"), "robot.urdf"),
         (lambda d: d["robot"].update(locked_joints={"shoulder_pan_joint": 0.0}), "robot.locked_joints"),
-        (lambda d: d["sequence"].update(prior="missing.h5") if "sequence" in d else d.update(sequence={"prior": "missing.h5"}), "sequence.prior"),
+        (
+            lambda d: (
+                d["sequence"].update(prior="missing.h5")
+                if "sequence" in d
+                else d.update(sequence={"prior": "missing.h5"})
+            ),
+            "sequence.prior",
+        ),
     ],
 )
 def test_bad_fields_are_named(tmp_path, edit, field):

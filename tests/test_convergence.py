@@ -8,16 +8,24 @@ import copy
 import h5py
 import numpy as np
 import pytest
+from conftest import UR5, write_config
 from scipy.optimize import nnls
 from typer.testing import CliRunner
 
-from conftest import UR5, write_config
 from excite_cli.cli import app
 from excite_cli.config import load_problem
 from excite_cli.optimization.excitation import build_excitation
-from excite_cli.optimization.optimality import (ACTIVE_TOLERANCE, CONVERGED, SOLVER_FAILED, STALLED, STILL_IMPROVING, Optimality,
-                                   kkt_optimality, stop_reason)
-from excite_cli.optimization.optimizer import _Evaluations, _accepted, project, repair
+from excite_cli.optimization.optimality import (
+    ACTIVE_TOLERANCE,
+    CONVERGED,
+    SOLVER_FAILED,
+    STALLED,
+    STILL_IMPROVING,
+    Optimality,
+    kkt_optimality,
+    stop_reason,
+)
+from excite_cli.optimization.optimizer import _accepted, _Evaluations, project, repair
 
 runner = CliRunner()
 
@@ -44,7 +52,9 @@ def test_stop_reasons():
     assert stop_reason(near, flat, limit=True, failed=True, tolerance=1e-3) == CONVERGED
     assert stop_reason(far, falling, limit=True, failed=False, tolerance=1e-3) == STILL_IMPROVING
     assert stop_reason(far, flat, limit=True, failed=False, tolerance=1e-3) == STALLED
-    assert stop_reason(far, falling, limit=False, failed=False, tolerance=1e-3) == STALLED  # the solver's own test, not KKT
+    assert (
+        stop_reason(far, falling, limit=False, failed=False, tolerance=1e-3) == STALLED
+    )  # the solver's own test, not KKT
     assert stop_reason(far, falling, limit=False, failed=True, tolerance=1e-3) == SOLVER_FAILED
 
 
@@ -61,8 +71,13 @@ def _fd_kkt(excitation, prior, alpha, step=1e-6):
     in the optimizer's variables by central differences, the multipliers by NNLS."""
     boundary, criterion = excitation.boundary, excitation.criterion(prior)
     z = boundary.to_variables(alpha)
-    gradient = np.array([(criterion.value(boundary.to_alpha(z + step * e)) - criterion.value(boundary.to_alpha(z - step * e))) / (2 * step)
-                         for e in np.eye(z.size)])
+    gradient = np.array(
+        [
+            (criterion.value(boundary.to_alpha(z + step * e)) - criterion.value(boundary.to_alpha(z - step * e)))
+            / (2 * step)
+            for e in np.eye(z.size)
+        ]
+    )
     parts = [c.evaluate(boundary.to_alpha(z)) for c in excitation.constraints]
     values = np.concatenate([g for g, _ in parts])
     jacobian = boundary.chain(np.vstack([J for _, J in parts]))
@@ -141,7 +156,7 @@ def test_excitation_level_is_the_scaled_standard_regressor_and_does_not_depend_o
     Q, QD, QDD = excitation.cost_basis.evaluate(alpha)
     Y = robot.regressor_stack(Q, QD, QDD)  # the standard regressor, independent of any base
     d = parameter_magnitudes(robot)
-    truth = np.exp(np.log(np.linalg.svd(Y * d, compute_uv=False)[:base.count]).mean())
+    truth = np.exp(np.log(np.linalg.svd(Y * d, compute_uv=False)[: base.count]).mean())
     C = Y[:, base.independent]
     assert excitation_level(C, base, d) == pytest.approx(truth, rel=1e-8)
     T = np.eye(base.count) + 0.3 * np.random.default_rng(1).standard_normal((base.count, base.count))

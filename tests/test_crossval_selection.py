@@ -16,7 +16,9 @@ PHI = np.array([1.5, -0.7, 0.4])
 
 def _smooth(rng, size, cutoff_steps=40):
     """(size,) a smooth random signal (moving average of noise)."""
-    return np.convolve(rng.normal(0, 1, size + cutoff_steps), np.ones(cutoff_steps) / np.sqrt(cutoff_steps), "valid")[:size]
+    return np.convolve(rng.normal(0, 1, size + cutoff_steps), np.ones(cutoff_steps) / np.sqrt(cutoff_steps), "valid")[
+        :size
+    ]
 
 
 def dataset(effects: dict[Term, float], cfg: IdentificationConfig, noise: float = 0.02, seed: int = 0) -> Dataset:
@@ -35,7 +37,9 @@ def dataset(effects: dict[Term, float], cfg: IdentificationConfig, noise: float 
         if term.effect == "offset":
             blocks[term] = np.vstack([run_offset_columns(r, [0, 1], N_RUN, 2) for r in (0, 1)])
         else:
-            blocks[term] = effect_columns(term.effect, q[:, term.joint], qd[:, term.joint], qdd[:, term.joint], 0.01, term.shape)
+            blocks[term] = effect_columns(
+                term.effect, q[:, term.joint], qd[:, term.joint], qdd[:, term.joint], 0.01, term.shape
+            )
     tau = (Y @ PHI).reshape(-1, n) + rng.normal(0, noise, (N, n))
     for term, value in effects.items():
         tau[:, term.joint] += blocks[term] @ np.atleast_1d(value)
@@ -78,12 +82,16 @@ def test_fold_errors_equal_explicit_weighted_refits():
 
 
 def test_search_finds_the_true_effects_and_shape_and_lowers_its_objective_at_every_step():
-    cfg = IdentificationConfig(candidates=["coulomb", "viscous", "held", "offset", "armature"], held_velocity=[0.05, 0.1, 0.2, 0.4])
+    cfg = IdentificationConfig(
+        candidates=["coulomb", "viscous", "held", "offset", "armature"], held_velocity=[0.05, 0.1, 0.2, 0.4]
+    )
     truth = {Term("coulomb", 0): 0.5, Term("held", 1, 0.2): 0.3, Term("viscous", 1): 0.4}
     selection = select_effects(dataset(truth, cfg), cfg, [], margin=0.05)
     assert set(selection.terms) == set(truth)
     for k, term in enumerate(selection.terms):
-        assert selection.fit.x[B + k] == pytest.approx(truth[term], abs=max(0.03 * truth[term], 3 * selection.fit.std[B + k]))
+        assert selection.fit.x[B + k] == pytest.approx(
+            truth[term], abs=max(0.03 * truth[term], 3 * selection.fit.std[B + k])
+        )
     for search in selection.searches:
         models = [search.initial] + [step.terms for step in search.steps]
         errors = [search.initial_error] + [step.cv_error for step in search.steps]
@@ -92,7 +100,9 @@ def test_search_finds_the_true_effects_and_shape_and_lowers_its_objective_at_eve
         assert objectives[-1] == pytest.approx(search.objective) and models[-1] == search.terms
         for step, before, error in zip(search.steps, models, errors):  # each step's model is its move applied
             assert (step.term in step.terms) != (step.move == "remove") and len(set(step.terms) ^ set(before)) in (1, 2)
-            assert step.before == error and (step.move != "add" or step.gain > 100 * (1 - 1 / (1 + cfg.min_improvement)))
+            assert step.before == error and (
+                step.move != "add" or step.gain > 100 * (1 - 1 / (1 + cfg.min_improvement))
+            )
     assert selection.searches[selection.chosen].objective == min(s.objective for s in selection.searches)
 
 

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 import scipy.io
 
-from excite_cli.identification.config import IdentifyProblem
 from excite_cli.errors import ExciteError
+from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.measurements import load_run
 
 JOINTS = [f"panda_joint{k}" for k in range(1, 8)]
@@ -21,10 +21,16 @@ KT = np.array([2.0, 2.5, 1.5, 3.0, 0.5, 0.8, 1.2])
 
 
 def _load(tmp_path: Path, name: str, columns: dict, **data):
-    problem = IdentifyProblem.model_validate({
-        "robot": {"urdf": "panda_description/urdf/panda.urdf", "source": "example-robot-data", "active_joints": JOINTS},
-        "data": {"runs": [{"file": name}], "columns": columns, **data},
-    })
+    problem = IdentifyProblem.model_validate(
+        {
+            "robot": {
+                "urdf": "panda_description/urdf/panda.urdf",
+                "source": "example-robot-data",
+                "active_joints": JOINTS,
+            },
+            "data": {"runs": [{"file": name}], "columns": columns, **data},
+        }
+    )
     problem.source_path = tmp_path / "identify.yaml"
     return load_run(problem.data.runs[0], problem.data, problem, 7)
 
@@ -41,21 +47,39 @@ def _check(run, dropped=0):
 
 def test_headerless_csv_with_currents_and_torque_constants(tmp_path):
     np.savetxt(tmp_path / "run.csv", np.column_stack([TIME, TAU / KT, Q]), delimiter=",", fmt="%.17g")
-    run = _load(tmp_path, "run.csv", {"time": 0, "q": list(range(8, 15)), "current": list(range(1, 8))},
-                torque_constants=KT.tolist())
+    run = _load(
+        tmp_path,
+        "run.csv",
+        {"time": 0, "q": list(range(8, 15)), "current": list(range(1, 8))},
+        torque_constants=KT.tolist(),
+    )
     _check(run)
 
 
 def test_npz_and_mat_runs(tmp_path):
     np.savez(tmp_path / "run.npz", t=TIME, q=Q, tau=TAU)
-    _check(_load(tmp_path, "run.npz", {"time": "t", "q": [f"q[{k}]" for k in range(7)], "tau": [f"tau[{k}]" for k in range(7)]}))
+    _check(
+        _load(
+            tmp_path,
+            "run.npz",
+            {"time": "t", "q": [f"q[{k}]" for k in range(7)], "tau": [f"tau[{k}]" for k in range(7)]},
+        )
+    )
     scipy.io.savemat(tmp_path / "run.mat", {"t": TIME, "Q": Q.T, "tau": TAU})  # Q stored joints × samples
-    _check(_load(tmp_path, "run.mat", {"time": "t", "q": [f"Q[{k}]" for k in range(7)], "tau": [f"tau[{k}]" for k in range(7)]}))
+    _check(
+        _load(
+            tmp_path,
+            "run.mat",
+            {"time": "t", "q": [f"Q[{k}]" for k in range(7)], "tau": [f"tau[{k}]" for k in range(7)]},
+        )
+    )
 
 
 def test_semicolon_csv_with_header(tmp_path):
     header = ";".join(["time"] + [f"q{k}" for k in range(7)] + [f"t{k}" for k in range(7)])
-    np.savetxt(tmp_path / "run.csv", np.column_stack([TIME, Q, TAU]), delimiter=";", header=header, comments="", fmt="%.17g")
+    np.savetxt(
+        tmp_path / "run.csv", np.column_stack([TIME, Q, TAU]), delimiter=";", header=header, comments="", fmt="%.17g"
+    )
     _check(_load(tmp_path, "run.csv", {"q": [f"q{k}" for k in range(7)], "tau": [f"t{k}" for k in range(7)]}))
 
 
@@ -88,12 +112,15 @@ def test_corrupt_rows_stop_with_file_and_line_or_are_dropped_and_counted(tmp_pat
     _check(_load(tmp_path, "run.csv", columns, bad_rows="drop"), dropped=2)
 
 
-@pytest.mark.parametrize("name, content, message", [
-    ("run.csv", bytes(range(256)) * 4, "is not a text file"),
-    ("run.npz", b"not a zip archive", "cannot read run.npz as NPZ"),
-    ("run.h5", b"not HDF5 at all", "cannot read run.h5 as H5"),
-    ("run.csv", b"", "has no data rows"),
-])
+@pytest.mark.parametrize(
+    "name, content, message",
+    [
+        ("run.csv", bytes(range(256)) * 4, "is not a text file"),
+        ("run.npz", b"not a zip archive", "cannot read run.npz as NPZ"),
+        ("run.h5", b"not HDF5 at all", "cannot read run.h5 as H5"),
+        ("run.csv", b"", "has no data rows"),
+    ],
+)
 def test_unreadable_files_give_one_message(tmp_path, name, content, message):
     (tmp_path / name).write_bytes(content)
     with pytest.raises(ExciteError, match=message):

@@ -9,9 +9,9 @@ import pytest
 import excite_cli.optimization.engine as engine_module
 from excite_cli.config import load_problem
 from excite_cli.errors import ExciteError
+from excite_cli.optimization.engine import Engine
 from excite_cli.optimization.excitation import build_excitation
 from excite_cli.optimization.optimizer import RestartResult, best_restart
-from excite_cli.optimization.engine import Engine
 from excite_cli.optimization.random_baseline import draw_pool
 from excite_cli.optimization.sequence import RestartTask, run_sequence
 
@@ -47,7 +47,9 @@ def test_two_workers_give_the_serial_result(excitation, serial):
 
 def test_dask_local_cluster_gives_the_serial_result(excitation, serial):
     distributed = pytest.importorskip("dask.distributed")
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None) as cluster:
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None
+    ) as cluster:
         with Engine(excitation, scheduler=cluster.scheduler_address) as engine:
             on_cluster = run_sequence(excitation, 2, seed=5, engine=engine)
             pool_on_cluster = draw_pool(engine, 30, seed=2)

@@ -3,11 +3,11 @@
 import numpy as np
 import pinocchio as pin
 import pytest
-
 from conftest import small
+
+from excite_cli.dynamics.virtual_dynamics import VirtualDynamics
 from excite_cli.optimization.criterion import Criterion, condition_number, objective_terms
 from excite_cli.optimization.excitation import build_excitation
-from excite_cli.dynamics.virtual_dynamics import VirtualDynamics
 from excite_cli.optimization.verify import check_gradient, finite_difference_gradient
 
 
@@ -39,10 +39,13 @@ def test_gradient_with_prior_rows_and_base_wrench_rows(g1_problem):
     assert check.error_central < 1e-6
 
 
-@pytest.mark.parametrize("objective, expected", [
-    ("sigma_min", lambda s: -np.log(s[-1])),
-    ("log_det", lambda s: -np.sum(np.log(s**2)) / s.size),
-])
+@pytest.mark.parametrize(
+    "objective, expected",
+    [
+        ("sigma_min", lambda s: -np.log(s[-1])),
+        ("log_det", lambda s: -np.sum(np.log(s**2)) / s.size),
+    ],
+)
 def test_d_and_e_optimal_values(panda_problem, objective, expected):
     excitation = build_excitation(small(panda_problem))
     criterion = Criterion(excitation.robot, excitation.base, excitation.cost_basis, objective=objective)
@@ -69,7 +72,9 @@ def test_condition_number_is_infinite_at_rank_loss():
     assert condition_number(np.ones((2, 3))) == float("inf")
 
 
-@pytest.mark.parametrize("objective, expected", [("cond", 1e14), ("log_cond", np.log(1e14)), ("sigma_min", -np.log(2e-14))])
+@pytest.mark.parametrize(
+    "objective, expected", [("cond", 1e14), ("log_cond", np.log(1e14)), ("sigma_min", -np.log(2e-14))]
+)
 def test_rank_loss_is_floored_to_finite_values_and_gradient_weights(objective, expected):
     """σ_min = 0 (λ = 0 of CᵀC): σ_min is floored at 1e-14 σ_max = 2e-14, so value and the gradient's
     coefficients a_r are finite."""
@@ -109,7 +114,9 @@ def test_mass_shift_changes_no_torque_with_the_motion(name, base_rows, request):
     problem.robot.base_wrench_rows = base_rows
     robot = build_excitation(problem).robot
     dynamics = VirtualDynamics(robot)
-    assert dynamics.model.nv == robot.n_joints + (6 if base_rows else 0)  # the held base is locked unless its wrench is a row
+    assert dynamics.model.nv == robot.n_joints + (
+        6 if base_rows else 0
+    )  # the held base is locked unless its wrench is a row
     models, datas = dynamics._virtual_models(np.zeros((robot.n_parameters, 1)))
     assert len(models) == 1 and all(models[0].inertias[j].mass > 0.5 for j in range(1, models[0].njoints))
     for q, qd, qdd in zip(*robot.random_states(5, np.random.default_rng(0))):

@@ -9,11 +9,12 @@ import numpy as np
 import pinocchio as pin
 import pytest
 import yaml
+from conftest import CONFIGS, write_config
 from typer.testing import CliRunner
 
-from conftest import CONFIGS, write_config
 from excite_cli.cli import app
 from excite_cli.config import load_problem
+from excite_cli.dynamics.robot import load_robot
 from excite_cli.identification.config import DEFAULT_CANDIDATES, IdentifyProblem, PreprocessingConfig, SimulationConfig
 from excite_cli.identification.dataset import run_offset_columns
 from excite_cli.identification.effects import COEFFICIENTS, EFFECT_NAMES, POSITION, SHAPE_FIELDS, SHAPES, effect_columns
@@ -21,9 +22,8 @@ from excite_cli.identification.measurements import Run, load_run
 from excite_cli.identification.pipeline import effect_values, run_identification
 from excite_cli.identification.preprocessing import MIN_CUTOFF, Filter, choose_cutoff
 from excite_cli.identification.validate import validate_model
-from excite_cli.dynamics.robot import load_robot
-from excite_cli.workflows.simulate import simulate_runs
 from excite_cli.trajectory.fourier import FourierTrajectory
+from excite_cli.workflows.simulate import simulate_runs
 
 runner = CliRunner()
 HERE = Path(__file__).resolve().parent
@@ -75,7 +75,10 @@ def test_asymmetric_coulomb_gives_direction_dependent_levels():
     qd = np.array([-1.0, 1.0])
     fc, fa = 0.5, 0.1
     z = np.zeros(2)
-    tau = fc * effect_columns("coulomb", z, qd, z, 0.01)[:, 0] + fa * effect_columns("coulomb_asymmetric", z, qd, z, 0.01)[:, 0]
+    tau = (
+        fc * effect_columns("coulomb", z, qd, z, 0.01)[:, 0]
+        + fa * effect_columns("coulomb_asymmetric", z, qd, z, 0.01)[:, 0]
+    )
     assert tau == pytest.approx([-(fc - fa), fc + fa])
 
 
@@ -86,9 +89,16 @@ def test_run_offsets_are_indicators_or_the_mean_for_an_unfitted_run():
 
 def test_default_cutoff_from_the_fitted_runs_hann_spectrum():
     rate, t = 1000.0, np.arange(0, 12.0, 0.001)
-    moving = lambda f, crop: Run("m", "fit", t[: int(crop * rate)], np.column_stack([np.sin(2 * np.pi * f * t[: int(crop * rate)])] * 2),  # noqa: E731
-                                None, None, np.zeros((int(crop * rate), 2)))
-    static = Run("s", "validation", t, np.random.default_rng(0).normal(0, 1e-3, (t.size, 2)), None, None, np.zeros((t.size, 2)))
+
+    def moving(f, crop):
+        n = int(crop * rate)
+        return Run(
+            "m", "fit", t[:n], np.column_stack([np.sin(2 * np.pi * f * t[:n])] * 2), None, None, np.zeros((n, 2))
+        )
+
+    static = Run(
+        "s", "validation", t, np.random.default_rng(0).normal(0, 1e-3, (t.size, 2)), None, None, np.zeros((t.size, 2))
+    )
     cfg = PreprocessingConfig()
     # a 0.8 Hz motion cropped mid-period: 10 x its bandwidth, within the spectrum's resolution (2 bins
     # of 1/7.3 s); the static, noisy validation run has no bandwidth and is not looked at (with it:
@@ -114,13 +124,25 @@ def optimized(tmp_path_factory):
 def _simulate_and_identify(tmp: Path, optimized: Path, effects: dict, candidates: list | None = None, **sim_extra):
     # 8 periods per run and time blocks in every run: ~720 independent held-out samples per joint
     # at the 5 Hz cut-off, so each joint's RMS is known to ~2.6 % (1 sigma)
-    sim = {"sample_rate": 500, "periods": 8, "timestamp_jitter": 0.1, "torque_noise": NOISE, "seed": 4, "effects": effects, **sim_extra}
-    result = runner.invoke(app, ["simulate", str(optimized), str(write_config(tmp, sim, "effects.yaml")), "-o", str(tmp), "--force"])
+    sim = {
+        "sample_rate": 500,
+        "periods": 8,
+        "timestamp_jitter": 0.1,
+        "torque_noise": NOISE,
+        "seed": 4,
+        "effects": effects,
+        **sim_extra,
+    }
+    result = runner.invoke(
+        app, ["simulate", str(optimized), str(write_config(tmp, sim, "effects.yaml")), "-o", str(tmp), "--force"]
+    )
     assert result.exit_code == 0, result.output
     config = {
         "robot": {"urdf": "panda_description/urdf/panda.urdf", "source": "example-robot-data", "active_joints": JOINTS},
-        "data": {"runs": [{"file": f"run_{k}.csv", "role": "blocks"} for k in (1, 2, 3)],
-                 "columns": {"q": [f"q_{j}" for j in JOINTS], "tau": [f"tau_{j}" for j in JOINTS]}},
+        "data": {
+            "runs": [{"file": f"run_{k}.csv", "role": "blocks"} for k in (1, 2, 3)],
+            "columns": {"q": [f"q_{j}" for j in JOINTS], "tau": [f"tau_{j}" for j in JOINTS]},
+        },
         "output": str(tmp / "ident.h5"),
     }
     if candidates is not None:
@@ -184,8 +206,12 @@ def test_each_undeclared_effect_is_named_with_its_value_and_shape(tmp_path, opti
     effects, shapes = NEW_EFFECTS[case]
     opt_in = list(DEFAULT_CANDIDATES) + [case] if case in POSITION else None
     report, *_ = _simulate_and_identify(tmp_path, optimized, effects, opt_in, **shapes)
-    truth = {(e, c, j): v for e, per_joint in effects.items() for j, value in per_joint.items()
-             for c, v in zip(COEFFICIENTS[e], np.atleast_1d(value))}
+    truth = {
+        (e, c, j): v
+        for e, per_joint in effects.items()
+        for j, value in per_joint.items()
+        for c, v in zip(COEFFICIENTS[e], np.atleast_1d(value))
+    }
     found = _found(report)
     assert {(e, j) for e, _, j in found} == {(e, j) for e, _, j in truth}, found
     for (effect, coefficient, joint), (value, std, shape) in found.items():
@@ -199,16 +225,32 @@ def test_offsets_per_run_and_a_known_payload(tmp_path, optimized):
     """Two runs with different torque offsets on joint 3 and a 1.5 kg payload on the flange in the
     first: the payload's torque (pinocchio RNEA with the payload added to link 7, independent of
     the regressor the identification uses) is taken out, and each run gets its own offset."""
-    payload = {"mass": 1.5, "com": [0.0, 0.02, 0.1], "inertia": [0.004, 0.0, 0.004, 0.0, 0.0, 0.002], "frame": "panda_hand"}
+    payload = {
+        "mass": 1.5,
+        "com": [0.0, 0.02, 0.1],
+        "inertia": [0.004, 0.0, 0.004, 0.0, 0.0, 0.002],
+        "frame": "panda_hand",
+    }
     for prefix, offset in (("a", 0.4), ("b", -0.3)):
-        simulate_runs(optimized, SimulationConfig(sample_rate=500, periods=8, torque_noise=NOISE, seed=len(prefix + str(offset)),
-                                                  effects={"offset": {"panda_joint3": offset}}), tmp_path, prefix)
+        simulate_runs(
+            optimized,
+            SimulationConfig(
+                sample_rate=500,
+                periods=8,
+                torque_noise=NOISE,
+                seed=len(prefix + str(offset)),
+                effects={"offset": {"panda_joint3": offset}},
+            ),
+            tmp_path,
+            prefix,
+        )
     robot = load_robot(load_problem(CONFIGS / "panda.yaml"))
     loaded = robot.model.copy()
     frame = loaded.frames[loaded.getFrameId("panda_hand")]
     xx, xy, yy, xz, yz, zz = payload["inertia"]
-    loaded.inertias[frame.parentJoint] += frame.placement.act(pin.Inertia(1.5, np.array(payload["com"]),
-                                                                            np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])))
+    loaded.inertias[frame.parentJoint] += frame.placement.act(
+        pin.Inertia(1.5, np.array(payload["com"]), np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]]))
+    )
     table = np.loadtxt(tmp_path / "a_1.csv", delimiter=",", skiprows=1)
     with h5py.File(optimized) as f:
         problem = yaml.safe_load(f.attrs["config"])
@@ -216,13 +258,27 @@ def test_offsets_per_run_and_a_known_payload(tmp_path, optimized):
         alpha = f["iterations/1/alpha"][()]
     q, qd, qdd = trajectory.basis(table[:, 0]).evaluate(alpha)
     data = loaded.createData()
-    extra = np.array([pin.rnea(loaded, data, *robot.state(*x)) - robot.torques(*x) for x in zip(q, qd, qdd)])[:, robot.v_idx]
+    extra = np.array([pin.rnea(loaded, data, *robot.state(*x)) - robot.torques(*x) for x in zip(q, qd, qdd)])[
+        :, robot.v_idx
+    ]
     table[:, 8:] += extra
-    np.savetxt(tmp_path / "a_1.csv", table, delimiter=",", header=(tmp_path / "b_1.csv").read_text().splitlines()[0], comments="")
-    config = {"robot": {"urdf": "panda_description/urdf/panda.urdf", "source": "example-robot-data", "active_joints": JOINTS},
-              "data": {"runs": [{"file": "a_1.csv", "role": "blocks", "payload": payload}, {"file": "b_1.csv", "role": "blocks"}],
-                       "columns": {"q": [f"q_{j}" for j in JOINTS], "tau": [f"tau_{j}" for j in JOINTS]}}}
-    report, robot, base, _ = run_identification(load_problem(write_config(tmp_path, config, "two.yaml"), IdentifyProblem))
+    np.savetxt(
+        tmp_path / "a_1.csv",
+        table,
+        delimiter=",",
+        header=(tmp_path / "b_1.csv").read_text().splitlines()[0],
+        comments="",
+    )
+    config = {
+        "robot": {"urdf": "panda_description/urdf/panda.urdf", "source": "example-robot-data", "active_joints": JOINTS},
+        "data": {
+            "runs": [{"file": "a_1.csv", "role": "blocks", "payload": payload}, {"file": "b_1.csv", "role": "blocks"}],
+            "columns": {"q": [f"q_{j}" for j in JOINTS], "tau": [f"tau_{j}" for j in JOINTS]},
+        },
+    }
+    report, robot, base, _ = run_identification(
+        load_problem(write_config(tmp_path, config, "two.yaml"), IdentifyProblem)
+    )
     found = _found(report)
     assert {(e, j) for e, _, j in found} == {("offset", "panda_joint3")}, found
     values = {c: (v, s) for (_, c, _), (v, s, _) in found.items()}
@@ -241,7 +297,9 @@ def test_identify_command_writes_report_and_prior(tmp_path, optimized):
     _simulate_and_identify(tmp_path, optimized, effects)
     config = yaml.safe_load((tmp_path / "identify.yaml").read_text())
     config["identification"] = {"declared_effects": {"panda_joint1": ["viscous"]}}  # not in the data
-    result = runner.invoke(app, ["identify", str(write_config(tmp_path, config, "identify.yaml"))], env={"COLUMNS": "200"})
+    result = runner.invoke(
+        app, ["identify", str(write_config(tmp_path, config, "identify.yaml"))], env={"COLUMNS": "200"}
+    )
     assert result.exit_code == 0, result.output
     assert "before [Nm]" in result.output and "coulomb" in result.output and "Selection steps" in result.output
     with h5py.File(tmp_path / "ident.h5") as f:
@@ -273,8 +331,12 @@ def test_identify_command_writes_report_and_prior(tmp_path, optimized):
     assert (tmp_path / "ident_ladder.png").stat().st_size > 20000
     # the measured regressor serves as prior data C0 of optimize (Eq. 41)
     data = yaml.safe_load((HERE.parent / "configs" / "smoke.yaml").read_text())
-    data.update(sequence={"iterations": 1, "prior": str(tmp_path / "ident.h5")}, optimizer={"max_iterations": 10, "restarts": 1})
-    result = runner.invoke(app, ["optimize", str(write_config(tmp_path, data, "prior.yaml")), "-o", str(tmp_path / "p.h5")])
+    data.update(
+        sequence={"iterations": 1, "prior": str(tmp_path / "ident.h5")}, optimizer={"max_iterations": 10, "restarts": 1}
+    )
+    result = runner.invoke(
+        app, ["optimize", str(write_config(tmp_path, data, "prior.yaml")), "-o", str(tmp_path / "p.h5")]
+    )
     assert result.exit_code == 0, result.output
 
 
@@ -285,7 +347,10 @@ def _bad_csv(tmp_path, text: str, columns=None, crop=None):
         run["crop"] = crop
     config = {
         "robot": {"urdf": "panda_description/urdf/panda.urdf", "source": "example-robot-data", "active_joints": JOINTS},
-        "data": {"runs": [run], "columns": columns or {"q": [f"q{k}" for k in range(1, 8)], "tau": [f"t{k}" for k in range(1, 8)]}},
+        "data": {
+            "runs": [run],
+            "columns": columns or {"q": [f"q{k}" for k in range(1, 8)], "tau": [f"t{k}" for k in range(1, 8)]},
+        },
         "output": str(tmp_path / "out.h5"),
     }
     result = runner.invoke(app, ["identify", str(write_config(tmp_path, config, "bad.yaml"))])
@@ -310,16 +375,21 @@ def test_bad_data_gets_one_clear_message(tmp_path):
     assert "NaN or missing value in q at data row 6" in _bad_csv(tmp_path, _csv(3000, nan_at=5))
     assert "time is not strictly increasing at data row 11" in _bad_csv(tmp_path, _csv(3000, repeat_time_at=10))
     assert "data.columns.q: 6 columns for the robot's 7 active joints" in _bad_csv(
-        tmp_path, _csv(3000), {"q": [f"q{k}" for k in range(1, 7)], "tau": [f"t{k}" for k in range(1, 8)]})
+        tmp_path, _csv(3000), {"q": [f"q{k}" for k in range(1, 7)], "tau": [f"t{k}" for k in range(1, 8)]}
+    )
     assert "has no column 'q9'" in _bad_csv(
-        tmp_path, _csv(3000), {"q": [f"q{k}" for k in range(1, 7)] + ["q9"], "tau": [f"t{k}" for k in range(1, 8)]})
+        tmp_path, _csv(3000), {"q": [f"q{k}" for k in range(1, 7)] + ["q9"], "tau": [f"t{k}" for k in range(1, 8)]}
+    )
     assert "fewer than the" in _bad_csv(tmp_path, _csv(3000), crop=[0.0, 0.05])
 
 
 def test_unknown_joint_in_declared_effects(tmp_path):
     config = {
         "robot": {"urdf": "panda_description/urdf/panda.urdf", "source": "example-robot-data", "active_joints": JOINTS},
-        "data": {"runs": [{"file": "x.csv"}], "columns": {"q": [f"q{k}" for k in range(1, 8)], "tau": [f"t{k}" for k in range(1, 8)]}},
+        "data": {
+            "runs": [{"file": "x.csv"}],
+            "columns": {"q": [f"q{k}" for k in range(1, 8)], "tau": [f"t{k}" for k in range(1, 8)]},
+        },
         "identification": {"declared_effects": {"panda_joint9": ["viscous"]}},
     }
     (tmp_path / "x.csv").write_text(_csv(3000))
@@ -332,9 +402,14 @@ def test_unknown_joint_in_declared_effects(tmp_path):
 def test_real_panda_run(tmp_path):
     config = {
         "robot": {"urdf": "panda_description/urdf/panda.urdf", "source": "example-robot-data", "active_joints": JOINTS},
-        "data": {"runs": [{"file": str(SHARED / "exciting_traj_1.csv"), "role": "blocks"}],
-                 "columns": {"q": [f"q{k}" for k in range(1, 8)], "qd": [f"dq{k}" for k in range(1, 8)],
-                             "tau": [f"tau{k}" for k in range(1, 8)]}},
+        "data": {
+            "runs": [{"file": str(SHARED / "exciting_traj_1.csv"), "role": "blocks"}],
+            "columns": {
+                "q": [f"q{k}" for k in range(1, 8)],
+                "qd": [f"dq{k}" for k in range(1, 8)],
+                "tau": [f"tau{k}" for k in range(1, 8)],
+            },
+        },
     }
     report, *_ = run_identification(load_problem(write_config(tmp_path, config), IdentifyProblem))
     assert report.selection.terms  # real joints have friction
@@ -345,7 +420,9 @@ def test_real_panda_run(tmp_path):
 
 def _phase_split(cutoff):
     problem = load_problem(HERE.parent / "configs" / "panda_identify_phase.yaml", IdentifyProblem)
-    problem.data.runs = [run.model_copy(update={"file": str(SHARED / "exciting_traj_1.csv")}) for run in problem.data.runs]
+    problem.data.runs = [
+        run.model_copy(update={"file": str(SHARED / "exciting_traj_1.csv")}) for run in problem.data.runs
+    ]
     problem.preprocessing.cutoff = cutoff
     return run_identification(problem)[0]
 
@@ -386,17 +463,25 @@ def test_validate_scores_a_report_on_other_runs(tmp_path):
     result = runner.invoke(app, ["identify", str(tmp_path / "phase.yaml")], env={"COLUMNS": "200"})
     assert result.exit_code == 0, result.output
     # the held-out phase again: exactly identify's validation errors; the whole run: its own
-    config["data"]["runs"] = [{"file": str(SHARED / "exciting_traj_1.csv"), "crop": [7.8, 13.2]},
-                              {"file": str(SHARED / "exciting_traj_1.csv")}]
-    errors = validate_model(tmp_path / "phase.h5", load_problem(write_config(tmp_path, config, "val.yaml"), IdentifyProblem))
+    config["data"]["runs"] = [
+        {"file": str(SHARED / "exciting_traj_1.csv"), "crop": [7.8, 13.2]},
+        {"file": str(SHARED / "exciting_traj_1.csv")},
+    ]
+    errors = validate_model(
+        tmp_path / "phase.h5", load_problem(write_config(tmp_path, config, "val.yaml"), IdentifyProblem)
+    )
     np.testing.assert_allclose(errors[0].relative, report.relative_after, rtol=1e-9)
     assert errors[1].instants > 3 * errors[0].instants and errors[1].relative.mean() < report.relative_before.mean()
-    result = runner.invoke(app, ["validate", str(tmp_path / "phase.h5"), str(tmp_path / "val.yaml")], env={"COLUMNS": "200"})
+    result = runner.invoke(
+        app, ["validate", str(tmp_path / "phase.h5"), str(tmp_path / "val.yaml")], env={"COLUMNS": "200"}
+    )
     assert result.exit_code == 0 and "[7.8, 13.2] s" in result.output
     # a report of other joints, and a file that is not a report: one message each
     config["robot"]["active_joints"] = JOINTS[:6]
     config["data"]["columns"] = {"q": [f"q{k}" for k in range(1, 7)], "tau": [f"tau{k}" for k in range(1, 7)]}
-    result = runner.invoke(app, ["validate", str(tmp_path / "phase.h5"), str(write_config(tmp_path, config, "other.yaml"))])
+    result = runner.invoke(
+        app, ["validate", str(tmp_path / "phase.h5"), str(write_config(tmp_path, config, "other.yaml"))]
+    )
     assert result.exit_code == 2 and "other joints" in result.output
     result = runner.invoke(app, ["validate", str(HERE / "panda_capsules.yaml"), str(tmp_path / "val.yaml")])
     assert result.exit_code == 2 and "Traceback" not in result.output
@@ -408,15 +493,20 @@ def test_report_has_per_run_validation_errors(tmp_path):
     runs = config["data"]["runs"]
     for run in runs:
         run["file"] = str(SHARED / "exciting_traj_1.csv")
-    runs[2:] = [{"file": str(SHARED / "exciting_traj_1.csv"), "crop": crop, "role": "validation"}
-                for crop in ([7.8, 10.5], [10.5, 13.2])]  # the unseen phase as two runs
+    runs[2:] = [
+        {"file": str(SHARED / "exciting_traj_1.csv"), "crop": crop, "role": "validation"}
+        for crop in ([7.8, 10.5], [10.5, 13.2])
+    ]  # the unseen phase as two runs
     config["output"] = str(tmp_path / "r.h5")
     result = runner.invoke(app, ["identify", str(write_config(tmp_path, config, "r.yaml"))], env={"COLUMNS": "200"})
     assert result.exit_code == 0, result.output
     with h5py.File(tmp_path / "r.h5") as f:
         table = f["identification/validation_runs"][()]
         rms_after = f["identification/rms_after"][()]
-    assert [r.decode() for r in table["run"]] == ["exciting_traj_1.csv [7.8, 10.5] s", "exciting_traj_1.csv [10.5, 13.2] s"]
+    assert [r.decode() for r in table["run"]] == [
+        "exciting_traj_1.csv [7.8, 10.5] s",
+        "exciting_traj_1.csv [10.5, 13.2] s",
+    ]
     # the runs' mean squared errors, weighted by their instants, make up the whole validation's
     total = (table["instants"][:, None] * table["rms_after"] ** 2).sum(axis=0) / table["instants"].sum()
     np.testing.assert_allclose(np.sqrt(total), rms_after, rtol=1e-9)
@@ -427,7 +517,9 @@ def test_shipped_simulated_runs_give_back_their_undeclared_friction():
     every joint, undeclared in configs/panda_identify_simulated.yaml."""
     problem = load_problem(CONFIGS / "panda_identify_simulated.yaml", IdentifyProblem)
     report, *_ = run_identification(problem)
-    assert {(t.effect, report.joints[t.joint]) for t in report.selection.terms} == {(e, j) for e in ("coulomb", "viscous") for j in JOINTS}
+    assert {(t.effect, report.joints[t.joint]) for t in report.selection.terms} == {
+        (e, j) for e in ("coulomb", "viscous") for j in JOINTS
+    }
     for term, _, value, std in effect_values(report):
         assert value == pytest.approx({"coulomb": 0.6, "viscous": 0.4}[term.effect], rel=0.15), term
     assert report.relative_before.mean() > 30.0 and report.relative_after.mean() < 5.0

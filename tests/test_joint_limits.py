@@ -2,8 +2,8 @@
 
 import numpy as np
 import pytest
-
 from conftest import small
+
 from excite_cli.constraints.joint_limits import JointLimits
 from excite_cli.constraints.lse import GRID_MARGIN, SHARPNESS
 from excite_cli.optimization.excitation import build_excitation
@@ -27,7 +27,12 @@ def test_aggregate_is_conservative_and_tight(panda):
         alpha = limits.random_start(panda.trajectory.n_coefficients, rng, rng.uniform(0.3, 0.99))
         alpha[:, 1:] *= rng.uniform(0.8, 1.3)  # some beyond the limits
         g = limits.evaluate(alpha)[0].reshape(6, -1)
-        z = np.stack([(B @ alpha.T - limits.centre[d]) / limits.half[d] for d, B in enumerate((panda.grid_basis.q, panda.grid_basis.qd, panda.grid_basis.qdd))])
+        z = np.stack(
+            [
+                (B @ alpha.T - limits.centre[d]) / limits.half[d]
+                for d, B in enumerate((panda.grid_basis.q, panda.grid_basis.qd, panda.grid_basis.qdd))
+            ]
+        )
         exact = np.concatenate([z.max(axis=1) - 1.0, -z.min(axis=1) - 1.0])
         assert np.all(g >= exact + GRID_MARGIN - 1e-12)
         assert np.all(g <= exact + GRID_MARGIN + np.log(z.shape[1]) / SHARPNESS)

@@ -5,13 +5,13 @@ import copy
 import h5py
 import numpy as np
 import pytest
+from conftest import UR5, write_config
 from typer.testing import CliRunner
 
-from excite_cli.optimization.engine import Engine
-from conftest import UR5, write_config
 from excite_cli.cli import app
 from excite_cli.config import load_problem
 from excite_cli.dynamics.robot import load_robot
+from excite_cli.optimization.engine import Engine
 
 runner = CliRunner()
 

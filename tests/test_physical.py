@@ -9,27 +9,33 @@ import numpy as np
 import pinocchio as pin
 import pytest
 import yaml
+from conftest import CONFIGS, write_config
+from test_identification import JOINTS, SHARED, optimized  # noqa: F401  (module fixture)
 from typer.testing import CliRunner
 
-from conftest import CONFIGS, write_config
-from excite_cli.dynamics.base_parameters import compute_base_parameters
 from excite_cli.cli import app
 from excite_cli.config import load_problem
+from excite_cli.dynamics.base_parameters import compute_base_parameters
+from excite_cli.dynamics.robot import load_robot
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.physical import pseudo_inertia
 from excite_cli.identification.pipeline import run_identification
 from excite_cli.storage.results import problem_of_result, read_alphas
-from excite_cli.dynamics.robot import load_robot
 from excite_cli.trajectory.fourier import FourierTrajectory
-from test_identification import JOINTS, SHARED, optimized  # noqa: F401  (module fixture)
 
 runner = CliRunner()
 
 
 def _eigenvalues(phi: np.ndarray) -> np.ndarray:
     """Smallest pseudo-inertia eigenvalue of each body, from pinocchio's PseudoInertia (independent)."""
-    return np.array([np.linalg.eigvalsh(pin.Inertia.FromDynamicParameters(phi[10 * i: 10 * i + 10]).toPseudoInertia().toMatrix())[0]
-                     for i in range(phi.size // 10)])
+    return np.array(
+        [
+            np.linalg.eigvalsh(
+                pin.Inertia.FromDynamicParameters(phi[10 * i : 10 * i + 10]).toPseudoInertia().toMatrix()
+            )[0]
+            for i in range(phi.size // 10)
+        ]
+    )
 
 
 def test_pseudo_inertia_matches_pinocchio_and_tells_physical_bodies():
@@ -52,7 +58,9 @@ def test_real_panda_consistent_fit_and_its_urdf(tmp_path):
     config["data"]["runs"][0]["file"] = str(SHARED / "exciting_traj_1.csv")
     path = write_config(tmp_path, config, "identify.yaml")
     urdf, report = tmp_path / "panda_identified.urdf", tmp_path / "ident.h5"
-    run = runner.invoke(app, ["identify", str(path), "--urdf-out", str(urdf), "-o", str(report)], env={"COLUMNS": "200"})
+    run = runner.invoke(
+        app, ["identify", str(path), "--urdf-out", str(urdf), "-o", str(report)], env={"COLUMNS": "200"}
+    )
     assert run.exit_code == 0, run.output
     with h5py.File(report) as f:
         g = f["identification"]
@@ -83,17 +91,27 @@ def test_real_panda_consistent_fit_and_its_urdf(tmp_path):
 def _identify(tmp: Path, runs: list[str], consistency: bool = True):
     config = {
         "robot": {"urdf": "panda_description/urdf/panda.urdf", "source": "example-robot-data", "active_joints": JOINTS},
-        "data": {"runs": [{"file": f, "role": "blocks"} for f in runs],
-                 "columns": {"q": [f"q_{j}" for j in JOINTS], "tau": [f"tau_{j}" for j in JOINTS]}},
+        "data": {
+            "runs": [{"file": f, "role": "blocks"} for f in runs],
+            "columns": {"q": [f"q_{j}" for j in JOINTS], "tau": [f"tau_{j}" for j in JOINTS]},
+        },
         "identification": {"physical_consistency": consistency},
     }
     return run_identification(load_problem(write_config(tmp, config, "identify.yaml"), IdentifyProblem))
 
 
 def test_simulated_data_consistent_fit_recovers_the_base_parameters(tmp_path, optimized):  # noqa: F811
-    sim = {"sample_rate": 500, "periods": 8, "timestamp_jitter": 0.1, "torque_noise": 0.05, "seed": 4,
-           "effects": {"coulomb": {"*": 0.6}, "viscous": {"*": 0.4}}}
-    result = runner.invoke(app, ["simulate", str(optimized), str(write_config(tmp_path, sim, "effects.yaml")), "-o", str(tmp_path)])
+    sim = {
+        "sample_rate": 500,
+        "periods": 8,
+        "timestamp_jitter": 0.1,
+        "torque_noise": 0.05,
+        "seed": 4,
+        "effects": {"coulomb": {"*": 0.6}, "viscous": {"*": 0.4}},
+    }
+    result = runner.invoke(
+        app, ["simulate", str(optimized), str(write_config(tmp_path, sim, "effects.yaml")), "-o", str(tmp_path)]
+    )
     assert result.exit_code == 0, result.output
     report, robot, base, _ = _identify(tmp_path, [f"run_{k}.csv" for k in (1, 2, 3)])
     truth = base.from_standard(robot.urdf_parameters())

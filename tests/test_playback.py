@@ -5,14 +5,14 @@ import h5py
 import numpy as np
 import pinocchio as pin
 import pytest
+from conftest import CONFIGS
 from typer.testing import CliRunner
 
-from conftest import CONFIGS
 from excite_cli.cli import app
 from excite_cli.constraints import JointLimits
 from excite_cli.constraints.lse import GRID_MARGIN
-from excite_cli.optimization.playback import RESOLUTION, Transition, plan_transition
 from excite_cli.dynamics.robot import example_robot_data_root
+from excite_cli.optimization.playback import RESOLUTION, Transition, plan_transition
 from excite_cli.plots.skeleton import skeleton
 
 runner = CliRunner()
@@ -23,7 +23,7 @@ def _fourier_rates(alpha, omega, t):
     """q̇, q̈ (n,) of Eq. 50 at time t, written out independently of the library."""
     N = (alpha.shape[1] - 1) // 2
     k = np.arange(1, N + 1) * omega
-    a, b = alpha[:, 1:N + 1], alpha[:, N + 1:]
+    a, b = alpha[:, 1 : N + 1], alpha[:, N + 1 :]
     qd = (a * k * np.cos(k * t) - b * k * np.sin(k * t)).sum(axis=1)
     qdd = (-a * k**2 * np.sin(k * t) - b * k**2 * np.cos(k * t)).sum(axis=1)
     return qd, qdd
@@ -97,25 +97,44 @@ def test_export_at_1khz_plays_from_home_to_home_with_rnea_torques(panda_runs, tm
     # feed-forward torques against pinocchio's RNEA of the full URDF (fingers at 0) at random rows
     data = full.createData()
     for row in np.random.default_rng(0).choice(len(time), 25, replace=False):
-        expected = pin.rnea(full, data, np.r_[q[row], 0.0, 0.0], np.r_[qd[row], 0.0, 0.0], np.r_[qdd[row], 0.0, 0.0])[:n]
+        expected = pin.rnea(full, data, np.r_[q[row], 0.0, 0.0], np.r_[qd[row], 0.0, 0.0], np.r_[qdd[row], 0.0, 0.0])[
+            :n
+        ]
         assert np.allclose(tau[row], expected, rtol=1e-8, atol=1e-8)
     assert "every constraint holds" in run.output
 
 
 def test_export_npz_has_the_same_samples(panda_runs, tmp_path):
-    run = runner.invoke(app, ["export", str(panda_runs["rest"]), "-k", "1", "--rate", "200", "--format", "npz", "-o", str(tmp_path / "a.npz")])
+    run = runner.invoke(
+        app,
+        [
+            "export",
+            str(panda_runs["rest"]),
+            "-k",
+            "1",
+            "--rate",
+            "200",
+            "--format",
+            "npz",
+            "-o",
+            str(tmp_path / "a.npz"),
+        ],
+    )
     assert run.exit_code == 0, run.output
     data = np.load(tmp_path / "a.npz")
     assert list(data["joint_names"])[0] == "panda_joint1" and data["q"].shape == data["tau"].shape
     assert np.allclose(np.diff(data["time"]), 5e-3)
 
 
-@pytest.mark.parametrize("args, message", [
-    (["-k", "9"], "--iteration"),
-    (["--rate", "0"], "--rate"),
-    (["--periods", "0"], "--periods"),
-    (["--rate", "100000", "--periods", "1000"], "samples"),
-])
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["-k", "9"], "--iteration"),
+        (["--rate", "0"], "--rate"),
+        (["--periods", "0"], "--periods"),
+        (["--rate", "100000", "--periods", "1000"], "samples"),
+    ],
+)
 def test_export_rejects_bad_options_without_writing(panda_runs, tmp_path, args, message):
     target = tmp_path / "x.csv"
     run = runner.invoke(app, ["export", str(panda_runs["rest"]), *args, "-o", str(target)])
@@ -148,8 +167,11 @@ def test_rest_to_rest_transition_is_as_short_as_the_velocity_limit_allows():
     basis_time = np.linspace(0.0, 1.0, 3)
     from excite_cli.trajectory.fourier import FourierTrajectory
 
-    limits = JointLimits(np.array([[-3.0], [-1.0], [-100.0]]), np.array([[3.0], [1.0], [100.0]]),
-                         FourierTrajectory(1, 1.0).basis(basis_time))
+    limits = JointLimits(
+        np.array([[-3.0], [-1.0], [-100.0]]),
+        np.array([[3.0], [1.0], [100.0]]),
+        FourierTrajectory(1, 1.0).basis(basis_time),
+    )
     start, end = np.zeros((3, 1)), np.zeros((3, 1))
     end[0, 0] = 2.0
     transition = plan_transition(start, end, limits, "test")

@@ -8,9 +8,9 @@ import h5py
 import numpy as np
 import pytest
 import yaml
+from conftest import write_config
 from typer.testing import CliRunner
 
-from conftest import write_config
 from excite_cli.cli import app
 from excite_cli.config import load_problem
 from excite_cli.optimization.excitation import build_excitation
@@ -59,8 +59,9 @@ def test_candidates_fill_the_limits_and_hold_the_constraints():
 
 def test_compare_random_command(tmp_path):
     data = yaml.safe_load((HERE / "panda_capsules.yaml").read_text())
-    data.update(optimizer={"max_iterations": 30, "restarts": 1}, sequence={"iterations": 2},
-                output=str(tmp_path / "panda.h5"))
+    data.update(
+        optimizer={"max_iterations": 30, "restarts": 1}, sequence={"iterations": 2}, output=str(tmp_path / "panda.h5")
+    )
     config = write_config(tmp_path, data)
     result = CliRunner().invoke(app, ["compare-random", str(config), "--pool", "12"], env={"COLUMNS": "200"})
     assert result.exit_code == 0, result.output

@@ -4,7 +4,6 @@ equal to the same restarts in this process."""
 
 import copy
 import json
-import os
 import subprocess
 import sys
 import time
@@ -12,9 +11,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import UR5, write_config
 from threadpoolctl import threadpool_limits
 
-from conftest import UR5, write_config
 from excite_cli.config import load_problem
 from excite_cli.optimization.engine import Engine
 from excite_cli.optimization.excitation import build_excitation
@@ -27,7 +26,9 @@ def test_a_seed_gives_bit_identical_starts_with_one_and_two_blas_threads(g1_prob
     starts = {}
     for threads in (1, 2):
         with threadpool_limits(limits=threads):
-            starts[threads] = [excitation.random_start(RestartTask(1, r, seed, prior).rng()) for seed in (0, 1) for r in (0, 1)]
+            starts[threads] = [
+                excitation.random_start(RestartTask(1, r, seed, prior).rng()) for seed in (0, 1) for r in (0, 1)
+            ]
     for one, two in zip(starts[1], starts[2]):
         assert one.tobytes() == two.tobytes()
         assert all(c.accepts(one) for c in excitation.constraints)
@@ -40,13 +41,43 @@ def _dask(tmp_path: Path) -> tuple[list[subprocess.Popen], str]:
         pytest.skip("the dask command line is not installed beside this Python")
     file = tmp_path / "scheduler.json"
     quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL, "cwd": tmp_path}
-    processes = [subprocess.Popen([str(dask), "scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
-                                   "--scheduler-file", str(file)], **quiet)]
+    processes = [
+        subprocess.Popen(
+            [
+                str(dask),
+                "scheduler",
+                "--host",
+                "127.0.0.1",
+                "--port",
+                "0",
+                "--no-dashboard",
+                "--scheduler-file",
+                str(file),
+            ],
+            **quiet,
+        )
+    ]
     deadline = time.monotonic() + 60
     while not file.exists() and time.monotonic() < deadline:
         time.sleep(0.2)
-    processes.append(subprocess.Popen([str(dask), "worker", "--scheduler-file", str(file), "--nthreads", "1", "--nworkers", "2",
-                                       "--no-dashboard", "--host", "127.0.0.1"], **quiet))
+    processes.append(
+        subprocess.Popen(
+            [
+                str(dask),
+                "worker",
+                "--scheduler-file",
+                str(file),
+                "--nthreads",
+                "1",
+                "--nworkers",
+                "2",
+                "--no-dashboard",
+                "--host",
+                "127.0.0.1",
+            ],
+            **quiet,
+        )
+    )
     return processes, json.loads(file.read_text())["address"]
 
 

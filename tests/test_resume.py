@@ -12,9 +12,9 @@ import h5py
 import numpy as np
 import pytest
 import yaml
+from conftest import UR5, write_config
 from typer.testing import CliRunner
 
-from conftest import UR5, write_config
 from excite_cli.cli import app
 
 runner = CliRunner()
@@ -30,7 +30,9 @@ def _config(tmp_path, iterations=3):
 
 def _arrays(path):
     with h5py.File(path) as f:
-        arrays = {f"{k}/{name}": f["iterations"][k][name][()] for k in f["iterations"] for name in ("alpha", "regressor", "q")}
+        arrays = {
+            f"{k}/{name}": f["iterations"][k][name][()] for k in f["iterations"] for name in ("alpha", "regressor", "q")
+        }
         arrays["table"] = f["table"][()]
         return arrays
 
@@ -55,8 +57,11 @@ def test_same_seed_gives_bit_identical_arrays(uninterrupted, tmp_path):
 
 def test_resume_after_sigkill_ends_as_an_uninterrupted_run(uninterrupted, tmp_path):
     out = tmp_path / "killed.h5"
-    process = subprocess.Popen([sys.executable, "-m", "excite_cli", "optimize", str(_config(tmp_path)), "-o", str(out)],
-                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    process = subprocess.Popen(
+        [sys.executable, "-m", "excite_cli", "optimize", str(_config(tmp_path)), "-o", str(out)],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
     deadline = time.monotonic() + 120
     while not out.exists() and time.monotonic() < deadline and process.poll() is None:
         time.sleep(0.05)
@@ -68,7 +73,9 @@ def test_resume_after_sigkill_ends_as_an_uninterrupted_run(uninterrupted, tmp_pa
     resumed = runner.invoke(app, ["optimize", str(_config(tmp_path)), "-o", str(out), "--resume"])
     assert resumed.exit_code == 0, resumed.output
     whole, done = _arrays(uninterrupted), _arrays(out)
-    np.testing.assert_array_equal(done["table"][["cond_own", "cond_stacked"]], whole["table"][["cond_own", "cond_stacked"]])
+    np.testing.assert_array_equal(
+        done["table"][["cond_own", "cond_stacked"]], whole["table"][["cond_own", "cond_stacked"]]
+    )
     for key in whole:
         np.testing.assert_array_equal(done[key], whole[key], err_msg=key)
 
@@ -92,10 +99,15 @@ def test_existing_result_is_kept_without_force(uninterrupted, tmp_path):
 def test_effective_config_is_stored(uninterrupted, tmp_path):
     with h5py.File(uninterrupted) as f:
         effective, original = yaml.safe_load(f.attrs["config"]), yaml.safe_load(f.attrs["config_original"])
-    assert effective["sequence"]["iterations"] == 3 and effective["optimizer"]["tolerance"] == 1e-6  # defaults filled in
+    assert (
+        effective["sequence"]["iterations"] == 3 and effective["optimizer"]["tolerance"] == 1e-6
+    )  # defaults filled in
     assert "tolerance" not in original["optimizer"]
     out = tmp_path / "k1.h5"
-    assert runner.invoke(app, ["optimize", str(_config(tmp_path)), "-o", str(out), "-k", "1", "--seed", "7"]).exit_code == 0
+    assert (
+        runner.invoke(app, ["optimize", str(_config(tmp_path)), "-o", str(out), "-k", "1", "--seed", "7"]).exit_code
+        == 0
+    )
     with h5py.File(out) as f:
         effective = yaml.safe_load(f.attrs["config"])
     assert effective["sequence"]["iterations"] == 1 and effective["optimizer"]["seed"] == 7  # the overrides that ran

@@ -2,9 +2,9 @@
 
 import re
 
+from conftest import UR5, write_config
 from typer.testing import CliRunner
 
-from conftest import UR5, write_config
 from excite_cli.cli import app
 
 
@@ -12,7 +12,11 @@ def test_verify_gradient_command(tmp_path):
     result = CliRunner().invoke(app, ["verify-gradient", str(write_config(tmp_path, UR5))], env={"COLUMNS": "200"})
     assert result.exit_code == 0, result.output
     rows = [line for line in result.output.splitlines() if "random" in line and "×" in line]
-    assert [name for name in ("log_cond", "log_det", "sigma_min") if any(name in row for row in rows)] == ["log_cond", "log_det", "sigma_min"]
+    assert [name for name in ("log_cond", "log_det", "sigma_min") if any(name in row for row in rows)] == [
+        "log_cond",
+        "log_det",
+        "sigma_min",
+    ]
     for row in rows:
         numbers = re.findall(r"\d\.\d+e[-+]\d+", row)
         assert float(numbers[0]) < 1e-6  # central-difference relative error
@@ -20,6 +24,9 @@ def test_verify_gradient_command(tmp_path):
 
 
 def test_verify_gradient_fails_with_status_1_above_the_tolerance(tmp_path):
-    result = CliRunner().invoke(app, ["verify-gradient", str(write_config(tmp_path, UR5)), "--objective", "cond",
-                                      "--tolerance", "1e-15"], env={"COLUMNS": "200"})
+    result = CliRunner().invoke(
+        app,
+        ["verify-gradient", str(write_config(tmp_path, UR5)), "--objective", "cond", "--tolerance", "1e-15"],
+        env={"COLUMNS": "200"},
+    )
     assert result.exit_code == 1 and "FAIL" in result.output

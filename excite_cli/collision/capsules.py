@@ -8,11 +8,11 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from excite_cli.config import SelfCollisionConfig
-from excite_cli.errors import ExciteError
 from excite_cli.collision.geometry import link_points, links_with_geometry
+from excite_cli.config import SelfCollisionConfig
 from excite_cli.dynamics.kinematics import BatchKinematics
 from excite_cli.dynamics.robot import Robot
+from excite_cli.errors import ExciteError
 
 
 @dataclass(frozen=True)
@@ -62,7 +62,7 @@ def capsules_from_config(cfg: SelfCollisionConfig, robot: Robot) -> list[Capsule
     frames = {f.name: f for f in robot.model.frames}
     for name in cfg.ignore_links:
         if name not in frames:
-            raise ExciteError(f"constraints.self_collision.ignore_links: '{name}' is not a link of the robot")
+            raise ExciteError("constraints.self_collision.ignore_links", f"'{name}' is not a link of the robot")
     capsules = []
     if cfg.capsules == "auto":
         for link in links_with_geometry(robot):
@@ -73,11 +73,18 @@ def capsules_from_config(cfg: SelfCollisionConfig, robot: Robot) -> list[Capsule
         return capsules
     for spec in cfg.capsules:
         if spec.link not in frames:
-            raise ExciteError(f"constraints.self_collision.capsules: '{spec.link}' is not a link of the robot")
+            raise ExciteError("constraints.self_collision.capsules", f"'{spec.link}' is not a link of the robot")
         frame = frames[spec.link]
         to_joint = frame.placement
-        capsules.append(Capsule(spec.link, int(frame.parentJoint), spec.radius,
-                                to_joint.act(np.asarray(spec.start, dtype=float)), to_joint.act(np.asarray(spec.end, dtype=float))))
+        capsules.append(
+            Capsule(
+                spec.link,
+                int(frame.parentJoint),
+                spec.radius,
+                to_joint.act(np.asarray(spec.start, dtype=float)),
+                to_joint.act(np.asarray(spec.end, dtype=float)),
+            )
+        )
     return capsules
 
 
@@ -104,7 +111,7 @@ def capsule_pairs(cfg: SelfCollisionConfig, robot: Robot, capsules: list[Capsule
     for a, b in cfg.exclude_pairs:
         for link in (a, b):
             if link not in names:
-                raise ExciteError(f"constraints.self_collision.exclude_pairs: '{link}' has no capsule")
+                raise ExciteError("constraints.self_collision.exclude_pairs", f"'{link}' has no capsule")
         excluded.add(frozenset((a, b)))
     parents = robot.model.parents
     pairs = []
@@ -132,7 +139,9 @@ def capsule_frame(capsule: Capsule) -> pin.SE3:
     return pin.SE3(np.column_stack([x, np.cross(z, x), z]), (capsule.start + capsule.end) / 2.0)
 
 
-def capsule_placements(kinematics: BatchKinematics, capsules: list[Capsule], Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def capsule_placements(
+    kinematics: BatchKinematics, capsules: list[Capsule], Q: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """World placements of every capsule's centred frame (z along the axis) at each configuration of
     the active joints Q (T, n): rotations (T, C, 3, 3) and centres (T, C, 3) [m]."""
     return capsule_frames(*kinematics.placements(Q), capsules)
@@ -150,7 +159,9 @@ def capsule_frames(R: np.ndarray, p: np.ndarray, capsules: list[Capsule]) -> tup
     return rotations, centres
 
 
-def segment_ends(kinematics: BatchKinematics, capsules: list[Capsule], Q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def segment_ends(
+    kinematics: BatchKinematics, capsules: list[Capsule], Q: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Every capsule's segment in the world frame at each configuration of the active joints Q (T, n):
     start and end points (3, T, C) [m] (coordinates first, see :func:`segment_closest_points`), with
     the joint placements they came from (:meth:`BatchKinematics.placements`: rotations (T, J, 3, 3),
@@ -159,11 +170,17 @@ def segment_ends(kinematics: BatchKinematics, capsules: list[Capsule], Q: np.nda
     joints = [c.joint for c in capsules]
     starts, ends = np.stack([c.start for c in capsules]), np.stack([c.end for c in capsules])
     Rc, pc = R[:, joints], p[:, joints]
-    return (np.einsum("tcij,cj->itc", Rc, starts) + pc.transpose(2, 0, 1),
-            np.einsum("tcij,cj->itc", Rc, ends) + pc.transpose(2, 0, 1), R, p)
+    return (
+        np.einsum("tcij,cj->itc", Rc, starts) + pc.transpose(2, 0, 1),
+        np.einsum("tcij,cj->itc", Rc, ends) + pc.transpose(2, 0, 1),
+        R,
+        p,
+    )
 
 
-def segment_closest_points(p1: np.ndarray, q1: np.ndarray, p2: np.ndarray, q2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def segment_closest_points(
+    p1: np.ndarray, q1: np.ndarray, p2: np.ndarray, q2: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """Closest points c1 on segment [p1, q1] and c2 on [p2, q2] [m], vectorized: every array has its
     coordinates on the first axis, (3, ...) (contiguous coordinate planes are faster here).
 

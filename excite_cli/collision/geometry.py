@@ -6,15 +6,17 @@ import coal
 import numpy as np
 import pinocchio as pin
 
-from excite_cli.errors import ExciteError
 from excite_cli.dynamics.robot import Robot
+from excite_cli.errors import ExciteError
 
 
 def _shape_points(shape: coal.CollisionGeometry) -> np.ndarray:
     """(k, 3) points on the surface of one collision shape, in its own frame [m]."""
     if hasattr(shape, "vertices") and hasattr(shape, "num_vertices"):
         return np.asarray(shape.vertices(), dtype=float)
-    directions = np.vstack([np.eye(3), -np.eye(3), np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1])).reshape(3, -1).T / np.sqrt(3)])
+    directions = np.vstack(
+        [np.eye(3), -np.eye(3), np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1])).reshape(3, -1).T / np.sqrt(3)]
+    )
     if isinstance(shape, coal.Sphere):
         return shape.radius * directions
     if isinstance(shape, coal.Box):
@@ -26,7 +28,12 @@ def _shape_points(shape: coal.CollisionGeometry) -> np.ndarray:
         if isinstance(shape, coal.Capsule):
             ends += [np.array([[0, 0, -shape.halfLength - shape.radius], [0, 0, shape.halfLength + shape.radius]])]
         return np.vstack(ends)
-    raise ExciteError(f"collision shape {type(shape).__name__} is not supported; give capsules in the config")
+    raise ExciteError(
+        "constraints.self_collision.capsules",
+        f"collision shape {type(shape).__name__} is not supported",
+        type(shape).__name__,
+        "capsules given in the config",
+    )
 
 
 def links_with_geometry(robot: Robot) -> list[str]:
@@ -53,7 +60,7 @@ def link_points(robot: Robot, link: str, field: str = "constraints.self_collisio
             parts.append(local @ obj.placement.rotation.T + obj.placement.translation)
             joint = obj.parentJoint
     if joint is None:
-        raise ExciteError(f"{field}: link '{link}' has no collision geometry in the URDF (or is not a link)")
+        raise ExciteError(field, f"link '{link}' has no collision geometry in the URDF (or is not a link)")
     return np.vstack(parts), int(joint)
 
 

@@ -15,7 +15,6 @@ from excite_cli.config import Problem
 from excite_cli.optimization.optimizer import ProgressHook
 from excite_cli.optimization.sequence import IterationResult
 
-
 #: Width of printed tables where the output is not a terminal (a log, a pipe): rich's default of 80
 #: columns would cut their numbers.
 LOG_WIDTH = 200
@@ -33,8 +32,15 @@ class Bars:
 
     def __init__(self, console: Console):
         self.console = console
-        self.bar = Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.fields[status]}"),
-                            TimeElapsedColumn(), TextColumn("ETA"), TimeRemainingColumn(), console=console)
+        self.bar = Progress(
+            TextColumn("{task.description}"),
+            BarColumn(),
+            TextColumn("{task.fields[status]}"),
+            TimeElapsedColumn(),
+            TextColumn("ETA"),
+            TimeRemainingColumn(),
+            console=console,
+        )
         self._live = False
 
     def __enter__(self) -> "Bars":
@@ -64,18 +70,28 @@ class Bars:
 
             def hook(restart: int, it: int, value: float) -> None:
                 steps[restart] = it
-                bar.update(tasks[k], completed=sum(steps.values()),
-                           status=f"run {restart + 1}/{opts.screened + opts.restarts if opts.screened else opts.restarts} · "
-                                  f"{label} {shown(value):.4g}")
+                bar.update(
+                    tasks[k],
+                    completed=sum(steps.values()),
+                    status=f"run {restart + 1}/{opts.screened + opts.restarts if opts.screened else opts.restarts} · "
+                    f"{label} {shown(value):.4g}",
+                )
+
             return hook
 
         def done(result: IterationResult) -> None:
-            bar.update(tasks[result.index], completed=opts.planned_iterations,
-                       status=f"cond(C) {result.cond_stacked:.1f} · {result.stop}")
+            bar.update(
+                tasks[result.index],
+                completed=opts.planned_iterations,
+                status=f"cond(C) {result.cond_stacked:.1f} · {result.stop}",
+            )
             if not self.console.is_terminal:
-                self.console.print(f"iteration {result.index}: cond(C(i)) {result.cond_own:.1f}, cond(C) {result.cond_stacked:.1f}, "
-                                   f"{result.wall_time_s:.0f} s, {result.sqp_iterations} solver iterations, stop: {result.stop}",
-                                   highlight=False)
+                self.console.print(
+                    f"iteration {result.index}: cond(C(i)) {result.cond_own:.1f}, cond(C) {result.cond_stacked:.1f}, "
+                    f"{result.wall_time_s:.0f} s, {result.sqp_iterations} solver iterations, stop: {result.stop}",
+                    highlight=False,
+                )
+
         return progress, done
 
     def draws(self, total: int | None) -> Callable[[int, int], None]:
@@ -86,4 +102,5 @@ class Bars:
             if not task:
                 task.append(self._task("random candidates", total, ""))
             self.bar.update(task[0], completed=kept, status=f"{kept} kept of {drawn} drawn")
+
         return hook

@@ -12,12 +12,12 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import ConvexHull, QhullError
 
+from excite_cli.collision.geometry import world_points
 from excite_cli.config import ComConfig
 from excite_cli.constraints.constraint import Constraint, FineCheck
 from excite_cli.constraints.lse import ACCEPT_MARGIN, smooth_max
-from excite_cli.errors import ExciteError
-from excite_cli.collision.geometry import world_points
 from excite_cli.dynamics.robot import Robot
+from excite_cli.errors import ExciteError
 from excite_cli.trajectory.fourier import FourierBasis
 
 #: Points of the support links within this height of their lowest point form the soles [m].
@@ -36,11 +36,13 @@ def support_centre(robot: Robot, links: list[str]) -> np.ndarray:
     try:
         hull = ConvexHull(sole)
     except QhullError:  # degenerate input (collinear or coincident points)
-        raise ExciteError("constraints.com.support_links: the soles of these links span no area") from None
+        raise ExciteError("constraints.com.support_links", "the soles of these links span no area") from None
     v = sole[hull.vertices]
     cross = v[:, 0] * np.roll(v[:, 1], -1) - np.roll(v[:, 0], -1) * v[:, 1]
     area = cross.sum() / 2.0
-    return np.array([((v[:, 0] + np.roll(v[:, 0], -1)) * cross).sum(), ((v[:, 1] + np.roll(v[:, 1], -1)) * cross).sum()]) / (6.0 * area)
+    return np.array(
+        [((v[:, 0] + np.roll(v[:, 0], -1)) * cross).sum(), ((v[:, 1] + np.roll(v[:, 1], -1)) * cross).sum()]
+    ) / (6.0 * area)
 
 
 class ComRegion(Constraint):
@@ -60,8 +62,14 @@ class ComRegion(Constraint):
     name = "com_region"
     grid_margin = ACCEPT_MARGIN
 
-    def __init__(self, robot: Robot, basis: FourierBasis, centre: np.ndarray, radius: float | None = None,
-                 polygon: np.ndarray | None = None):
+    def __init__(
+        self,
+        robot: Robot,
+        basis: FourierBasis,
+        centre: np.ndarray,
+        radius: float | None = None,
+        polygon: np.ndarray | None = None,
+    ):
         self.robot, self.basis, self.centre = robot, basis, np.asarray(centre, dtype=float)
         self._data = robot.model.createData()  # this constraint's own pinocchio Data
         self.radius = radius
@@ -75,7 +83,7 @@ class ComRegion(Constraint):
             offsets = np.einsum("kx,kx->k", normals, v)
             turn = edge[:, 0] * np.roll(edge[:, 1], -1) - edge[:, 1] * np.roll(edge[:, 0], -1)
             if np.any(offsets <= 0) or np.any(turn < 0):
-                raise ExciteError("constraints.com.polygon: must be convex and contain the support centre")
+                raise ExciteError("constraints.com.polygon", "must be convex and contain the support centre")
             self.normals, self.offsets = normals, offsets
 
     def _com(self, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

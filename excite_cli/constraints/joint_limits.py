@@ -16,8 +16,8 @@ import numpy as np
 from excite_cli.config import LimitsConfig, PerJoint
 from excite_cli.constraints.constraint import Constraint, FineCheck
 from excite_cli.constraints.lse import ACCEPT_MARGIN, GRID_MARGIN, smooth_max
-from excite_cli.errors import ExciteError
 from excite_cli.dynamics.robot import Robot
+from excite_cli.errors import ExciteError
 from excite_cli.trajectory.fourier import FourierBasis
 
 ORDERS = ("position_rad", "velocity_rad_s", "acceleration_rad_s2")
@@ -103,8 +103,14 @@ class JointLimits(Constraint):
         out[:, 1:] *= np.clip(scale, 0.0, 1.0)[:, None]
         return out
 
-    def random_start(self, coefficients: int, rng: np.random.Generator, fill: float, offset: np.ndarray | None = None,
-                     wave_space: np.ndarray | None = None) -> np.ndarray:
+    def random_start(
+        self,
+        coefficients: int,
+        rng: np.random.Generator,
+        fill: float,
+        offset: np.ndarray | None = None,
+        wave_space: np.ndarray | None = None,
+    ) -> np.ndarray:
         """Random α (n, coefficients) oscillating about ``offset`` (n,) [rad] (default: the centre of
         each position range), scaled so that each joint uses the fraction ``fill`` of its room on the
         grid in position, velocity and acceleration (fill < 1: strictly feasible). With
@@ -140,14 +146,14 @@ def _per_joint(field: str, value: PerJoint | None, default: np.ndarray, robot: R
     if isinstance(value, dict):
         for name, v in value.items():
             if name not in robot.joint_names:
-                raise ExciteError(f"{field}: '{name}' is not an active joint")
+                raise ExciteError(field, f"'{name}' is not an active joint")
             out[robot.joint_names.index(name)] = v
     elif value is not None:
         out[:] = value
     for name, v in zip(robot.joint_names, out):
         if not np.isfinite(v) or v <= 0:
             source = "the URDF has none" if value is None else f"got {v:g}"
-            raise ExciteError(f"{field}: joint '{name}' needs a positive finite limit ({source})")
+            raise ExciteError(field, f"joint '{name}' needs a positive finite limit ({source})")
     return out
 
 
@@ -164,10 +170,10 @@ def joint_limit_bounds(cfg: LimitsConfig, robot: Robot) -> tuple[np.ndarray, np.
     upper = robot.upper - cfg.position_margin
     for name, lo, hi in zip(robot.joint_names, lower, upper):
         if not (np.isfinite(lo) and np.isfinite(hi)):
-            raise ExciteError(f"limits: joint '{name}' has no finite position limits in the URDF")
+            raise ExciteError("limits", f"joint '{name}' has no finite position limits in the URDF")
         if hi <= lo:
             raise ExciteError(
-                f"limits.position_margin: {cfg.position_margin:g} rad leaves no range for joint '{name}'"
+                "limits.position_margin", f"{cfg.position_margin:g} rad leaves no range for joint '{name}'"
             )
     velocity = _per_joint("limits.velocity", cfg.velocity, robot.velocity_limit, robot)
     acceleration = _per_joint("limits.acceleration", cfg.acceleration, np.full(robot.n_joints, np.nan), robot)

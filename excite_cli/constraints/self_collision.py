@@ -44,7 +44,9 @@ class SelfCollision(Constraint):
     name = "self_collision"
     grid_margin = ACCEPT_MARGIN
 
-    def __init__(self, robot: Robot, basis: FourierBasis, capsules: list[Capsule], pairs: list[tuple[int, int]], margin: float):
+    def __init__(
+        self, robot: Robot, basis: FourierBasis, capsules: list[Capsule], pairs: list[tuple[int, int]], margin: float
+    ):
         self.robot, self.basis, self.capsules, self.pairs, self.margin = robot, basis, capsules, pairs, margin
         self._shapes = [coal.Capsule(c.radius, float(np.linalg.norm(c.end - c.start))) for c in capsules]
         self._first = np.array([i for i, _ in pairs], dtype=int)
@@ -60,8 +62,14 @@ class SelfCollision(Constraint):
         """coal's distance of pair p at instant t, from capsule placements (T, C, 3, 3), (T, C, 3)."""
         i, j = self.pairs[p]
         result = coal.DistanceResult()
-        coal.distance(self._shapes[i], coal.Transform3s(rotations[t, i], centres[t, i]),
-                      self._shapes[j], coal.Transform3s(rotations[t, j], centres[t, j]), coal.DistanceRequest(), result)
+        coal.distance(
+            self._shapes[i],
+            coal.Transform3s(rotations[t, i], centres[t, i]),
+            self._shapes[j],
+            coal.Transform3s(rotations[t, j], centres[t, j]),
+            coal.DistanceRequest(),
+            result,
+        )
         return result
 
     def _closest(self, Q: np.ndarray) -> tuple[np.ndarray, ...]:
@@ -112,7 +120,10 @@ class SelfCollision(Constraint):
         pair = f"{self.capsules[i].link}–{self.capsules[j].link}"
         return FineCheck(
             max_violation=(self.margin - best) / LENGTH_SCALE,
-            details={"min_capsule_distance_m": float(best), "min_capsule_pair": pair,
-                     "min_capsule_time_s": float(time[where[0]])},
+            details={
+                "min_capsule_distance_m": float(best),
+                "min_capsule_pair": pair,
+                "min_capsule_time_s": float(time[where[0]]),
+            },
             where=f"capsules {pair} {best * 100:.2f} cm apart (margin {self.margin * 100:.1f} cm)",
         )

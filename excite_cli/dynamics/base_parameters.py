@@ -17,8 +17,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
-from excite_cli.errors import ExciteError
 from excite_cli.dynamics.robot import Robot
+from excite_cli.errors import ExciteError
 
 #: |R_kk| / |R_00| below this is rank loss.
 RANK_TOLERANCE = 1e-9
@@ -83,7 +83,7 @@ def compute_base_parameters(robot: Robot, seed: int = 0, samples: int | None = N
     diag = np.abs(np.diag(R))
     b = int(np.sum(diag > RANK_TOLERANCE * diag[0])) if diag.size and diag[0] > 0 else 0
     if b == 0:
-        raise ExciteError("robot.active_joints: no inertial parameter affects the selected regressor rows")
+        raise ExciteError("robot.active_joints", "no inertial parameter affects the selected regressor rows")
     independent, dependent = perm[:b], perm[b:]
     beta = scipy.linalg.solve_triangular(R[:b, :b], R[:b, b:])
     X = np.zeros((p, b))

@@ -34,8 +34,11 @@ class BatchKinematics:
         pin.computeJointJacobians(model, data, robot.q_reference)
         self.robot = robot
         self.parents = list(model.parents)
-        self._column = {j: robot.v_idx.tolist().index(model.joints[j].idx_v)
-                        for j in range(1, model.njoints) if model.joints[j].idx_v in robot.v_idx}
+        self._column = {
+            j: robot.v_idx.tolist().index(model.joints[j].idx_v)
+            for j in range(1, model.njoints)
+            if model.joints[j].idx_v in robot.v_idx
+        }
         self.joint_of = [0] * robot.n_joints
         self.axes = np.zeros((robot.n_joints, 3))
         self.revolute = np.zeros(robot.n_joints, dtype=bool)
@@ -96,9 +99,11 @@ class BatchKinematics:
         either point gives the same rates (x₂ × n = x₁ × n), so ∂d/∂q_k is the rate times
         ancestors[body₂, k] − ancestors[body₁, k].
         """
-        axes = np.einsum("tkij,kj->tik", R[:, self.joint_of], self.axes)      # (T, 3, n)
-        moments = np.cross(axes, p[:, self.joint_of].transpose(0, 2, 1), axis=1)   # a_k × o_k, (T, 3, n)
-        turning = np.concatenate([_cross(points, normals), -normals]).transpose(1, 2, 0) @ np.concatenate([axes, moments], axis=1)
+        axes = np.einsum("tkij,kj->tik", R[:, self.joint_of], self.axes)  # (T, 3, n)
+        moments = np.cross(axes, p[:, self.joint_of].transpose(0, 2, 1), axis=1)  # a_k × o_k, (T, 3, n)
+        turning = np.concatenate([_cross(points, normals), -normals]).transpose(1, 2, 0) @ np.concatenate(
+            [axes, moments], axis=1
+        )
         if self.revolute.all():
             return turning
         return np.where(self.revolute, turning, normals.transpose(1, 2, 0) @ axes)

@@ -33,7 +33,7 @@ def example_robot_data_root() -> Path:
     try:
         dist = metadata.distribution("example-robot-data")
     except metadata.PackageNotFoundError:
-        raise ExciteError("robot.source: example-robot-data is not installed (run `make install`)") from None
+        raise ExciteError("robot.source", "example-robot-data is not installed (run `make install`)") from None
     return Path(dist.locate_file("cmeel.prefix/share")).resolve()
 
 
@@ -52,14 +52,14 @@ def resolve_urdf(problem: Problem) -> tuple[Path, list[str]]:
         path = problem.resolve(cfg.urdf)
         dirs = [str(path.parent), str(path.parent.parent)]
     if not path.is_file():
-        raise ExciteError(f"robot.urdf: no URDF file at {path}")
+        raise ExciteError("robot.urdf", f"no URDF file at {path}")
     return path, dirs
 
 
 def _unknown_joint(field_name: str, name: str, known: list[str]) -> ExciteError:
     close = difflib.get_close_matches(name, known, n=1)
     hint = f"; did you mean '{close[0]}'?" if close else ""
-    return ExciteError(f"{field_name}: '{name}' is not a joint of the robot{hint}")
+    return ExciteError(field_name, f"'{name}' is not a joint of the robot{hint}")
 
 
 @dataclass
@@ -146,7 +146,9 @@ class Robot:
         Y = pin.computeJointTorqueRegressor(self.model, data or self.data, *self.state(q, qd, qdd))
         return Y[self.row_idx]
 
-    def regressor_stack(self, Q: np.ndarray, QD: np.ndarray, QDD: np.ndarray, data: pin.Data | None = None) -> np.ndarray:
+    def regressor_stack(
+        self, Q: np.ndarray, QD: np.ndarray, QDD: np.ndarray, data: pin.Data | None = None
+    ) -> np.ndarray:
         """Regressors at T instants stacked as in Eq. 3: (T·n_rows, p) from (T, n) arrays."""
         return np.vstack([self.regressor(Q[t], QD[t], QDD[t], data) for t in range(Q.shape[0])])
 
@@ -204,18 +206,20 @@ def _check_joints(cfg: RobotConfig, full: pin.Model) -> list[str]:
         if name not in movable:
             raise _unknown_joint("robot.active_joints", name, movable)
         if full.joints[full.getJointId(name)].nq != 1:
-            raise ExciteError(f"robot.active_joints: '{name}' is not a 1-DoF revolute or prismatic joint")
+            raise ExciteError("robot.active_joints", f"'{name}' is not a 1-DoF revolute or prismatic joint")
     if len(set(cfg.active_joints)) != len(cfg.active_joints):
-        raise ExciteError("robot.active_joints: a joint is listed twice")
+        raise ExciteError("robot.active_joints", "a joint is listed twice")
     for name, value in cfg.locked_joints.items():
         if name not in movable:
             raise _unknown_joint("robot.locked_joints", name, movable)
         if name in cfg.active_joints:
-            raise ExciteError(f"robot.locked_joints: '{name}' is also an active joint")
+            raise ExciteError("robot.locked_joints", f"'{name}' is also an active joint")
         j = full.getJointId(name)
         lo, hi = full.lowerPositionLimit[full.idx_qs[j]], full.upperPositionLimit[full.idx_qs[j]]
         if full.joints[j].nq == 1 and not lo <= value <= hi:
-            raise ExciteError(f"robot.locked_joints.{name}: {value} rad is outside the joint limits [{lo:g}, {hi:g}]")
+            raise ExciteError(
+                f"robot.locked_joints.{name}", f"{value} rad is outside the joint limits [{lo:g}, {hi:g}]"
+            )
     return movable
 
 
@@ -235,7 +239,7 @@ def load_robot(problem: Problem, collision: bool = False) -> Robot:
     try:
         full = pin.buildModelFromUrdf(str(path), *([pin.JointModelFreeFlyer()] if cfg.floating_base else []))
     except (RuntimeError, ValueError) as exc:
-        raise ExciteError(f"robot.urdf: cannot read {path}: {exc}") from None
+        raise ExciteError("robot.urdf", f"cannot read {path}: {exc}") from None
 
     movable = _check_joints(cfg, full)
     q_full = pin.neutral(full)
@@ -247,7 +251,7 @@ def load_robot(problem: Problem, collision: bool = False) -> Robot:
         try:
             geometry = pin.buildGeomFromUrdf(full, str(path), pin.COLLISION, package_dirs=package_dirs)
         except (RuntimeError, ValueError) as exc:
-            raise ExciteError(f"robot.urdf: cannot load the collision geometry of {path}: {exc}") from None
+            raise ExciteError("robot.urdf", f"cannot load the collision geometry of {path}: {exc}") from None
         model, geometry = pin.buildReducedModel(full, geometry, lock_ids, q_full)
     else:
         model = pin.buildReducedModel(full, lock_ids, q_full)
@@ -257,7 +261,7 @@ def load_robot(problem: Problem, collision: bool = False) -> Robot:
     v_idx = np.array([model.idx_vs[j] for j in ids])
     base_rows = np.arange(6) if (cfg.floating_base and cfg.base_wrench_rows) else np.arange(0)
     if cfg.base_wrench_rows and not cfg.floating_base:
-        raise ExciteError("robot.base_wrench_rows: needs robot.floating_base: true")
+        raise ExciteError("robot.base_wrench_rows", "needs robot.floating_base: true")
     lower, upper = model.lowerPositionLimit[q_idx].copy(), model.upperPositionLimit[q_idx].copy()
     unknown = [name for name in cfg.home_posture if name not in cfg.active_joints]
     if unknown:

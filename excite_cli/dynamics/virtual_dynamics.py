@@ -33,9 +33,13 @@ class VirtualDynamics:
 
     def __init__(self, robot: Robot):
         self.robot = robot
-        held = [j for j in range(1, robot.model.njoints) if robot.model.joints[j].idx_v not in set(robot.v_idx.tolist())]
+        held = [
+            j for j in range(1, robot.model.njoints) if robot.model.joints[j].idx_v not in set(robot.v_idx.tolist())
+        ]
         rows_held = robot.n_rows > robot.n_joints  # the base wrench is a regressor row
-        self.model = robot.model if (rows_held or not held) else pin.buildReducedModel(robot.model, held, robot.q_reference)
+        self.model = (
+            robot.model if (rows_held or not held) else pin.buildReducedModel(robot.model, held, robot.q_reference)
+        )
         model = self.model
         ids = [model.getJointId(name) for name in robot.joint_names]
         self.q_idx = np.array([model.idx_qs[j] for j in ids])
@@ -45,13 +49,16 @@ class VirtualDynamics:
         # parameter block (in the robot's order) of each body of this model
         self.blocks = [robot.model.getJointId(model.names[j]) - 1 for j in range(1, model.njoints)]
         revolute = [model.joints[j].shortname().startswith("JointModelR") for j in range(model.njoints)]
-        self.shift_free = all(revolute[j] for j in range(1, model.njoints) if model.joints[j].idx_v in set(self.v_idx.tolist()))
+        self.shift_free = all(
+            revolute[j] for j in range(1, model.njoints) if model.joints[j].idx_v in set(self.v_idx.tolist())
+        )
         self._unit_shift = self._shift_per_mass(revolute) @ self._subtree_sizes()
         self._models: list[pin.Model] = []
         self._datas: list[pin.Data] = []
 
-    def weighted_derivatives(self, phis: np.ndarray, weights: np.ndarray, Q: np.ndarray, QD: np.ndarray,
-                             QDD: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def weighted_derivatives(
+        self, phis: np.ndarray, weights: np.ndarray, Q: np.ndarray, QD: np.ndarray, QDD: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Σ_r w_{r,t}ᵀ ∂τ(x_t; φ_r)/∂(q_t, q̇_t, q̈_t) over the regressor rows, for each instant.
 
         Args:
@@ -89,7 +96,7 @@ class VirtualDynamics:
         blocks = phis.reshape(-1, 10, phis.shape[1])
         shift = (1.0 + 2.0 * np.abs(blocks[:, 0, :]).max()) * self._unit_shift
         for j, block in enumerate(self.blocks, start=1):
-            own = shift[10 * (j - 1):10 * j]
+            own = shift[10 * (j - 1) : 10 * j]
             for r, model in enumerate(self._models):
                 extra = blocks[block, :, r] if r < phis.shape[1] else 0.0
                 model.inertias[j] = pin.Inertia.FromDynamicParameters(own + extra)
@@ -112,5 +119,5 @@ class VirtualDynamics:
             parent = model.parents[j]
             if parent > 0 and revolute[j]:
                 point = pin.Inertia(1.0, model.jointPlacements[j].translation, np.zeros((3, 3)))
-                A[10 * (parent - 1):10 * parent, j - 1] = -point.toDynamicParameters()
+                A[10 * (parent - 1) : 10 * parent, j - 1] = -point.toDynamicParameters()
         return A

@@ -12,7 +12,6 @@ from pydantic import Field, NonNegativeInt, PositiveFloat, field_validator, mode
 from excite_cli.config import Problem, RobotConfig, Section
 from excite_cli.identification.effects import EFFECT_NAMES, POSITION, SHAPE_GRID
 
-
 Effect = Literal[EFFECT_NAMES]
 #: The default candidates: every effect but the position-dependent ones, which fitted the seen phases
 #: of the real Panda run and extrapolated badly to an unseen one (README), so they are opt-in.

@@ -24,7 +24,9 @@ from excite_cli.identification.effects import Term
 from excite_cli.identification.normal import NormalEquations, solve
 
 
-def fold_assignment(time: np.ndarray, run: np.ndarray, folds: int, margin: float) -> tuple[np.ndarray, list[np.ndarray]]:
+def fold_assignment(
+    time: np.ndarray, run: np.ndarray, folds: int, margin: float
+) -> tuple[np.ndarray, list[np.ndarray]]:
     """Blocked folds of the fit instants.
 
     Args:
@@ -75,8 +77,10 @@ class CrossValidation:
         margin_parts = [NormalEquations(data, keys, np.flatnonzero(m)).stacked(keys) for m in margins]
         weighted = [(np.einsum("j,jab->ab", w2, G), w2 @ c) for G, c, _ in held]
         total_G, total_c = sum(G for G, _ in weighted), sum(c for _, c in weighted)
-        self.train = [(total_G - G - np.einsum("j,jab->ab", w2, mG), total_c - c - w2 @ mc)
-                      for (G, c), (mG, mc, _) in zip(weighted, margin_parts)]
+        self.train = [
+            (total_G - G - np.einsum("j,jab->ab", w2, mG), total_c - c - w2 @ mc)
+            for (G, c), (mG, mc, _) in zip(weighted, margin_parts)
+        ]
         self.held = held
         measured = sum(s for _, _, s in held)
         self.rms = np.sqrt(measured / max(self.instants, 1))

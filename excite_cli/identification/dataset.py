@@ -8,10 +8,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from excite_cli.dynamics.base_parameters import BaseParameters
+from excite_cli.dynamics.robot import Robot
 from excite_cli.errors import ExciteError
 from excite_cli.identification.effects import COEFFICIENTS, PER_RUN, TWO_STAGE, Term, effect_columns
 from excite_cli.identification.preprocessing import Samples
-from excite_cli.dynamics.robot import Robot
 
 
 @dataclass(frozen=True)
@@ -86,8 +86,16 @@ def _run_columns(s: Samples, index: int, terms: list[Term], fitted: list[int], o
     kept = s.filter.kept(s.time.size)
     for j in range(len(s.q)):
         for t in (t for t in terms if t.joint == j):
-            yield t, (run_offset_columns(index, fitted, kept, offsets) if t.effect in PER_RUN else
-                      s.filter.decimate(effect_columns(t.effect, s.q[j], s.qd[j], s.qdd[j], coulomb_velocity, t.shape)))
+            yield (
+                t,
+                (
+                    run_offset_columns(index, fitted, kept, offsets)
+                    if t.effect in PER_RUN
+                    else s.filter.decimate(
+                        effect_columns(t.effect, s.q[j], s.qd[j], s.qdd[j], coulomb_velocity, t.shape)
+                    )
+                ),
+            )
         s.q[j] = s.qd[j] = s.qdd[j] = None
 
 
@@ -106,9 +114,17 @@ def _regressor_chunks(robot: Robot, X: np.ndarray, s: Samples, payload: np.ndarr
         yield start, chunk[:, : n * b], None if payload is None else chunk[:, n * b :]
 
 
-def build_datasets(robot: Robot, base: BaseParameters, samples: list[Samples], terms: list[Term], coulomb_velocity: float,
-                   blocks: int, payloads: list[np.ndarray | None] | None = None, split: bool = True,
-                   offset_runs: int | None = None) -> tuple[Dataset, Dataset, list[int]]:
+def build_datasets(
+    robot: Robot,
+    base: BaseParameters,
+    samples: list[Samples],
+    terms: list[Term],
+    coulomb_velocity: float,
+    blocks: int,
+    payloads: list[np.ndarray | None] | None = None,
+    split: bool = True,
+    offset_runs: int | None = None,
+) -> tuple[Dataset, Dataset, list[int]]:
     """The fit and validation datasets: regressor, the effect columns of ``terms`` and torques of the
     samples, each low-passed by its run's filter in parallel and decimated (so the filtered τ still
     equals the filtered columns × φ), split by :func:`fit_instants`. Written straight into
@@ -130,14 +146,21 @@ def build_datasets(robot: Robot, base: BaseParameters, samples: list[Samples], t
     masks = [fit_instants(s.role if split else "validation", s.filter.kept(s.time.size), blocks) for s in samples]
     sizes = {True: sum(int(m.sum()) for m in masks), False: sum(int((~m).sum()) for m in masks)}
     if split and (not sizes[True] or not sizes[False]):
-        raise ExciteError("data.runs: need data for fitting and for validation (roles fit/validation, or blocks)")
+        raise ExciteError("data.runs", "need data for fitting and for validation (roles fit/validation, or blocks)")
     fitted = [k for k, m in enumerate(masks) if m.any()] if split else []
     offsets = len(fitted) if split else max(offset_runs or 1, 1)
     terms = list(dict.fromkeys(t for t in terms if t.effect not in TWO_STAGE))
     width = {t: offsets if t.effect in PER_RUN else len(COEFFICIENTS[t.effect]) for t in terms}
-    out = {side: {"Y": np.empty((size, n * b)), "tau": np.empty((size, n)), "time": np.empty(size),
-                  "run": np.empty(size, dtype=int), "blocks": {t: np.empty((size, width[t])) for t in terms}}
-           for side, size in sizes.items()}
+    out = {
+        side: {
+            "Y": np.empty((size, n * b)),
+            "tau": np.empty((size, n)),
+            "time": np.empty(size),
+            "run": np.empty(size, dtype=int),
+            "blocks": {t: np.empty((size, width[t])) for t in terms},
+        }
+        for side, size in sizes.items()
+    }
     at = {True: 0, False: 0}
     for index, mask in enumerate(masks):
         s = samples.pop(0)
@@ -148,7 +171,9 @@ def build_datasets(robot: Robot, base: BaseParameters, samples: list[Samples], t
         for side in (True, False):
             out[side]["tau"][where[side]], out[side]["time"][where[side]] = tau[rows[side]], time[rows[side]]
             out[side]["run"][where[side]] = index
-        for start, Y, load in _regressor_chunks(robot, base.composition_matrix, s, payloads[index] if payloads else None):
+        for start, Y, load in _regressor_chunks(
+            robot, base.composition_matrix, s, payloads[index] if payloads else None
+        ):
             part = mask[start : start + Y.shape[0]]
             for side in (True, False):
                 first = at[side] + int(np.searchsorted(rows[side], start))  # this side's rows before the chunk
@@ -156,10 +181,15 @@ def build_datasets(robot: Robot, base: BaseParameters, samples: list[Samples], t
                 out[side]["Y"][first : first + count] = Y[part == side]
                 if load is not None:
                     out[side]["tau"][first : first + count] -= load[part == side]
-        for t, columns in _run_columns(s, index, terms, fitted, offsets, coulomb_velocity):  # releases the run's signals
+        for t, columns in _run_columns(
+            s, index, terms, fitted, offsets, coulomb_velocity
+        ):  # releases the run's signals
             for side in (True, False):
                 out[side]["blocks"][t][where[side]] = columns[rows[side]]
         for side in (True, False):
             at[side] += rows[side].size
-    fit, val = (Dataset(o["Y"].reshape(-1, b), o["tau"].ravel(), o["time"], o["run"], o["blocks"]) for o in (out[True], out[False]))
+    fit, val = (
+        Dataset(o["Y"].reshape(-1, b), o["tau"].ravel(), o["time"], o["run"], o["blocks"])
+        for o in (out[True], out[False])
+    )
     return fit, val, fitted

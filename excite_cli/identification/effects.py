@@ -66,8 +66,22 @@ SHAPE_FIELDS = {"stribeck": "stribeck_velocity", "held": "held_velocity"}
 SHAPE_GRID = (0.02, 0.05, 0.1, 0.2, 0.5)
 #: Effects whose columns depend on the position (they extrapolate to positions the fit never saw).
 POSITION = ("spring", "gravity_compensator", "position_2")
-UNITS = {"Fc": "Nm", "Fa": "Nm", "Fv": "Nm·s/rad", "Fva": "Nm·s/rad", "Fs": "Nm", "Fh": "Nm", "Fl": "Nm/Nm", "tau0": "Nm",
-         "Ia": "kg·m²", "k": "Nm/rad", "gs": "Nm", "gc": "Nm", "gs2": "Nm", "gc2": "Nm"}
+UNITS = {
+    "Fc": "Nm",
+    "Fa": "Nm",
+    "Fv": "Nm·s/rad",
+    "Fva": "Nm·s/rad",
+    "Fs": "Nm",
+    "Fh": "Nm",
+    "Fl": "Nm/Nm",
+    "tau0": "Nm",
+    "Ia": "kg·m²",
+    "k": "Nm/rad",
+    "gs": "Nm",
+    "gc": "Nm",
+    "gs2": "Nm",
+    "gc2": "Nm",
+}
 
 
 class Term(NamedTuple):
@@ -85,7 +99,9 @@ class Term(NamedTuple):
 
     def label(self, joints: list[str]) -> str:
         """e.g. ``held panda_joint7 (v_h 0.1 rad/s)``."""
-        return f"{self.effect} {joints[self.joint]}" + (f" ({SHAPES[self.effect]} {self.shape:g} rad/s)" if self.shape else "")
+        return f"{self.effect} {joints[self.joint]}" + (
+            f" ({SHAPES[self.effect]} {self.shape:g} rad/s)" if self.shape else ""
+        )
 
 
 def held_sign(qd: np.ndarray, held_velocity: float) -> np.ndarray:
@@ -95,8 +111,15 @@ def held_sign(qd: np.ndarray, held_velocity: float) -> np.ndarray:
     return np.where(~moving & (last >= 0), np.sign(qd[np.maximum(last, 0)]), 0.0)
 
 
-def effect_columns(effect: str, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, coulomb_velocity: float,
-                   shape: float | None = None, rigid: np.ndarray | None = None) -> np.ndarray:
+def effect_columns(
+    effect: str,
+    q: np.ndarray,
+    qd: np.ndarray,
+    qdd: np.ndarray,
+    coulomb_velocity: float,
+    shape: float | None = None,
+    rigid: np.ndarray | None = None,
+) -> np.ndarray:
     """Columns (T, k) of ``effect`` for one joint's samples q, q̇, q̈ (T,) [rad, rad/s, rad/s²] in time
     order, for one run (an offset is a single column of ones here: the dataset spreads it per run).
 

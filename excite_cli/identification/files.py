@@ -1,10 +1,10 @@
 """Measured-data files as labs have them, read into one table of numeric columns.
 
-| format | columns |
-|---|---|
-| CSV, TSV, text | by header name, or by position (0-based) with or without a header; the delimiter (``,`` ``;`` tab or blanks) is detected, a header is a first row that is not all numbers |
-| NPZ (numpy), MAT (MATLAB, scipy.io) | each 1-D array by its name; a 2-D array ``x`` of T rows as ``x[0]``, ``x[1]``, ... (a short-and-wide array is transposed) |
-| HDF5 | datasets as for NPZ; non-numeric datasets are left out |
+- CSV, TSV, text: columns by header name, or by position (0-based) with or without a header; the
+  delimiter (``,`` ``;`` tab or blanks) is detected, a header is a first row that is not all numbers.
+- NPZ (numpy), MAT (MATLAB, scipy.io): each 1-D array by its name; a 2-D array ``x`` of T rows as
+  ``x[0]``, ``x[1]``, ... (a short-and-wide array is transposed).
+- HDF5: datasets as for NPZ; non-numeric datasets are left out.
 
 Rows that cannot be read (a wrong number of values, text where a number belongs) are errors naming
 the file and the line, or, with ``bad_rows: drop``, left out and counted.
@@ -12,8 +12,8 @@ the file and the line, or, with ``bad_rows: drop``, left out and counted.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 import re
+from dataclasses import dataclass
 from pathlib import Path
 
 import h5py
@@ -52,11 +52,16 @@ class Table:
         if isinstance(key, int):
             if key < self.values.shape[1]:
                 return self.values[:, key]
-            raise ExciteError(f"data.columns.{field}: {path.name} has {self.values.shape[1]} columns, no column {key} (0-based)")
+            raise ExciteError(
+                f"data.columns.{field}", f"{path.name} has {self.values.shape[1]} columns, no column {key} (0-based)"
+            )
         if key in self.names:
             return self.values[:, self.names.index(key)]
-        raise ExciteError(f"data.columns.{field}: {path.name} has no column '{key}' (it has: {', '.join(self.names[:12])}"
-                          f"{', ...' if len(self.names) > 12 else ''})")
+        raise ExciteError(
+            f"data.columns.{field}",
+            f"{path.name} has no column '{key}' (it has: {', '.join(self.names[:12])}"
+            f"{', ...' if len(self.names) > 12 else ''})",
+        )
 
 
 def _number(text: str) -> bool:
@@ -75,11 +80,14 @@ def _read_text(path: Path, drop: bool) -> Table:
     try:
         lines = path.read_text().splitlines()
     except UnicodeDecodeError:
-        raise ExciteError(f"data: {path.name} is not a text file (CSV expected from its name; NPZ, MAT and HDF5 "
-                          f"files need the .npz, .mat or .h5 ending)") from None
+        raise ExciteError(
+            "data",
+            f"{path.name} is not a text file (CSV expected from its name; NPZ, MAT and HDF5 "
+            f"files need the .npz, .mat or .h5 ending)",
+        ) from None
     numbered = [(k + 1, line) for k, line in enumerate(lines) if line.strip() and not line.lstrip().startswith("#")]
     if not numbered:
-        raise ExciteError(f"data: {path.name} has no data rows")
+        raise ExciteError("data", f"{path.name} has no data rows")
     first = numbered[0][1]
     delimiter = max(DELIMITERS, key=first.count) if any(d in first for d in DELIMITERS) else None
     if delimiter == ";" and any(DECIMAL_COMMA.search(line) for _, line in numbered[1:3]):
@@ -89,7 +97,7 @@ def _read_text(path: Path, drop: bool) -> Table:
     names = head if header else [str(k) for k in range(len(head))]
     body = numbered[1:] if header else numbered
     if not body:
-        raise ExciteError(f"data: {path.name} has a header but no data rows")
+        raise ExciteError("data", f"{path.name} has a header but no data rows")
     try:  # the fast path: every row complete and numeric
         values = np.loadtxt([line for _, line in body], delimiter=delimiter, ndmin=2, dtype=float)
         if values.shape[1] == len(names) and values.shape[0] == len(body):
@@ -101,16 +109,20 @@ def _read_text(path: Path, drop: bool) -> Table:
         parts = _split(line, delimiter)
         try:
             if len(parts) != len(names):
-                raise ValueError(f"{len(parts)} values where the {'header has' if header else 'first row has'} {len(names)}")
+                raise ValueError(
+                    f"{len(parts)} values where the {'header has' if header else 'first row has'} {len(names)}"
+                )
             rows.append([float(x) if x else np.nan for x in parts])
             kept.append(number)
         except ValueError as exc:
             if not drop:
                 reason = str(exc) if "values where" in str(exc) else "a value that is not a number"
-                raise ExciteError(f"data: {path.name}: line {number}: {reason} (data.bad_rows: drop leaves such rows out)") from None
+                raise ExciteError(
+                    "data", f"{path.name}: line {number}: {reason} (data.bad_rows: drop leaves such rows out)"
+                ) from None
             dropped += 1
     if not rows:
-        raise ExciteError(f"data: {path.name} has a header but no data rows")
+        raise ExciteError("data", f"{path.name} has a header but no data rows")
     return Table(names, np.array(rows, dtype=float), dropped, np.array(kept))
 
 
@@ -131,7 +143,7 @@ def _columns(arrays: dict[str, np.ndarray], path: Path) -> Table:
             columns += [array[:, k].astype(float) for k in range(array.shape[1])]
     lengths = {c.size for c in columns}
     if not columns:
-        raise ExciteError(f"data: {path.name} holds no numeric 1-D or 2-D arrays")
+        raise ExciteError("data", f"{path.name} holds no numeric 1-D or 2-D arrays")
     if len(lengths) > 1:
         longest = max(lengths)
         keep = [k for k, c in enumerate(columns) if c.size == longest]
@@ -161,5 +173,7 @@ def read_table(path: Path, drop: bool = False) -> Table:
             with h5py.File(path, "r") as f:
                 return _columns({name: f[name][()] for name in f if isinstance(f[name], h5py.Dataset)}, path)
     except (OSError, ValueError, NotImplementedError) as exc:
-        raise ExciteError(f"data: cannot read {path.name} as {suffix[1:].upper()}: {' '.join(str(exc).split())[:160]}") from None
+        raise ExciteError(
+            "data", f"cannot read {path.name} as {suffix[1:].upper()}: {' '.join(str(exc).split())[:160]}"
+        ) from None
     return _read_text(path, drop)

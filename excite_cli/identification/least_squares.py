@@ -35,8 +35,9 @@ class Fit:
     sigma: np.ndarray
 
 
-def least_squares(normal: NormalEquations, effects: list[Term], weights: np.ndarray | None = None,
-                  oversampling: float = 1.0) -> Fit:
+def least_squares(
+    normal: NormalEquations, effects: list[Term], weights: np.ndarray | None = None, oversampling: float = 1.0
+) -> Fit:
     """Ordinary (Eq. 4) or weighted least squares of the model [Y_B, ``effects``] with standard
     deviations σ² diag((AᵀWA)⁻¹), scaled by √r.
 

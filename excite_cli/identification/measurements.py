@@ -10,8 +10,8 @@ from typing import Optional
 
 import numpy as np
 
+from excite_cli.errors import ExciteError, FileNotFound
 from excite_cli.identification.config import DataConfig, IdentifyProblem, RunConfig
-from excite_cli.errors import ExciteError
 from excite_cli.identification.files import Table, read_table
 
 
@@ -44,7 +44,7 @@ IMPLAUSIBLE = 1e6
 
 def _matrix(table: Table, keys: list, field: str, path: Path, n: int) -> np.ndarray:
     if len(keys) != n:
-        raise ExciteError(f"data.columns.{field}: {len(keys)} columns for the robot's {n} active joints")
+        raise ExciteError(f"data.columns.{field}", f"{len(keys)} columns for the robot's {n} active joints")
     return np.column_stack([table.column(key, field, path) for key in keys])
 
 
@@ -56,7 +56,9 @@ def _usable(time: np.ndarray, signals: dict[str, np.ndarray]) -> tuple[np.ndarra
     for name, values in signals.items():
         bad = ~np.all(np.isfinite(values) & (np.abs(values) < IMPLAUSIBLE), axis=1)
         if bad.any() and not problem:
-            kind = "NaN or missing value" if not np.all(np.isfinite(values[bad])) else f"a value beyond ±{IMPLAUSIBLE:g}"
+            kind = (
+                "NaN or missing value" if not np.all(np.isfinite(values[bad])) else f"a value beyond ±{IMPLAUSIBLE:g}"
+            )
             problem = f"{kind} in {name} at data row {int(np.flatnonzero(bad)[0]) + 1}"
         ok &= ~bad
     latest = -np.inf
@@ -87,7 +89,7 @@ def load_run(run: RunConfig, data: DataConfig, problem: IdentifyProblem, n: int)
     """
     path = problem.resolve(run.file)
     if not path.is_file():
-        raise ExciteError(f"data.runs: file not found: {path}")
+        raise FileNotFound("data.runs", path)
     drop = data.bad_rows == "drop"
     table = read_table(path, drop)
     cols = data.columns
@@ -99,23 +101,29 @@ def load_run(run: RunConfig, data: DataConfig, problem: IdentifyProblem, n: int)
         tau = _matrix(table, cols.tau, "tau", path, n)
     else:
         if data.torque_constants is None or len(data.torque_constants) != n:
-            raise ExciteError(f"data.torque_constants: give one torque constant [Nm/A] per active joint ({n})")
+            raise ExciteError("data.torque_constants", f"give one torque constant [Nm/A] per active joint ({n})")
         if not np.all(np.isfinite(data.torque_constants)):
-            raise ExciteError("data.torque_constants: every torque constant must be a finite number [Nm/A]")
+            raise ExciteError("data.torque_constants", "every torque constant must be a finite number [Nm/A]")
         tau = _matrix(table, cols.current, "current", path, n) * np.asarray(data.torque_constants)
-    signals = {name: x for name, x in (("time", time[:, None]), ("q", q), ("qd", qd), ("qdd", qdd), ("tau", tau)) if x is not None}
+    signals = {
+        name: x
+        for name, x in (("time", time[:, None]), ("q", q), ("qd", qd), ("qdd", qdd), ("tau", tau))
+        if x is not None
+    }
     ok, issue = _usable(time, signals)
     if issue and not drop:
-        raise ExciteError(f"data: {path.name}: {issue} (data.bad_rows: drop leaves such rows out)")
+        raise ExciteError("data", f"{path.name}: {issue} (data.bad_rows: drop leaves such rows out)")
     if data.angle_unit == "deg":
         q, qd, qdd = (None if x is None else np.deg2rad(x) for x in (q, qd, qdd))
     if data.signs is not None:
         if len(data.signs) != n:
-            raise ExciteError(f"data.signs: {len(data.signs)} signs for {n} active joints")
+            raise ExciteError("data.signs", f"{len(data.signs)} signs for {n} active joints")
         s = np.asarray(data.signs, dtype=float)
         q, qd, qdd, tau = (None if x is None else x * s for x in (q, qd, qdd, tau))
     keep = ok if run.crop is None else ok & (time >= run.crop[0]) & (time <= run.crop[1])
     if keep.sum() < 2:
-        raise ExciteError(f"data.runs.crop: {run.crop} leaves no samples of {path.name} ({time[0]:g} to {time[-1]:g} s)")
-    pick = (lambda x: None if x is None else x[keep])
-    return Run(path.name, run.role, time[keep], q[keep], pick(qd), pick(qdd), tau[keep], table.dropped + int((~ok).sum()))
+        raise ExciteError(
+            "data.runs.crop", f"{run.crop} leaves no samples of {path.name} ({time[0]:g} to {time[-1]:g} s)"
+        )
+    qd, qdd = (None if x is None else x[keep] for x in (qd, qdd))
+    return Run(path.name, run.role, time[keep], q[keep], qd, qdd, tau[keep], table.dropped + int((~ok).sum()))

@@ -7,9 +7,9 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
+from excite_cli.dynamics.robot import Robot
 from excite_cli.errors import ExciteError
 from excite_cli.identification.config import PayloadConfig
-from excite_cli.dynamics.robot import Robot
 
 
 def payload_parameters(robot: Robot, payload: PayloadConfig, field_name: str) -> np.ndarray:
@@ -26,10 +26,14 @@ def payload_parameters(robot: Robot, payload: PayloadConfig, field_name: str) ->
     """
     frame = payload.frame or robot.body_names[-1]
     if not robot.model.existFrame(frame):
-        raise ExciteError(f"{field_name}.frame: '{frame}' is not a frame of the robot's model")
+        raise ExciteError(
+            f"{field_name}.frame", f"'{frame}' is not a frame of the robot's model", frame, "a frame of the URDF"
+        )
     placement = robot.model.frames[robot.model.getFrameId(frame)]
     xx, xy, yy, xz, yz, zz = payload.inertia
-    inertia = pin.Inertia(payload.mass, np.asarray(payload.com, dtype=float), np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]]))
+    inertia = pin.Inertia(
+        payload.mass, np.asarray(payload.com, dtype=float), np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
+    )
     out = np.zeros(robot.n_parameters)
     body = placement.parentJoint - 1
     out[10 * body : 10 * body + 10] = placement.placement.act(inertia).toDynamicParameters()

@@ -65,10 +65,9 @@ def _pseudo_inertia_expression(phi) -> cp.Expression:
     """The same as :func:`pseudo_inertia` for a cvxpy vector of 10 (affine in φ)."""
     m, hx, hy, hz, ixx, ixy, iyy, ixz, iyz, izz = (phi[k] for k in range(10))
     half = 0.5 * (ixx + iyy + izz)
-    return cp.bmat([[half - ixx, -ixy, -ixz, hx],
-                    [-ixy, half - iyy, -iyz, hy],
-                    [-ixz, -iyz, half - izz, hz],
-                    [hx, hy, hz, m]])
+    return cp.bmat(
+        [[half - ixx, -ixy, -ixz, hx], [-ixy, half - iyy, -iyz, hy], [-ixz, -iyz, half - izz, hz], [hx, hy, hz, m]]
+    )
 
 
 @dataclass(frozen=True)
@@ -115,15 +114,23 @@ def _solve(problem: cp.Problem) -> cp.Problem:
             warnings.simplefilter("ignore", UserWarning)
             problem.solve(solver=cp.CLARABEL)
     except cp.SolverError as exc:
-        raise ExciteError(f"identification.physical_consistency: the SDP solver failed: {exc}") from None
+        raise ExciteError("identification.physical_consistency", f"the SDP solver failed: {exc}") from None
     if problem.status not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE):
-        raise ExciteError(f"identification.physical_consistency: the SDP ended {problem.status}")
+        raise ExciteError("identification.physical_consistency", f"the SDP ended {problem.status}")
     return problem
 
 
-def consistent_fit(regressor: np.ndarray, effects: np.ndarray, tau: np.ndarray, weights: np.ndarray,
-                   regrouping: np.ndarray, phi_urdf: np.ndarray, effect_names: list[str], regularization: float,
-                   bodies: list[str]) -> ConsistentFit:
+def consistent_fit(
+    regressor: np.ndarray,
+    effects: np.ndarray,
+    tau: np.ndarray,
+    weights: np.ndarray,
+    regrouping: np.ndarray,
+    phi_urdf: np.ndarray,
+    effect_names: list[str],
+    regularization: float,
+    bodies: list[str],
+) -> ConsistentFit:
     """Solve the semidefinite program of the module docstring.
 
     Args:
@@ -151,26 +158,36 @@ def consistent_fit(regressor: np.ndarray, effects: np.ndarray, tau: np.ndarray, 
     rows = tau.size
     u = cp.Variable(design.shape[1])  # u = column ⊙ [δ; θ], φ = φ_URDF + D δ
     delta = cp.multiply(u[: scale.size], 1.0 / column[: scale.size])
-    theta = cp.multiply(u[scale.size:], 1.0 / column[scale.size:]) if k else None
+    theta = cp.multiply(u[scale.size :], 1.0 / column[scale.size :]) if k else None
     phi = phi_urdf + cp.multiply(scale, delta)
     epsilon = MARGIN * scale[0::10] * LENGTH**2
     # T J T ⪰ ε T² with T = diag(1/ℓ, 1/ℓ, 1/ℓ, 1)/√m₀: a congruence, same cone, entries of order 1
     T = np.diag([1.0 / LENGTH] * 3 + [1.0])
-    constraints = [T @ _pseudo_inertia_expression(phi[10 * i: 10 * i + 10]) @ T / scale[10 * i] >> MARGIN * np.diag([1.0] * 3 + [LENGTH**2])
-                   for i in range(len(bodies))]
+    constraints = [
+        T @ _pseudo_inertia_expression(phi[10 * i : 10 * i + 10]) @ T / scale[10 * i]
+        >> MARGIN * np.diag([1.0] * 3 + [LENGTH**2])
+        for i in range(len(bodies))
+    ]
     if k and nonnegative.any():
         constraints.append(theta[np.flatnonzero(nonnegative)] >= 0)
     objective = cp.sum_squares(R @ u - z) / rows + regularization * cp.sum_squares(delta)
     problem = _solve(cp.Problem(cp.Minimize(objective), constraints))
     standard = phi_urdf + scale * (u.value[: scale.size] / column[: scale.size])
-    coefficients = u.value[scale.size:] / column[scale.size:]
-    eigen = np.array([np.linalg.eigvalsh(pseudo_inertia(standard[10 * i: 10 * i + 10]))[0] for i in range(len(bodies))])
+    coefficients = u.value[scale.size :] / column[scale.size :]
+    eigen = np.array(
+        [np.linalg.eigvalsh(pseudo_inertia(standard[10 * i : 10 * i + 10]))[0] for i in range(len(bodies))]
+    )
     if np.any(eigen <= 0.0):
-        raise ExciteError(f"identification.physical_consistency: the SDP ended {problem.status} with a pseudo-inertia "
-                          f"that is not positive definite (body {bodies[int(np.argmin(eigen))]})")
+        raise ExciteError(
+            "identification.physical_consistency",
+            f"the SDP ended {problem.status} with a pseudo-inertia "
+            f"that is not positive definite (body {bodies[int(np.argmin(eigen))]})",
+        )
     active = [f"pseudo-inertia of {name}" for name, e, eps in zip(bodies, eigen, epsilon) if e <= ACTIVE * eps]
     active += [f"{effect_names[c]} ≥ 0" for c in np.flatnonzero(nonnegative & (coefficients <= 1e-9))]
     stacked = np.vstack([R / np.sqrt(rows), np.sqrt(regularization) * np.diag(1.0 / column)[: scale.size]])
     plain = np.linalg.lstsq(stacked, np.concatenate([z / np.sqrt(rows), np.zeros(scale.size)]), rcond=None)[0]
     unconstrained = phi_urdf + scale * plain[: scale.size] / column[: scale.size]
-    return ConsistentFit(standard, coefficients, regrouping @ standard, eigen, active, str(problem.status), unconstrained)
+    return ConsistentFit(
+        standard, coefficients, regrouping @ standard, eigen, active, str(problem.status), unconstrained
+    )

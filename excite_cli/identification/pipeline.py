@@ -4,13 +4,14 @@ the validation data, which neither the fit nor the selection saw."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from excite_cli.dynamics.base_parameters import BaseParameters, compute_base_parameters
 from excite_cli.config import with_overrides
+from excite_cli.dynamics.base_parameters import BaseParameters, compute_base_parameters
+from excite_cli.dynamics.robot import Robot, load_robot, resolve_urdf
 from excite_cli.errors import ExciteError
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.dataset import Dataset, build_datasets
@@ -21,79 +22,10 @@ from excite_cli.identification.normal import NormalEquations, excited_rank
 from excite_cli.identification.payload import payload_parameters
 from excite_cli.identification.physical import ConsistentFit, consistent_fit
 from excite_cli.identification.preprocessing import choose_cutoff, preprocess
+from excite_cli.identification.report import Report
 from excite_cli.identification.selection import Selection, candidate_terms, select_effects
 from excite_cli.identification.urdf_out import urdf_deviation, write_urdf
 from excite_cli.memory import return_freed_memory
-from excite_cli.dynamics.robot import Robot, load_robot, resolve_urdf
-
-
-@dataclass
-class Report:
-    """What ``identify`` found.
-
-    Attributes:
-        joints: (n,) active joint names.
-        base_names: (b,) base-parameter names.
-        selection: chosen effects, fits, the search's steps.
-        rms_before, rms_after: (n,) validation torque RMS error [Nm], rigid body only / with effects.
-        rms_torque: (n,) RMS of the measured validation torques [Nm].
-        validation: the validation samples; predicted_before, predicted_after: (N, n) [Nm] on them.
-        cutoff: low-pass cut-off of every run [Hz]; cutoff_source: how it was chosen, in words.
-        fit_samples, validation_samples: instants used for fitting / validation.
-        dropped: (file, rows) left out as unusable, per run with ``data.bad_rows: drop``.
-        run_names: (runs,) each configured run's label (file and crop), indexed by ``Dataset.run``.
-        offset_runs: the runs whose offsets the fit has (one column each), as labels.
-        ladder: (step, CV error on the fit data [%], mean relative validation error [%]) for the
-            rigid body, the search's start and after each step of the kept search.
-        consistent: the physically consistent fit with the same effects, or None.
-        rms_consistent: (n,) its validation torque RMS error [Nm] (None without it).
-    """
-
-    joints: list[str]
-    base_names: list[str]
-    selection: Selection
-    rms_before: np.ndarray
-    rms_after: np.ndarray
-    rms_torque: np.ndarray
-    validation: Dataset
-    predicted_before: np.ndarray
-    predicted_after: np.ndarray
-    cutoff: float
-    cutoff_source: str
-    fit_samples: int
-    validation_samples: int
-    dropped: list[tuple[str, int]] = field(default_factory=list)
-    run_names: list[str] = field(default_factory=list)
-    offset_runs: list[str] = field(default_factory=list)
-    ladder: list[tuple[str, float, float]] = field(default_factory=list)
-    consistent: ConsistentFit | None = None
-    rms_consistent: np.ndarray | None = None
-
-    @property
-    def relative_before(self) -> np.ndarray:
-        """(n,) RMS error / RMS torque [%] before."""
-        return 100.0 * self.rms_before / self.rms_torque
-
-    @property
-    def relative_after(self) -> np.ndarray:
-        """(n,) RMS error / RMS torque [%] after."""
-        return 100.0 * self.rms_after / self.rms_torque
-
-    def per_run(self) -> list[tuple[str, int, np.ndarray, np.ndarray, np.ndarray]]:
-        """(run name, instants, RMS error before (n,) [Nm], after (n,) [Nm], RMS torque (n,) [Nm]) of
-        each validation run."""
-        measured = self.validation.tau.reshape(-1, len(self.joints))
-        out = []
-        for r in np.unique(self.validation.run):
-            rows = self.validation.run == r
-            (before, torque, _), (after, _, _) = (torque_errors(measured[rows], p[rows]) for p in (self.predicted_before, self.predicted_after))
-            out.append((self.run_names[r] if r < len(self.run_names) else str(r), int(rows.sum()), before, after, torque))
-        return out
-
-    @property
-    def relative_consistent(self) -> np.ndarray | None:
-        """(n,) RMS error / RMS torque [%] of the physically consistent fit, or None."""
-        return None if self.rms_consistent is None else 100.0 * self.rms_consistent / self.rms_torque
 
 
 def declared_terms(problem: IdentifyProblem, robot: Robot) -> list[Term]:
@@ -107,7 +39,7 @@ def declared_terms(problem: IdentifyProblem, robot: Robot) -> list[Term]:
     out: list[Term] = []
     for name, effects in cfg.declared_effects.items():
         if name != "*" and name not in robot.joint_names:
-            raise ExciteError(f"identification.declared_effects: '{name}' is not an active joint")
+            raise ExciteError("identification.declared_effects", f"'{name}' is not an active joint")
         joints = range(robot.n_joints) if name == "*" else [robot.joint_names.index(name)]
         for e in effects:
             grid = getattr(cfg, SHAPE_FIELDS[e]) if e in SHAPE_FIELDS else None
@@ -127,7 +59,10 @@ def error_ladder(val_data: Dataset, selection: Selection, joints: list[str]) -> 
     if search.initial:
         models.append((f"start: {search.start}", search.initial, search.initial_error))
     models += [(step.label(joints), step.terms, step.cv_error) for step in search.steps]
-    fitted = ((label, cv, predict(val_data, least_squares(selection.normal, terms, selection.weights).x, terms)) for label, terms, cv in models)
+    fitted = (
+        (label, cv, predict(val_data, least_squares(selection.normal, terms, selection.weights).x, terms))
+        for label, terms, cv in models
+    )
     return [(label, cv, float(torque_errors(measured, predicted)[2].mean())) for label, cv, predicted in fitted]
 
 
@@ -156,23 +91,38 @@ def prepare_data(problem: IdentifyProblem, robot: Robot, base: BaseParameters, t
             fit runs that do not excite every base parameter.
     """
     cfg = problem.identification
-    payloads = [payload_parameters(robot, r.payload, f"data.runs[{k}].payload") if r.payload else None
-                for k, r in enumerate(problem.data.runs)]
+    payloads = [
+        payload_parameters(robot, r.payload, f"data.runs[{k}].payload") if r.payload else None
+        for k, r in enumerate(problem.data.runs)
+    ]
     runs = [load_run(r, problem.data, problem, robot.n_joints) for r in problem.data.runs]
     cutoff, source = choose_cutoff(runs, problem.preprocessing)
     dropped = [(r.name, r.dropped) for r in runs if r.dropped]
     samples = [preprocess(runs.pop(0), problem.preprocessing, cutoff) for _ in range(len(runs))]
     rate = max(s.filter.rate / s.filter.step for s in samples)
     coulomb = [Term("coulomb", j) for j in range(robot.n_joints)]  # the load column's sign
-    fit, val, fitted = build_datasets(robot, base, samples, terms + coulomb, cfg.coulomb_velocity, problem.data.validation_blocks, payloads)
+    fit, val, fitted = build_datasets(
+        robot, base, samples, terms + coulomb, cfg.coulomb_velocity, problem.data.validation_blocks, payloads
+    )
     rigid_only = NormalEquations(fit, [])
     rank = excited_rank(rigid_only.system(None, [])[0])
     if rank < base.count:
-        raise ExciteError(f"data: the fit runs excite {rank} of the {base.count} base parameters; the robot must move "
-                          "through an exciting trajectory (see `excite optimize`), motionless or small motions cannot identify it")
+        raise ExciteError(
+            "data",
+            f"the fit runs excite {rank} of the {base.count} base parameters; the robot must move "
+            "through an exciting trajectory (see `excite optimize`), motionless or small motions cannot identify it",
+        )
     first = least_squares(rigid_only, [], joint_weights(rigid_only, cfg.method == "wls"))
     load = [t for t in terms if t.effect in TWO_STAGE]
-    return Prepared(fit.with_load_columns(first.x, load), val.with_load_columns(first.x, load), fitted, cutoff, source, dropped, rate)
+    return Prepared(
+        fit.with_load_columns(first.x, load),
+        val.with_load_columns(first.x, load),
+        fitted,
+        cutoff,
+        source,
+        dropped,
+        rate,
+    )
 
 
 def run_identification(problem: IdentifyProblem) -> tuple[Report, Robot, BaseParameters, list[np.ndarray]]:
@@ -192,33 +142,52 @@ def run_identification(problem: IdentifyProblem) -> tuple[Report, Robot, BasePar
     base = compute_base_parameters(robot)
     declared = declared_terms(problem, robot)  # before any data is read
     cfg = problem.identification
-    data = prepare_data(problem, robot, base, declared + [t for t in candidate_terms(cfg, robot.n_joints) if t not in declared])
+    data = prepare_data(
+        problem, robot, base, declared + [t for t in candidate_terms(cfg, robot.n_joints) if t not in declared]
+    )
     fit_data, val_data = data.fit, data.validation
-    selection = select_effects(fit_data, cfg, declared, margin=1.0 / data.cutoff,
-                               oversampling=max(1.0, data.rate / (2.0 * data.cutoff)))
+    selection = select_effects(
+        fit_data, cfg, declared, margin=1.0 / data.cutoff, oversampling=max(1.0, data.rate / (2.0 * data.cutoff))
+    )
     before = predict(val_data, selection.rigid.x, [])
     after = predict(val_data, selection.fit.x, selection.terms)
     measured = val_data.tau.reshape(-1, val_data.n)
     labels = [r.label for r in problem.data.runs]
     offset_runs = [labels[k] for k in data.fitted]
-    consistent = fit_consistent(fit_data, selection, robot, base, cfg, offset_runs) if cfg.physical_consistency else None
+    consistent = (
+        fit_consistent(fit_data, selection, robot, base, cfg, offset_runs) if cfg.physical_consistency else None
+    )
     rms_consistent = None
     if consistent is not None:
         predicted = predict(val_data, np.concatenate([consistent.base, consistent.effects]), selection.terms)
         rms_consistent = torque_errors(measured, predicted)[0]
     report = Report(
-        joints=robot.joint_names, base_names=base.names, selection=selection,
-        rms_before=torque_errors(measured, before)[0], rms_after=torque_errors(measured, after)[0],
-        rms_torque=torque_errors(measured, after)[1], validation=val_data, predicted_before=before, predicted_after=after,
-        cutoff=data.cutoff, cutoff_source=data.cutoff_source, fit_samples=fit_data.time.size, validation_samples=val_data.time.size,
-        dropped=data.dropped, run_names=labels, offset_runs=offset_runs,
-        ladder=error_ladder(val_data, selection, robot.joint_names), consistent=consistent, rms_consistent=rms_consistent,
+        joints=robot.joint_names,
+        base_names=base.names,
+        selection=selection,
+        rms_before=torque_errors(measured, before)[0],
+        rms_after=torque_errors(measured, after)[0],
+        rms_torque=torque_errors(measured, after)[1],
+        validation=val_data,
+        predicted_before=before,
+        predicted_after=after,
+        cutoff=data.cutoff,
+        cutoff_source=data.cutoff_source,
+        fit_samples=fit_data.time.size,
+        validation_samples=val_data.time.size,
+        dropped=data.dropped,
+        run_names=labels,
+        offset_runs=offset_runs,
+        ladder=error_ladder(val_data, selection, robot.joint_names),
+        consistent=consistent,
+        rms_consistent=rms_consistent,
     )
     return report, robot, base, [fit_data.regressor, val_data.regressor]
 
 
-def fit_consistent(fit_data: Dataset, selection: Selection, robot: Robot, base: BaseParameters, cfg,
-                   offset_runs: list[str]) -> ConsistentFit:
+def fit_consistent(
+    fit_data: Dataset, selection: Selection, robot: Robot, base: BaseParameters, cfg, offset_runs: list[str]
+) -> ConsistentFit:
     """The physically consistent fit (:mod:`excite_cli.identification.physical`) of the selected model
     on the fit data, with the selection's per-joint weights (WLS) or none (LS); ``offset_runs``
     names the offsets' columns.
@@ -227,9 +196,20 @@ def fit_consistent(fit_data: Dataset, selection: Selection, robot: Robot, base: 
         ExciteError: the semidefinite program has no solution.
     """
     weights = np.ones(fit_data.tau.size) if selection.weights is None else selection.weights[fit_data.joint]
-    names = [f"{name} {robot.joint_names[t.joint]}" for t in selection.terms for name in coefficient_names(t, offset_runs)]
-    return consistent_fit(fit_data.regressor, design(fit_data, selection.terms)[:, base.count:], fit_data.tau, weights,
-                          base.regrouping, robot.urdf_parameters(), names, cfg.regularization, robot.body_names)
+    names = [
+        f"{name} {robot.joint_names[t.joint]}" for t in selection.terms for name in coefficient_names(t, offset_runs)
+    ]
+    return consistent_fit(
+        fit_data.regressor,
+        design(fit_data, selection.terms)[:, base.count :],
+        fit_data.tau,
+        weights,
+        base.regrouping,
+        robot.urdf_parameters(),
+        names,
+        cfg.regularization,
+        robot.body_names,
+    )
 
 
 def coefficient_names(term: Term, offset_runs: list[str]) -> list[str]:
@@ -251,7 +231,9 @@ def effect_values(report: Report, consistent: bool = False) -> list[tuple[Term, 
     return [(term, name, float(v), float(s)) for (term, name), v, s in zip(names, values, stds)]
 
 
-def write_identified_urdf(problem: IdentifyProblem, report: Report, robot: Robot, base: BaseParameters, target: Path) -> float:
+def write_identified_urdf(
+    problem: IdentifyProblem, report: Report, robot: Robot, base: BaseParameters, target: Path
+) -> float:
     """Write the URDF of the physically consistent fit (:mod:`excite_cli.identification.urdf_out`) and
     return the largest deviation [Nm] of its RNEA from the identified rigid-body torques.
 
@@ -259,10 +241,16 @@ def write_identified_urdf(problem: IdentifyProblem, report: Report, robot: Robot
         ExciteError: no consistent fit in ``report``, or the file cannot be written or loaded back.
     """
     if report.consistent is None:
-        raise ExciteError("--urdf-out: needs the physically consistent fit (identification.physical_consistency)")
+        raise ExciteError("urdf_out", "needs the physically consistent fit (identification.physical_consistency)")
     source, _ = resolve_urdf(problem)
     effects = [(t.effect, c, report.joints[t.joint], v) for t, c, v, _ in effect_values(report, consistent=True)]
-    write_urdf(source, target, robot, report.consistent.standard, effects,
-               f"physically consistent parameters identified from {problem.source_path or 'measured data'}")
+    write_urdf(
+        source,
+        target,
+        robot,
+        report.consistent.standard,
+        effects,
+        f"physically consistent parameters identified from {problem.source_path or 'measured data'}",
+    )
     X, phi_base = base.composition_matrix, report.consistent.base
     return urdf_deviation(problem, robot, lambda q, qd, qdd: robot.regressor(q, qd, qdd) @ X @ phi_base, target)

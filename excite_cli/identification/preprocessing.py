@@ -20,8 +20,8 @@ from typing import Callable, Iterator
 import numpy as np
 from scipy import signal
 
-from excite_cli.identification.config import PreprocessingConfig
 from excite_cli.errors import ExciteError
+from excite_cli.identification.config import PreprocessingConfig
 from excite_cli.identification.measurements import Run
 
 #: Default cut-off = this × the frequency below which ``POWER_FRACTION`` of q's power lies ...
@@ -80,7 +80,9 @@ class Filter:
         """Number of samples :meth:`decimate` keeps of a signal of ``length`` samples."""
         return len(range(self.trim, length - self.trim, self.step))
 
-    def chunks(self, values: Callable[[int, int], np.ndarray], length: int, chunk: int = CHUNK) -> Iterator[tuple[int, np.ndarray]]:
+    def chunks(
+        self, values: Callable[[int, int], np.ndarray], length: int, chunk: int = CHUNK
+    ) -> Iterator[tuple[int, np.ndarray]]:
         """:meth:`decimate` of a long signal that is never held whole, in pieces: ``values(lo, hi)``
         gives its samples [lo, hi) (rows along axis 0); yields (k, rows), the kept samples k, k+1, ...
         Each chunk of about ``chunk`` samples is filtered with ``CHUNK_MARGIN`` × ``trim`` samples of
@@ -147,8 +149,10 @@ def choose_cutoff(runs: list[Run], cfg: PreprocessingConfig) -> tuple[float, str
     widest = max(bandwidth(np.column_stack(resample(r, r.q, uniform_grid(r))), run_rate(r)) for r in fitted)
     top = MAX_CUTOFF_FRACTION * min(cfg.sample_rate, min(run_rate(r) for r in runs))
     cutoff = float(min(max(MIN_CUTOFF, CUTOFF_FACTOR * widest), top))
-    return cutoff, (f"default: {CUTOFF_FACTOR:g} × the {100 * POWER_FRACTION:g} % power bandwidth of q in the fitted runs "
-                    f"({widest:.3g} Hz), at least {MIN_CUTOFF:g} Hz, at most {100 * MAX_CUTOFF_FRACTION:g} % of the rate")
+    return cutoff, (
+        f"default: {CUTOFF_FACTOR:g} × the {100 * POWER_FRACTION:g} % power bandwidth of q in the fitted runs "
+        f"({widest:.3g} Hz), at least {MIN_CUTOFF:g} Hz, at most {100 * MAX_CUTOFF_FRACTION:g} % of the rate"
+    )
 
 
 def preprocess(run: Run, cfg: PreprocessingConfig, cutoff: float) -> Samples:
@@ -165,21 +169,26 @@ def preprocess(run: Run, cfg: PreprocessingConfig, cutoff: float) -> Samples:
     grid = uniform_grid(run)
     q, qd, qdd = (resample(run, x, grid) for x in (run.q, run.qd, run.qdd))
     if cfg.sample_rate > 1.01 * rate:
-        raise ExciteError(f"preprocessing.sample_rate: {cfg.sample_rate:g} Hz is above the {rate:.4g} Hz of {run.name}; "
-                          "resampling cannot add information (use at most the data's rate)")
+        raise ExciteError(
+            "preprocessing.sample_rate",
+            f"{cfg.sample_rate:g} Hz is above the {rate:.4g} Hz of {run.name}; "
+            "resampling cannot add information (use at most the data's rate)",
+        )
     target = min(cfg.sample_rate, rate)
     if cutoff >= 0.5 * target:
         raise ExciteError(
-            f"preprocessing.cutoff: {cutoff:.3g} Hz is not below the Nyquist frequency {0.5 * target:.3g} Hz of "
-            f"preprocessing.sample_rate (and of {run.name}); raise sample_rate or lower cutoff"
+            "preprocessing.cutoff",
+            f"{cutoff:.3g} Hz is not below the Nyquist frequency {0.5 * target:.3g} Hz of "
+            f"preprocessing.sample_rate (and of {run.name}); raise sample_rate or lower cutoff",
         )
     sos = signal.butter(cfg.filter_order, cutoff, fs=rate, output="sos")
     trim = int(np.ceil(EDGE_PERIODS * rate / cutoff))
     needed = max(3 * (2 * len(sos) + 1), 2 * trim + 10)
     if grid.size <= needed:
         raise ExciteError(
-            f"data: {run.name}: {grid.size} samples ({grid[-1] - grid[0]:.3g} s) are fewer than the "
-            f"{needed} that the {cutoff:.3g} Hz filter needs"
+            "data",
+            f"{run.name}: {grid.size} samples ({grid[-1] - grid[0]:.3g} s) are fewer than the "
+            f"{needed} that the {cutoff:.3g} Hz filter needs",
         )
     filt = Filter(sos, rate, cutoff, trim, max(1, int(round(rate / target))))
     dt = 1.0 / rate

@@ -10,20 +10,27 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.config import effective_yaml
+from excite_cli.dynamics.base_parameters import BaseParameters
+from excite_cli.dynamics.robot import Robot
+from excite_cli.h5 import atomic_h5, write_strings
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.effects import COEFFICIENTS, UNITS
 from excite_cli.identification.physical import body_properties
-from excite_cli.identification.pipeline import Report, effect_values
-from excite_cli.storage.results import atomic_h5, write_strings
-from excite_cli.dynamics.robot import Robot
+from excite_cli.identification.pipeline import effect_values
+from excite_cli.identification.report import Report
 
 STR = h5py.string_dtype()
 
 
-def write_identification(path: Path, report: Report, robot: Robot, base: BaseParameters, problem: IdentifyProblem,
-                         regressor: list[np.ndarray]) -> None:
+def write_identification(
+    path: Path,
+    report: Report,
+    robot: Robot,
+    base: BaseParameters,
+    problem: IdentifyProblem,
+    regressor: list[np.ndarray],
+) -> None:
     """Write (atomically) an ``identify`` report.
 
     Args:
@@ -43,7 +50,11 @@ def write_identification(path: Path, report: Report, robot: Robot, base: BasePar
         write_strings(group, "base_parameter_names", base.names)
         _write_regressor(f, regressor, b)
         g = f.create_group("identification")
-        g.attrs["method"], g.attrs["cutoff_Hz"], g.attrs["cutoff_source"] = problem.identification.method, report.cutoff, report.cutoff_source
+        g.attrs["method"], g.attrs["cutoff_Hz"], g.attrs["cutoff_source"] = (
+            problem.identification.method,
+            report.cutoff,
+            report.cutoff_source,
+        )
         g.attrs["fit_samples"], g.attrs["validation_samples"] = report.fit_samples, report.validation_samples
         g.attrs["dropped_rows"] = "; ".join(f"{name}: {rows}" for name, rows in report.dropped) or "none"
         g.attrs["folds"], g.attrs["min_improvement"] = sel.folds, sel.min_improvement
@@ -75,7 +86,9 @@ def _write_regressor(f: h5py.File, regressor: list[np.ndarray], b: int) -> None:
     for part in regressor:
         data[at : at + part.shape[0]] = part
         at += part.shape[0]
-    data.attrs["description"] = "base regressor of all preprocessed (decimated) samples, fit then validation (prior data C0, Eq. 41)"
+    data.attrs["description"] = (
+        "base regressor of all preprocessed (decimated) samples, fit then validation (prior data C0, Eq. 41)"
+    )
 
 
 def _term_fields(term, joints: list[str]) -> tuple[str, str, float]:
@@ -87,8 +100,21 @@ def _write_effects(g: h5py.Group, report: Report) -> None:
     """The chosen effects in the order they were added, declared ones flagged, with units, and what
     was absorbed."""
     sel, rows = report.selection, effect_values(report)
-    effects = np.zeros(len(rows), dtype=[("order", "i4"), ("effect", STR), ("coefficient", STR), ("joint", STR), ("shape", "f8"),
-                                         ("value", "f8"), ("std", "f8"), ("unit", STR), ("declared", "?"), ("value_consistent", "f8")])
+    effects = np.zeros(
+        len(rows),
+        dtype=[
+            ("order", "i4"),
+            ("effect", STR),
+            ("coefficient", STR),
+            ("joint", STR),
+            ("shape", "f8"),
+            ("value", "f8"),
+            ("std", "f8"),
+            ("unit", STR),
+            ("declared", "?"),
+            ("value_consistent", "f8"),
+        ],
+    )
     effects["value_consistent"] = np.nan if report.consistent is None else report.consistent.effects
     order = {t: k + 1 for k, t in enumerate(sel.terms)}
     for row, (term, coefficient, value, std) in zip(effects, rows):
@@ -106,42 +132,92 @@ def _write_search(g: h5py.Group, report: Report) -> None:
     """The selection: the ladder (CV and validation error after each step), the kept search's steps,
     every move tried at each step with its gain, and the outcome of every start."""
     ladder = np.array(report.ladder, dtype=[("step", STR), ("cv_error", "f8"), ("validation_error", "f8")])
-    g.create_dataset("ladder", data=ladder).attrs["units"] = "% (mean relative RMS torque error: cross-validated on the fit data, on the validation data)"
+    g.create_dataset("ladder", data=ladder).attrs["units"] = (
+        "% (mean relative RMS torque error: cross-validated on the fit data, on the validation data)"
+    )
     sel = report.selection
-    move = [("step", "i4"), ("move", STR), ("effect", STR), ("joint", STR), ("shape", "f8"), ("cv_error", "f8"), ("gain", "f8")]
+    move = [
+        ("step", "i4"),
+        ("move", STR),
+        ("effect", STR),
+        ("joint", STR),
+        ("shape", "f8"),
+        ("cv_error", "f8"),
+        ("gain", "f8"),
+    ]
     steps, tried = [], []
     for k, step in enumerate(sel.steps, start=1):
         steps.append((k, step.move, *_term_fields(step.term, report.joints), step.cv_error, step.gain))
         tried += [(k, m, *_term_fields(t, report.joints), v, step.gain_of(v)) for m, t, v in step.tried]
     units = "cv_error in %, gain in % of the CV error before the step, shape in rad/s"
     g.create_dataset("steps", data=np.array(steps, dtype=move)).attrs["units"] = units
-    g.create_dataset("candidates", data=np.array(tried, dtype=move)).attrs["units"] = units + "; every move tried at each step"
-    searches = np.array([(s.start, ", ".join(t.label(report.joints) for t in s.terms), s.cv_error, s.objective, len(s.steps), s.stop,
-                          k == sel.chosen) for k, s in enumerate(sel.searches)],
-                        dtype=[("start", STR), ("effects", STR), ("cv_error", "f8"), ("objective", "f8"), ("steps", "i4"),
-                               ("stop_reason", STR), ("chosen", "?")])
-    g.create_dataset("searches", data=searches).attrs["units"] = "cv_error in %; objective J = log CV + p log(1 + min_improvement)"
+    g.create_dataset("candidates", data=np.array(tried, dtype=move)).attrs["units"] = (
+        units + "; every move tried at each step"
+    )
+    searches = np.array(
+        [
+            (
+                s.start,
+                ", ".join(t.label(report.joints) for t in s.terms),
+                s.cv_error,
+                s.objective,
+                len(s.steps),
+                s.stop,
+                k == sel.chosen,
+            )
+            for k, s in enumerate(sel.searches)
+        ],
+        dtype=[
+            ("start", STR),
+            ("effects", STR),
+            ("cv_error", "f8"),
+            ("objective", "f8"),
+            ("steps", "i4"),
+            ("stop_reason", STR),
+            ("chosen", "?"),
+        ],
+    )
+    g.create_dataset("searches", data=searches).attrs["units"] = (
+        "cv_error in %; objective J = log CV + p log(1 + min_improvement)"
+    )
 
 
 def _write_validation(g: h5py.Group, report: Report) -> None:
     """Torque errors on the validation data (never fitted, never used by the selection): per joint
     and per run, and the measured and predicted torques."""
     n, runs = len(report.joints), report.per_run()
-    table = np.zeros(len(runs), dtype=[("run", STR), ("instants", "i8"), ("rms_before", "f8", n),
-                                       ("rms_after", "f8", n), ("relative_after", "f8", n)])
+    table = np.zeros(
+        len(runs),
+        dtype=[
+            ("run", STR),
+            ("instants", "i8"),
+            ("rms_before", "f8", n),
+            ("rms_after", "f8", n),
+            ("relative_after", "f8", n),
+        ],
+    )
     for row, (name, count, before, after, torque) in zip(table, runs):
         row["run"], row["instants"], row["rms_before"], row["rms_after"] = name, count, before, after
         row["relative_after"] = 100.0 * after / np.where(torque > 0, torque, 1.0)
-    g.create_dataset("validation_runs", data=table).attrs["units"] = "rms in Nm; relative_after in % of the run's RMS torque"
-    for name, values, unit in (("rms_before", report.rms_before, "Nm"), ("rms_after", report.rms_after, "Nm"),
-                               ("rms_torque", report.rms_torque, "Nm"), ("relative_before", report.relative_before, "%"),
-                               ("relative_after", report.relative_after, "%")):
+    g.create_dataset("validation_runs", data=table).attrs["units"] = (
+        "rms in Nm; relative_after in % of the run's RMS torque"
+    )
+    for name, values, unit in (
+        ("rms_before", report.rms_before, "Nm"),
+        ("rms_after", report.rms_after, "Nm"),
+        ("rms_torque", report.rms_torque, "Nm"),
+        ("relative_before", report.relative_before, "%"),
+        ("relative_after", report.relative_after, "%"),
+    ):
         g.create_dataset(name, data=values).attrs["unit"] = unit
     val = g.create_group("validation")
     val.create_dataset("time", data=report.validation.time).attrs["unit"] = "s"
     val.create_dataset("run", data=report.validation.run).attrs["description"] = "index into the config's data.runs"
-    for name, values in (("measured", report.validation.tau.reshape(-1, n)), ("predicted_before", report.predicted_before),
-                         ("predicted_after", report.predicted_after)):
+    for name, values in (
+        ("measured", report.validation.tau.reshape(-1, n)),
+        ("predicted_before", report.predicted_before),
+        ("predicted_after", report.predicted_after),
+    ):
         val.create_dataset(name, data=values, compression="gzip").attrs["unit"] = "Nm (filtered and decimated)"
 
 
@@ -149,19 +225,37 @@ def _write_consistent(g: h5py.Group, report: Report, robot: Robot) -> None:
     """The physically consistent fit: standard parameters, per-body properties beside the URDF's,
     active constraints, its validation errors."""
     consistent = report.consistent
-    g.create_dataset("standard_parameters", data=consistent.standard).attrs["unit"] = "kg, kg m, kg m^2 (pinocchio order per body)"
+    g.create_dataset("standard_parameters", data=consistent.standard).attrs["unit"] = (
+        "kg, kg m, kg m^2 (pinocchio order per body)"
+    )
     write_strings(g, "standard_parameter_names", robot.parameter_names)
     g.attrs["solver_status"] = consistent.status
     write_strings(g, "active_constraints", consistent.active)
     urdf = robot.urdf_parameters()
-    bodies = np.zeros(len(robot.body_names), dtype=[("body", STR), ("mass", "f8"), ("com", "f8", 3),
-                                                     ("principal_moments", "f8", 3), ("inertia_com", "f8", (3, 3)),
-                                                     ("urdf_mass", "f8"), ("urdf_com", "f8", 3), ("urdf_principal_moments", "f8", 3),
-                                                     ("pseudo_inertia_min_eigenvalue", "f8")])
+    bodies = np.zeros(
+        len(robot.body_names),
+        dtype=[
+            ("body", STR),
+            ("mass", "f8"),
+            ("com", "f8", 3),
+            ("principal_moments", "f8", 3),
+            ("inertia_com", "f8", (3, 3)),
+            ("urdf_mass", "f8"),
+            ("urdf_com", "f8", 3),
+            ("urdf_principal_moments", "f8", 3),
+            ("pseudo_inertia_min_eigenvalue", "f8"),
+        ],
+    )
     for i, row in enumerate(bodies):
-        m, c, I, moments = body_properties(consistent.standard[10 * i: 10 * i + 10])
-        um, uc, _, umoments = body_properties(urdf[10 * i: 10 * i + 10])
-        row["body"], row["mass"], row["com"], row["principal_moments"], row["inertia_com"] = robot.body_names[i], m, c, moments, I
+        m, c, I, moments = body_properties(consistent.standard[10 * i : 10 * i + 10])
+        um, uc, _, umoments = body_properties(urdf[10 * i : 10 * i + 10])
+        row["body"], row["mass"], row["com"], row["principal_moments"], row["inertia_com"] = (
+            robot.body_names[i],
+            m,
+            c,
+            moments,
+            I,
+        )
         row["urdf_mass"], row["urdf_com"], row["urdf_principal_moments"] = um, uc, umoments
         row["pseudo_inertia_min_eigenvalue"] = consistent.min_eigenvalues[i]
     table = g.create_dataset("bodies", data=bodies)

@@ -39,7 +39,11 @@ from excite_cli.identification.normal import ABSORBED, NormalEquations, outside_
 #: How a move is written: added, removed, shape changed.
 MOVE_SIGNS = {"add": "+", "remove": "−", "shape": "~"}
 #: Starts of the search beyond the declared effects: friction a real joint is most likely to have.
-STARTS = {"declared effects": (), "Coulomb on every joint": ("coulomb",), "Coulomb and viscous on every joint": ("coulomb", "viscous")}
+STARTS = {
+    "declared effects": (),
+    "Coulomb on every joint": ("coulomb",),
+    "Coulomb and viscous on every joint": ("coulomb", "viscous"),
+}
 
 
 @dataclass(frozen=True)
@@ -131,7 +135,12 @@ class Selection:
 
 def candidate_terms(cfg: IdentificationConfig, n: int) -> list[Term]:
     """Every candidate term: each candidate effect on each joint, one per shape of ``SHAPES`` effects."""
-    return [Term(e, j, s) for e in cfg.candidates for j in range(n) for s in (getattr(cfg, SHAPE_FIELDS[e]) if e in SHAPE_FIELDS else [None])]
+    return [
+        Term(e, j, s)
+        for e in cfg.candidates
+        for j in range(n)
+        for s in (getattr(cfg, SHAPE_FIELDS[e]) if e in SHAPE_FIELDS else [None])
+    ]
 
 
 class _Search:
@@ -161,15 +170,22 @@ class _Search:
         family = {(t.effect, t.joint): t for t in terms}
         out = []
         if len(terms) - len(self.declared) < self.cfg.max_effects:
-            out += [("add", c, terms + [c]) for c in self.candidates
-                    if (c.effect, c.joint) not in family and (c.effect not in REQUIRES or (REQUIRES[c.effect], c.joint) in family)]
+            out += [
+                ("add", c, terms + [c])
+                for c in self.candidates
+                if (c.effect, c.joint) not in family
+                and (c.effect not in REQUIRES or (REQUIRES[c.effect], c.joint) in family)
+            ]
         for t in terms:
             needed = any(REQUIRES.get(u.effect) == t.effect and u.joint == t.joint for u in terms)
             if (t.effect, t.joint) not in self.fixed and not needed:
                 out.append(("remove", t, [u for u in terms if u != t]))
             if t.shape is not None:
-                out += [("shape", c, [c if u == t else u for u in terms]) for c in self.candidates
-                        if c.effect == t.effect and c.joint == t.joint and c.shape != t.shape]
+                out += [
+                    ("shape", c, [c if u == t else u for u in terms])
+                    for c in self.candidates
+                    if c.effect == t.effect and c.joint == t.joint and c.shape != t.shape
+                ]
         return out
 
     def run(self, name: str, start: list[Term]) -> Search:
@@ -183,8 +199,10 @@ class _Search:
                 break
             move, term, after, value = min(tried, key=lambda m: self.cost(m[0], m[2], m[3]))
             if self.cost(move, after, value) >= search.objective - 1e-12:
-                search.stop = (f"no addition, removal or shape change lowers the cross-validated error by "
-                               f"min_improvement ({100 * self.cfg.min_improvement:g} %)")
+                search.stop = (
+                    f"no addition, removal or shape change lowers the cross-validated error by "
+                    f"min_improvement ({100 * self.cfg.min_improvement:g} %)"
+                )
                 if len(terms) - len(self.declared) >= self.cfg.max_effects:
                     search.stop = f"max_effects ({self.cfg.max_effects}) reached; no removal or shape change helps"
                 break
@@ -195,8 +213,9 @@ class _Search:
         return search
 
 
-def select_effects(fit_data: Dataset, cfg: IdentificationConfig, declared: list[Term], margin: float,
-                   oversampling: float = 1.0) -> Selection:
+def select_effects(
+    fit_data: Dataset, cfg: IdentificationConfig, declared: list[Term], margin: float, oversampling: float = 1.0
+) -> Selection:
     """The stepwise search of the module docstring on the fit data.
 
     Args:
@@ -225,7 +244,19 @@ def select_effects(fit_data: Dataset, cfg: IdentificationConfig, declared: list[
         searches.append(search.run(name, start))
     chosen = min(range(len(searches)), key=lambda k: searches[k].objective)
     terms = searches[chosen].terms
-    return Selection(terms=terms, declared=len(declared), fit=least_squares(total, terms, weights, oversampling),
-                     rigid=least_squares(total, [], weights, oversampling), weights=weights, cv_rigid=cv.error([])[0],
-                     cv_error=searches[chosen].cv_error, cv_joint=cv.error(terms)[1], searches=searches, chosen=chosen,
-                     absorbed=absorbed, folds=cfg.folds, min_improvement=cfg.min_improvement, normal=total)
+    return Selection(
+        terms=terms,
+        declared=len(declared),
+        fit=least_squares(total, terms, weights, oversampling),
+        rigid=least_squares(total, [], weights, oversampling),
+        weights=weights,
+        cv_rigid=cv.error([])[0],
+        cv_error=searches[chosen].cv_error,
+        cv_joint=cv.error(terms)[1],
+        searches=searches,
+        chosen=chosen,
+        absorbed=absorbed,
+        folds=cfg.folds,
+        min_improvement=cfg.min_improvement,
+        normal=total,
+    )

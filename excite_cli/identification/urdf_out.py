@@ -19,8 +19,9 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from excite_cli.errors import ExciteError
 from excite_cli.dynamics.robot import Robot, load_robot
+from excite_cli.errors import ExciteError
+from excite_cli.h5 import atomic_path
 
 #: Friction coefficients that URDF's <dynamics> carries: coefficient → attribute.
 DYNAMICS = {"Fc": "friction", "Fv": "damping"}
@@ -39,8 +40,16 @@ def _inertial(link: ET.Element, phi: np.ndarray) -> None:
     ET.SubElement(element, "origin", xyz=" ".join(_number(x) for x in inertia.lever), rpy="0 0 0")
     ET.SubElement(element, "mass", value=_number(inertia.mass))
     I = inertia.inertia
-    ET.SubElement(element, "inertia", ixx=_number(I[0, 0]), ixy=_number(I[0, 1]), ixz=_number(I[0, 2]),
-                  iyy=_number(I[1, 1]), iyz=_number(I[1, 2]), izz=_number(I[2, 2]))
+    ET.SubElement(
+        element,
+        "inertia",
+        ixx=_number(I[0, 0]),
+        ixy=_number(I[0, 1]),
+        ixz=_number(I[0, 2]),
+        iyy=_number(I[1, 1]),
+        iyz=_number(I[1, 2]),
+        izz=_number(I[2, 2]),
+    )
 
 
 def merged_links(robot: Robot) -> dict[str, list[str]]:
@@ -55,8 +64,14 @@ def merged_links(robot: Robot) -> dict[str, list[str]]:
     return out
 
 
-def write_urdf(source: Path, target: Path, robot: Robot, standard: np.ndarray,
-               effects: list[tuple[str, str, str, float]], note: str) -> Path:
+def write_urdf(
+    source: Path,
+    target: Path,
+    robot: Robot,
+    standard: np.ndarray,
+    effects: list[tuple[str, str, str, float]],
+    note: str,
+) -> Path:
     """Write ``source`` with the identified inertias to ``target`` (atomically).
 
     Args:
@@ -72,14 +87,14 @@ def write_urdf(source: Path, target: Path, robot: Robot, standard: np.ndarray,
     try:
         tree = ET.parse(source)
     except (ET.ParseError, OSError) as exc:
-        raise ExciteError(f"robot.urdf: cannot parse {source}: {exc}") from None
+        raise ExciteError("robot.urdf", f"cannot parse {source}: {exc}") from None
     root = tree.getroot()
     links = {link.get("name"): link for link in root.findall("link")}
     joints = {joint.get("name"): joint for joint in root.findall("joint")}
     for i, (body, merged) in enumerate(merged_links(robot).items()):
         if body not in links:
-            raise ExciteError(f"--urdf-out: the body link '{body}' is not in {source}")
-        _inertial(links[body], standard[10 * i: 10 * i + 10])
+            raise ExciteError("urdf_out", f"the body link '{body}' is not in {source}")
+        _inertial(links[body], standard[10 * i : 10 * i + 10])
         for name in merged:
             for old in links[name].findall("inertial") if name in links else []:
                 links[name].remove(old)
@@ -95,18 +110,17 @@ def write_urdf(source: Path, target: Path, robot: Robot, standard: np.ndarray,
         else:
             joints[joint].append(ET.Comment(f" excite: {effect} {coefficient} = {value:.6g} "))
     stamp = datetime.now(timezone.utc).isoformat(timespec="seconds")
-    root.insert(0, ET.Comment(f" excite identify, {stamp}: {note}. Links merged into a body (locked or fixed "
-                              f"joints) carry no <inertial>: their mass is in the body's. "))
+    root.insert(
+        0,
+        ET.Comment(
+            f" excite identify, {stamp}: {note}. Links merged into a body (locked or fixed "
+            f"joints) carry no <inertial>: their mass is in the body's. "
+        ),
+    )
     ET.indent(tree, space="  ")
     target = Path(target)
-    tmp = target.with_name(target.name + ".partial")
-    try:
-        target.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_path(target, "urdf_out") as tmp:
         tree.write(tmp, encoding="utf-8", xml_declaration=True)
-        tmp.replace(target)
-    except OSError as exc:
-        tmp.unlink(missing_ok=True)
-        raise ExciteError(f"--urdf-out: cannot write {target}: {exc}") from None
     return target
 
 

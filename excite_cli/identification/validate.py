@@ -13,21 +13,22 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Optional
 
 import numpy as np
 
-from excite_cli.dynamics.base_parameters import compute_base_parameters
 from excite_cli.config import with_overrides
-from excite_cli.identification.config import IdentifyProblem
+from excite_cli.dynamics.base_parameters import compute_base_parameters
+from excite_cli.dynamics.robot import load_robot
 from excite_cli.errors import ExciteError
+from excite_cli.h5 import open_h5, read_strings
+from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.dataset import build_datasets
 from excite_cli.identification.effects import TWO_STAGE, Term
 from excite_cli.identification.least_squares import predict, torque_errors
 from excite_cli.identification.measurements import load_run
 from excite_cli.identification.payload import payload_parameters
 from excite_cli.identification.preprocessing import preprocess
-from excite_cli.storage.results import open_result
-from excite_cli.dynamics.robot import load_robot
 
 
 @dataclass(frozen=True)
@@ -40,36 +41,63 @@ class RunError:
     instants: int
 
 
-def _strings(values) -> list[str]:
-    return [v.decode() if isinstance(v, bytes) else str(v) for v in values]
+@dataclass
+class IdentifiedModel:
+    """The model an ``identify`` report holds (the physically consistent fit when it has one).
+
+    Attributes:
+        joints: (n,) active joint names; base_names: (b,) base-parameter names.
+        base: (b,) base parameters [SI]; rigid: (b,) the rigid-body-only fit's (for load-dependent terms).
+        terms: (effect, joint name, shape or None) of every effect column, in order.
+        coefficients: effect coefficients, in the order of ``terms``' columns [SI].
+        offset_runs: offset columns (one per fitted run, at least 1).
+        cutoff: low-pass cut-off [Hz]; coulomb_velocity: smoothing velocity of sign(q̇) [rad/s].
+    """
+
+    joints: list[str]
+    base_names: list[str]
+    base: np.ndarray
+    rigid: np.ndarray
+    terms: list[tuple[str, str, Optional[float]]]
+    coefficients: np.ndarray
+    offset_runs: int
+    cutoff: float
+    coulomb_velocity: float
 
 
-def read_model(path: Path) -> dict:
-    """The model of an ``identify`` report: joint and base-parameter names, base parameters, the
-    rigid-body-only ones, effect terms [(effect, joint name, shape)] in order with their
-    coefficients, the number of offset columns (fitted runs), cut-off, Coulomb velocity.
+def read_model(path: Path) -> IdentifiedModel:
+    """The model of the ``identify`` report at ``path``.
 
     Raises:
         ExciteError: missing or unreadable file, or not an identify report.
     """
-    with open_result(path, "REPORT") as f:
+    with open_h5(path, "report") as f:
         if "identification" not in f or "effects" not in f["identification"]:
-            raise ExciteError(f"REPORT: {path} is not an excite identify report (no /identification/effects)")
+            raise ExciteError("report", f"{path} is not an excite identify report (no /identification/effects)")
         g = f["identification"]
         rows = g["effects"][()]
         consistent = bool(g["physically_consistent"][()]) if "physically_consistent" in g else False
         values = rows["value_consistent"] if consistent else rows["value"]
         shapes = rows["shape"] if "shape" in rows.dtype.names else np.full(len(rows), np.nan)
         terms: list[tuple[str, str, float | None]] = []
-        for effect, joint, shape in zip(_strings(rows["effect"]), _strings(rows["joint"]), shapes):
+        effects, joints = (
+            [v.decode() if isinstance(v, bytes) else str(v) for v in rows[c]] for c in ("effect", "joint")
+        )
+        for effect, joint, shape in zip(effects, joints, shapes):
             term = (effect, joint, None if np.isnan(shape) else float(shape))
             if term not in terms:
                 terms.append(term)
-        return {"joints": _strings(g["joint_names"][()]), "base_names": _strings(g["base_parameter_names"][()]),
-                "base": g["base_parameters"][()], "rigid": g["base_parameters_rigid_only"][()], "terms": terms,
-                "coefficients": np.asarray(values, dtype=float), "cutoff": float(g.attrs["cutoff_Hz"]),
-                "offset_runs": max(1, len(g["offset_runs"][()])) if "offset_runs" in g else 1,
-                "coulomb_velocity": float(g.attrs.get("coulomb_velocity_rad_s", 0.01))}
+        return IdentifiedModel(
+            read_strings(g, "joint_names"),
+            read_strings(g, "base_parameter_names"),
+            g["base_parameters"][()],
+            g["base_parameters_rigid_only"][()],
+            terms,
+            np.asarray(values, dtype=float),
+            max(1, len(g["offset_runs"][()])) if "offset_runs" in g else 1,
+            float(g.attrs["cutoff_Hz"]),
+            float(g.attrs.get("coulomb_velocity_rad_s", 0.01)),
+        )
 
 
 def validate_model(report: Path, problem: IdentifyProblem) -> list[RunError]:
@@ -84,19 +112,35 @@ def validate_model(report: Path, problem: IdentifyProblem) -> list[RunError]:
     problem = with_overrides(problem, {"robot.base_wrench_rows": False})  # a copy: the caller's config is not changed
     robot = load_robot(problem)
     base = compute_base_parameters(robot)
-    if model["joints"] != robot.joint_names or model["base_names"] != base.names:
-        raise ExciteError(f"REPORT: {report} was identified for other joints or base parameters than the config's robot")
-    terms = [Term(e, robot.joint_names.index(j), s) for e, j, s in model["terms"]]
+    if model.joints != robot.joint_names or model.base_names != base.names:
+        raise ExciteError(
+            "report", f"{report} was identified for other joints or base parameters than the config's robot"
+        )
+    terms = [Term(e, robot.joint_names.index(j), s) for e, j, s in model.terms]
     needed = terms + [Term("coulomb", j) for j in range(robot.n_joints)]
     errors = []
     for k, run in enumerate(problem.data.runs):
         payload = [payload_parameters(robot, run.payload, f"data.runs[{k}].payload") if run.payload else None]
-        samples = [preprocess(load_run(run.model_copy(update={"role": "validation"}), problem.data, problem, robot.n_joints),
-                   problem.preprocessing, model["cutoff"])]
-        _, data, _ = build_datasets(robot, base, samples, needed, model["coulomb_velocity"], problem.data.validation_blocks, payload,
-                                    split=False, offset_runs=model["offset_runs"])
-        data = data.with_load_columns(model["rigid"], [t for t in terms if t.effect in TWO_STAGE])
-        predicted = predict(data, np.concatenate([model["base"], model["coefficients"]]), terms)
+        samples = [
+            preprocess(
+                load_run(run.model_copy(update={"role": "validation"}), problem.data, problem, robot.n_joints),
+                problem.preprocessing,
+                model.cutoff,
+            )
+        ]
+        _, data, _ = build_datasets(
+            robot,
+            base,
+            samples,
+            needed,
+            model.coulomb_velocity,
+            problem.data.validation_blocks,
+            payload,
+            split=False,
+            offset_runs=model.offset_runs,
+        )
+        data = data.with_load_columns(model.rigid, [t for t in terms if t.effect in TWO_STAGE])
+        predicted = predict(data, np.concatenate([model.base, model.coefficients]), terms)
         rms, _, relative = torque_errors(data.tau.reshape(-1, data.n), predicted)
         errors.append(RunError(run.label, rms, relative, data.time.size))
     return errors

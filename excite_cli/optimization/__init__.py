@@ -1,1 +1,2 @@
-"""Designing persistently exciting trajectories: criterion, solvers, restarts, the sequence, the random baseline, playback."""
+"""Designing persistently exciting trajectories: criterion, solvers, restarts, the sequence, the
+random baseline, playback."""

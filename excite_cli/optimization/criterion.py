@@ -22,10 +22,10 @@ import numpy as np
 import pinocchio as pin
 
 from excite_cli.dynamics.base_parameters import BaseParameters
-from excite_cli.errors import ExciteError
 from excite_cli.dynamics.robot import Robot
-from excite_cli.trajectory.fourier import FourierBasis
 from excite_cli.dynamics.virtual_dynamics import VirtualDynamics
+from excite_cli.errors import ExciteError
+from excite_cli.trajectory.fourier import FourierBasis
 
 #: σ_b is floored at this fraction of σ₁, so rank loss gives a large finite value, never NaN.
 RANK_FLOOR = 1e-14
@@ -71,7 +71,7 @@ def objective_terms(objective: str, eigenvalues: np.ndarray) -> tuple[float, np.
         return float(-0.5 * np.log(lam[0])), np.array([0]), np.array([-1.0 / lam[0]])
     if objective == "log_det":
         return float(-np.log(lam).sum() / lam.size), np.arange(lam.size), -2.0 / (lam.size * lam)
-    raise ExciteError(f"optimizer.objective: unknown '{objective}', expected one of {', '.join(OBJECTIVES)}")
+    raise ExciteError("optimizer.objective", f"unknown '{objective}', expected one of {', '.join(OBJECTIVES)}")
 
 
 @dataclass
@@ -100,7 +100,9 @@ class Criterion:
         if self.prior.size == 0:
             self.prior = np.zeros((0, self.base.count))
         if self.prior.shape[1] != self.base.count:
-            raise ExciteError(f"sequence.prior: {self.prior.shape[1]} columns, but the robot has {self.base.count} base parameters")
+            raise ExciteError(
+                "sequence.prior", f"{self.prior.shape[1]} columns, but the robot has {self.base.count} base parameters"
+            )
         objective_terms(self.objective, np.ones(1))  # fail early on an unknown objective
         self._dynamics = VirtualDynamics(self.robot)
         self._data = self.robot.model.createData()  # this criterion's own, so no result depends on other users

@@ -21,8 +21,8 @@ from threadpoolctl import threadpool_limits
 
 from excite_cli.config import Problem
 from excite_cli.errors import ExciteError
-from excite_cli.optimization.excitation import Excitation, build_excitation
 from excite_cli.memory import keep_freed_memory
+from excite_cli.optimization.excitation import Excitation, build_excitation
 
 #: How long to wait for a Dask scheduler to answer.
 CONNECT_TIMEOUT = "10s"
@@ -83,7 +83,9 @@ class Engine:
             try:
                 self._client = Client(self.scheduler, timeout=CONNECT_TIMEOUT)
             except (OSError, TimeoutError) as exc:
-                raise ExciteError(f"optimizer.scheduler: cannot reach the Dask scheduler at {self.scheduler}: {exc}") from None
+                raise ExciteError(
+                    "optimizer.scheduler", f"cannot reach the Dask scheduler at {self.scheduler}: {exc}"
+                ) from None
         elif self.workers > 1:
             self._pool = ProcessPoolExecutor(max_workers=self.workers)
         return self
@@ -101,8 +103,12 @@ class Engine:
         """Whether tasks run in other processes (a pool or a cluster)."""
         return self._pool is not None or self._client is not None
 
-    def run(self, tasks: Sequence[Task], progress: Optional[Callable] = None,
-            on_result: Optional[Callable[[Any], None]] = None) -> list[Any]:
+    def run(
+        self,
+        tasks: Sequence[Task],
+        progress: Optional[Callable] = None,
+        on_result: Optional[Callable[[Any], None]] = None,
+    ) -> list[Any]:
         """Results of all ``tasks``, in task order.
 
         Args:

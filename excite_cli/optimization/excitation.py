@@ -10,18 +10,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from excite_cli.dynamics.base_parameters import BaseParameters, compute_base_parameters
-from excite_cli.trajectory.boundary import BoundaryConditions, boundary_rows
-from excite_cli.config import Problem
 from excite_cli.collision.capsules import capsule_pairs, capsules_from_config
+from excite_cli.config import Problem
 from excite_cli.constraints import Constraint, JointLimits, SelfCollision
 from excite_cli.constraints.com_region import com_region_from_config
 from excite_cli.constraints.joint_limits import joint_limit_bounds
 from excite_cli.constraints.lse import GRID_MARGIN
-from excite_cli.optimization.criterion import Criterion
-from excite_cli.errors import ExciteError
-from excite_cli.optimization.information import excitation_level, parameter_magnitudes
+from excite_cli.dynamics.base_parameters import BaseParameters, compute_base_parameters
 from excite_cli.dynamics.robot import Robot, load_robot
+from excite_cli.errors import ExciteError
+from excite_cli.optimization.criterion import Criterion
+from excite_cli.optimization.information import excitation_level, parameter_magnitudes
+from excite_cli.trajectory.boundary import BoundaryConditions, boundary_rows
 from excite_cli.trajectory.fourier import FourierBasis, FourierTrajectory, sample_times
 
 #: Decimals [rad] random starts are rounded to (see :meth:`Excitation.random_start`).
@@ -124,8 +124,11 @@ def build_excitation(problem: Problem) -> Excitation:
     base = compute_base_parameters(robot)
     tcfg = problem.trajectory
     if tcfg.cost_samples * robot.n_rows < base.count:
-        raise ExciteError(f"trajectory.cost_samples: {tcfg.cost_samples} samples × {robot.n_rows} regressor rows are fewer "
-                          f"than the robot's {base.count} base parameters; cond(C) would be infinite")
+        raise ExciteError(
+            "trajectory.cost_samples",
+            f"{tcfg.cost_samples} samples × {robot.n_rows} regressor rows are fewer "
+            f"than the robot's {base.count} base parameters; cond(C) would be infinite",
+        )
     trajectory = FourierTrajectory(tcfg.harmonics, tcfg.base_frequency)
     fine_period = tcfg.constraint_period / problem.limits.check_refinement
     grid_basis = trajectory.basis(sample_times(tcfg.duration, tcfg.constraint_period, include_end=True))
@@ -154,9 +157,11 @@ def build_excitation(problem: Problem) -> Excitation:
     return excitation
 
 
-def _boundary_conditions(problem: Problem, trajectory: FourierTrajectory, limits: JointLimits,
-                         home: np.ndarray) -> BoundaryConditions:
-    """The boundary conditions of ``trajectory.boundary`` / ``ends_at_home`` (see :mod:`excite_cli.trajectory.boundary`).
+def _boundary_conditions(
+    problem: Problem, trajectory: FourierTrajectory, limits: JointLimits, home: np.ndarray
+) -> BoundaryConditions:
+    """The boundary conditions of ``trajectory.boundary`` / ``ends_at_home``
+    (see :mod:`excite_cli.trajectory.boundary`).
 
     Raises:
         ExciteError: the conditions leave the joints no oscillation (too few harmonics).
@@ -169,8 +174,9 @@ def _boundary_conditions(problem: Problem, trajectory: FourierTrajectory, limits
     boundary = BoundaryConditions(rows, targets, limits.coefficient_scale())
     if boundary.wave_space.shape[1] == 0:
         raise ExciteError(
-            f"trajectory.harmonics: {tcfg.harmonics} harmonic(s) leave no free oscillation under "
-            f"boundary '{tcfg.boundary}'{' with ends_at_home' if tcfg.ends_at_home else ''}; use more harmonics"
+            "trajectory.harmonics",
+            f"{tcfg.harmonics} harmonic(s) leave no free oscillation under "
+            f"boundary '{tcfg.boundary}'{' with ends_at_home' if tcfg.ends_at_home else ''}; use more harmonics",
         )
     return boundary
 
@@ -182,12 +188,16 @@ def _check_home_posture(excitation: Excitation) -> None:
         ExciteError: naming the constraint and where it fails (the capsule pair, the CoM distance).
     """
     static = excitation.static()
-    fields = {"joint_limits": "robot.home_posture", "com_region": "constraints.com",
-              "self_collision": "constraints.self_collision"}
+    fields = {
+        "joint_limits": "robot.home_posture",
+        "com_region": "constraints.com",
+        "self_collision": "constraints.self_collision",
+    }
     for c in excitation.constraints:
         check = c.check(static, excitation.grid_basis)
         if check.max_violation > -c.grid_margin:
             raise ExciteError(
-                f"{fields[c.name]}: violated before optimization, at the home posture with the locked "
-                f"joints: {check.where or 'joint limits'}"
+                fields[c.name],
+                f"violated before optimization, at the home posture with the locked "
+                f"joints: {check.where or 'joint limits'}",
             )

@@ -29,7 +29,12 @@ IMPROVEMENT_WINDOW = 10
 IMPROVEMENT = 1e-3
 
 #: The stop reasons a restart can end with.
-CONVERGED, STILL_IMPROVING, STALLED, SOLVER_FAILED = "converged", "iteration limit, still improving", "stalled", "solver failed"
+CONVERGED, STILL_IMPROVING, STALLED, SOLVER_FAILED = (
+    "converged",
+    "iteration limit, still improving",
+    "stalled",
+    "solver failed",
+)
 
 
 @dataclass(frozen=True)
@@ -52,12 +57,15 @@ class Optimality:
 def kkt_optimality(gradient: np.ndarray, values: np.ndarray, jacobian: np.ndarray) -> Optimality:
     """The KKT residual (module docstring) from ∇f (n_z,), g (m,) and ∂g/∂z (m, n_z) at one point."""
     active = values >= -ACTIVE_TOLERANCE
-    lam = nnls(jacobian[active].T, -gradient, maxiter=50 * max(1, int(active.sum())))[0] if active.any() else np.zeros(0)
+    lam = (
+        nnls(jacobian[active].T, -gradient, maxiter=50 * max(1, int(active.sum())))[0] if active.any() else np.zeros(0)
+    )
     stationarity = np.abs(gradient + jacobian[active].T @ lam).max() if gradient.size else 0.0
     complementarity = float(np.max(lam * np.abs(values[active]), initial=0.0))
     norm = float(np.abs(gradient).max(initial=0.0))
-    return Optimality(max(stationarity, complementarity) / max(1.0, norm), int(active.sum()), norm,
-                      float(values.max(initial=-np.inf)))
+    return Optimality(
+        max(stationarity, complementarity) / max(1.0, norm), int(active.sum()), norm, float(values.max(initial=-np.inf))
+    )
 
 
 def stop_reason(optimality: Optimality, history: Sequence[float], limit: bool, failed: bool, tolerance: float) -> str:

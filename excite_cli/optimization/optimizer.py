@@ -18,12 +18,12 @@ from typing import Callable, Optional, Sequence
 import numpy as np
 from scipy.optimize import minimize
 
-from excite_cli.trajectory.boundary import BoundaryConditions
 from excite_cli.config import OptimizerConfig
 from excite_cli.constraints import Constraint
 from excite_cli.optimization.criterion import Criterion
 from excite_cli.optimization.optimality import Optimality, kkt_optimality, stop_reason
 from excite_cli.optimization.solvers import solve
+from excite_cli.trajectory.boundary import BoundaryConditions
 
 #: Progress hook: (restart index, solver iteration, objective at the current iterate).
 ProgressHook = Callable[[int, int, float], None]
@@ -75,8 +75,13 @@ def _accepted(constraints: Sequence[Constraint], alpha: np.ndarray) -> bool:
     return all(c.accepts(alpha) for c in constraints)
 
 
-def repair(constraints: Sequence[Constraint], alpha: np.ndarray, feasible: np.ndarray,
-           boundary: Optional[BoundaryConditions] = None, steps: int = 12) -> np.ndarray:
+def repair(
+    constraints: Sequence[Constraint],
+    alpha: np.ndarray,
+    feasible: np.ndarray,
+    boundary: Optional[BoundaryConditions] = None,
+    steps: int = 12,
+) -> np.ndarray:
     """A feasible point near α: the constraints' own exact repairs, moved back onto the boundary
     conditions, then, if some constraint still rejects it, the farthest point towards it from
     ``feasible`` (bisection on the segment, which keeps the boundary conditions: they are affine).
@@ -110,8 +115,9 @@ class _Evaluations:
         best_inside: its α (n, 2N+1), or None.
     """
 
-    def __init__(self, criterion: Criterion, constraints: Sequence[Constraint], boundary: BoundaryConditions,
-                 start_value: float):
+    def __init__(
+        self, criterion: Criterion, constraints: Sequence[Constraint], boundary: BoundaryConditions, start_value: float
+    ):
         self.criterion, self.all, self.boundary = criterion, constraints, boundary
         self.best_value, self.best_inside = start_value, None
         self._constraints: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
@@ -133,7 +139,10 @@ class _Evaluations:
             self._objective.clear()
             alpha = self.boundary.to_alpha(z)
             value, grad = self.criterion.value_and_gradient(alpha)
-            if value < (self.best_value if self.best_inside is not None else np.inf) and self.constraints(z)[0].max() <= 0.0:
+            if (
+                value < (self.best_value if self.best_inside is not None else np.inf)
+                and self.constraints(z)[0].max() <= 0.0
+            ):
                 self.best_value, self.best_inside = value, alpha.copy()
             self._objective[key] = (value, self.boundary.chain(grad.ravel()))
         return self._objective[key]
@@ -154,10 +163,16 @@ def project(problem: _Evaluations, z: np.ndarray, iterations: int = PROJECTION_I
     argmin ½‖y − z‖² s.t. g(y) ≤ 0, by SLSQP from z (a convex objective: it converges where the
     criterion's problem does not), then the constraints' own exact repairs. Returns its α (n, 2N+1)
     if every constraint accepts it, else None."""
-    result = minimize(lambda y: (0.5 * float((y - z) @ (y - z)), y - z), z, jac=True, method="SLSQP",
-                      constraints=[{"type": "ineq", "fun": lambda y: -problem.constraints(y)[0],
-                                    "jac": lambda y: -problem.constraints(y)[1]}],
-                      options={"maxiter": iterations, "ftol": 1e-12})
+    result = minimize(
+        lambda y: (0.5 * float((y - z) @ (y - z)), y - z),
+        z,
+        jac=True,
+        method="SLSQP",
+        constraints=[
+            {"type": "ineq", "fun": lambda y: -problem.constraints(y)[0], "jac": lambda y: -problem.constraints(y)[1]}
+        ],
+        options={"maxiter": iterations, "ftol": 1e-12},
+    )
     alpha = problem.boundary.to_alpha(result.x)
     for c in problem.all:
         alpha = c.restore(alpha)
@@ -203,8 +218,14 @@ def optimize_restart(
         if progress is not None:
             progress(index, len(history), history[-1][0])
 
-    run = solve(options.method, problem, boundary.to_variables(start), max_iterations or options.max_iterations,
-                options.tolerance, on_iterate)
+    run = solve(
+        options.method,
+        problem,
+        boundary.to_variables(start),
+        max_iterations or options.max_iterations,
+        options.tolerance,
+        on_iterate,
+    )
     ends = [("start", start)]
     projected = project(problem, run.z)
     if projected is not None:
@@ -213,10 +234,24 @@ def optimize_restart(
         ends.append(("bisection", repair(constraints, boundary.to_alpha(run.z), start, boundary)))
     if problem.best_inside is not None:
         ends.append(("inside", problem.best_inside))
-    scored = [(criterion.value(alpha), k, name, alpha) for k, (name, alpha) in enumerate(ends)
-              if name in ("start", "projected") or _accepted(constraints, alpha)]  # both already accepted
+    scored = [
+        (criterion.value(alpha), k, name, alpha)
+        for k, (name, alpha) in enumerate(ends)
+        if name in ("start", "projected") or _accepted(constraints, alpha)
+    ]  # both already accepted
     value, _, end, alpha = min(scored, key=lambda item: item[:2])
     optimality = problem.optimality(alpha)
     stop = stop_reason(optimality, [f for f, _ in history], run.limit, run.failed, options.optimality_tolerance)
-    return RestartResult(index, alpha, value, run.iterations, run.message, time.perf_counter() - begin, start_value,
-                         np.array(history, dtype=float).reshape(-1, 2), optimality, stop, end)
+    return RestartResult(
+        index,
+        alpha,
+        value,
+        run.iterations,
+        run.message,
+        time.perf_counter() - begin,
+        start_value,
+        np.array(history, dtype=float).reshape(-1, 2),
+        optimality,
+        stop,
+        end,
+    )

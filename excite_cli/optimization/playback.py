@@ -104,8 +104,11 @@ def plan_transition(start: np.ndarray, end: np.ndarray, limits: JointLimits, nam
     delta = np.abs(end[0] - start[0])
     velocity = inner * np.minimum(-limits.lower[1], limits.upper[1])
     acceleration = inner * np.minimum(-limits.lower[2], limits.upper[2])
-    shortest = max(float(np.max(15.0 * delta / (8.0 * velocity))),
-                   float(np.sqrt(np.max(10.0 * delta / (np.sqrt(3.0) * acceleration)))), RESOLUTION)
+    shortest = max(
+        float(np.max(15.0 * delta / (8.0 * velocity))),
+        float(np.sqrt(np.max(10.0 * delta / (np.sqrt(3.0) * acceleration)))),
+        RESOLUTION,
+    )
     duration = shortest
     while duration <= LONGEST:
         transition = Transition(start, end, float(np.ceil(duration / RESOLUTION - 1e-9) * RESOLUTION), name)
@@ -113,7 +116,7 @@ def plan_transition(start: np.ndarray, end: np.ndarray, limits: JointLimits, nam
         if limits.check_samples(t, *transition.evaluate(t)).max_violation <= -ACCEPT_MARGIN / 2:
             return transition
         duration *= 1.1
-    raise ExciteError(f"{name}: no quintic of up to {LONGEST:g} s keeps the joint limits")
+    raise ExciteError(name, f"no quintic of up to {LONGEST:g} s keeps the joint limits")
 
 
 @dataclass(frozen=True)
@@ -127,7 +130,9 @@ class Playback:
         """Total duration [s]."""
         return float(sum(s.duration for s in self.segments))
 
-    def sample(self, rate: float, only: Sequence[str] | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    def sample(
+        self, rate: float, only: Sequence[str] | None = None
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """time (S,) [s] = k / ``rate`` [Hz] up to the first instant at or after the end (held at the
         final state there), and q, q̇, q̈ (S, n); with ``only``, just the samples of segments with
         those names."""
@@ -153,7 +158,7 @@ def plan_playback(excitation: Excitation, alpha: np.ndarray, periods: int = 1) -
         ExciteError: ``periods`` < 1, or a transition cannot keep the joint limits.
     """
     if periods < 1:
-        raise ExciteError(f"--periods: must be at least 1 (got {periods})")
+        raise ExciteError("periods", f"{periods} is out of range", periods, "at least 1")
     home = np.stack([excitation.home, np.zeros_like(excitation.home), np.zeros_like(excitation.home)])
     trajectory = FourierSegment(excitation.trajectory, alpha, excitation.problem.trajectory.duration)
     first, last = trajectory.state(0.0), trajectory.state(trajectory.duration)
@@ -167,8 +172,9 @@ def plan_playback(excitation: Excitation, alpha: np.ndarray, periods: int = 1) -
     return Playback(tuple(s for s in pieces if s is not None))
 
 
-def check_motion(constraints: Sequence[Constraint], time: np.ndarray, q: np.ndarray, qd: np.ndarray,
-                 qdd: np.ndarray) -> tuple[float, str]:
+def check_motion(
+    constraints: Sequence[Constraint], time: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray
+) -> tuple[float, str]:
     """Largest normalized violation of every constraint on sampled motion (≤ 0: satisfied) and where
     the worst one is, in words. ``time`` (T,) [s], q, q̇, q̈ (T, n)."""
     if time.size == 0:

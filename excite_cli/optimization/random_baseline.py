@@ -46,6 +46,7 @@ class Pool:
 def random_candidate(excitation: Excitation, rng: np.random.Generator) -> Optional[np.ndarray]:
     """One feasible random α (n, 2N+1) that uses as much of the limits as the constraints allow, or
     None when even a small motion violates a constraint."""
+
     def accepted(alpha: np.ndarray) -> bool:
         return all(c.accepts(alpha) for c in excitation.constraints)
 
@@ -77,7 +78,9 @@ class DrawTask:
     count: int
     budget_s: Optional[float] = None
 
-    def __call__(self, excitation: Excitation, progress: Optional[Callable[[int, int], None]] = None) -> tuple[np.ndarray, np.ndarray, int]:
+    def __call__(
+        self, excitation: Excitation, progress: Optional[Callable[[int, int], None]] = None
+    ) -> tuple[np.ndarray, np.ndarray, int]:
         rng = np.random.default_rng(np.random.SeedSequence(self.seed, spawn_key=(self.index,)))
         start = time.perf_counter()
         alphas, drawn = [], 0
@@ -92,11 +95,20 @@ class DrawTask:
         shape = (excitation.robot.n_joints, excitation.trajectory.n_coefficients)
         regressors = [criterion.regressor(a) for a in alphas]
         rows = excitation.cost_basis.time.size * excitation.robot.n_rows
-        return np.array(alphas).reshape(-1, *shape), np.array(regressors).reshape(len(alphas), rows, excitation.base.count), drawn
+        return (
+            np.array(alphas).reshape(-1, *shape),
+            np.array(regressors).reshape(len(alphas), rows, excitation.base.count),
+            drawn,
+        )
 
 
-def draw_pool(engine: Engine, size: Optional[int], seed: int, budget_s: Optional[float] = None,
-              progress: Optional[Callable[[int, int], None]] = None) -> Pool:
+def draw_pool(
+    engine: Engine,
+    size: Optional[int],
+    seed: int,
+    budget_s: Optional[float] = None,
+    progress: Optional[Callable[[int, int], None]] = None,
+) -> Pool:
     """Draw ``size`` feasible candidates, or as many as ``engine``'s workers find in ``budget_s``
     seconds each (``size`` None), in tasks of ``DRAWS_PER_TASK`` candidates with their own seeds:
     the pool does not depend on how many workers draw it.
@@ -109,7 +121,9 @@ def draw_pool(engine: Engine, size: Optional[int], seed: int, budget_s: Optional
     if size is None:
         tasks = [DrawTask(k, seed, 10**9, budget_s) for k in range(max(engine.workers, 1))]
     else:
-        tasks = [DrawTask(k, seed, min(DRAWS_PER_TASK, size - k * DRAWS_PER_TASK)) for k in range(-(-size // DRAWS_PER_TASK))]
+        tasks = [
+            DrawTask(k, seed, min(DRAWS_PER_TASK, size - k * DRAWS_PER_TASK)) for k in range(-(-size // DRAWS_PER_TASK))
+        ]
     done = {"kept": 0, "drawn": 0}
 
     def finished(result: tuple[np.ndarray, np.ndarray, int]) -> None:
@@ -128,7 +142,9 @@ def draw_pool(engine: Engine, size: Optional[int], seed: int, budget_s: Optional
     return Pool(alphas, regressors, time.perf_counter() - start, sum(r[2] for r in results))
 
 
-def greedy_selection(regressors: np.ndarray, count: int, prior: Optional[np.ndarray] = None) -> tuple[list[int], list[float]]:
+def greedy_selection(
+    regressors: np.ndarray, count: int, prior: Optional[np.ndarray] = None
+) -> tuple[list[int], list[float]]:
     """Greedy set selection: at step i, add the candidate minimizing cond of [prior; selected; it].
 
     Args:

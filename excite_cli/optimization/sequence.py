@@ -8,10 +8,10 @@ from typing import Callable, Optional, Sequence
 
 import numpy as np
 
-from excite_cli.optimization.criterion import condition_number
 from excite_cli.errors import ExciteError
-from excite_cli.optimization.excitation import Excitation
+from excite_cli.optimization.criterion import condition_number
 from excite_cli.optimization.engine import Engine
+from excite_cli.optimization.excitation import Excitation
 from excite_cli.optimization.optimizer import ProgressHook, RestartResult, best_restart, optimize_restart
 from excite_cli.optimization.playback import check_motion, plan_playback
 
@@ -101,12 +101,26 @@ class RestartTask:
     def __call__(self, excitation: Excitation, progress: Optional[ProgressHook] = None) -> RestartResult:
         """Draw the start (or take the warm start) and optimize from it (:func:`optimize_restart`)."""
         start = self.warm_start.copy() if self.warm_start is not None else excitation.random_start(self.rng())
-        return optimize_restart(excitation.criterion(self.prior), excitation.constraints, excitation.problem.optimizer,
-                                start, excitation.boundary, self.index, progress, self.iterations)
+        return optimize_restart(
+            excitation.criterion(self.prior),
+            excitation.constraints,
+            excitation.problem.optimizer,
+            start,
+            excitation.boundary,
+            self.index,
+            progress,
+            self.iterations,
+        )
 
 
-def describe(excitation: Excitation, index: int, alpha: np.ndarray, prior: np.ndarray, wall_time_s: float = 0.0,
-             restarts: Sequence[RestartResult] = ()) -> IterationResult:
+def describe(
+    excitation: Excitation,
+    index: int,
+    alpha: np.ndarray,
+    prior: np.ndarray,
+    wall_time_s: float = 0.0,
+    restarts: Sequence[RestartResult] = (),
+) -> IterationResult:
     """The :class:`IterationResult` of trajectory α (n, 2N+1) stacked under ``prior`` (m, b): its
     regressor, condition numbers, samples on the constraint grid and every constraint's fine check."""
     own = excitation.criterion().regressor(alpha)
@@ -128,15 +142,24 @@ def describe(excitation: Excitation, index: int, alpha: np.ndarray, prior: np.nd
         excitation_stacked=excitation.excitation_level(np.vstack([prior, own])),
         max_violation=max(c.max_violation for c in checks),
         checks=details,
-        tracks={key: value for c in excitation.constraints for key, value in c.track(alpha, excitation.grid_basis).items()},
+        tracks={
+            key: value for c in excitation.constraints for key, value in c.track(alpha, excitation.grid_basis).items()
+        },
         track_units={key: unit for c in excitation.constraints for key, unit in c.track_units.items()},
         wall_time_s=wall_time_s,
         restarts=tuple(restarts),
     )
 
 
-def run_restarts(excitation: Excitation, engine: Engine, k: int, seed: int, prior: np.ndarray,
-                 warm_start: Optional[np.ndarray], hook: Optional[ProgressHook] = None) -> list[RestartResult]:
+def run_restarts(
+    excitation: Excitation,
+    engine: Engine,
+    k: int,
+    seed: int,
+    prior: np.ndarray,
+    warm_start: Optional[np.ndarray],
+    hook: Optional[ProgressHook] = None,
+) -> list[RestartResult]:
     """The restarts of iteration k: ``optimizer.restarts`` solver runs of ``max_iterations``, the
     first from ``warm_start`` (n, 2N+1) when given, the others from random starts.
 
@@ -150,24 +173,36 @@ def run_restarts(excitation: Excitation, engine: Engine, k: int, seed: int, prio
         value, iterations and history included).
     """
     opts = excitation.problem.optimizer
-    count, iterations = (opts.screened, min(opts.screen_iterations, opts.max_iterations)) if opts.screened else (opts.restarts, None)
+    count, iterations = (
+        (opts.screened, min(opts.screen_iterations, opts.max_iterations)) if opts.screened else (opts.restarts, None)
+    )
     tasks = [RestartTask(k, r, seed, prior, warm_start if r == 0 else None, iterations) for r in range(count)]
     runs = engine.run(tasks, hook, (lambda r: hook(r.index, r.iterations, r.objective)) if hook else None)
     if not opts.screened or iterations >= opts.max_iterations:
         return runs
-    chosen = sorted(runs, key=lambda r: (r.objective, r.index))[:opts.restarts]
+    chosen = sorted(runs, key=lambda r: (r.objective, r.index))[: opts.restarts]
     more = [RestartTask(k, r.index, seed, prior, r.alpha, opts.max_iterations - iterations) for r in chosen]
     shifted = (lambda r, it, value: hook(count + r, it, value)) if hook else None  # continuations count on their own
-    continued = {c.index: c for c in engine.run(more, shifted, (lambda c: shifted(c.index, c.iterations, c.objective)) if hook else None)}
+    continued = {
+        c.index: c
+        for c in engine.run(more, shifted, (lambda c: shifted(c.index, c.iterations, c.objective)) if hook else None)
+    }
     screened = {r.index: r for r in chosen}
-    return [_joined(screened[r.index], continued[r.index]) if r.index in continued else replace(r, stop="screened out")
-            for r in runs]
+    return [
+        _joined(screened[r.index], continued[r.index]) if r.index in continued else replace(r, stop="screened out")
+        for r in runs
+    ]
 
 
 def _joined(screen: RestartResult, more: RestartResult) -> RestartResult:
     """One restart of a screening and its continuation."""
-    return replace(more, iterations=screen.iterations + more.iterations, start_objective=screen.start_objective,
-                   wall_time_s=screen.wall_time_s + more.wall_time_s, history=np.vstack([screen.history, more.history]))
+    return replace(
+        more,
+        iterations=screen.iterations + more.iterations,
+        start_objective=screen.start_objective,
+        wall_time_s=screen.wall_time_s + more.wall_time_s,
+        history=np.vstack([screen.history, more.history]),
+    )
 
 
 def transition_checks(excitation: Excitation, alpha: np.ndarray) -> dict[str, float | str]:
@@ -182,8 +217,12 @@ def transition_checks(excitation: Excitation, alpha: np.ndarray) -> dict[str, fl
     fine_period = excitation.fine_basis.time[1] - excitation.fine_basis.time[0]
     samples = playback.sample(1.0 / fine_period, only=("transition in", "transition out"))
     violation, where = check_motion(excitation.constraints, *samples)
-    return {"transition_in_s": durations.get("transition in", 0.0), "transition_out_s": durations.get("transition out", 0.0),
-            "transition_max_violation": violation, "transition_worst": where}
+    return {
+        "transition_in_s": durations.get("transition in", 0.0),
+        "transition_out_s": durations.get("transition out", 0.0),
+        "transition_max_violation": violation,
+        "transition_worst": where,
+    }
 
 
 def run_sequence(
@@ -220,12 +259,21 @@ def run_sequence(
     if engine is None:
         with Engine(excitation) as serial:
             return run_sequence(excitation, iterations, seed, prior, progress, on_iteration, serial, finished)
-    stacked = np.vstack([np.zeros((0, excitation.base.count)) if prior is None else prior, *[r.regressor for r in finished]])
+    stacked = np.vstack(
+        [np.zeros((0, excitation.base.count)) if prior is None else prior, *[r.regressor for r in finished]]
+    )
     results: list[IterationResult] = list(finished)
     for k in range(len(finished) + 1, iterations + 1):
         start = time.perf_counter()
-        runs = run_restarts(excitation, engine, k, seed, stacked, results[-1].alpha if results else None,
-                            progress(k) if progress else None)
+        runs = run_restarts(
+            excitation,
+            engine,
+            k,
+            seed,
+            stacked,
+            results[-1].alpha if results else None,
+            progress(k) if progress else None,
+        )
         result = describe(excitation, k, best_restart(runs).alpha, stacked, time.perf_counter() - start, runs)
         stacked = np.vstack([stacked, result.regressor])
         results.append(result)

@@ -57,7 +57,9 @@ class SolverRun:
     failed: bool
 
 
-def solve(method: str, nlp: NLP, z0: np.ndarray, max_iterations: int, tolerance: float, on_iterate: IterateHook) -> SolverRun:
+def solve(
+    method: str, nlp: NLP, z0: np.ndarray, max_iterations: int, tolerance: float, on_iterate: IterateHook
+) -> SolverRun:
     """Run ``method`` (one of ``METHODS``) from z0 (n_z,) for at most ``max_iterations`` iterations.
 
     Args:
@@ -74,22 +76,41 @@ def solve(method: str, nlp: NLP, z0: np.ndarray, max_iterations: int, tolerance:
         return _trust_constr(nlp, z0, max_iterations, tolerance, on_iterate)
     if method == "ipopt":
         return _ipopt(nlp, z0, max_iterations, tolerance, on_iterate)
-    raise ExciteError(f"optimizer.method: unknown '{method}', expected one of {', '.join(METHODS)}")
+    raise ExciteError("optimizer.method", f"unknown '{method}', expected one of {', '.join(METHODS)}")
 
 
 def _slsqp(nlp: NLP, z0: np.ndarray, max_iterations: int, tolerance: float, on_iterate: IterateHook) -> SolverRun:
-    result = minimize(nlp.objective, z0, jac=True, method="SLSQP",
-                      constraints=[{"type": "ineq", "fun": lambda z: -nlp.constraints(z)[0], "jac": lambda z: -nlp.constraints(z)[1]}],
-                      options={"maxiter": max_iterations, "ftol": tolerance}, callback=lambda z, *_: on_iterate(z))
+    result = minimize(
+        nlp.objective,
+        z0,
+        jac=True,
+        method="SLSQP",
+        constraints=[
+            {"type": "ineq", "fun": lambda z: -nlp.constraints(z)[0], "jac": lambda z: -nlp.constraints(z)[1]}
+        ],
+        options={"maxiter": max_iterations, "ftol": tolerance},
+        callback=lambda z, *_: on_iterate(z),
+    )
     # scipy's SLSQP exit modes: 0 converged (ftol), 9 iteration limit, anything else a failure
     return SolverRun(result.x, int(result.nit), str(result.message), result.status == 9, result.status not in (0, 9))
 
 
-def _trust_constr(nlp: NLP, z0: np.ndarray, max_iterations: int, tolerance: float, on_iterate: IterateHook) -> SolverRun:
-    constraint = NonlinearConstraint(lambda z: nlp.constraints(z)[0], -np.inf, 0.0, jac=lambda z: nlp.constraints(z)[1], hess=BFGS())
-    result = minimize(nlp.objective, z0, jac=True, hess=BFGS(), method="trust-constr", constraints=[constraint],
-                      options={"maxiter": max_iterations, "gtol": tolerance, "xtol": 1e-10},
-                      callback=lambda z, *_: on_iterate(z))
+def _trust_constr(
+    nlp: NLP, z0: np.ndarray, max_iterations: int, tolerance: float, on_iterate: IterateHook
+) -> SolverRun:
+    constraint = NonlinearConstraint(
+        lambda z: nlp.constraints(z)[0], -np.inf, 0.0, jac=lambda z: nlp.constraints(z)[1], hess=BFGS()
+    )
+    result = minimize(
+        nlp.objective,
+        z0,
+        jac=True,
+        hess=BFGS(),
+        method="trust-constr",
+        constraints=[constraint],
+        options={"maxiter": max_iterations, "gtol": tolerance, "xtol": 1e-10},
+        callback=lambda z, *_: on_iterate(z),
+    )
     # trust-constr's status: 0 iteration limit, 1 gtol met, 2 xtol met (steps too small)
     return SolverRun(result.x, int(result.nit), str(result.message), result.status == 0, False)
 
@@ -98,8 +119,11 @@ def _ipopt(nlp: NLP, z0: np.ndarray, max_iterations: int, tolerance: float, on_i
     try:
         import cyipopt
     except ImportError:
-        raise ExciteError("optimizer.method: 'ipopt' needs cyipopt, which `make install` builds against Debian's "
-                          "coinor-libipopt-dev (see README 'Quick start')") from None
+        raise ExciteError(
+            "optimizer.method",
+            "'ipopt' needs cyipopt, which `make install` builds against Debian's "
+            "coinor-libipopt-dev (see README 'Quick start')",
+        ) from None
     last, count = [z0], [0]
 
     class _Callbacks:
@@ -123,9 +147,16 @@ def _ipopt(nlp: NLP, z0: np.ndarray, max_iterations: int, tolerance: float, on_i
             return True
 
     m = nlp.constraints(z0)[0].size
-    problem = cyipopt.Problem(n=z0.size, m=m, problem_obj=_Callbacks(), lb=None, ub=None, cl=np.full(m, -1e20), cu=np.zeros(m))
-    for option, value in (("hessian_approximation", "limited-memory"), ("max_iter", max_iterations), ("tol", tolerance),
-                          ("print_level", 0), ("sb", "yes")):
+    problem = cyipopt.Problem(
+        n=z0.size, m=m, problem_obj=_Callbacks(), lb=None, ub=None, cl=np.full(m, -1e20), cu=np.zeros(m)
+    )
+    for option, value in (
+        ("hessian_approximation", "limited-memory"),
+        ("max_iter", max_iterations),
+        ("tol", tolerance),
+        ("print_level", 0),
+        ("sb", "yes"),
+    ):
         problem.add_option(option, value)
     z, info = problem.solve(z0)
     status = int(info["status"])

@@ -11,6 +11,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from excite_cli.identification.report import Report  # noqa: E402
+
 
 def _end_to_end(time: np.ndarray, run: np.ndarray) -> np.ndarray:
     """(N,) time [s] of samples from several runs laid end to end, NaN at every gap (between runs
@@ -25,7 +27,7 @@ def _end_to_end(time: np.ndarray, run: np.ndarray) -> np.ndarray:
     return out
 
 
-def plot_identification(path: Path, report) -> Path:
+def plot_identification(path: Path, report: Report) -> Path:
     """Per joint, on all validation data (runs laid end to end, a gap between runs and between
     held-out time blocks): measured torque with the rigid-body and the final prediction, and the
     residuals before and after; written to ``path`` (PNG)."""
@@ -41,10 +43,18 @@ def plot_identification(path: Path, report) -> Path:
         ax.plot(t, report.predicted_after[:, j], linewidth=0.7, label="with effects")
         ax.set_ylabel(f"{name}\nτ [Nm]", fontsize=7)
         ax = axes[j, 1]
-        ax.plot(t, measured[:, j] - report.predicted_before[:, j], linewidth=0.7,
-                label=f"before: RMS {report.rms_before[j]:.3f} Nm")
-        ax.plot(t, measured[:, j] - report.predicted_after[:, j], linewidth=0.7,
-                label=f"after: RMS {report.rms_after[j]:.3f} Nm")
+        ax.plot(
+            t,
+            measured[:, j] - report.predicted_before[:, j],
+            linewidth=0.7,
+            label=f"before: RMS {report.rms_before[j]:.3f} Nm",
+        )
+        ax.plot(
+            t,
+            measured[:, j] - report.predicted_after[:, j],
+            linewidth=0.7,
+            label=f"after: RMS {report.rms_after[j]:.3f} Nm",
+        )
         ax.set_ylabel("residual [Nm]", fontsize=7)
         ax.legend(fontsize=6, loc="upper right")
         for a in axes[j]:
@@ -61,17 +71,21 @@ def plot_identification(path: Path, report) -> Path:
     return path
 
 
-def plot_ladder(path: Path, report) -> Path:
+def plot_ladder(path: Path, report: Report) -> Path:
     """Two panels, written to ``path`` (PNG): the mean relative error after each step of the kept
     search (bars: validation data; dots: cross-validated on the fit data, what the search minimizes),
     and every move tried at each step with its gain (cut of the cross-validated error [%]), the one
     taken marked, the ``min_improvement`` line beside them."""
     labels, cv, val = zip(*report.ladder)
     sel = report.selection
-    fig, (top, bottom) = plt.subplots(2, 1, figsize=(max(6.0, 0.42 * len(labels) + 2.5), 7.5), gridspec_kw={"height_ratios": [3, 2]})
+    fig, (top, bottom) = plt.subplots(
+        2, 1, figsize=(max(6.0, 0.42 * len(labels) + 2.5), 7.5), gridspec_kw={"height_ratios": [3, 2]}
+    )
     x = np.arange(len(labels))
     top.bar(x, val, color=["0.55"] + ["C0"] * (len(labels) - 1), label="validation (never seen by fit or selection)")
-    top.plot(x, cv, "o-", color="C3", markersize=4, label=f"cross-validated ({sel.folds} blocked folds of the fit data)")
+    top.plot(
+        x, cv, "o-", color="C3", markersize=4, label=f"cross-validated ({sel.folds} blocked folds of the fit data)"
+    )
     top.set_xticks(x, labels, rotation=60, ha="right", fontsize=7)
     top.set_ylabel("mean relative error [%]")
     top.set_title("what each effect bought", fontsize=9)
@@ -79,10 +93,17 @@ def plot_ladder(path: Path, report) -> Path:
     top.grid(axis="y", alpha=0.3)
     for k, step in enumerate(sel.steps, start=1):
         gains = np.array([step.gain_of(v) for _, _, v in step.tried])
-        bottom.plot(np.full(gains.size, k) + np.linspace(-0.25, 0.25, gains.size), gains, ".", color="0.6", markersize=3)
+        bottom.plot(
+            np.full(gains.size, k) + np.linspace(-0.25, 0.25, gains.size), gains, ".", color="0.6", markersize=3
+        )
         bottom.plot(k, step.gain, "*", color="C3", markersize=9)
-    bottom.axhline(100.0 * (1.0 - 1.0 / (1.0 + sel.min_improvement)), color="k", linewidth=0.8, linestyle="--",
-                   label="min_improvement")
+    bottom.axhline(
+        100.0 * (1.0 - 1.0 / (1.0 + sel.min_improvement)),
+        color="k",
+        linewidth=0.8,
+        linestyle="--",
+        label="min_improvement",
+    )
     bottom.set_xlabel("step of the search (★ the move taken, dots every move tried)")
     bottom.set_ylabel("gain [%]")
     bottom.set_ylim(bottom=max(-20.0, bottom.get_ylim()[0]))

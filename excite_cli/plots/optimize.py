@@ -10,7 +10,6 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-
 import numpy as np  # noqa: E402
 
 from excite_cli.constraints import ComRegion, SelfCollision  # noqa: E402
@@ -28,19 +27,33 @@ def plot_result(target: Path, excitation: Excitation, results: Sequence[Iteratio
     capsules = collision.capsules if collision else []
     limits = excitation.limits
     plots = [
-        plot_trajectories(stem.with_name(stem.name + "_trajectories.png"), excitation.robot.joint_names, results,
-                          limits.lower, limits.upper),
+        plot_trajectories(
+            stem.with_name(stem.name + "_trajectories.png"),
+            excitation.robot.joint_names,
+            results,
+            limits.lower,
+            limits.upper,
+        ),
         plot_condition_numbers(stem.with_name(stem.name + "_cond.png"), results),
-        plot_postures(stem.with_name(stem.name + "_postures.png"), results,
-                      lambda q: (skeleton(excitation.robot, q), capsule_segments(excitation.robot, capsules, q)),
-                      [c.radius for c in capsules], excitation.home),
+        plot_postures(
+            stem.with_name(stem.name + "_postures.png"),
+            results,
+            lambda q: (skeleton(excitation.robot, q), capsule_segments(excitation.robot, capsules, q)),
+            [c.radius for c in capsules],
+            excitation.home,
+        ),
     ]
     if any(r.tracks for r in results):
-        plots.append(plot_constraint_tracks(
-            stem.with_name(stem.name + "_constraints.png"), results,
-            centre=com.centre if com else None, radius=com.radius if com else None,
-            polygon=com.polygon if com else None, margin=collision.margin if collision else None,
-        ))
+        plots.append(
+            plot_constraint_tracks(
+                stem.with_name(stem.name + "_constraints.png"),
+                results,
+                centre=com.centre if com else None,
+                radius=com.radius if com else None,
+                polygon=com.polygon if com else None,
+                margin=collision.margin if collision else None,
+            )
+        )
     return plots
 
 
@@ -50,8 +63,13 @@ def _joint_colours(count: int) -> list:
     return [palette[j % len(palette)] for j in range(count)]
 
 
-def plot_trajectories(path: Path, joint_names: Sequence[str], results: Sequence[IterationResult],
-                      lower: np.ndarray | None = None, upper: np.ndarray | None = None) -> Path:
+def plot_trajectories(
+    path: Path,
+    joint_names: Sequence[str],
+    results: Sequence[IterationResult],
+    lower: np.ndarray | None = None,
+    upper: np.ndarray | None = None,
+) -> Path:
     """q, q̇, q̈ of every iteration over time, one column per iteration, each joint in its own colour,
     with the joint limits (Eq. 51) as dashed lines in the joint's colour; written to ``path`` (PNG).
 
@@ -90,7 +108,9 @@ def plot_condition_numbers(path: Path, results: Sequence[IterationResult]) -> Pa
     ax.plot(k, [r.cond_own for r in results], "o-", label="cond(C⁽ⁱ⁾) own")
     ax.plot(k, [r.cond_stacked for r in results], "s-", label="cond(C) stacked")
     for r in results:
-        ax.annotate(f"{r.cond_stacked:.1f}", (r.index, r.cond_stacked), textcoords="offset points", xytext=(4, -10), fontsize=7)
+        ax.annotate(
+            f"{r.cond_stacked:.1f}", (r.index, r.cond_stacked), textcoords="offset points", xytext=(4, -10), fontsize=7
+        )
     ax.set_yscale("log")
     ax.margins(x=0.12)
     ax.set_xlabel("iteration")
@@ -109,13 +129,16 @@ def _stadium(a: np.ndarray, b: np.ndarray, radius: float, points: int = 12) -> n
     d = b - a
     angle = np.arctan2(d[1], d[0]) if np.linalg.norm(d) > 1e-12 else 0.0
     arc = np.linspace(-np.pi / 2, np.pi / 2, points)
-    ends = [b + radius * np.column_stack([np.cos(angle + arc), np.sin(angle + arc)]),
-            a + radius * np.column_stack([np.cos(angle + np.pi + arc), np.sin(angle + np.pi + arc)])]
+    ends = [
+        b + radius * np.column_stack([np.cos(angle + arc), np.sin(angle + arc)]),
+        a + radius * np.column_stack([np.cos(angle + np.pi + arc), np.sin(angle + np.pi + arc)]),
+    ]
     return np.vstack(ends)
 
 
-def plot_postures(path: Path, results: Sequence[IterationResult], draw, radii: Sequence[float], home: np.ndarray,
-                  columns: int = 6) -> Path:
+def plot_postures(
+    path: Path, results: Sequence[IterationResult], draw, radii: Sequence[float], home: np.ndarray, columns: int = 6
+) -> Path:
     """A strip of postures over one period per iteration, front view (from +x, the robot's left on the
     right) and side view (from −y, forward to the right), like the paper's Fig. 2; the home posture
     in grey behind every one. Written to ``path`` (PNG).
@@ -144,7 +167,14 @@ def plot_postures(path: Path, results: Sequence[IterationResult], draw, radii: S
                     outline = _stadium(np.array([sign * a[axis], a[2]]), np.array([sign * b[axis], b[2]]), radius)
                     ax.fill(outline[:, 0], outline[:, 1], color="tab:blue", alpha=0.15, linewidth=0)
                 for a, b in bones:
-                    ax.plot([sign * a[axis], sign * b[axis]], [a[2], b[2]], color="k", linewidth=1.2, marker="o", markersize=1.5)
+                    ax.plot(
+                        [sign * a[axis], sign * b[axis]],
+                        [a[2], b[2]],
+                        color="k",
+                        linewidth=1.2,
+                        marker="o",
+                        markersize=1.5,
+                    )
                 horizontal = sign * points[:, axis]
                 ax.set_xlim(horizontal.min() - pad, horizontal.max() + pad)
                 ax.set_ylim(points[:, 2].min() - pad, points[:, 2].max() + pad)
@@ -158,8 +188,14 @@ def plot_postures(path: Path, results: Sequence[IterationResult], draw, radii: S
     return path
 
 
-def plot_constraint_tracks(path: Path, results: Sequence[IterationResult], centre=None, radius: float | None = None,
-                           polygon=None, margin: float | None = None) -> Path:
+def plot_constraint_tracks(
+    path: Path,
+    results: Sequence[IterationResult],
+    centre=None,
+    radius: float | None = None,
+    polygon=None,
+    margin: float | None = None,
+) -> Path:
     """Per iteration: the CoM ground track against its region (Eq. 52) and the smallest capsule
     distance over time against the margin (Eq. 53), in cm; written to ``path`` (PNG).
 
@@ -206,7 +242,9 @@ def plot_comparison(path: Path, random_table, optimized_table) -> Path:
         k = np.asarray(random_table["iteration"])
         ax.bar(k - 0.2, random_table[column], width=0.4, label="random + selection")
         if optimized_table is not None:
-            ax.bar(np.asarray(optimized_table["iteration"]) + 0.2, optimized_table[column], width=0.4, label="optimized")
+            ax.bar(
+                np.asarray(optimized_table["iteration"]) + 0.2, optimized_table[column], width=0.4, label="optimized"
+            )
         ax.set_yscale("log")
         ax.set_xticks(k)
         ax.set_xlabel("motion index")

@@ -15,10 +15,11 @@ from pathlib import Path
 import numpy as np
 
 from excite_cli.errors import ExciteError
+from excite_cli.h5 import atomic_path
 from excite_cli.optimization.excitation import build_excitation
-from excite_cli.storage.results import problem_of_result, read_alphas
 from excite_cli.optimization.playback import check_motion, plan_playback
 from excite_cli.storage.paths import check_target
+from excite_cli.storage.results import problem_of_result, read_alphas
 
 #: Highest export rate accepted [Hz] (memory grows with rate × duration).
 MAX_RATE = 100_000.0
@@ -66,43 +67,63 @@ def export_trajectory(result: Path, iteration: int | None = None, rate: float = 
             constraint (the message names it).
     """
     if not (np.isfinite(rate) and 0.0 < rate <= MAX_RATE):
-        raise ExciteError(f"--rate: must be in (0, {MAX_RATE:g}] Hz (got {rate:g})")
+        raise ExciteError("rate", f"{rate:g} Hz is out of range", rate, f"(0, {MAX_RATE:g}] Hz")
     if not 1 <= periods <= MAX_PERIODS:
-        raise ExciteError(f"--periods: must be from 1 to {MAX_PERIODS} (got {periods})")
+        raise ExciteError("periods", f"{periods} is out of range", periods, f"1 to {MAX_PERIODS}")
     problem = problem_of_result(result)
     problem.robot.base_wrench_rows = False
     alphas = dict(read_alphas(result))
     k = max(alphas) if iteration is None else iteration
     if k not in alphas:
-        raise ExciteError(f"--iteration: {result} has iterations {sorted(alphas)}, not {k}")
+        raise ExciteError(
+            "iteration", f"{result} has iterations {sorted(alphas)}, not {k}", k, f"one of {sorted(alphas)}"
+        )
     excitation = build_excitation(problem)
     alpha = alphas[k]
     if alpha.shape != (excitation.robot.n_joints, excitation.trajectory.n_coefficients):
-        raise ExciteError(f"{result}: iteration {k} has α of shape {alpha.shape}, its config needs "
-                          f"{(excitation.robot.n_joints, excitation.trajectory.n_coefficients)}")
+        raise ExciteError(
+            "result",
+            f"{result}: iteration {k} has α of shape {alpha.shape}, its config needs "
+            f"{(excitation.robot.n_joints, excitation.trajectory.n_coefficients)}",
+        )
     playback = plan_playback(excitation, alpha, periods)
     if playback.duration * rate > MAX_SAMPLES:
-        raise ExciteError(f"--rate / --periods: {playback.duration:.0f} s at {rate:g} Hz is {playback.duration * rate:.3g} samples; "
-                          f"at most {MAX_SAMPLES:.0e} fit in one file (lower the rate or the periods)")
+        raise ExciteError(
+            "rate",
+            f"{playback.duration:.0f} s at {rate:g} Hz is {playback.duration * rate:.3g} samples; "
+            f"at most {MAX_SAMPLES:.0e} fit in one file (lower the rate or the periods)",
+        )
     time, q, qd, qdd = playback.sample(rate)
     violation, worst = check_motion(excitation.constraints, time, q, qd, qdd)
     if violation > 0.0:
-        raise ExciteError(f"{result}: iteration {k} played at {rate:g} Hz violates {worst}; no file written")
+        raise ExciteError("result", f"{result}: iteration {k} played at {rate:g} Hz violates {worst}; no file written")
     robot = excitation.robot
     tau = np.array([robot.torques(*x) for x in zip(q, qd, qdd)])
     starts = np.cumsum([0.0] + [s.duration for s in playback.segments])
     return Export(
-        joint_names=list(robot.joint_names), time=time, q=q, qd=qd, qdd=qdd, tau=tau, rate=rate, iteration=k,
-        periods=periods, segments=[(s.name, float(t0), s.duration) for s, t0 in zip(playback.segments, starts)],
-        max_violation=violation, worst=worst,
+        joint_names=list(robot.joint_names),
+        time=time,
+        q=q,
+        qd=qd,
+        qdd=qdd,
+        tau=tau,
+        rate=rate,
+        iteration=k,
+        periods=periods,
+        segments=[(s.name, float(t0), s.duration) for s, t0 in zip(playback.segments, starts)],
+        max_violation=violation,
+        worst=worst,
     )
 
 
 def columns(joint_names: list[str]) -> list[str]:
     """Column names with units: ``time_s``, ``q_<joint>_rad``, ``qd_<joint>_rad_s``,
     ``qdd_<joint>_rad_s2``, ``tau_<joint>_Nm``."""
-    return ["time_s"] + [f"{x}_{j}_{unit}" for x, unit in (("q", "rad"), ("qd", "rad_s"), ("qdd", "rad_s2"), ("tau", "Nm"))
-                         for j in joint_names]
+    return ["time_s"] + [
+        f"{x}_{j}_{unit}"
+        for x, unit in (("q", "rad"), ("qd", "rad_s"), ("qdd", "rad_s2"), ("tau", "Nm"))
+        for j in joint_names
+    ]
 
 
 def write_export(path: Path, export: Export, fmt: str = "csv") -> Path:
@@ -113,34 +134,45 @@ def write_export(path: Path, export: Export, fmt: str = "csv") -> Path:
         ExciteError: an unknown format or a file that cannot be written.
     """
     if fmt not in FORMATS:
-        raise ExciteError(f"--format: must be one of {', '.join(FORMATS)} (got {fmt!r})")
+        raise ExciteError("format", f"must be one of {', '.join(FORMATS)} (got {fmt!r})")
     path = Path(path)
-    tmp = path.with_name(path.name + ".partial")
     table = np.column_stack([export.time, export.q, export.qd, export.qdd, export.tau])
     names = columns(export.joint_names)
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_path(path, "output") as tmp:
         if fmt == "csv":
-            comments = [f"excite export: iteration {export.iteration}, {export.rate:g} Hz, {export.periods} period(s)",
-                        "segments: " + "; ".join(f"{n} {t0:.3f}-{t0 + d:.3f} s" for n, t0, d in export.segments),
-                        "tau: feed-forward RNEA torque of the URDF model",
-                        f"largest constraint violation (normalized, <= 0 satisfied): {export.max_violation:.3g}"]
+            comments = [
+                f"excite export: iteration {export.iteration}, {export.rate:g} Hz, {export.periods} period(s)",
+                "segments: " + "; ".join(f"{n} {t0:.3f}-{t0 + d:.3f} s" for n, t0, d in export.segments),
+                "tau: feed-forward RNEA torque of the URDF model",
+                f"largest constraint violation (normalized, <= 0 satisfied): {export.max_violation:.3g}",
+            ]
             with open(tmp, "w") as f:
                 f.write("".join(f"# {line}\n" for line in comments))
                 np.savetxt(f, table, delimiter=",", header=",".join(names), comments="", fmt="%.10g")
         else:
             with open(tmp, "wb") as f:
-                np.savez(f, time=export.time, q=export.q, qd=export.qd, qdd=export.qdd, tau=export.tau,
-                         joint_names=np.array(export.joint_names), columns=np.array(names))
-        tmp.replace(path)
-    except OSError as exc:
-        tmp.unlink(missing_ok=True)
-        raise ExciteError(f"--output: cannot write {path}: {exc}") from None
+                np.savez(
+                    f,
+                    time=export.time,
+                    q=export.q,
+                    qd=export.qd,
+                    qdd=export.qdd,
+                    tau=export.tau,
+                    joint_names=np.array(export.joint_names),
+                    columns=np.array(names),
+                )
     return path
 
 
-def export_to_file(result: Path, iteration: int | None = None, rate: float = 1000.0, periods: int = 1, fmt: str = "csv",
-                   output: Path | None = None, force: bool = False) -> tuple[Export, Path]:
+def export_to_file(
+    result: Path,
+    iteration: int | None = None,
+    rate: float = 1000.0,
+    periods: int = 1,
+    fmt: str = "csv",
+    output: Path | None = None,
+    force: bool = False,
+) -> tuple[Export, Path]:
     """:func:`export_trajectory` written by :func:`write_export` to ``output`` (default
     ``<result>_iteration<K>_<rate>Hz.<fmt>`` beside the result); a given ``output`` is checked first.
 
@@ -148,9 +180,9 @@ def export_to_file(result: Path, iteration: int | None = None, rate: float = 100
         ExciteError: see both, and a bad or existing (without ``force``) output path.
     """
     if fmt not in FORMATS:
-        raise ExciteError(f"--format: must be one of {', '.join(FORMATS)} (got {fmt!r})")
+        raise ExciteError("format", f"must be one of {', '.join(FORMATS)} (got {fmt!r})")
     if output is not None:
-        check_target(output, "--output", force)
+        check_target(output, "output", force)
     export = export_trajectory(result, iteration, rate, periods)
     target = output or result.with_name(f"{result.stem}_iteration{export.iteration}_{rate:g}Hz.{fmt}")
-    return export, write_export(check_target(target, "--output", force), export, fmt)
+    return export, write_export(check_target(target, "output", force), export, fmt)

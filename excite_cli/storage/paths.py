@@ -6,41 +6,42 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from excite_cli.errors import ExciteError
+from excite_cli.errors import ExciteError, OutputExists
 
 
-def check_target(path: Path, option: str, force: bool = False, exists_ok: bool = False) -> Path:
+def check_target(path: Path, field: str, force: bool = False, exists_ok: bool = False) -> Path:
     """Check that ``path`` can be written, without creating anything.
 
     Args:
         path: the file to write (its folder is created later, when the result is written).
-        option: the option or config field that named it, for the messages (e.g. ``--output``).
+        field: the argument or config field that named it, for the messages (e.g. ``output``).
         force: replacing an existing file is allowed.
-        exists_ok: an existing file is expected (``--resume``).
+        exists_ok: an existing file is expected (a result to resume).
 
     Returns:
         ``path``.
 
     Raises:
-        ExciteError: ``path`` is a folder, a file is in the way of its folder, its nearest existing
-            folder is not writable, or the file exists and neither ``force`` nor ``exists_ok``.
+        OutputExists: the file exists and neither ``force`` nor ``exists_ok``.
+        ExciteError: ``path`` is a folder, a file is in the way of its folder, or its nearest
+            existing folder is not writable.
     """
     path = Path(path)
     if path.is_dir():
-        raise ExciteError(f"{option}: {path} is a folder; give a file name")
+        raise ExciteError(field, f"{path} is a folder", path, "a file name")
     if path.exists() and not (force or exists_ok):
-        raise ExciteError(f"{option}: {path} exists; use --force to replace it")
+        raise OutputExists(field, path)
     folder = path.parent
     while not folder.exists():
         folder = folder.parent
     if not folder.is_dir():
-        raise ExciteError(f"{option}: cannot create the folder of {path}: {folder} is a file")
+        raise ExciteError(field, f"cannot create the folder of {path}: {folder} is a file", path)
     if not os.access(folder, os.W_OK | os.X_OK):
-        raise ExciteError(f"{option}: cannot write into {folder} (permission denied)")
+        raise ExciteError(field, f"cannot write into {folder} (permission denied)", path)
     return path
 
 
-def check_folder(folder: Path, names: list[str], option: str, force: bool = False) -> Path:
+def check_folder(folder: Path, names: list[str], field: str, force: bool = False) -> Path:
     """Check that the files ``names`` can be written into ``folder`` (see :func:`check_target`).
 
     Raises:
@@ -48,7 +49,7 @@ def check_folder(folder: Path, names: list[str], option: str, force: bool = Fals
     """
     folder = Path(folder)
     if folder.exists() and not folder.is_dir():
-        raise ExciteError(f"{option}: {folder} is a file, not a folder")
+        raise ExciteError(field, f"{folder} is a file, not a folder", folder, "a folder")
     for name in names:
-        check_target(folder / name, option, force)
+        check_target(folder / name, field, force)
     return folder

@@ -7,65 +7,31 @@ iterations and never a half-written one.
 
 from __future__ import annotations
 
-import os
-from contextlib import contextmanager
-from datetime import datetime, timezone
-from importlib import metadata
 from pathlib import Path
-from typing import Iterator, Sequence
+from typing import Sequence
 
 import h5py
 import numpy as np
 import yaml
 from pydantic import ValidationError
 
-from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.config import Problem, effective_yaml
+from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.errors import ExciteError
+from excite_cli.h5 import atomic_h5, open_h5, read_strings, write_strings
 from excite_cli.optimization.excitation import Excitation
 from excite_cli.optimization.optimality import Optimality
 from excite_cli.optimization.optimizer import RestartResult
 from excite_cli.optimization.sequence import IterationResult, describe
 
-UNITS = {"alpha": "rad", "time": "s", "q": "rad", "qd": "rad/s", "qdd": "rad/s^2", "regressor": "SI (N·m per parameter unit)"}
-VERSIONED_PACKAGES = ("excite", "pin", "coal", "numpy", "scipy", "h5py", "example-robot-data")
-
-
-@contextmanager
-def open_result(path: Path, field: str = "") -> Iterator[h5py.File]:
-    """An HDF5 file opened for reading, with one clear message when it is missing or unreadable.
-
-    Args:
-        field: config field or option named in the messages (e.g. ``sequence.prior``).
-
-    Raises:
-        ExciteError: the file does not exist or is not HDF5.
-    """
-    prefix = f"{field}: " if field else ""
-    path = Path(path)
-    if not path.is_file():
-        raise ExciteError(f"{prefix}file not found: {path}")
-    try:
-        with h5py.File(path, "r") as f:
-            yield f
-    except OSError as exc:
-        raise ExciteError(f"{prefix}cannot read {path} as HDF5: {exc}") from None
-
-
-def package_versions() -> dict[str, str]:
-    """Installed versions of the packages a result depends on."""
-    versions = {}
-    for name in VERSIONED_PACKAGES:
-        try:
-            versions[name] = metadata.version(name)
-        except metadata.PackageNotFoundError:
-            versions[name] = "not installed"
-    return versions
-
-
-def write_strings(group: h5py.Group, name: str, values: Sequence[str]) -> None:
-    """A dataset of variable-length strings."""
-    group.create_dataset(name, data=np.array(values, dtype=h5py.string_dtype()))
+UNITS = {
+    "alpha": "rad",
+    "time": "s",
+    "q": "rad",
+    "qd": "rad/s",
+    "qdd": "rad/s^2",
+    "regressor": "SI (N·m per parameter unit)",
+}
 
 
 def results_table(results: Sequence[IterationResult]) -> np.ndarray:
@@ -80,32 +46,9 @@ def results_table(results: Sequence[IterationResult]) -> np.ndarray:
     return table
 
 
-@contextmanager
-def atomic_h5(path: Path) -> Iterator[h5py.File]:
-    """An HDF5 file written as ``<path>.partial`` and moved onto ``path`` when complete, so a crash or
-    Ctrl-C never leaves a half-written file; creation time and package versions are set.
-
-    Raises:
-        ExciteError: the file cannot be written.
-    """
-    path = Path(path)
-    tmp = path.with_name(path.name + ".partial")
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with h5py.File(tmp, "w") as f:
-            f.attrs["created"] = datetime.now(timezone.utc).isoformat(timespec="seconds")
-            for name, version in package_versions().items():
-                f.attrs[f"version_{name}"] = version
-            yield f
-        os.replace(tmp, path)
-    except OSError as exc:
-        raise ExciteError(f"output: cannot write {path}: {exc}") from None
-    finally:
-        tmp.unlink(missing_ok=True)
-
-
-def write_result(path: Path, excitation: Excitation, results: Sequence[IterationResult], seed: int,
-                 attributes: dict | None = None) -> None:
+def write_result(
+    path: Path, excitation: Excitation, results: Sequence[IterationResult], seed: int, attributes: dict | None = None
+) -> None:
     """Write (or replace atomically) the result file of a sequential generation.
 
     Args:
@@ -131,8 +74,10 @@ def write_result(path: Path, excitation: Excitation, results: Sequence[Iteration
         for r in results:
             _write_iteration(iterations.create_group(str(r.index)), r)
         table = f.create_dataset("table", data=results_table(results))
-        table.attrs["description"] = ("Table I: cond of each iteration's regressor and of the stacked regressor, and their "
-                                      "base-independent excitation e [N m] (README 'Output')")
+        table.attrs["description"] = (
+            "Table I: cond of each iteration's regressor and of the stacked regressor, and their "
+            "base-independent excitation e [N m] (README 'Output')"
+        )
 
 
 def _write_robot(group: h5py.Group, excitation: Excitation) -> None:
@@ -140,7 +85,9 @@ def _write_robot(group: h5py.Group, excitation: Excitation) -> None:
     write_strings(group, "joint_names", robot.joint_names)
     write_strings(group, "parameter_names", robot.parameter_names)
     write_strings(group, "base_parameter_names", base.names)
-    group.create_dataset("composition_matrix", data=base.composition_matrix).attrs["description"] = "X (p x b): Y_B = Y X (Eq. 2)"
+    group.create_dataset("composition_matrix", data=base.composition_matrix).attrs["description"] = (
+        "X (p x b): Y_B = Y X (Eq. 2)"
+    )
     group.create_dataset("regrouping_matrix", data=base.regrouping).attrs["description"] = "K (b x p): phi_B = K phi"
     group.create_dataset("urdf_base_parameters", data=base.from_standard(robot.urdf_parameters()))
     group.attrs["urdf"] = excitation.problem.robot.urdf
@@ -179,16 +126,32 @@ def _write_restart(group: h5py.Group, r: RestartResult) -> None:
     for name in ("objective", "start_objective", "iterations", "message", "wall_time_s", "stop", "end"):
         group.attrs[name] = getattr(r, name)
     o = r.optimality
-    group.attrs.update(kkt_residual=o.residual, active_constraints=o.active, gradient_norm=o.gradient_norm,
-                       max_constraint=o.max_constraint)
+    group.attrs.update(
+        kkt_residual=o.residual,
+        active_constraints=o.active,
+        gradient_norm=o.gradient_norm,
+        max_constraint=o.max_constraint,
+    )
 
 
 def _read_restart(group: h5py.Group, index: int) -> RestartResult:
     a = group.attrs
-    optimality = Optimality(float(a["kkt_residual"]), int(a["active_constraints"]), float(a["gradient_norm"]), float(a["max_constraint"]))
-    return RestartResult(index, group["alpha"][()], float(a["objective"]), int(a["iterations"]), str(a["message"]),
-                         float(a["wall_time_s"]), float(a["start_objective"]), group["history"][()], optimality,
-                         str(a["stop"]), str(a["end"]))
+    optimality = Optimality(
+        float(a["kkt_residual"]), int(a["active_constraints"]), float(a["gradient_norm"]), float(a["max_constraint"])
+    )
+    return RestartResult(
+        index,
+        group["alpha"][()],
+        float(a["objective"]),
+        int(a["iterations"]),
+        str(a["message"]),
+        float(a["wall_time_s"]),
+        float(a["start_objective"]),
+        group["history"][()],
+        optimality,
+        str(a["stop"]),
+        str(a["end"]),
+    )
 
 
 def read_prior(path: Path, base: BaseParameters) -> np.ndarray:
@@ -198,7 +161,7 @@ def read_prior(path: Path, base: BaseParameters) -> np.ndarray:
     Raises:
         ExciteError: missing or unreadable file, no regressor inside, or base parameters that differ.
     """
-    with open_result(path, "sequence.prior") as f:
+    with open_h5(path, "sequence.prior") as f:
         if "iterations" in f:
             keys = sorted(f["iterations"].keys(), key=int)
             blocks = [f["iterations"][k]["regressor"][()] for k in keys]
@@ -206,17 +169,23 @@ def read_prior(path: Path, base: BaseParameters) -> np.ndarray:
         elif "regressor" in f:
             prior = np.asarray(f["regressor"][()], dtype=float)
         else:
-            raise ExciteError(f"sequence.prior: {path} has neither /iterations nor /regressor")
-        names = [n.decode() if isinstance(n, bytes) else n for n in f["robot/base_parameter_names"][()]] if "robot/base_parameter_names" in f else None
+            raise ExciteError("sequence.prior", f"{path} has neither /iterations nor /regressor")
+        names = read_strings(f["robot"], "base_parameter_names") if "robot/base_parameter_names" in f else None
     if prior.ndim != 2 or prior.shape[1] != base.count:
-        raise ExciteError(f"sequence.prior: {path} has {prior.shape[-1]} regressor columns, the problem's robot has "
-                          f"{base.count} base parameters (prior data of another robot or joint set?)")
+        raise ExciteError(
+            "sequence.prior",
+            f"{path} has {prior.shape[-1]} regressor columns, the problem's robot has "
+            f"{base.count} base parameters (prior data of another robot or joint set?)",
+        )
     if names is not None and names != base.names:
         differ = next(k for k, (a, b) in enumerate(zip(names, base.names)) if a != b)
-        raise ExciteError(f"sequence.prior: {path} has the same number of base parameters ({base.count}) but other ones "
-                          f"(number {differ + 1} is '{names[differ]}', the problem's is '{base.names[differ]}')")
+        raise ExciteError(
+            "sequence.prior",
+            f"{path} has the same number of base parameters ({base.count}) but other ones "
+            f"(number {differ + 1} is '{names[differ]}', the problem's is '{base.names[differ]}')",
+        )
     if not np.all(np.isfinite(prior)):
-        raise ExciteError(f"sequence.prior: {path} contains NaN or infinite values")
+        raise ExciteError("sequence.prior", f"{path} contains NaN or infinite values")
     return prior
 
 
@@ -226,14 +195,20 @@ def problem_of_result(path: Path) -> Problem:
     Raises:
         ExciteError: missing or unreadable file, or no valid stored config (not an excite result).
     """
-    with open_result(path) as f:
+    with open_h5(path) as f:
         if "config" not in f.attrs or "iterations" not in f:
-            raise ExciteError(f"{path}: not an excite optimize result (no stored config or /iterations)")
+            raise ExciteError(
+                "result", f"{path} is not an excite optimize result (no stored config or /iterations)", path
+            )
         text, origin = str(f.attrs["config"]), str(f.attrs.get("config_path", ""))
     try:
         problem = Problem.model_validate(yaml.safe_load(text))
     except (yaml.YAMLError, ValidationError):
-        raise ExciteError(f"{path}: its stored config is not a valid optimize problem (not an excite optimize result?)") from None
+        raise ExciteError(
+            "result",
+            f"the stored config of {path} is not a valid optimize problem (not an excite optimize result?)",
+            path,
+        ) from None
     problem.source_path = Path(origin) if origin else None
     problem.source_text = text
     return problem
@@ -248,7 +223,9 @@ def read_last_alpha(path: Path) -> tuple[int, np.ndarray]:
     return read_alphas(path)[-1]
 
 
-def read_iterations(path: Path, excitation: Excitation, prior: np.ndarray | None = None, field: str = "--resume") -> list[IterationResult]:
+def read_iterations(
+    path: Path, excitation: Excitation, prior: np.ndarray | None = None, field: str = "resume"
+) -> list[IterationResult]:
     """The finished iterations of a result of the same problem, as :class:`IterationResult` (checks
     recomputed from the stored α, wall time, SQP iterations and message as stored), to resume it.
 
@@ -257,30 +234,34 @@ def read_iterations(path: Path, excitation: Excitation, prior: np.ndarray | None
     """
     stacked = np.zeros((0, excitation.base.count)) if prior is None else prior
     results = []
-    with open_result(path, field) as f:
+    with open_h5(path, field) as f:
         if "iterations" not in f:
-            raise ExciteError(f"{field}: {path} is not an excite optimize result (no /iterations)")
+            raise ExciteError(field, f"{path} is not an excite optimize result (no /iterations)")
         for key in sorted(f["iterations"].keys(), key=int):
             g = f["iterations"][key]
             alpha = g["alpha"][()]
             if alpha.shape != (excitation.robot.n_joints, excitation.trajectory.n_coefficients):
-                raise ExciteError(f"{field}: {path} was made for another problem (alpha shape {alpha.shape})")
-            restarts = [_read_restart(g["restarts"][r], int(r)) for r in sorted(g["restarts"].keys(), key=int)] if "restarts" in g else []
+                raise ExciteError(field, f"{path} was made for another problem (alpha shape {alpha.shape})")
+            restarts = (
+                [_read_restart(g["restarts"][r], int(r)) for r in sorted(g["restarts"].keys(), key=int)]
+                if "restarts" in g
+                else []
+            )
             results.append(describe(excitation, int(key), alpha, stacked, float(g.attrs["wall_time_s"]), restarts))
             stacked = np.vstack([stacked, results[-1].regressor])
     return results
 
 
-def read_table(path: Path, field: str = "") -> tuple[np.ndarray, float]:
+def read_table(path: Path, field: str = "result") -> tuple[np.ndarray, float]:
     """The condition-number table (iteration, cond_own, cond_stacked) of an excite result and the
     summed wall time of its iterations [s].
 
     Raises:
         ExciteError: missing or unreadable file, or no table in it.
     """
-    with open_result(path, field) as f:
+    with open_h5(path, field) as f:
         if "table" not in f or "iterations" not in f:
-            raise ExciteError(f"{field + ': ' if field else ''}{path} is not an excite result (no /table)")
+            raise ExciteError(field, f"{path} is not an excite result (no /table)", path)
         wall = sum(float(g.attrs.get("wall_time_s", 0.0)) for g in f["iterations"].values())
         return f["table"][()], wall
 
@@ -291,8 +272,8 @@ def read_alphas(path: Path) -> list[tuple[int, np.ndarray]]:
     Raises:
         ExciteError: missing or unreadable file, or no iteration in it.
     """
-    with open_result(path) as f:
+    with open_h5(path) as f:
         keys = sorted(f["iterations"].keys(), key=int) if "iterations" in f else []
         if not keys:
-            raise ExciteError(f"{path} has no finished iteration")
+            raise ExciteError("result", f"{path} has no finished iteration", path)
         return [(int(k), f["iterations"][k]["alpha"][()]) for k in keys]

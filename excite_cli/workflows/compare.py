@@ -11,13 +11,14 @@ import numpy as np
 
 from excite_cli.config import Problem
 from excite_cli.errors import ExciteError
+from excite_cli.h5 import open_h5, read_strings
 from excite_cli.optimization.excitation import Excitation, build_excitation
 from excite_cli.optimization.optimizer import ProgressHook
 from excite_cli.optimization.random_baseline import draw_pool, greedy_selection, pool_convergence
 from excite_cli.optimization.sequence import describe
 from excite_cli.plots.optimize import plot_comparison
 from excite_cli.storage.paths import check_target
-from excite_cli.storage.results import open_result, read_table, results_table, write_result
+from excite_cli.storage.results import read_table, results_table, write_result
 from excite_cli.workflows.optimize import engine_for, run_optimize
 
 
@@ -44,9 +45,15 @@ class Comparison:
     plot: Path
 
 
-def run_compare_random(problem: Problem, optimized: Optional[Path], target: Optional[Path], equal_effort: bool = False,
-                       force: bool = False, progress: Optional[Callable[[int], ProgressHook]] = None,
-                       draws: Optional[Callable[[int, int], None]] = None) -> Comparison:
+def run_compare_random(
+    problem: Problem,
+    optimized: Optional[Path],
+    target: Optional[Path],
+    equal_effort: bool = False,
+    force: bool = False,
+    progress: Optional[Callable[[int], ProgressHook]] = None,
+    draws: Optional[Callable[[int, int], None]] = None,
+) -> Comparison:
     """The conventional baseline (ref. [16], Table II) against an optimized result: random feasible
     candidates (``random_baseline.pool_size``, or for as long as the optimizer took with
     ``equal_effort``), greedy selection, written to ``target`` in the optimize schema.
@@ -61,24 +68,32 @@ def run_compare_random(problem: Problem, optimized: Optional[Path], target: Opti
         ExciteError: bad paths, a result of another problem, too few feasible candidates.
     """
     base = Path(problem.output)
-    target = check_target(target or base.with_name(base.stem + "_random.h5"), "--output", force)
+    target = check_target(target or base.with_name(base.stem + "_random.h5"), "output", force)
     excitation = build_excitation(problem)
     with engine_for(problem, excitation) as engine:
         if optimized is None:  # run here: its table is in memory
-            run = run_optimize(problem, base.with_name(base.stem + "_optimized.h5"), force, progress=progress, engine=engine)
+            run = run_optimize(
+                problem, base.with_name(base.stem + "_optimized.h5"), force, progress=progress, engine=engine
+            )
             optimized_table, optimized_time = results_table(run.results), sum(r.wall_time_s for r in run.results)
         else:
-            optimized_table, optimized_time = read_table(optimized, "--optimized")
+            optimized_table, optimized_time = read_table(optimized, "optimized")
             _check_same_problem(optimized, excitation)
         count = len(optimized_table)
         rcfg = problem.random_baseline
         if not equal_effort and rcfg.pool_size < count:
-            raise ExciteError(f"random_baseline.pool_size: {rcfg.pool_size} candidates cannot fill {count} iterations")
-        drawn = draw_pool(engine, None if equal_effort else rcfg.pool_size, rcfg.seed,
-                          optimized_time if equal_effort else None, draws)
+            raise ExciteError(
+                "random_baseline.pool_size", f"{rcfg.pool_size} candidates cannot fill {count} iterations"
+            )
+        drawn = draw_pool(
+            engine, None if equal_effort else rcfg.pool_size, rcfg.seed, optimized_time if equal_effort else None, draws
+        )
     if len(drawn.alphas) < count:
-        raise ExciteError(f"random_baseline: only {len(drawn.alphas)} feasible candidates of {drawn.drawn} drawn; "
-                          f"{count} are needed (enlarge the pool or the time)")
+        raise ExciteError(
+            "random_baseline",
+            f"only {len(drawn.alphas)} feasible candidates of {drawn.drawn} drawn; "
+            f"{count} are needed (enlarge the pool or the time)",
+        )
     begin = time.perf_counter()
     chosen, _ = greedy_selection(drawn.regressors, count)
     selection_s = time.perf_counter() - begin
@@ -87,21 +102,55 @@ def run_compare_random(problem: Problem, optimized: Optional[Path], target: Opti
     for k, index in enumerate(chosen, start=1):
         results.append(describe(excitation, k, drawn.alphas[index], stacked))
         stacked = np.vstack([stacked, results[-1].regressor])
-    write_result(target, excitation, results, rcfg.seed, {"method": "random_selection", "pool_size": len(drawn.alphas),
-                                                          "drawn": drawn.drawn, "generation_time_s": drawn.generation_time_s,
-                                                          "selection_time_s": selection_s})
+    write_result(
+        target,
+        excitation,
+        results,
+        rcfg.seed,
+        {
+            "method": "random_selection",
+            "pool_size": len(drawn.alphas),
+            "drawn": drawn.drawn,
+            "generation_time_s": drawn.generation_time_s,
+            "selection_time_s": selection_s,
+        },
+    )
     random_table = results_table(results)
-    sizes = sorted({s for s in (count, 10, 30, 100, 300, 1000, 3000, len(drawn.alphas)) if count <= s <= len(drawn.alphas)})
-    plot = plot_comparison(target.with_suffix("").with_name(target.stem + "_comparison.png"), random_table, optimized_table)
-    return Comparison(random_table, optimized_table, drawn.generation_time_s + selection_s, optimized_time, len(drawn.alphas),
-                      drawn.drawn, pool_convergence(drawn.regressors, count, sizes), target, plot)
+    sizes = sorted(
+        {s for s in (count, 10, 30, 100, 300, 1000, 3000, len(drawn.alphas)) if count <= s <= len(drawn.alphas)}
+    )
+    plot = plot_comparison(
+        target.with_suffix("").with_name(target.stem + "_comparison.png"), random_table, optimized_table
+    )
+    return Comparison(
+        random_table,
+        optimized_table,
+        drawn.generation_time_s + selection_s,
+        optimized_time,
+        len(drawn.alphas),
+        drawn.drawn,
+        pool_convergence(drawn.regressors, count, sizes),
+        target,
+        plot,
+    )
 
 
 def _check_same_problem(path: Path, excitation: Excitation) -> None:
     """Raise unless the result at ``path`` has the robot joints and Fourier size of ``excitation``."""
-    with open_result(path, "--optimized") as f:
-        joints = [str(j.decode() if isinstance(j, bytes) else j) for j in f["robot/joint_names"][()]] if "robot" in f else []
-        shape = f["iterations"][sorted(f["iterations"].keys(), key=int)[0]]["alpha"].shape if len(f.get("iterations", {})) else None
-    if joints != excitation.robot.joint_names or shape != (excitation.robot.n_joints, excitation.trajectory.n_coefficients):
-        raise ExciteError(f"--optimized: {path} was made for another problem (joints {joints}, alpha shape {shape})")
-
+    with open_h5(path, "optimized") as f:
+        joints = read_strings(f["robot"], "joint_names") if "robot/joint_names" in f else []
+        shape = (
+            f["iterations"][sorted(f["iterations"].keys(), key=int)[0]]["alpha"].shape
+            if len(f.get("iterations", {}))
+            else None
+        )
+    if joints != excitation.robot.joint_names or shape != (
+        excitation.robot.n_joints,
+        excitation.trajectory.n_coefficients,
+    ):
+        raise ExciteError(
+            "optimized",
+            f"{path} was made for another problem (joints {joints}, alpha shape {shape})",
+            path,
+            "a result of the same robot joints and harmonics",
+        )

@@ -7,8 +7,10 @@ from pathlib import Path
 from typing import Optional
 
 from excite_cli.config import with_overrides
+from excite_cli.dynamics.robot import Robot
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.pipeline import run_identification, write_identified_urdf
+from excite_cli.identification.report import Report
 from excite_cli.identification.report_file import write_identification
 from excite_cli.plots.identification import plot_identification, plot_ladder
 from excite_cli.storage.paths import check_target
@@ -19,28 +21,32 @@ class IdentifyRun:
     """``identify``: the report, the robot, the files written (report, plots) and the URDF round-trip
     deviation [Nm]."""
 
-    report: object
-    robot: object
+    report: Report
+    robot: Robot
     target: Path
     plots: list[Path]
     urdf_deviation: Optional[float]
 
 
-def run_identify(problem: IdentifyProblem, target: Path, urdf_out: Optional[Path] = None, force: bool = False) -> IdentifyRun:
+def run_identify(
+    problem: IdentifyProblem, target: Path, urdf_out: Optional[Path] = None, force: bool = False
+) -> IdentifyRun:
     """Identify (:func:`run_identification`), write the report (HDF5), the residual plot and, with
     ``urdf_out``, the identified URDF (physical consistency is then fitted too).
 
     Raises:
         ExciteError: bad paths or data (see :func:`run_identification`).
     """
-    check_target(target, "--output", force)
+    check_target(target, "output", force)
     if urdf_out is not None:
-        check_target(urdf_out, "--urdf-out", force)
+        check_target(urdf_out, "urdf_out", force)
         problem = with_overrides(problem, {"identification.physical_consistency": True})
     report, robot, base, regressor = run_identification(problem)
     write_identification(target, report, robot, base, problem, regressor)
     deviation = write_identified_urdf(problem, report, robot, base, urdf_out) if urdf_out is not None else None
     stem = target.with_suffix("")
-    plots = [plot_identification(stem.with_name(target.stem + "_residuals.png"), report),
-             plot_ladder(stem.with_name(target.stem + "_ladder.png"), report)]
+    plots = [
+        plot_identification(stem.with_name(target.stem + "_residuals.png"), report),
+        plot_ladder(stem.with_name(target.stem + "_ladder.png"), report),
+    ]
     return IdentifyRun(report, robot, target, plots, deviation)

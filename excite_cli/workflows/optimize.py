@@ -10,15 +10,15 @@ import numpy as np
 import yaml
 
 from excite_cli.config import Problem, effective_yaml
-from excite_cli.errors import ExciteError, Interrupted
+from excite_cli.errors import ExciteError, FileNotFound, Interrupted
+from excite_cli.h5 import open_h5
 from excite_cli.optimization.engine import Engine, default_workers
 from excite_cli.optimization.excitation import Excitation, build_excitation
 from excite_cli.optimization.optimizer import ProgressHook
 from excite_cli.optimization.sequence import IterationResult, run_sequence
 from excite_cli.plots.optimize import plot_result
 from excite_cli.storage.paths import check_target
-from excite_cli.storage.results import open_result, read_iterations, read_prior, write_result
-
+from excite_cli.storage.results import read_iterations, read_prior, write_result
 
 RESUMABLE_CHANGES = ("sequence.iterations", "optimizer.workers", "optimizer.scheduler")
 
@@ -39,10 +39,15 @@ class OptimizeRun:
     plots: list[Path]
 
 
-def run_optimize(problem: Problem, target: Path, force: bool = False, resume: bool = False,
-                 progress: Optional[Callable[[int], ProgressHook]] = None,
-                 on_iteration: Optional[Callable[[IterationResult], None]] = None,
-                 engine: Optional[Engine] = None) -> OptimizeRun:
+def run_optimize(
+    problem: Problem,
+    target: Path,
+    force: bool = False,
+    resume: bool = False,
+    progress: Optional[Callable[[int], ProgressHook]] = None,
+    on_iteration: Optional[Callable[[IterationResult], None]] = None,
+    engine: Optional[Engine] = None,
+) -> OptimizeRun:
     """The sequential generation of ``problem``, writing ``target`` after every iteration, then plots.
 
     Args:
@@ -56,9 +61,9 @@ def run_optimize(problem: Problem, target: Path, force: bool = False, resume: bo
         ExciteError: bad target, prior data or problem; a result to resume made with another config.
         Interrupted: Ctrl-C; the finished iterations are in ``target``.
     """
-    check_target(target, "--output", force, exists_ok=resume)
+    check_target(target, "output", force, exists_ok=resume)
     if resume and not target.is_file():
-        raise ExciteError(f"--resume: no result at {target} to continue")
+        raise FileNotFound("resume", target, "result to continue")
     excitation = build_excitation(problem)
     prior = read_prior(problem.resolve(problem.sequence.prior), excitation.base) if problem.sequence.prior else None
     finished = _resumable(target, excitation, prior) if resume else []
@@ -72,8 +77,9 @@ def run_optimize(problem: Problem, target: Path, force: bool = False, resume: bo
 
     try:
         with engine or engine_for(problem, excitation) as active:
-            results = run_sequence(excitation, problem.sequence.iterations, problem.optimizer.seed, prior, progress,
-                                   done, active, finished)
+            results = run_sequence(
+                excitation, problem.sequence.iterations, problem.optimizer.seed, prior, progress, done, active, finished
+            )
     except KeyboardInterrupt:
         raise Interrupted(target, len(written)) from None
     return OptimizeRun(excitation, results, target, plot_result(target, excitation, results))
@@ -81,7 +87,7 @@ def run_optimize(problem: Problem, target: Path, force: bool = False, resume: bo
 
 def _resumable(target: Path, excitation: Excitation, prior: Optional[np.ndarray]) -> list[IterationResult]:
     """The iterations of ``target`` if it was made with the same config (see ``RESUMABLE_CHANGES``)."""
-    with open_result(target, "--resume") as f:
+    with open_h5(target, "resume") as f:
         stored = yaml.safe_load(str(f.attrs.get("config", ""))) or {}
     current = yaml.safe_load(effective_yaml(excitation.problem))
     for dotted in RESUMABLE_CHANGES:
@@ -90,10 +96,14 @@ def _resumable(target: Path, excitation: Excitation, prior: Optional[np.ndarray]
             config.get(section, {}).pop(name, None)
     if stored != current:
         differing = sorted(k for k in set(stored) | set(current) if stored.get(k) != current.get(k))
-        raise ExciteError(f"--resume: {target} was made with another config ({', '.join(differing) or 'the whole file'} differ)")
+        raise ExciteError(
+            "resume", f"{target} was made with another config ({', '.join(differing) or 'the whole file'} differ)"
+        )
     finished = read_iterations(target, excitation, prior)
     if len(finished) > excitation.problem.sequence.iterations:
-        raise ExciteError(f"--resume: {target} has {len(finished)} iterations, more than the {excitation.problem.sequence.iterations} asked for")
+        raise ExciteError(
+            "resume",
+            f"{target} has {len(finished)} iterations, "
+            f"more than the {excitation.problem.sequence.iterations} asked for",
+        )
     return finished
-
-

@@ -11,17 +11,19 @@ from pathlib import Path
 
 import numpy as np
 
-from excite_cli.identification.config import SimulationConfig
-from excite_cli.errors import ExciteError
-from excite_cli.identification.effects import COEFFICIENTS, SHAPE_FIELDS, effect_columns
-from excite_cli.storage.results import problem_of_result, read_alphas
 from excite_cli.dynamics.robot import Robot, load_robot
+from excite_cli.errors import ExciteError
+from excite_cli.h5 import atomic_path
+from excite_cli.identification.config import SimulationConfig
+from excite_cli.identification.effects import COEFFICIENTS, SHAPE_FIELDS, effect_columns
 from excite_cli.storage.paths import check_folder
+from excite_cli.storage.results import problem_of_result, read_alphas
 from excite_cli.trajectory.fourier import FourierTrajectory
 
 
-def effect_torques(sim: SimulationConfig, robot: Robot, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray,
-                   rigid: np.ndarray) -> np.ndarray:
+def effect_torques(
+    sim: SimulationConfig, robot: Robot, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, rigid: np.ndarray
+) -> np.ndarray:
     """(T, n) torques [Nm] of the effects in ``sim.effects`` ({effect: {joint or "*": value}}) at the
     samples q, q̇, q̈ (T, n) in time order, ``rigid`` (T, n) the rigid-body torques [Nm].
 
@@ -32,18 +34,22 @@ def effect_torques(sim: SimulationConfig, robot: Robot, q: np.ndarray, qd: np.nd
     for effect, per_joint in sim.effects.items():
         for name, value in per_joint.items():
             if name != "*" and name not in robot.joint_names:
-                raise ExciteError(f"effects.{effect}: '{name}' is not an active joint")
+                raise ExciteError(f"effects.{effect}", f"'{name}' is not an active joint")
             coefficients = np.atleast_1d(np.asarray(value, dtype=float))
             if coefficients.size != len(COEFFICIENTS[effect]):
-                raise ExciteError(f"effects.{effect}.{name}: needs {len(COEFFICIENTS[effect])} value(s) {COEFFICIENTS[effect]}")
-            for j in (range(robot.n_joints) if name == "*" else [robot.joint_names.index(name)]):
+                raise ExciteError(
+                    f"effects.{effect}.{name}", f"needs {len(COEFFICIENTS[effect])} value(s) {COEFFICIENTS[effect]}"
+                )
+            for j in range(robot.n_joints) if name == "*" else [robot.joint_names.index(name)]:
                 shape = getattr(sim, SHAPE_FIELDS[effect]) if effect in SHAPE_FIELDS else None
                 cols = effect_columns(effect, q[:, j], qd[:, j], qdd[:, j], sim.coulomb_velocity, shape, rigid[:, j])
                 tau[:, j] += cols @ coefficients
     return tau
 
 
-def simulate_runs(result: Path, sim: SimulationConfig, out_dir: Path, prefix: str = "run", force: bool = False) -> list[Path]:
+def simulate_runs(
+    result: Path, sim: SimulationConfig, out_dir: Path, prefix: str = "run", force: bool = False
+) -> list[Path]:
     """Write one CSV per iteration of ``result`` into ``out_dir``; everything is computed (and every
     error raised) before the first file is written.
 
@@ -66,7 +72,7 @@ def simulate_runs(result: Path, sim: SimulationConfig, out_dir: Path, prefix: st
     trajectory = FourierTrajectory(problem.trajectory.harmonics, problem.trajectory.base_frequency)
     rng = np.random.default_rng(sim.seed)
     alphas = read_alphas(result)
-    check_folder(out_dir, [f"{prefix}_{k}.csv" for k, _ in alphas], "--output-dir", force)
+    check_folder(out_dir, [f"{prefix}_{k}.csv" for k, _ in alphas], "output_dir", force)
     header = ["time"] + [f"q_{j}" for j in robot.joint_names] + [f"tau_{j}" for j in robot.joint_names]
     tables = {}
     for k, alpha in alphas:
@@ -79,13 +85,12 @@ def simulate_runs(result: Path, sim: SimulationConfig, out_dir: Path, prefix: st
         tau += rng.normal(0.0, sim.torque_noise, tau.shape)
         tables[k] = np.column_stack([time, q + rng.normal(0.0, sim.position_noise, q.shape), tau])
         if not np.all(np.isfinite(tables[k])):
-            raise ExciteError("effects: a value makes non-finite torques (NaN or inf in the effects file?)")
+            raise ExciteError("effects", "a value makes non-finite torques (NaN or inf in the effects file?)")
     out_dir.mkdir(parents=True, exist_ok=True)
     written = []
     for k, table in tables.items():
         path = out_dir / f"{prefix}_{k}.csv"
-        tmp = path.with_name(path.name + ".partial")
-        np.savetxt(tmp, table, delimiter=",", header=",".join(header), comments="", fmt="%.10g")
-        tmp.replace(path)
+        with atomic_path(path, "output_dir") as tmp:
+            np.savetxt(tmp, table, delimiter=",", header=",".join(header), comments="", fmt="%.10g")
         written.append(path)
     return written

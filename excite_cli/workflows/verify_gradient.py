@@ -29,8 +29,13 @@ class Verification:
         return max([c.error_central for _, _, c in self.gradients] + [e for _, _, e in self.jacobians])
 
 
-def run_verify(problem: Problem, result: Optional[Path] = None, objectives: Sequence[str] = OBJECTIVES,
-               step: float = 1e-6, seed: int = 0) -> Verification:
+def run_verify(
+    problem: Problem,
+    result: Optional[Path] = None,
+    objectives: Sequence[str] = OBJECTIVES,
+    step: float = 1e-6,
+    seed: int = 0,
+) -> Verification:
     """Every criterion's analytic gradient against finite differences at a random feasible α (and at
     the last optimum of ``result``, with the earlier iterations as C₀), and every constraint's
     Jacobian against central differences at a livelier α.
@@ -40,16 +45,18 @@ def run_verify(problem: Problem, result: Optional[Path] = None, objectives: Sequ
     """
     for name in objectives:
         if name not in OBJECTIVES:
-            raise ExciteError(f"--objective: '{name}' is not a criterion; expected one of {', '.join(OBJECTIVES)}")
+            raise ExciteError("objective", f"'{name}' is not a criterion", name, f"one of {', '.join(OBJECTIVES)}")
     if seed < 0:
-        raise ExciteError(f"--seed: must be ≥ 0 (got {seed})")
+        raise ExciteError("seed", "must be ≥ 0", seed, "an integer ≥ 0")
     if not 1e-12 <= step <= 1e-2:
-        raise ExciteError(f"--step: {step:g} is not a finite-difference step for coefficients in rad; use 1e-12 to 1e-2")
+        raise ExciteError(
+            "step", f"{step:g} is not a finite-difference step for coefficients in rad", step, "1e-12 to 1e-2"
+        )
     excitation = build_excitation(problem)
     m = excitation.trajectory.n_coefficients
     points = [("random", None, excitation.limits.random_start(m, np.random.default_rng(seed), fill=0.7))]
     if result is not None:
-        finished = read_iterations(result, excitation, field="--result")
+        finished = read_iterations(result, excitation, field="result")
         stacked = np.vstack([np.zeros((0, excitation.base.count)), *[r.regressor for r in finished[:-1]]])
         points.append((f"optimum {finished[-1].index}", stacked, finished[-1].alpha))
     gradients = []
@@ -58,6 +65,7 @@ def run_verify(problem: Problem, result: Optional[Path] = None, objectives: Sequ
             criterion = excitation.criterion(prior, name)
             gradients.append((label, name, check_gradient(criterion, alpha, step=step)))
     lively = excitation.limits.random_start(m, np.random.default_rng(seed), 0.9, excitation.home)
-    jacobians = [(c.name, c.evaluate(lively)[0].size, constraint_jacobian_error(c, lively)) for c in excitation.constraints]
+    jacobians = [
+        (c.name, c.evaluate(lively)[0].size, constraint_jacobian_error(c, lively)) for c in excitation.constraints
+    ]
     return Verification(gradients, jacobians)
-

@@ -1,0 +1,164 @@
+"""What ``identify`` and ``validate`` print: rich tables built from the identify report."""
+
+from __future__ import annotations
+
+from typing import Sequence
+
+import numpy as np
+from rich.table import Table
+
+from excite_cli.console.tables import titled_table
+from excite_cli.dynamics.robot import Robot
+from excite_cli.identification.effects import COEFFICIENTS
+from excite_cli.identification.effects import UNITS as EFFECT_UNITS
+from excite_cli.identification.physical import body_properties, pseudo_inertia
+from excite_cli.identification.pipeline import effect_values
+from excite_cli.identification.report import Report
+from excite_cli.identification.selection import MOVE_SIGNS
+from excite_cli.identification.validate import RunError
+
+
+def validation(name: str, joints: Sequence[str], errors: Sequence[RunError]) -> Table:
+    """Relative RMS torque error per run and joint of ``validate``."""
+    return titled_table(
+        f"Validation of {name}: relative RMS torque error [%] per run",
+        ("run", "instants", *joints, "mean"),
+        [(e.name, str(e.instants), *[f"{x:.1f}" for x in e.relative], f"{e.relative.mean():.1f}") for e in errors],
+    )
+
+
+def preprocessing_notes(report: Report) -> list[str]:
+    """The cut-off used (and where it came from) and the rows dropped per run."""
+    return [f"low-pass cut-off {report.cutoff:.3g} Hz ({report.cutoff_source}); stored as cutoff_Hz"] + [
+        f"data.bad_rows: dropped {rows} unusable row(s) of {name}" for name, rows in report.dropped
+    ]
+
+
+def identification(report: Report) -> list[Table | str]:
+    """The before/after error table, the ladder, the selection's steps, the chosen effects, what was
+    absorbed, the base parameters."""
+    consistent, sel = report.relative_consistent, report.selection
+    extra = consistent is not None
+    errors = titled_table(
+        f"Validation torque error, rigid body only → with the chosen effects ({report.validation_samples} instants "
+        "that neither the fit nor the selection saw)",
+        ("joint", "RMS τ [Nm]", "before [Nm]", "after [Nm]", "before [%]", "after [%]")
+        + (("consistent [%]",) if extra else ()),
+        [
+            (
+                name,
+                f"{report.rms_torque[j]:.3f}",
+                f"{report.rms_before[j]:.3f}",
+                f"{report.rms_after[j]:.3f}",
+                f"{report.relative_before[j]:.1f}",
+                f"{report.relative_after[j]:.1f}",
+                *((f"{consistent[j]:.1f}",) if extra else ()),
+            )
+            for j, name in enumerate(report.joints)
+        ],
+        f"mean: before {report.relative_before.mean():.1f} %, after {report.relative_after.mean():.1f} %"
+        + (f", physically consistent {consistent.mean():.1f} %" if extra else ""),
+    )
+    ladder = titled_table(
+        "What each effect bought: mean relative error after each step",
+        ("step", "cross-validated [%]", "validation [%]"),
+        [(label, f"{cv:.2f}", f"{val:.2f}") for label, cv, val in report.ladder],
+        f"cross-validated: {sel.folds} blocked folds of the fit data (what the selection minimizes); "
+        "validation: data it never saw",
+    )
+    order = {t: k + 1 for k, t in enumerate(sel.terms)}
+    effects = titled_table(
+        "Effects, in the order they were added (declared ones first)",
+        ("#", "effect", "joint", "shape [rad/s]", "coefficient", "value", "std"),
+        [
+            (
+                str(order[t]),
+                t.effect,
+                report.joints[t.joint],
+                "" if t.shape is None else f"{t.shape:g}",
+                f"{name} [{EFFECT_UNITS[COEFFICIENTS[t.effect][0]]}]",
+                f"{value:.5g}",
+                f"{std:.2g}",
+            )
+            for t, name, value, std in effect_values(report)
+        ],
+    )
+    params = titled_table(
+        "Identified base parameters",
+        ("base parameter", "value", "std"),
+        [(name, f"{value:.5g}", f"{std:.2g}") for name, value, std in zip(report.base_names, sel.fit.x, sel.fit.std)],
+    )
+    absorbed = (
+        [
+            "not separately identifiable (in the span of the base parameters): "
+            + ", ".join(t.label(report.joints) for t in sel.absorbed)
+        ]
+        if sel.absorbed
+        else []
+    )
+    return [errors, ladder, *search(report), effects, *absorbed, params]
+
+
+def search(report: Report, runners_up: int = 2) -> list[Table | str]:
+    """Each step of the kept search with its gain and the best moves it did not take (every move
+    tried is in the HDF5 report), and the outcome of every start."""
+    sel = report.selection
+    kept = sel.searches[sel.chosen]
+    rows = []
+    for k, step in enumerate(sel.steps, start=1):
+        others = sorted(((v, m, t) for m, t, v in step.tried if (m, t) != (step.move, step.term)), key=lambda o: o[0])[
+            :runners_up
+        ]
+        rows.append(
+            (
+                str(k),
+                step.label(report.joints),
+                f"{step.gain:.1f}",
+                str(len(step.tried)),
+                "; ".join(f"{MOVE_SIGNS[m]} {t.label(report.joints)} {step.gain_of(v):.1f}" for v, m, t in others),
+            )
+        )
+    steps = titled_table(
+        f"Selection steps from the start '{kept.start}' (gain: cut of the cross-validated error [%])",
+        ("step", "move", "gain [%]", "tried", f"next best {runners_up} [gain %]"),
+        rows,
+        f"stopped: {kept.stop}",
+    )
+    starts = "; ".join(
+        f"{s.start}: {s.cv_error:.2f} % with {len(s.terms)} effects" + (" (kept)" if k == sel.chosen else "")
+        for k, s in enumerate(sel.searches)
+    )
+    return [steps, f"searches (cross-validated error at their end): {starts}"]
+
+
+def bodies(report: Report, robot: Robot) -> Table:
+    """Identified (physically consistent) bodies beside the URDF's, and the active constraints."""
+    urdf, fit = robot.urdf_parameters(), report.consistent
+    vector = lambda v: " ".join(f"{x:+.3f}" for x in v)  # noqa: E731
+    rows = []
+    for i, name in enumerate(robot.body_names):
+        m, c, _, moments = body_properties(fit.standard[10 * i : 10 * i + 10])
+        um, uc, _, umoments = body_properties(urdf[10 * i : 10 * i + 10])
+        rows.append(
+            (
+                name,
+                f"{m:.3f} / {um:.3f}",
+                f"{vector(c)} / {vector(uc)}",
+                f"{' '.join(f'{x:.2e}' for x in moments)} / {' '.join(f'{x:.2e}' for x in umoments)}",
+                f"{fit.min_eigenvalues[i]:.1e}",
+            )
+        )
+    plain = [
+        (name, body_properties(fit.unconstrained[10 * i : 10 * i + 10])[0])
+        for i, name in enumerate(robot.body_names)
+        if np.linalg.eigvalsh(pseudo_inertia(fit.unconstrained[10 * i : 10 * i + 10]))[0] <= 0.0
+    ]
+    return titled_table(
+        f"Physically consistent bodies (identified / URDF), solver {fit.status}",
+        ("body", "mass [kg]", "CoM [m]", "principal moments about the CoM [kg m²]", "λmin(J)"),
+        rows,
+        "active: "
+        + (", ".join(fit.active) or "none")
+        + "\nplain least squares (same regularization) is not physical for: "
+        + (", ".join(f"{name} (mass {m:.3f} kg)" for name, m in plain) or "none"),
+    )

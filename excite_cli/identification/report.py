@@ -1,0 +1,86 @@
+"""The identify report: what ``excite identify`` found, as one typed record that the report file,
+the printed tables, the figures and ``--urdf-out`` read."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from excite_cli.identification.dataset import Dataset
+from excite_cli.identification.least_squares import torque_errors
+from excite_cli.identification.physical import ConsistentFit
+from excite_cli.identification.selection import Selection
+
+
+@dataclass
+class Report:
+    """What ``identify`` found.
+
+    Attributes:
+        joints: (n,) active joint names.
+        base_names: (b,) base-parameter names.
+        selection: chosen effects, fits, the search's steps.
+        rms_before, rms_after: (n,) validation torque RMS error [Nm], rigid body only / with effects.
+        rms_torque: (n,) RMS of the measured validation torques [Nm].
+        validation: the validation samples; predicted_before, predicted_after: (N, n) [Nm] on them.
+        cutoff: low-pass cut-off of every run [Hz]; cutoff_source: how it was chosen, in words.
+        fit_samples, validation_samples: instants used for fitting / validation.
+        dropped: (file, rows) left out as unusable, per run with ``data.bad_rows: drop``.
+        run_names: (runs,) each configured run's label (file and crop), indexed by ``Dataset.run``.
+        offset_runs: the runs whose offsets the fit has (one column each), as labels.
+        ladder: (step, CV error on the fit data [%], mean relative validation error [%]) for the
+            rigid body, the search's start and after each step of the kept search.
+        consistent: the physically consistent fit with the same effects, or None.
+        rms_consistent: (n,) its validation torque RMS error [Nm] (None without it).
+    """
+
+    joints: list[str]
+    base_names: list[str]
+    selection: Selection
+    rms_before: np.ndarray
+    rms_after: np.ndarray
+    rms_torque: np.ndarray
+    validation: Dataset
+    predicted_before: np.ndarray
+    predicted_after: np.ndarray
+    cutoff: float
+    cutoff_source: str
+    fit_samples: int
+    validation_samples: int
+    dropped: list[tuple[str, int]] = field(default_factory=list)
+    run_names: list[str] = field(default_factory=list)
+    offset_runs: list[str] = field(default_factory=list)
+    ladder: list[tuple[str, float, float]] = field(default_factory=list)
+    consistent: ConsistentFit | None = None
+    rms_consistent: np.ndarray | None = None
+
+    @property
+    def relative_before(self) -> np.ndarray:
+        """(n,) RMS error / RMS torque [%] before."""
+        return 100.0 * self.rms_before / self.rms_torque
+
+    @property
+    def relative_after(self) -> np.ndarray:
+        """(n,) RMS error / RMS torque [%] after."""
+        return 100.0 * self.rms_after / self.rms_torque
+
+    def per_run(self) -> list[tuple[str, int, np.ndarray, np.ndarray, np.ndarray]]:
+        """(run name, instants, RMS error before (n,) [Nm], after (n,) [Nm], RMS torque (n,) [Nm]) of
+        each validation run."""
+        measured = self.validation.tau.reshape(-1, len(self.joints))
+        out = []
+        for r in np.unique(self.validation.run):
+            rows = self.validation.run == r
+            (before, torque, _), (after, _, _) = (
+                torque_errors(measured[rows], p[rows]) for p in (self.predicted_before, self.predicted_after)
+            )
+            out.append(
+                (self.run_names[r] if r < len(self.run_names) else str(r), int(rows.sum()), before, after, torque)
+            )
+        return out
+
+    @property
+    def relative_consistent(self) -> np.ndarray | None:
+        """(n,) RMS error / RMS torque [%] of the physically consistent fit, or None."""
+        return None if self.rms_consistent is None else 100.0 * self.rms_consistent / self.rms_torque

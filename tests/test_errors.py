@@ -1,0 +1,69 @@
+"""Errors carry the field at fault, the offending value and what is expected; the library names
+arguments and config fields, the command line words them as its own options."""
+
+import pytest
+import yaml
+from conftest import UR5, write_config
+
+from excite_cli.cli import export, validate
+from excite_cli.config import load_problem
+from excite_cli.console.errors import spellings, word
+from excite_cli.errors import CannotWrite, ExciteError, FileNotFound, OutputExists
+from excite_cli.h5 import atomic_path, open_h5
+from excite_cli.storage.export import export_trajectory
+from excite_cli.storage.paths import check_target
+
+
+def test_a_config_value_out_of_range_names_its_field_value_and_file(tmp_path):
+    path = write_config(tmp_path, {**UR5, "trajectory": {**UR5["trajectory"], "harmonics": -2}})
+    with pytest.raises(ExciteError) as caught:
+        load_problem(path)
+    error = caught.value
+    assert (error.field, error.value, error.source) == ("trajectory.harmonics", -2, path)
+    assert str(error).startswith(f"{path}: trajectory.harmonics: ")
+
+
+def test_library_errors_name_arguments_not_flags(tmp_path):
+    with pytest.raises(FileNotFound) as missing:
+        export_trajectory(tmp_path / "none.h5")
+    assert (missing.value.field, missing.value.value) == ("result", tmp_path / "none.h5")
+    with pytest.raises(ExciteError) as rate:
+        export_trajectory(tmp_path / "none.h5", rate=-1.0)
+    assert (rate.value.field, rate.value.value) == ("rate", -1.0) and "100000" in rate.value.expected
+    (tmp_path / "there.h5").write_bytes(b"")
+    with pytest.raises(OutputExists) as exists:
+        check_target(tmp_path / "there.h5", "output")
+    assert exists.value.field == "output" and "--" not in str(exists.value)
+
+
+def test_the_command_line_words_fields_as_its_options():
+    spelled = spellings(export)
+    assert spelled["fmt"] == spelled["format"] == "--format" and spelled["result"] == "RESULT"
+    assert spellings(validate)["report"] == "REPORT"
+    assert (
+        word(ExciteError("format", "unknown", "xml", "csv or npz"), spelled) == "--format: unknown; expected csv or npz"
+    )
+    assert word(ExciteError("limits.velocity", "must be > 0", -1.0), spelled) == "limits.velocity: must be > 0"
+    assert word(OutputExists("output", "r.h5"), spelled) == "--output: r.h5 exists; use --force to replace it"
+
+
+def test_an_atomic_write_that_fails_leaves_nothing_and_names_its_field(tmp_path):
+    target = tmp_path / "out.csv"
+    with pytest.raises(CannotWrite) as caught:
+        with atomic_path(target, "output_dir") as tmp:
+            tmp.write_text("half")
+            raise OSError(28, "No space left on device")
+    assert caught.value.field == "output_dir" and "No space left" in caught.value.reason
+    assert list(tmp_path.iterdir()) == []
+    with atomic_path(target) as tmp:
+        tmp.write_text("whole")
+    assert target.read_text() == "whole" and list(tmp_path.iterdir()) == [target]
+
+
+def test_a_file_that_is_not_hdf5_is_named_with_the_field_that_gave_it(tmp_path):
+    path = tmp_path / "prior.h5"
+    path.write_text(yaml.safe_dump({"not": "hdf5"}))
+    with pytest.raises(ExciteError) as caught:
+        with open_h5(path, "sequence.prior"):
+            pass
+    assert caught.value.field == "sequence.prior" and caught.value.value == path
