@@ -523,3 +523,36 @@ def test_shipped_simulated_runs_give_back_their_undeclared_friction():
     for term, _, value, std in effect_values(report):
         assert value == pytest.approx({"coulomb": 0.6, "viscous": 0.4}[term.effect], rel=0.15), term
     assert report.relative_before.mean() > 30.0 and report.relative_after.mean() < 5.0
+
+
+def test_data_as_labs_record_it_identify_without_conversion(tmp_path, optimized):
+    """93.7 Hz runs with no sample_rate set, Unix-time stamps, no header (columns by position) and a
+    byte-order mark: the default rate follows the data and the friction is found as in clean data."""
+    sim = {"sample_rate": 93.7, "periods": 8, "torque_noise": NOISE, "seed": 2, "effects": {"coulomb": {"*": 0.4}}}
+    result = runner.invoke(
+        app, ["simulate", str(optimized), str(write_config(tmp_path, sim, "effects.yaml")), "-o", str(tmp_path)]
+    )
+    assert result.exit_code == 0, result.output
+    for k in (1, 2, 3):
+        table = np.loadtxt(tmp_path / f"run_{k}.csv", delimiter=",", skiprows=1)
+        table[:, 0] += 1.46e9 + 1000.0 * k
+        rows = "\n".join(",".join(f"{v:.12g}" for v in row) for row in table)
+        (tmp_path / f"lab_{k}.csv").write_text("\ufeff" + rows + "\n", encoding="utf-8")
+    config = {
+        "robot": {"urdf": "panda_description/urdf/panda.urdf", "source": "example-robot-data", "active_joints": JOINTS},
+        "data": {
+            "runs": [{"file": f"lab_{k}.csv", "role": "blocks"} for k in (1, 2, 3)],
+            "columns": {"time": 0, "q": list(range(1, 8)), "tau": list(range(8, 15))},
+        },
+        "identification": {"candidates": ["coulomb"]},
+        "output": str(tmp_path / "ident.h5"),
+    }
+    problem = load_problem(write_config(tmp_path, config, "identify.yaml"), IdentifyProblem)
+    assert problem.preprocessing.sample_rate is None
+    report = run_identification(problem)[0]
+    assert report.cutoff < 0.4 * 93.7 + 1e-9
+    found = _found(report)
+    assert {j for e, _, j in found if e == "coulomb"} == set(JOINTS)
+    for (effect, _, _), (value, std, _) in found.items():
+        assert effect != "coulomb" or abs(value - 0.4) <= max(0.1 * 0.4, 3 * std)
+    assert np.mean(report.relative_after) < 0.5 * np.mean(report.relative_before)

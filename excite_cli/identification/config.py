@@ -77,9 +77,10 @@ class DataConfig(Section):
 
 
 class PreprocessingConfig(Section):
-    """Decimated rate [Hz], low-pass cut-off [Hz] (default from the bandwidth), filter order."""
+    """Decimated rate [Hz] (default: min(200 Hz, the data's rate)), low-pass cut-off [Hz] (default from
+    the bandwidth), filter order."""
 
-    sample_rate: float = Field(200.0, gt=0.0)
+    sample_rate: Optional[float] = Field(None, gt=0.0)
     cutoff: Optional[float] = Field(None, gt=0.0)
     filter_order: int = Field(4, ge=1, le=10)
 

@@ -78,7 +78,7 @@ def _split(line: str, delimiter: str | None) -> list[str]:
 
 def _read_text(path: Path, drop: bool) -> Table:
     try:
-        lines = path.read_text().splitlines()
+        lines = path.read_text(encoding="utf-8-sig").splitlines()  # a byte-order mark is not data
     except UnicodeDecodeError:
         raise ExciteError(
             "data",

@@ -38,7 +38,8 @@ class Run:
     dropped: int = 0
 
 
-#: Values beyond this magnitude (rad, rad/s, rad/s², s, Nm, A) are corrupt, not measured.
+#: Values beyond this magnitude (rad, rad/s, rad/s², Nm, A) are corrupt, not measured. Time is only
+#: checked for being finite and increasing: loggers write Unix or ROS time (1.5e9 s).
 IMPLAUSIBLE = 1e6
 
 
@@ -54,7 +55,8 @@ def _usable(time: np.ndarray, signals: dict[str, np.ndarray]) -> tuple[np.ndarra
     ok = np.ones(time.size, dtype=bool)
     problem = ""
     for name, values in signals.items():
-        bad = ~np.all(np.isfinite(values) & (np.abs(values) < IMPLAUSIBLE), axis=1)
+        bounded = np.isfinite(values) & (name == "time" or np.abs(values) < IMPLAUSIBLE)  # time may be absolute
+        bad = ~np.all(bounded, axis=1)
         if bad.any() and not problem:
             kind = (
                 "NaN or missing value" if not np.all(np.isfinite(values[bad])) else f"a value beyond ±{IMPLAUSIBLE:g}"

@@ -24,6 +24,8 @@ from excite_cli.errors import ExciteError
 from excite_cli.identification.config import PreprocessingConfig
 from excite_cli.identification.measurements import Run
 
+#: Decimated rate [Hz] when ``preprocessing.sample_rate`` is not set (data slower than this keep their rate).
+DEFAULT_SAMPLE_RATE = 200.0
 #: Default cut-off = this × the frequency below which ``POWER_FRACTION`` of q's power lies ...
 CUTOFF_FACTOR = 10.0
 POWER_FRACTION = 0.99
@@ -147,12 +149,18 @@ def choose_cutoff(runs: list[Run], cfg: PreprocessingConfig) -> tuple[float, str
         return cfg.cutoff, "preprocessing.cutoff"
     fitted = [r for r in runs if r.role != "validation"] or runs
     widest = max(bandwidth(np.column_stack(resample(r, r.q, uniform_grid(r))), run_rate(r)) for r in fitted)
-    top = MAX_CUTOFF_FRACTION * min(cfg.sample_rate, min(run_rate(r) for r in runs))
+    top = MAX_CUTOFF_FRACTION * min(target_rate(cfg, run_rate(r)) for r in runs)
     cutoff = float(min(max(MIN_CUTOFF, CUTOFF_FACTOR * widest), top))
     return cutoff, (
         f"default: {CUTOFF_FACTOR:g} × the {100 * POWER_FRACTION:g} % power bandwidth of q in the fitted runs "
         f"({widest:.3g} Hz), at least {MIN_CUTOFF:g} Hz, at most {100 * MAX_CUTOFF_FRACTION:g} % of the rate"
     )
+
+
+def target_rate(cfg: PreprocessingConfig, rate: float) -> float:
+    """The rate [Hz] a run of ``rate`` [Hz] is decimated to: ``preprocessing.sample_rate``, by default
+    ``DEFAULT_SAMPLE_RATE``, never above the run's own."""
+    return min(DEFAULT_SAMPLE_RATE if cfg.sample_rate is None else cfg.sample_rate, rate)
 
 
 def preprocess(run: Run, cfg: PreprocessingConfig, cutoff: float) -> Samples:
@@ -168,13 +176,13 @@ def preprocess(run: Run, cfg: PreprocessingConfig, cutoff: float) -> Samples:
     rate = run_rate(run)
     grid = uniform_grid(run)
     q, qd, qdd = (resample(run, x, grid) for x in (run.q, run.qd, run.qdd))
-    if cfg.sample_rate > 1.01 * rate:
+    if cfg.sample_rate is not None and cfg.sample_rate > 1.01 * rate:
         raise ExciteError(
             "preprocessing.sample_rate",
             f"{cfg.sample_rate:g} Hz is above the {rate:.4g} Hz of {run.name}; "
             "resampling cannot add information (use at most the data's rate)",
         )
-    target = min(cfg.sample_rate, rate)
+    target = target_rate(cfg, rate)
     if cutoff >= 0.5 * target:
         raise ExciteError(
             "preprocessing.cutoff",
