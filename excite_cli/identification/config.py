@@ -64,11 +64,13 @@ class RunConfig(Section):
 
 
 class DataConfig(Section):
-    """Measured runs, their columns, angle unit, torque constants [Nm/A], signs, validation blocks,
-    what to do with rows that cannot be used (stop with an error, or drop and count them)."""
+    """Measured runs, their columns (for ROS bags: the JointState ``topic``, joints by name), angle
+    unit, torque constants [Nm/A], signs, validation blocks, what to do with rows that cannot be used
+    (stop with an error, or drop and count them)."""
 
     runs: list[RunConfig] = Field(min_length=1)
-    columns: ColumnsConfig
+    columns: Optional[ColumnsConfig] = None
+    topic: str = "/joint_states"
     angle_unit: Literal["rad", "deg"] = "rad"
     torque_constants: Optional[list[float]] = None
     signs: Optional[list[float]] = None

@@ -11,7 +11,8 @@ from typing import Optional
 import numpy as np
 
 from excite_cli.errors import ExciteError, FileNotFound
-from excite_cli.identification.config import DataConfig, IdentifyProblem, RunConfig
+from excite_cli.identification.bags import bag_columns, is_bag, read_bag
+from excite_cli.identification.config import ColumnsConfig, DataConfig, IdentifyProblem, RunConfig
 from excite_cli.identification.files import Table, read_table
 
 
@@ -76,7 +77,7 @@ def _usable(time: np.ndarray, signals: dict[str, np.ndarray]) -> tuple[np.ndarra
 
 def load_run(run: RunConfig, data: DataConfig, problem: IdentifyProblem, n: int) -> Run:
     """Read, convert and validate one run (CSV with or without header, NPZ, MAT or HDF5, see
-    :mod:`excite_cli.identification.files`).
+    :mod:`excite_cli.identification.files`; a ROS bag, see :mod:`excite_cli.identification.bags`).
 
     Args:
         run: the run's entry of ``data.runs``.
@@ -90,11 +91,21 @@ def load_run(run: RunConfig, data: DataConfig, problem: IdentifyProblem, n: int)
             a crop that leaves nothing.
     """
     path = problem.resolve(run.file)
-    if not path.is_file():
+    if not path.exists():
         raise FileNotFound("data.runs", path)
     drop = data.bad_rows == "drop"
-    table = read_table(path, drop)
-    cols = data.columns
+    joints = problem.robot.active_joints
+    if is_bag(path):
+        table = read_bag(path, data.topic, joints)
+        cols = data.columns or ColumnsConfig(**bag_columns(joints, table))
+    elif path.is_dir():
+        raise ExciteError("data.runs", f"{path} is a folder, not a data file or a ROS 2 bag", path)
+    elif data.columns is None:
+        raise ExciteError(
+            "data.columns", f"is required for {path.name} (only a ROS bag's columns follow the joint names)"
+        )
+    else:
+        table, cols = read_table(path, drop), data.columns
     time = table.column(cols.time, "time", path)
     q = _matrix(table, cols.q, "q", path, n)
     qd = _matrix(table, cols.qd, "qd", path, n) if cols.qd else None

@@ -1,0 +1,105 @@
+"""ROS bags as labs record them, read with the ``rosbags`` library (no ROS installation): a ROS 1
+``.bag``, or a ROS 2 bag (its folder, or its ``.db3`` SQLite3 or ``.mcap`` file). The
+``sensor_msgs/JointState`` messages of one topic become a :class:`~excite_cli.identification.files.Table`
+with the columns ``time`` (the header stamp [s]; the recording time where the stamp is 0) and, per
+joint, ``position/<joint>``, ``velocity/<joint>``, ``effort/<joint>`` (those the messages fill).
+
+Joints are matched by name, so the order of ``name`` in the messages does not matter; messages that
+do not carry every wanted joint (another publisher on the same topic, e.g. a gripper) are skipped.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+from rosbags.highlevel import AnyReader, AnyReaderError
+from rosbags.typesys import Stores, get_typestore
+
+from excite_cli.errors import ExciteError
+from excite_cli.identification.files import Table
+
+BAG_SUFFIXES = (".bag", ".db3", ".mcap")
+FIELDS = ("position", "velocity", "effort")
+
+
+def is_bag(path: Path) -> bool:
+    """Whether ``path`` is a ROS bag: a ``.bag``, ``.db3`` or ``.mcap`` file, or a ROS 2 bag folder."""
+    return path.suffix.lower() in BAG_SUFFIXES or (path.is_dir() and (path / "metadata.yaml").is_file())
+
+
+def _bag_paths(path: Path) -> list[Path]:
+    """What ``AnyReader`` opens: a ROS 1 file, or the folder of a ROS 2 bag."""
+    if path.suffix.lower() in (".db3", ".mcap") and (path.parent / "metadata.yaml").is_file():
+        return [path.parent]
+    return [path]
+
+
+def _rows(reader: AnyReader, connections: list, joints: Sequence[str]) -> tuple[list[np.ndarray], int]:
+    """(1 + 3n,) rows [time, position, velocity, effort] of the messages carrying every joint (NaN
+    where a message leaves a field empty), and the number of messages skipped."""
+    rows, skipped, n = [], 0, len(joints)
+    for connection, recorded_ns, raw in reader.messages(connections=connections):
+        message = reader.deserialize(raw, connection.msgtype)
+        names = list(message.name)
+        if not set(joints) <= set(names):
+            skipped += 1
+            continue
+        order = [names.index(j) for j in joints]
+        stamp = message.header.stamp.sec + 1e-9 * message.header.stamp.nanosec
+        row = [stamp if stamp > 0 else 1e-9 * recorded_ns]
+        for name in FIELDS:
+            values = np.asarray(getattr(message, name), dtype=float)
+            row += list(values[order]) if values.size == len(names) else [np.nan] * n
+        rows.append(np.array(row))
+    return rows, skipped
+
+
+def read_bag(path: Path, topic: str, joints: Sequence[str]) -> Table:
+    """The JointState messages of ``topic`` in the bag at ``path`` (module docstring) as a Table.
+
+    Args:
+        topic: the ``sensor_msgs/JointState`` topic (``data.topic``).
+        joints: (n,) the active joints' names, as in the URDF.
+
+    Raises:
+        ExciteError: not a readable bag, no such topic or not JointState, no message with every joint.
+    """
+    try:
+        with AnyReader(_bag_paths(path), default_typestore=get_typestore(Stores.LATEST)) as reader:
+            connections = [c for c in reader.connections if c.topic == topic]
+            if not connections:
+                found = sorted({c.topic for c in reader.connections})
+                raise ExciteError("data.topic", f"{path.name} has no topic {topic} (it has: {', '.join(found)})", topic)
+            kinds = {c.msgtype for c in connections}
+            if any(not k.endswith("JointState") for k in kinds):
+                raise ExciteError(
+                    "data.topic",
+                    f"{topic} in {path.name} carries {', '.join(sorted(kinds))}",
+                    topic,
+                    "sensor_msgs/JointState messages",
+                )
+            rows, skipped = _rows(reader, connections, joints)
+    except (AnyReaderError, OSError, KeyError, ValueError) as exc:
+        raise ExciteError("data", f"cannot read {path.name} as a ROS bag: {' '.join(str(exc).split())[:160]}") from None
+    if not rows:
+        raise ExciteError(
+            "data.runs",
+            f"no message on {topic} in {path.name} carries every active joint "
+            f"({', '.join(joints)}; {skipped} message(s) without some)",
+            path,
+        )
+    values = np.vstack(rows)
+    names = ["time"] + [f"{field}/{joint}" for field in FIELDS for joint in joints]
+    filled = [k for k in range(len(names)) if not np.all(np.isnan(values[:, k]))]
+    return Table([names[k] for k in filled], values[:, filled], 0, np.arange(1, values.shape[0] + 1))
+
+
+def bag_columns(joints: Sequence[str], table: Table) -> dict[str, list[str]]:
+    """The columns of a bag's Table by joint name: q from position, q̇ from velocity (if every joint
+    has it), τ from effort (the ``data.columns`` a bag needs no one to write)."""
+    columns = {"q": [f"position/{j}" for j in joints], "tau": [f"effort/{j}" for j in joints]}
+    if all(f"velocity/{j}" in table.names for j in joints):
+        columns["qd"] = [f"velocity/{j}" for j in joints]
+    return columns

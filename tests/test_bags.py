@@ -1,0 +1,133 @@
+"""ROS bags identify with no conversion: bags written here with rosbags' own writers (ROS 2 SQLite3
+and MCAP, ROS 1) from a simulated run read back to the same samples as its CSV, joints matched by
+name whatever their order in the messages, and a bag identifies the simulated friction."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from conftest import write_config
+from rosbags.rosbag1 import Writer as Ros1Writer
+from rosbags.rosbag2 import StoragePlugin
+from rosbags.rosbag2 import Writer as Ros2Writer
+from rosbags.typesys import Stores, get_typestore
+from typer.testing import CliRunner
+
+from excite_cli.cli import app
+from excite_cli.config import load_problem
+from excite_cli.errors import ExciteError
+from excite_cli.identification.config import IdentifyProblem, SimulationConfig
+from excite_cli.identification.measurements import load_run
+from excite_cli.identification.pipeline import effect_values, run_identification
+from excite_cli.workflows.simulate import simulate_runs
+
+JOINTS = [f"panda_joint{k}" for k in range(1, 8)]
+MSGTYPE = "sensor_msgs/msg/JointState"
+T0 = 1_700_000_000  # Unix time [s] of the first sample
+
+
+def _messages(table: np.ndarray, store: Stores, seq: bool):
+    """(timestamp [ns], message) per row, joints in reversed order, and a gripper's message between."""
+    types = get_typestore(store).types
+    Time, Header, JointState = (types[t] for t in ("builtin_interfaces/msg/Time", "std_msgs/msg/Header", MSGTYPE))
+    order = list(range(7))[::-1]
+    for k, row in enumerate(table):
+        ns = T0 * 10**9 + int(round(row[0] * 1e9))
+        header = Header(**({"seq": k} if seq else {}), stamp=Time(sec=ns // 10**9, nanosec=ns % 10**9), frame_id="")
+        q, tau = row[1:8], row[8:15]
+        yield (
+            ns,
+            JointState(
+                header=header,
+                name=[JOINTS[j] for j in order],
+                position=q[order],
+                velocity=np.zeros(0),
+                effort=tau[order],
+            ),
+        )
+        if k % 50 == 0:  # another publisher on the same topic
+            yield (
+                ns,
+                JointState(
+                    header=header,
+                    name=["panda_finger_joint1"],
+                    position=np.zeros(1),
+                    velocity=np.zeros(1),
+                    effort=np.zeros(1),
+                ),
+            )
+
+
+def write_bag(path: Path, table: np.ndarray, kind: str) -> Path:
+    """A bag of ``table`` (time, q (7), τ (7)) on /joint_states: ``ros2`` (SQLite3), ``mcap`` or ``ros1``."""
+    if kind == "ros1":
+        store = get_typestore(Stores.ROS1_NOETIC)
+        with Ros1Writer(path) as writer:
+            connection = writer.add_connection("/joint_states", MSGTYPE, typestore=store)
+            for ns, message in _messages(table, Stores.ROS1_NOETIC, seq=True):
+                writer.write(connection, ns, store.serialize_ros1(message, MSGTYPE))
+        return path
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    plugin = StoragePlugin.MCAP if kind == "mcap" else StoragePlugin.SQLITE3
+    with Ros2Writer(path, version=9, storage_plugin=plugin) as writer:
+        connection = writer.add_connection("/joint_states", MSGTYPE, typestore=store)
+        for ns, message in _messages(table, Stores.ROS2_HUMBLE, seq=False):
+            writer.write(connection, ns, store.serialize_cdr(message, MSGTYPE))
+    return path
+
+
+@pytest.fixture(scope="module")
+def simulated(tmp_path_factory):
+    """One simulated Panda run with Coulomb friction 0.4 Nm on every joint (CSV), from the smoke problem."""
+    tmp = tmp_path_factory.mktemp("bags")
+    data = yaml.safe_load((Path(__file__).resolve().parent.parent / "configs" / "smoke.yaml").read_text())
+    data.update(sequence={"iterations": 1}, output=str(tmp / "panda.h5"))
+    result = CliRunner().invoke(app, ["optimize", str(write_config(tmp, data))])
+    assert result.exit_code == 0, result.output
+    sim = SimulationConfig(sample_rate=250, periods=8, torque_noise=0.05, seed=3, effects={"coulomb": {"*": 0.4}})
+    simulate_runs(tmp / "panda.h5", sim, tmp)
+    return tmp, np.loadtxt(tmp / "run_1.csv", delimiter=",", skiprows=1)
+
+
+def _config(tmp: Path, run: str, extra: dict | None = None) -> IdentifyProblem:
+    config = {
+        "robot": {"urdf": "panda_description/urdf/panda.urdf", "source": "example-robot-data", "active_joints": JOINTS},
+        "data": {"runs": [{"file": run, "role": "blocks"}], **(extra or {})},
+        "identification": {"candidates": ["coulomb"]},
+        "output": str(tmp / "ident.h5"),
+    }
+    return load_problem(write_config(tmp, config, "identify.yaml"), IdentifyProblem)
+
+
+@pytest.mark.parametrize("kind, name", [("ros2", "sqlite_bag"), ("mcap", "mcap_bag"), ("ros1", "run.bag")])
+def test_a_bag_reads_to_the_samples_of_its_csv(simulated, kind, name):
+    tmp, table = simulated
+    write_bag(tmp / name, table, kind)
+    problem = _config(tmp, name)
+    run = load_run(problem.data.runs[0], problem.data, problem, 7)
+    np.testing.assert_allclose(run.time - T0, table[:, 0], atol=2e-6)
+    np.testing.assert_allclose(run.q, table[:, 1:8], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(run.tau, table[:, 8:15], rtol=0, atol=1e-12)
+    assert run.qd is None  # the messages leave velocity empty
+
+
+def test_a_bag_identifies_the_simulated_friction(simulated):
+    tmp, table = simulated
+    bag = write_bag(tmp / "identify_bag", table, "mcap")
+    report = run_identification(_config(tmp, next(bag.glob("*.mcap")).relative_to(tmp).as_posix()))[0]
+    found = {report.joints[t.joint]: v for t, _, v, _ in effect_values(report) if t.effect == "coulomb"}
+    assert set(found) == set(JOINTS) and all(abs(v - 0.4) < 0.06 for v in found.values())
+
+
+def test_a_bag_without_the_topic_or_a_file_without_columns_is_named(simulated):
+    tmp, table = simulated
+    write_bag(tmp / "topic.bag", table[:50], "ros1")
+    problem = _config(tmp, "topic.bag", {"topic": "/robot/joint_states"})
+    with pytest.raises(ExciteError) as caught:
+        load_run(problem.data.runs[0], problem.data, problem, 7)
+    assert caught.value.field == "data.topic" and "/joint_states" in caught.value.problem
+    problem = _config(tmp, "run_1.csv")
+    with pytest.raises(ExciteError) as caught:
+        load_run(problem.data.runs[0], problem.data, problem, 7)
+    assert caught.value.field == "data.columns"
