@@ -1,4 +1,4 @@
-"""Blocked cross-validation against explicit refits, and the stepwise effect search on a small
+"""Cross-validation (time blocks, whole runs) against explicit refits, and the stepwise effect search on a small
 synthetic model with known effects (two joints, a 3-parameter regressor, two runs)."""
 
 import numpy as np
@@ -63,7 +63,7 @@ def test_fold_errors_equal_explicit_weighted_refits():
     terms = [Term("coulomb", 0), Term("offset", 1)]
     data = dataset({Term("coulomb", 0): 0.5}, cfg)
     weights = np.array([2.0, 0.5])
-    cv = CrossValidation(data, terms, weights, folds=5, margin=0.05)
+    cv = CrossValidation(data, terms, weights, folds=5, margin=0.05, by_run=False)
     fold, margins = fold_assignment(data.time, data.run, 5, 0.05)
     A = np.hstack([data.regressor] + [data.block(t) for t in terms])
     w = weights[data.joint]
@@ -126,3 +126,42 @@ def test_a_declared_shape_effect_moves_along_its_grid_and_stays():
     search = _Search(None, [Term("held", 1, v) for v in cfg.held_velocity], [Term("held", 1, 0.05)], cfg)
     moves = search.moves([Term("held", 1, 0.2)])
     assert {m for m, _, _ in moves} == {"shape"}
+
+
+@pytest.mark.parametrize("fitted_offsets", [False, True])
+def test_run_folds_equal_explicit_leave_one_run_out_refits(fitted_offsets):
+    """The held-out run's offset: the training run's (the mean of one), or fitted to the held-out run."""
+    cfg = IdentificationConfig(candidates=["coulomb", "offset"])
+    terms = [Term("coulomb", 0), Term("offset", 1)]
+    data = dataset({Term("coulomb", 0): 0.5, Term("offset", 1): np.array([0.3, -0.2])}, cfg)
+    cv = CrossValidation(data, terms, None, folds=5, margin=0.05, fitted_offsets=fitted_offsets)
+    assert cv.by_run and cv.folds == 2
+    A = np.hstack([data.regressor] + [data.block(t) for t in terms])
+    expected = np.zeros((2, 2))
+    for k in range(2):
+        train, held = np.repeat(data.run != k, 2), np.repeat(data.run == k, 2)
+        x = np.linalg.lstsq(A[train], data.tau[train], rcond=None)[0]
+        own, other = B + 1 + k, B + 2 - k  # the offset columns of run k and of the training run
+        x[own] = x[other]
+        if fitted_offsets:  # the least-squares constant of joint 1's held-out residual
+            x[own] = 0.0
+            x[own] = (data.tau - A @ x)[held].reshape(-1, 2)[:, 1].mean()
+        expected[k] = ((data.tau - A @ x)[held].reshape(-1, 2) ** 2).sum(axis=0)
+    np.testing.assert_allclose(cv.fold_sse(terms), expected, rtol=1e-8)
+
+
+def test_an_effect_of_one_run_only_is_dropped_by_run_folds_and_kept_by_time_blocks():
+    """Viscous friction on joint 1 in run 0 only (a pattern of one run) and Coulomb friction on
+    joint 0 in both: time blocks inside the runs reward the one-run pattern, whole runs do not."""
+    cfg = IdentificationConfig(candidates=["coulomb", "viscous"])
+    data = dataset({Term("coulomb", 0): 0.5}, cfg)
+    one_run = np.repeat(data.run == 0, 2) & (np.tile([0, 1], data.time.size) == 1)
+    tau = data.tau + one_run * np.repeat(data.blocks[Term("viscous", 1)][:, 0], 2) * 0.4
+    data = Dataset(data.regressor, tau, data.time, data.run, data.blocks)
+    keys = candidate_terms(cfg, 2)
+    true, spurious = [Term("coulomb", 0)], [Term("coulomb", 0), Term("viscous", 1)]
+    blocks = CrossValidation(data, keys, None, folds=5, margin=0.05, by_run=False)
+    runs = CrossValidation(data, keys, None, folds=5, margin=0.05)
+    assert blocks.error(spurious)[0] < blocks.error(true)[0]
+    assert runs.error(spurious)[0] > runs.error(true)[0]
+    assert set(select_effects(data, cfg, [], margin=0.05).terms) == set(true)

@@ -63,7 +63,8 @@ def identification(report: Report) -> list[Table | str]:
         "What each effect bought: mean relative error after each step",
         ("step", "cross-validated [%]", "validation [%]"),
         [(label, f"{cv:.2f}", f"{val:.2f}") for label, cv, val in report.ladder],
-        f"cross-validated: {sel.folds} blocked folds of the fit data (what the selection minimizes); "
+        f"cross-validated: {sel.folds} folds of the fit data by {'run' if sel.by_run else 'time block'} "
+        "(what the selection minimizes); "
         "validation: data it never saw",
     )
     order = {t: k + 1 for k, t in enumerate(sel.terms)}

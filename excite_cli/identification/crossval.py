@@ -1,6 +1,15 @@
-"""Blocked cross-validation of a model on the fit data, through normal equations per fold.
+"""Cross-validation of a model on the fit data, through normal equations per fold.
 
-The fit instants of every run are cut into K contiguous time blocks; fold k holds out the k-th block
+**Whole runs** when the fit data hold two or more runs: fold k holds out run k (leave one run out),
+so the error estimates how a model fitted on some runs holds on another, with its own motion range,
+load and temperature, which is what the report's validation run asks. A run's offset is its own,
+and the held-out run's is what the report would use on it: with ``fitted_offsets`` (every
+validation run is also fitted, so the report knows its offset) it is fitted to the held-out run, one
+constant per joint; otherwise the mean of the training runs' offsets, as a run the fit never saw gets
+in the report (:func:`~excite_cli.identification.dataset.run_offset_columns`).
+
+**Time blocks** for a single fit run: its fit instants are cut into K contiguous time blocks; fold k
+holds out the k-th block
 of every run at once (for runs cropped from the same periodic excitation, the same phase of the
 period). Filtered samples are correlated over about one period of the cut-off, so the instants
 within ``margin`` seconds of a held-out block are left out of that fold's fit: correlated samples
@@ -20,23 +29,27 @@ from __future__ import annotations
 import numpy as np
 
 from excite_cli.identification.dataset import Dataset
-from excite_cli.identification.effects import Term
+from excite_cli.identification.effects import PER_RUN, Term
 from excite_cli.identification.normal import NormalEquations, solve
 
 
 def fold_assignment(
-    time: np.ndarray, run: np.ndarray, folds: int, margin: float
+    time: np.ndarray, run: np.ndarray, folds: int, margin: float, by_run: bool = False
 ) -> tuple[np.ndarray, list[np.ndarray]]:
-    """Blocked folds of the fit instants.
+    """Folds of the fit instants (module docstring).
 
     Args:
         time: (N,) [s] and run: (N,) run index of each instant, each run's instants in time order.
-        folds: K.
+        folds: K (time blocks).
         margin: [s] instants this close to a held-out block (same run) are left out of its fit.
+        by_run: one fold per run (in the order of the run indices), no margins, instead of time blocks.
 
     Returns:
         (N,) fold of each instant, and per fold a (N,) mask of its margin instants.
     """
+    if by_run:
+        runs = np.unique(run)
+        return np.searchsorted(runs, run), [np.zeros(time.size, dtype=bool) for _ in runs]
     fold = np.empty(time.size, dtype=int)
     margins = [np.zeros(time.size, dtype=bool) for _ in range(folds)]
     for r in np.unique(run):
@@ -53,7 +66,8 @@ def fold_assignment(
 
 
 class CrossValidation:
-    """K-fold blocked cross-validation (module docstring) of models built from ``keys``.
+    """K-fold cross-validation (module docstring) of models built from ``keys``: whole runs when the
+    fit data hold two or more, else time blocks.
 
     Every fold's per-joint normal equations are placed once in the unknowns of the largest model
     [Y_B, all ``keys``]; a model's systems are then selections of their rows and columns.
@@ -62,18 +76,36 @@ class CrossValidation:
         data: the fit data.
         keys: every term a model may contain.
         weights: (n,) the joints' weights (WLS) or None (LS), fixed for every model.
-        folds: K (≥ 2).
+        folds: K (≥ 2) of time blocks (a single fit run).
         margin: [s] left out around each held-out block (about one period of the cut-off).
+        by_run: hold out whole runs (default: when the fit data hold two or more runs).
+        fitted_offsets: in run folds, fit the held-out run's offsets to it instead of giving it the mean
+            of the training runs' (module docstring).
+
+    Attributes:
+        by_run: whether the folds are whole runs; folds: their number.
     """
 
-    def __init__(self, data: Dataset, keys: list[Term], weights: np.ndarray | None, folds: int, margin: float):
-        fold, margins = fold_assignment(data.time, data.run, folds, margin)
+    def __init__(
+        self,
+        data: Dataset,
+        keys: list[Term],
+        weights: np.ndarray | None,
+        folds: int,
+        margin: float,
+        by_run: bool | None = None,
+        fitted_offsets: bool = False,
+    ):
+        self.fitted_offsets = fitted_offsets
+        self.by_run = bool(np.unique(data.run).size >= 2) if by_run is None else by_run
+        fold, margins = fold_assignment(data.time, data.run, folds, margin, self.by_run)
+        self.folds = len(margins)
         self.b, self.n, self.instants = data.regressor.shape[1], data.n, data.time.size
         sizes = [data.blocks[key].shape[1] for key in keys]
         starts = self.b + np.concatenate([[0], np.cumsum(sizes)]).astype(int)
         self.place = {key: np.arange(starts[k], starts[k + 1]) for k, key in enumerate(keys)}
         w2 = np.ones(self.n) if weights is None else np.asarray(weights, dtype=float) ** 2
-        held = [NormalEquations(data, keys, np.flatnonzero(fold == k)).stacked(keys) for k in range(folds)]
+        held = [NormalEquations(data, keys, np.flatnonzero(fold == k)).stacked(keys) for k in range(self.folds)]
         margin_parts = [NormalEquations(data, keys, np.flatnonzero(m)).stacked(keys) for m in margins]
         weighted = [(np.einsum("j,jab->ab", w2, G), w2 @ c) for G, c, _ in held]
         total_G, total_c = sum(G for G, _ in weighted), sum(c for _, c in weighted)
@@ -89,15 +121,35 @@ class CrossValidation:
         """Indices of the model [Y_B, ``terms``]'s unknowns among the largest model's."""
         return np.concatenate([np.arange(self.b)] + [self.place[t] for t in terms])
 
+    def _offset_positions(self, terms: list[Term]) -> list[tuple[int, np.ndarray]]:
+        """(joint, positions among the model [Y_B, ``terms``]'s unknowns of its per-run columns) of
+        each offset term."""
+        out, start = [], self.b
+        for t in terms:
+            size = self.place[t].size
+            if t.effect in PER_RUN and size == self.folds:
+                out.append((t.joint, np.arange(start, start + size)))
+            start += size
+        return out
+
     def fold_sse(self, terms: list[Term]) -> np.ndarray:
         """(K, n) held-out residual sum of squares [Nm²] per fold and joint of the model [Y_B,
         ``terms``] fitted on the other folds minus the margin."""
         idx = self.unknowns(terms)
+        offsets = self._offset_positions(terms) if self.by_run else []
         out = np.zeros((len(self.held), self.n))
         for k, ((G, c), (Gj, cj, sj)) in enumerate(zip(self.train, self.held)):
             x = solve(G[np.ix_(idx, idx)], c[idx])
-            quadratic = np.einsum("a,jab,b->j", x, Gj[:, idx][:, :, idx], x)
-            out[k] = np.maximum(sj - 2.0 * cj[:, idx] @ x + quadratic, 0.0)
+            held_G, held_c = Gj[:, idx][:, :, idx], cj[:, idx]
+            for j, columns in offsets:  # the held-out run's offset (module docstring)
+                p = columns[k]
+                x[p] = 0.0
+                if not self.fitted_offsets:
+                    x[p] = np.delete(x[columns], k).mean()
+                elif held_G[j, p, p] > 0.0:
+                    x[p] = (held_c[j, p] - held_G[j, p] @ x) / held_G[j, p, p]
+            quadratic = np.einsum("a,jab,b->j", x, held_G, x)
+            out[k] = np.maximum(sj - 2.0 * held_c @ x + quadratic, 0.0)
         return out
 
     def error(self, terms: list[Term]) -> tuple[float, np.ndarray]:

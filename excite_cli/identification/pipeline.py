@@ -147,7 +147,12 @@ def run_identification(problem: IdentifyProblem) -> tuple[Report, Robot, BasePar
     )
     fit_data, val_data = data.fit, data.validation
     selection = select_effects(
-        fit_data, cfg, declared, margin=1.0 / data.cutoff, oversampling=max(1.0, data.rate / (2.0 * data.cutoff))
+        fit_data,
+        cfg,
+        declared,
+        margin=1.0 / data.cutoff,
+        oversampling=max(1.0, data.rate / (2.0 * data.cutoff)),
+        fitted_offsets=set(np.unique(val_data.run).tolist()) <= set(data.fitted),
     )
     before = predict(val_data, selection.rigid.x, [])
     after = predict(val_data, selection.fit.x, selection.terms)

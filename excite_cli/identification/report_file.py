@@ -58,6 +58,7 @@ def write_identification(
         g.attrs["fit_samples"], g.attrs["validation_samples"] = report.fit_samples, report.validation_samples
         g.attrs["dropped_rows"] = "; ".join(f"{name}: {rows}" for name, rows in report.dropped) or "none"
         g.attrs["folds"], g.attrs["min_improvement"] = sel.folds, sel.min_improvement
+        g.attrs["folds_by"] = "run" if sel.by_run else "time block"
         g.attrs["coulomb_velocity_rad_s"] = problem.identification.coulomb_velocity
         g.attrs["cv_error_rigid"], g.attrs["cv_error"] = sel.cv_rigid, sel.cv_error
         g.attrs["stop_reason"] = sel.searches[sel.chosen].stop

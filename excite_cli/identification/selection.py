@@ -108,7 +108,8 @@ class Selection:
         cv_joint: (n,) the chosen model's CV error per joint [%].
         searches: the search from every start; ``chosen`` indexes the one kept.
         absorbed: candidates skipped as not separately identifiable.
-        folds: K of the cross-validation; min_improvement: the price of an effect (a fraction).
+        folds: K of the cross-validation; by_run: its folds are whole runs (else time blocks).
+        min_improvement: the price of an effect (a fraction).
         normal: the fit data's normal equations (every candidate), for refitting other models.
     """
 
@@ -124,6 +125,7 @@ class Selection:
     chosen: int
     absorbed: list[Term]
     folds: int
+    by_run: bool
     min_improvement: float
     normal: NormalEquations
 
@@ -214,7 +216,12 @@ class _Search:
 
 
 def select_effects(
-    fit_data: Dataset, cfg: IdentificationConfig, declared: list[Term], margin: float, oversampling: float = 1.0
+    fit_data: Dataset,
+    cfg: IdentificationConfig,
+    declared: list[Term],
+    margin: float,
+    oversampling: float = 1.0,
+    fitted_offsets: bool = False,
 ) -> Selection:
     """The stepwise search of the module docstring on the fit data.
 
@@ -225,6 +232,8 @@ def select_effects(
         margin: [s] left out of a fold's fit around its held-out block (correlated samples).
         oversampling: samples per independent sample r (≥ 1) of the filtered data, for the
             standard deviations.
+        fitted_offsets: every validation run is fitted too, so its offsets are known (run folds fit
+            the held-out run's offsets; :class:`CrossValidation`).
     """
     n = fit_data.n
     candidates = [t for t in candidate_terms(cfg, n) if t not in declared and t in fit_data.blocks]
@@ -233,7 +242,7 @@ def select_effects(
     model = total.system(weights, declared)[0].shape[0]
     absorbed = [t for t in candidates if outside_fraction(total.system(weights, declared + [t])[0], model) < ABSORBED]
     candidates = [t for t in candidates if t not in absorbed]
-    cv = CrossValidation(fit_data, declared + candidates, weights, cfg.folds, margin)
+    cv = CrossValidation(fit_data, declared + candidates, weights, cfg.folds, margin, fitted_offsets=fitted_offsets)
     search = _Search(cv, candidates, declared, cfg)
     searches, seen = [], []
     for name, effects in STARTS.items():
@@ -256,7 +265,8 @@ def select_effects(
         searches=searches,
         chosen=chosen,
         absorbed=absorbed,
-        folds=cfg.folds,
+        folds=cv.folds,
+        by_run=cv.by_run,
         min_improvement=cfg.min_improvement,
         normal=total,
     )

@@ -84,7 +84,12 @@ def plot_ladder(path: Path, report: Report) -> Path:
     x = np.arange(len(labels))
     top.bar(x, val, color=["0.55"] + ["C0"] * (len(labels) - 1), label="validation (never seen by fit or selection)")
     top.plot(
-        x, cv, "o-", color="C3", markersize=4, label=f"cross-validated ({sel.folds} blocked folds of the fit data)"
+        x,
+        cv,
+        "o-",
+        color="C3",
+        markersize=4,
+        label=f"cross-validated ({sel.folds} folds of the fit data by {'run' if sel.by_run else 'time block'})",
     )
     top.set_xticks(x, labels, rotation=60, ha="right", fontsize=7)
     top.set_ylabel("mean relative error [%]")
