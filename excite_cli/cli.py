@@ -170,27 +170,25 @@ def verify_gradient(
 def identify(
     config: Path = typer.Argument(..., help="Identification YAML: robot, data, preprocessing, identification."),
     output: Optional[Path] = typer.Option(None, "--output", "-o", help="HDF5 report (overrides config 'output')."),
-    physical_consistency: bool = typer.Option(
-        False, "--physical-consistency", help="Also fit physically consistent parameters."
+    fit: Optional[str] = typer.Option(
+        None,
+        "--fit",
+        help="auto (the one the cross-validation prefers), least_squares or consistent (overrides config).",
     ),
     urdf_out: Optional[Path] = typer.Option(
-        None, "--urdf-out", help="Write the identified URDF (implies --physical-consistency)."
+        None, "--urdf-out", help="Write the identified URDF (of the physically consistent fit)."
     ),
     force: bool = FORCE,
 ) -> None:
     """Identify base parameters (Eq. 4), trace the residual to missing effects, report the error before/after."""
-    problem = with_overrides(
-        load_problem(config, IdentifyProblem), {"identification.physical_consistency": physical_consistency or None}
-    )
+    problem = with_overrides(load_problem(config, IdentifyProblem), {"identification.fit": fit})
     with err.status("preprocessing, fitting and selecting effects ..."):
         run = run_identify(problem, output or Path(problem.output), urdf_out, force)
     _say(identify_tables.preprocessing_notes(run.report), console=err)
     _say(
         identify_tables.identification(run.report),
         [identify_tables.bodies(run.report, run.robot)] if run.report.consistent else [],
-        [f"wrote {urdf_out}: its RNEA matches the identified rigid-body torques to {run.urdf_deviation:.1e} Nm"]
-        if urdf_out
-        else [],
+        [identify_tables.urdf_written(run.report, urdf_out, run.urdf_deviation)] if urdf_out else [],
         f"wrote {run.target} and {', '.join(str(p) for p in run.plots)}",
     )
 

@@ -63,7 +63,7 @@ def test_fold_errors_equal_explicit_weighted_refits():
     terms = [Term("coulomb", 0), Term("offset", 1)]
     data = dataset({Term("coulomb", 0): 0.5}, cfg)
     weights = np.array([2.0, 0.5])
-    cv = CrossValidation(data, terms, weights, folds=5, margin=0.05, by_run=False)
+    cv = CrossValidation(data, terms, weights, folds=5, margin=0.05)
     fold, margins = fold_assignment(data.time, data.run, 5, 0.05)
     A = np.hstack([data.regressor] + [data.block(t) for t in terms])
     w = weights[data.joint]
@@ -134,8 +134,10 @@ def test_run_folds_equal_explicit_leave_one_run_out_refits(fitted_offsets):
     cfg = IdentificationConfig(candidates=["coulomb", "offset"])
     terms = [Term("coulomb", 0), Term("offset", 1)]
     data = dataset({Term("coulomb", 0): 0.5, Term("offset", 1): np.array([0.3, -0.2])}, cfg)
-    cv = CrossValidation(data, terms, None, folds=5, margin=0.05, fitted_offsets=fitted_offsets)
-    assert cv.by_run and cv.folds == 2
+    cv = CrossValidation(
+        data, terms, None, folds=5, margin=0.05, recordings=np.arange(2), fitted_offsets=fitted_offsets
+    )
+    assert cv.by_recording and cv.folds == 2
     A = np.hstack([data.regressor] + [data.block(t) for t in terms])
     expected = np.zeros((2, 2))
     for k in range(2):
@@ -160,8 +162,8 @@ def test_an_effect_of_one_run_only_is_dropped_by_run_folds_and_kept_by_time_bloc
     data = Dataset(data.regressor, tau, data.time, data.run, data.blocks)
     keys = candidate_terms(cfg, 2)
     true, spurious = [Term("coulomb", 0)], [Term("coulomb", 0), Term("viscous", 1)]
-    blocks = CrossValidation(data, keys, None, folds=5, margin=0.05, by_run=False)
-    runs = CrossValidation(data, keys, None, folds=5, margin=0.05)
+    blocks = CrossValidation(data, keys, None, folds=5, margin=0.05)
+    runs = CrossValidation(data, keys, None, folds=5, margin=0.05, recordings=np.arange(2))
     assert blocks.error(spurious)[0] < blocks.error(true)[0]
     assert runs.error(spurious)[0] > runs.error(true)[0]
-    assert set(select_effects(data, cfg, [], margin=0.05).terms) == set(true)
+    assert set(select_effects(data, cfg, [], margin=0.05, recordings=np.arange(2)).terms) == set(true)

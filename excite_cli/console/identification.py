@@ -35,15 +35,20 @@ def preprocessing_notes(report: Report) -> list[str]:
 
 
 def identification(report: Report) -> list[Table | str]:
-    """The before/after error table, the ladder, the selection's steps, the chosen effects, what was
-    absorbed, the base parameters."""
-    consistent, sel = report.relative_consistent, report.selection
-    extra = consistent is not None
+    """The before/after error table, the fits compared, the ladder, the selection's steps, the chosen
+    effects, what was absorbed, the base parameters."""
+    choice = report.fit_choice
+    other_name, other = (
+        ("least squares", report.relative_least_squares)
+        if choice.is_consistent
+        else ("consistent", report.relative_consistent)
+    )
+    extra = other is not None
     errors = titled_table(
-        f"Validation torque error, rigid body only → with the chosen effects ({report.validation_samples} instants "
-        "that neither the fit nor the selection saw)",
+        f"Validation torque error, rigid body only → with the chosen effects, {choice.name} "
+        f"({report.validation_samples} instants that neither the fit nor the selection saw)",
         ("joint", "RMS τ [Nm]", "before [Nm]", "after [Nm]", "before [%]", "after [%]")
-        + (("consistent [%]",) if extra else ()),
+        + ((f"{other_name} [%]",) if extra else ()),
         [
             (
                 name,
@@ -52,25 +57,82 @@ def identification(report: Report) -> list[Table | str]:
                 f"{report.rms_after[j]:.3f}",
                 f"{report.relative_before[j]:.1f}",
                 f"{report.relative_after[j]:.1f}",
-                *((f"{consistent[j]:.1f}",) if extra else ()),
+                *((f"{other[j]:.1f}",) if extra else ()),
             )
             for j, name in enumerate(report.joints)
         ],
-        f"mean: before {report.relative_before.mean():.1f} %, after {report.relative_after.mean():.1f} %"
-        + (f", physically consistent {consistent.mean():.1f} %" if extra else ""),
+        f"mean: before {report.relative_before.mean():.1f} %, after {report.relative_after.mean():.1f} % "
+        f"({choice.name})" + (f", {other_name} {other.mean():.1f} %" if extra else ""),
     )
+    return [errors, *fits(report), *_selection_tables(report)]
+
+
+def urdf_written(report: Report, path, deviation: float) -> str:
+    """What ``--urdf-out`` wrote: its fit (always the physically consistent one) and how well its RNEA
+    reproduces the identified torques."""
+    choice, consistent = report.fit_choice, report.relative_consistent
+    note = (
+        ""
+        if choice.is_consistent
+        else f" (a URDF needs physical bodies: the reported model is {choice.name}, the URDF's validation error "
+        f"{consistent.mean():.1f} % against {report.relative_after.mean():.1f} %)"
+    )
+    return (
+        f"wrote {path} from the physically consistent fit{note}: its RNEA matches that fit's rigid-body "
+        f"torques to {deviation:.1e} Nm"
+    )
+
+
+def fits(report: Report) -> list[Table]:
+    """The candidate fits and their cross-validated errors, when there were several."""
+    choice = report.fit_choice
+    if len(choice.names) < 2:
+        return []
+    validation = {
+        "least squares": report.relative_least_squares.mean(),
+        "consistent": None if report.relative_consistent is None else report.relative_consistent.mean(),
+    }
+    best_consistent = min(
+        (k for k, lam in enumerate(choice.regularization) if not np.isnan(lam)), key=lambda k: choice.cv_error[k]
+    )
+    rows = []
+    for k, name in enumerate(choice.names):
+        kind = "least squares" if np.isnan(choice.regularization[k]) else "consistent"
+        shown = kind == "least squares" or k == best_consistent
+        rows.append(
+            (
+                name + (" (chosen)" if k == choice.chosen else ""),
+                f"{choice.cv_error[k]:.2f}",
+                f"{validation[kind]:.2f}" if shown and validation[kind] is not None else "",
+            )
+        )
+    return [
+        titled_table(
+            "Fits of the chosen model, scored on the selection's folds",
+            ("fit", "cross-validated [%]", "validation [%]"),
+            rows,
+            f"chosen: {choice.name}, {choice.lead:.2f} % points below the next (cross-validated)",
+        )
+    ]
+
+
+def _selection_tables(report: Report) -> list[Table | str]:
+    """The ladder, the search, the effects, what was absorbed, the base parameters."""
+    sel = report.selection
+    consistent = report.consistent
     ladder = titled_table(
         "What each effect bought: mean relative error after each step",
         ("step", "cross-validated [%]", "validation [%]"),
         [(label, f"{cv:.2f}", f"{val:.2f}") for label, cv, val in report.ladder],
-        f"cross-validated: {sel.folds} folds of the fit data by {'run' if sel.by_run else 'time block'} "
+        f"cross-validated: {sel.folds} folds of the fit data by {sel.folds_by} "
         "(what the selection minimizes); "
         "validation: data it never saw",
     )
     order = {t: k + 1 for k, t in enumerate(sel.terms)}
     effects = titled_table(
         "Effects, in the order they were added (declared ones first)",
-        ("#", "effect", "joint", "shape [rad/s]", "coefficient", "value", "std"),
+        ("#", "effect", "joint", "shape [rad/s]", "coefficient", "least squares", "std")
+        + (("consistent",) if consistent else ()),
         [
             (
                 str(order[t]),
@@ -80,14 +142,18 @@ def identification(report: Report) -> list[Table | str]:
                 f"{name} [{EFFECT_UNITS[COEFFICIENTS[t.effect][0]]}]",
                 f"{value:.5g}",
                 f"{std:.2g}",
+                *((f"{consistent.effects[k]:.5g}",) if consistent else ()),
             )
-            for t, name, value, std in effect_values(report)
+            for k, (t, name, value, std) in enumerate(effect_values(report))
         ],
     )
     params = titled_table(
         "Identified base parameters",
-        ("base parameter", "value", "std"),
-        [(name, f"{value:.5g}", f"{std:.2g}") for name, value, std in zip(report.base_names, sel.fit.x, sel.fit.std)],
+        ("base parameter", "least squares", "std") + (("consistent",) if consistent else ()),
+        [
+            (name, f"{value:.5g}", f"{std:.2g}", *((f"{consistent.base[k]:.5g}",) if consistent else ()))
+            for k, (name, value, std) in enumerate(zip(report.base_names, sel.fit.x, sel.fit.std))
+        ],
     )
     absorbed = (
         [
@@ -97,7 +163,7 @@ def identification(report: Report) -> list[Table | str]:
         if sel.absorbed
         else []
     )
-    return [errors, ladder, *search(report), effects, *absorbed, params]
+    return [ladder, *search(report), effects, *absorbed, params]
 
 
 def search(report: Report, runners_up: int = 2) -> list[Table | str]:

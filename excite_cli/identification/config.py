@@ -7,7 +7,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Literal, Optional, Union
 
-from pydantic import Field, NonNegativeInt, PositiveFloat, field_validator, model_validator
+from pydantic import Field, NonNegativeFloat, NonNegativeInt, PositiveFloat, field_validator, model_validator
 
 from excite_cli.config import Problem, RobotConfig, Section
 from excite_cli.identification.effects import EFFECT_NAMES, POSITION, SHAPE_GRID
@@ -16,6 +16,8 @@ Effect = Literal[EFFECT_NAMES]
 #: The default candidates: every effect but the position-dependent ones, which fitted the seen phases
 #: of the real Panda run and extrapolated badly to an unseen one (README), so they are opt-in.
 DEFAULT_CANDIDATES = tuple(e for e in EFFECT_NAMES if e not in POSITION)
+#: Default regularization weights λ of the consistent fit, among which the cross-validation chooses.
+REGULARIZATION = (1e-5, 1e-4, 1e-3, 1e-2, 1e-1)
 
 
 Column = Union[NonNegativeInt, str]
@@ -88,23 +90,26 @@ class PreprocessingConfig(Section):
 
 
 class IdentificationConfig(Section):
-    """LS or WLS, declared and candidate effects, the selection's cross-validation folds and threshold,
+    """LS or WLS, declared and candidate effects, the selection's cross-validation folds (what each holds
+    out, how many time blocks) and threshold,
     friction shape velocities [rad/s] (a Stribeck or held velocity: one value, or a grid the
-    selection searches), physically consistent standard parameters and their regularization."""
+    selection searches), the fit (least squares, physically consistent, or the one the cross-validation
+    prefers) and the consistent fit's regularization weights toward the URDF."""
 
     method: Literal["wls", "ls"] = "wls"
     declared_effects: dict[str, list[Effect]] = Field(default_factory=dict)
     candidates: list[Effect] = Field(default_factory=lambda: list(DEFAULT_CANDIDATES))
+    folds_by: Literal["auto", "recording", "run", "time_block"] = "auto"
     folds: int = Field(6, ge=3, le=50)
     min_improvement: float = Field(0.02, ge=0.0, lt=1.0)
     coulomb_velocity: PositiveFloat = 0.01
     stribeck_velocity: list[PositiveFloat] = Field(default_factory=lambda: list(SHAPE_GRID), min_length=1)
     held_velocity: list[PositiveFloat] = Field(default_factory=lambda: list(SHAPE_GRID), min_length=1)
     max_effects: int = Field(60, ge=0)
-    physical_consistency: bool = False
-    regularization: float = Field(1e-3, ge=0.0)
+    fit: Literal["auto", "least_squares", "consistent"] = "auto"
+    regularization: list[NonNegativeFloat] = Field(default_factory=lambda: list(REGULARIZATION), min_length=1)
 
-    @field_validator("stribeck_velocity", "held_velocity", mode="before")
+    @field_validator("stribeck_velocity", "held_velocity", "regularization", mode="before")
     @classmethod
     def _one_or_grid(cls, value):
         return [value] if isinstance(value, (int, float)) else value

@@ -1,15 +1,17 @@
 """Cross-validation of a model on the fit data, through normal equations per fold.
 
-**Whole runs** when the fit data hold two or more runs: fold k holds out run k (leave one run out),
-so the error estimates how a model fitted on some runs holds on another, with its own motion range,
-load and temperature, which is what the report's validation run asks. A run's offset is its own,
-and the held-out run's is what the report would use on it: with ``fitted_offsets`` (every
-validation run is also fitted, so the report knows its offset) it is fitted to the held-out run, one
-constant per joint; otherwise the mean of the training runs' offsets, as a run the fit never saw gets
-in the report (:func:`~excite_cli.identification.dataset.run_offset_columns`).
+**Whole recordings** when the fit data come from two or more recordings (files): fold k holds out
+recording k, every run cropped from it at once (leave one recording out), so the error estimates how
+a model fitted on some recordings holds on another, with its own motion, load and temperature, which
+is what a validation recording asks. Crops of one recording share all of that (for a periodic
+excitation even the phases they cover), so they are one fold. Each run's offset is its own, and a
+held-out run's is what the report would use on it: with ``fitted_offsets`` (every validation run is
+also fitted, so the report knows its offset) it is fitted to the held-out run, one constant per
+joint; otherwise the mean of the training runs' offsets, as a run the fit never saw gets in the
+report (:func:`~excite_cli.identification.dataset.run_offset_columns`).
 
-**Time blocks** for a single fit run: its fit instants are cut into K contiguous time blocks; fold k
-holds out the k-th block
+**Time blocks** for a single recording: the fit instants of every run are cut into K contiguous
+time blocks; fold k holds out the k-th block
 of every run at once (for runs cropped from the same periodic excitation, the same phase of the
 period). Filtered samples are correlated over about one period of the cut-off, so the instants
 within ``margin`` seconds of a held-out block are left out of that fold's fit: correlated samples
@@ -26,6 +28,8 @@ of its own size, whatever the number of samples.
 
 from __future__ import annotations
 
+from typing import Callable
+
 import numpy as np
 
 from excite_cli.identification.dataset import Dataset
@@ -34,7 +38,7 @@ from excite_cli.identification.normal import NormalEquations, solve
 
 
 def fold_assignment(
-    time: np.ndarray, run: np.ndarray, folds: int, margin: float, by_run: bool = False
+    time: np.ndarray, run: np.ndarray, folds: int, margin: float, recording: np.ndarray | None = None
 ) -> tuple[np.ndarray, list[np.ndarray]]:
     """Folds of the fit instants (module docstring).
 
@@ -42,14 +46,15 @@ def fold_assignment(
         time: (N,) [s] and run: (N,) run index of each instant, each run's instants in time order.
         folds: K (time blocks).
         margin: [s] instants this close to a held-out block (same run) are left out of its fit.
-        by_run: one fold per run (in the order of the run indices), no margins, instead of time blocks.
+        recording: (N,) recording of each instant: one fold per recording (in their sorted order), no
+            margins, instead of time blocks.
 
     Returns:
         (N,) fold of each instant, and per fold a (N,) mask of its margin instants.
     """
-    if by_run:
-        runs = np.unique(run)
-        return np.searchsorted(runs, run), [np.zeros(time.size, dtype=bool) for _ in runs]
+    if recording is not None:
+        recordings, fold = np.unique(recording, return_inverse=True)
+        return fold, [np.zeros(time.size, dtype=bool) for _ in recordings]
     fold = np.empty(time.size, dtype=int)
     margins = [np.zeros(time.size, dtype=bool) for _ in range(folds)]
     for r in np.unique(run):
@@ -66,8 +71,8 @@ def fold_assignment(
 
 
 class CrossValidation:
-    """K-fold cross-validation (module docstring) of models built from ``keys``: whole runs when the
-    fit data hold two or more, else time blocks.
+    """K-fold cross-validation (module docstring) of models built from ``keys``: whole recordings when
+    the fit data come from two or more, else time blocks.
 
     Every fold's per-joint normal equations are placed once in the unknowns of the largest model
     [Y_B, all ``keys``]; a model's systems are then selections of their rows and columns.
@@ -76,14 +81,15 @@ class CrossValidation:
         data: the fit data.
         keys: every term a model may contain.
         weights: (n,) the joints' weights (WLS) or None (LS), fixed for every model.
-        folds: K (≥ 2) of time blocks (a single fit run).
+        folds: K (≥ 2) of time blocks (a single recording).
         margin: [s] left out around each held-out block (about one period of the cut-off).
-        by_run: hold out whole runs (default: when the fit data hold two or more runs).
-        fitted_offsets: in run folds, fit the held-out run's offsets to it instead of giving it the mean
-            of the training runs' (module docstring).
+        recordings: recording of each run (indexed by ``data.run``): one fold per recording when they
+            are two or more; None: time blocks.
+        fitted_offsets: in recording folds, fit a held-out run's offsets to it instead of giving it
+            the mean of the training runs' (module docstring).
 
     Attributes:
-        by_run: whether the folds are whole runs; folds: their number.
+        by_recording: whether the folds are whole recordings; folds: their number.
     """
 
     def __init__(
@@ -93,13 +99,15 @@ class CrossValidation:
         weights: np.ndarray | None,
         folds: int,
         margin: float,
-        by_run: bool | None = None,
+        recordings: np.ndarray | None = None,
         fitted_offsets: bool = False,
     ):
-        self.fitted_offsets = fitted_offsets
-        self.by_run = bool(np.unique(data.run).size >= 2) if by_run is None else by_run
-        fold, margins = fold_assignment(data.time, data.run, folds, margin, self.by_run)
-        self.folds = len(margins)
+        runs = np.unique(data.run)
+        recording = None if recordings is None else np.asarray(recordings)[data.run]
+        self.by_recording = recording is not None and np.unique(recording).size >= 2
+        fold, margins = fold_assignment(data.time, data.run, folds, margin, recording if self.by_recording else None)
+        self.folds, self.fitted_offsets = len(margins), fitted_offsets
+        self.run_fold = fold[np.searchsorted(data.run, runs)] if self.by_recording else None  # (runs,)
         self.b, self.n, self.instants = data.regressor.shape[1], data.n, data.time.size
         sizes = [data.blocks[key].shape[1] for key in keys]
         starts = self.b + np.concatenate([[0], np.cumsum(sizes)]).astype(int)
@@ -113,6 +121,7 @@ class CrossValidation:
             (total_G - G - np.einsum("j,jab->ab", w2, mG), total_c - c - w2 @ mc)
             for (G, c), (mG, mc, _) in zip(weighted, margin_parts)
         ]
+        self.train_rows = [int(np.sum((fold != k) & ~m)) * self.n for k, m in enumerate(margins)]
         self.held = held
         measured = sum(s for _, _, s in held)
         self.rms = np.sqrt(measured / max(self.instants, 1))
@@ -123,38 +132,45 @@ class CrossValidation:
 
     def _offset_positions(self, terms: list[Term]) -> list[tuple[int, np.ndarray]]:
         """(joint, positions among the model [Y_B, ``terms``]'s unknowns of its per-run columns) of
-        each offset term."""
+        each offset term with one column per run."""
         out, start = [], self.b
         for t in terms:
             size = self.place[t].size
-            if t.effect in PER_RUN and size == self.folds:
+            if t.effect in PER_RUN and self.run_fold is not None and size == self.run_fold.size:
                 out.append((t.joint, np.arange(start, start + size)))
             start += size
         return out
 
-    def fold_sse(self, terms: list[Term]) -> np.ndarray:
-        """(K, n) held-out residual sum of squares [Nm²] per fold and joint of the model [Y_B,
-        ``terms``] fitted on the other folds minus the margin."""
+    def training_system(self, k: int, terms: list[Term]) -> tuple[np.ndarray, np.ndarray, int]:
+        """Fold k's weighted training normal equations G (P, P), c (P,) of the model [Y_B, ``terms``]
+        and the number of rows behind them: what any fit of fold k is fitted to."""
         idx = self.unknowns(terms)
-        offsets = self._offset_positions(terms) if self.by_run else []
+        G, c = self.train[k]
+        return G[np.ix_(idx, idx)], c[idx], self.train_rows[k]
+
+    def fold_sse(self, terms: list[Term], refit: Callable[[int], np.ndarray] | None = None) -> np.ndarray:
+        """(K, n) held-out residual sum of squares [Nm²] per fold and joint of the model [Y_B,
+        ``terms``] fitted on the other folds minus the margin: by least squares, or by ``refit(k)``,
+        which returns the model's coefficients fitted to :meth:`training_system` ``(k, terms)``."""
+        idx = self.unknowns(terms)
+        offsets = self._offset_positions(terms)
         out = np.zeros((len(self.held), self.n))
-        for k, ((G, c), (Gj, cj, sj)) in enumerate(zip(self.train, self.held)):
-            x = solve(G[np.ix_(idx, idx)], c[idx])
+        for k, (Gj, cj, sj) in enumerate(self.held):
+            x = solve(*self.training_system(k, terms)[:2]) if refit is None else np.array(refit(k), dtype=float)
             held_G, held_c = Gj[:, idx][:, :, idx], cj[:, idx]
-            for j, columns in offsets:  # the held-out run's offset (module docstring)
-                p = columns[k]
-                x[p] = 0.0
-                if not self.fitted_offsets:
-                    x[p] = np.delete(x[columns], k).mean()
-                elif held_G[j, p, p] > 0.0:
-                    x[p] = (held_c[j, p] - held_G[j, p] @ x) / held_G[j, p, p]
+            for j, columns in offsets:  # the held-out runs' offsets (module docstring)
+                out_of_fit = self.run_fold == k
+                x[columns[out_of_fit]] = 0.0 if self.fitted_offsets else x[columns[~out_of_fit]].mean()
+                for p in columns[out_of_fit] if self.fitted_offsets else []:  # disjoint rows: one at a time
+                    if held_G[j, p, p] > 0.0:
+                        x[p] = (held_c[j, p] - held_G[j, p] @ x) / held_G[j, p, p]
             quadratic = np.einsum("a,jab,b->j", x, held_G, x)
             out[k] = np.maximum(sj - 2.0 * held_c @ x + quadratic, 0.0)
         return out
 
-    def error(self, terms: list[Term]) -> tuple[float, np.ndarray]:
+    def error(self, terms: list[Term], refit: Callable[[int], np.ndarray] | None = None) -> tuple[float, np.ndarray]:
         """CV(M) [%] (module docstring) and the (n,) per-joint relative errors [%] of the model
-        [Y_B, ``terms``]."""
-        sse = self.fold_sse(terms).sum(axis=0)
+        [Y_B, ``terms``], fitted by least squares or ``refit`` (:meth:`fold_sse`)."""
+        sse = self.fold_sse(terms, refit).sum(axis=0)
         per_joint = 100.0 * np.sqrt(sse / max(self.instants, 1)) / np.where(self.rms > 0, self.rms, 1.0)
         return float(per_joint.mean()), per_joint

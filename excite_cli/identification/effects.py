@@ -152,3 +152,12 @@ def effect_columns(
         "position_2": lambda: [np.sin(2.0 * q), np.cos(2.0 * q)],
     }[effect]()
     return np.column_stack(columns)
+
+
+def coefficient_names(term: Term, offset_runs: list[str]) -> list[str]:
+    """Names of a term's coefficients: those of ``COEFFICIENTS``, an offset per run as
+    ``tau0[run label]`` when the fit has several runs (``offset_runs``)."""
+    names = COEFFICIENTS[term.effect]
+    if term.effect in PER_RUN and len(offset_runs) > 1:
+        return [f"{names[0]}[{label}]" for label in offset_runs]
+    return list(names)

@@ -17,8 +17,9 @@ is a semidefinite program (solved by cvxpy with Clarabel); Y_B K φ = Y φ (Eq. 
 weights of the weighted least-squares fit. D scales each body's parameters by its URDF mass m₀ (and
 m₀ℓ, m₀ℓ² with ℓ = ``LENGTH``), so λ is dimensionless; it picks, among equally good fits, the
 consistent one closest to the CAD model (the regularization of Sousa & Cortesão, IJRR 2014, and
-Lee et al., RA-L 2020, in a Euclidean metric). The data term enters through a QR factor of the
-weighted design matrix, so the SDP has only as many unknowns as parameters.
+Lee et al., RA-L 2020, in a Euclidean metric). The data term enters through the weighted normal
+equations of [Y_B, E] (a factor of them), so the SDP has only as many unknowns as parameters and
+a cross-validation fold costs no design matrix.
 """
 
 from __future__ import annotations
@@ -114,80 +115,106 @@ def _solve(problem: cp.Problem) -> cp.Problem:
             warnings.simplefilter("ignore", UserWarning)
             problem.solve(solver=cp.CLARABEL)
     except cp.SolverError as exc:
-        raise ExciteError("identification.physical_consistency", f"the SDP solver failed: {exc}") from None
+        raise ExciteError("identification.fit", f"the SDP solver failed: {exc}") from None
     if problem.status not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE):
-        raise ExciteError("identification.physical_consistency", f"the SDP ended {problem.status}")
+        raise ExciteError("identification.fit", f"the SDP ended {problem.status}")
     return problem
 
 
-def consistent_fit(
-    regressor: np.ndarray,
-    effects: np.ndarray,
-    tau: np.ndarray,
-    weights: np.ndarray,
-    regrouping: np.ndarray,
-    phi_urdf: np.ndarray,
-    effect_names: list[str],
-    regularization: float,
-    bodies: list[str],
-) -> ConsistentFit:
-    """Solve the semidefinite program of the module docstring.
+class ConsistentProgram:
+    """The semidefinite program of the module docstring for one model, compiled once (cvxpy
+    parameters) and solved for any normal equations of its unknowns and any λ: the fit on all data
+    and each cross-validation fold's refit differ only in G, c and λ.
 
     Args:
-        regressor: (M, b) base regressor Y_B; effects: (M, k) effect columns E; tau: (M,) torques [Nm].
-        weights: (M,) row weights W (1/σ_j of each row's joint).
+        reference: (b + k, b + k) weighted normal equations AᵀW²A of A = [Y_B, E], the base regressor
+            and the effect columns, on all fit data: they fix the unknowns' scaling and which
+            standard parameters the torques never see (null space of K).
         regrouping: K (b, p), φ_B = K φ; phi_urdf: (p,) the URDF's standard parameters.
         effect_names: (k,) ``"<coefficient> <joint>"`` of each effect column (e.g. ``"Fc panda_joint1"``);
             coefficients named in ``NONNEGATIVE`` are kept ≥ 0.
-        regularization: λ ≥ 0.
         bodies: (p/10,) body names, for the ``active`` list.
-
-    Raises:
-        ExciteError: the solver finds no solution (the message gives its status).
     """
-    scale = body_scales(phi_urdf)
-    k = effects.shape[1]
-    nonnegative = np.array([name.split()[0] in NONNEGATIVE for name in effect_names], dtype=bool)
-    design = weights[:, None] * np.hstack([regressor @ regrouping * scale, effects])
-    column = np.linalg.norm(design, axis=0)
-    unseen = column <= 1e-9 * column.max()  # standard parameters the torques do not see (null space of K)
-    design[:, unseen], column[unseen] = 0.0, 1.0
-    target = weights * (tau - regressor @ (regrouping @ phi_urdf))
-    Q, R = np.linalg.qr(design / column)
-    z = Q.T @ target
-    rows = tau.size
-    u = cp.Variable(design.shape[1])  # u = column ⊙ [δ; θ], φ = φ_URDF + D δ
-    delta = cp.multiply(u[: scale.size], 1.0 / column[: scale.size])
-    theta = cp.multiply(u[scale.size :], 1.0 / column[scale.size :]) if k else None
-    phi = phi_urdf + cp.multiply(scale, delta)
-    epsilon = MARGIN * scale[0::10] * LENGTH**2
-    # T J T ⪰ ε T² with T = diag(1/ℓ, 1/ℓ, 1/ℓ, 1)/√m₀: a congruence, same cone, entries of order 1
-    T = np.diag([1.0 / LENGTH] * 3 + [1.0])
-    constraints = [
-        T @ _pseudo_inertia_expression(phi[10 * i : 10 * i + 10]) @ T / scale[10 * i]
-        >> MARGIN * np.diag([1.0] * 3 + [LENGTH**2])
-        for i in range(len(bodies))
-    ]
-    if k and nonnegative.any():
-        constraints.append(theta[np.flatnonzero(nonnegative)] >= 0)
-    objective = cp.sum_squares(R @ u - z) / rows + regularization * cp.sum_squares(delta)
-    problem = _solve(cp.Problem(cp.Minimize(objective), constraints))
-    standard = phi_urdf + scale * (u.value[: scale.size] / column[: scale.size])
-    coefficients = u.value[scale.size :] / column[scale.size :]
-    eigen = np.array(
-        [np.linalg.eigvalsh(pseudo_inertia(standard[10 * i : 10 * i + 10]))[0] for i in range(len(bodies))]
-    )
-    if np.any(eigen <= 0.0):
-        raise ExciteError(
-            "identification.physical_consistency",
-            f"the SDP ended {problem.status} with a pseudo-inertia "
-            f"that is not positive definite (body {bodies[int(np.argmin(eigen))]})",
+
+    def __init__(
+        self,
+        reference: np.ndarray,
+        regrouping: np.ndarray,
+        phi_urdf: np.ndarray,
+        effect_names: list[str],
+        bodies: list[str],
+    ):
+        self.regrouping, self.phi_urdf, self.names, self.bodies = regrouping, phi_urdf, effect_names, bodies
+        self.scale = scale = body_scales(phi_urdf)
+        b, k, p = regrouping.shape[0], len(effect_names), scale.size
+        self.nonnegative = np.array([name.split()[0] in NONNEGATIVE for name in effect_names], dtype=bool)
+        # [Y_B K D, E]: the design in the unknowns [δ; θ], φ = φ_URDF + D δ
+        self.to_unknowns = np.zeros((b + k, p + k))
+        self.to_unknowns[:b, :p] = regrouping * scale
+        self.to_unknowns[b:, p:] = np.eye(k)
+        column = np.sqrt(np.maximum(np.diag(self.to_unknowns.T @ reference @ self.to_unknowns), 0.0))
+        self.unseen = column <= 1e-9 * column.max()
+        column[self.unseen] = 1.0
+        self.column = column
+        size = p + k
+        self.R, self.z = cp.Parameter((size, size)), cp.Parameter(size)  # the data term ‖R u − z‖², scaled by 1/M
+        self.weight, self.pinned = cp.Parameter(nonneg=True), cp.Parameter(k, nonneg=True)
+        self.u = u = cp.Variable(size)  # u = column ⊙ [δ; θ]
+        delta = cp.multiply(u[:p], 1.0 / column[:p])
+        phi = phi_urdf + cp.multiply(scale, delta)
+        # T J T ⪰ ε T² with T = diag(1/ℓ, 1/ℓ, 1/ℓ, 1)/√m₀: a congruence, same cone, entries of order 1
+        T = np.diag([1.0 / LENGTH] * 3 + [1.0])
+        constraints = [
+            T @ _pseudo_inertia_expression(phi[10 * i : 10 * i + 10]) @ T / scale[10 * i]
+            >> MARGIN * np.diag([1.0] * 3 + [LENGTH**2])
+            for i in range(len(bodies))
+        ]
+        if k and self.nonnegative.any():
+            constraints.append(u[p + np.flatnonzero(self.nonnegative)] >= 0)
+        if k:  # an effect column a fold's data never see (a held-out run's offset) is kept at 0
+            constraints.append(cp.multiply(self.pinned, u[p:]) == 0)
+        objective = cp.sum_squares(self.R @ u - self.z) + self.weight * cp.sum_squares(delta)
+        self.problem = cp.Problem(cp.Minimize(objective), constraints)
+
+    def solve(self, G: np.ndarray, c: np.ndarray, rows: int, regularization: float) -> ConsistentFit:
+        """The consistent fit to the weighted normal equations G (b + k, b + k), c (b + k,) of ``rows``
+        rows, with regularization λ ≥ 0.
+
+        Raises:
+            ExciteError: the solver finds no solution (the message gives its status).
+        """
+        b, p = self.regrouping.shape[0], self.scale.size
+        column = self.column
+        normal = self.to_unknowns.T @ G @ self.to_unknowns / np.outer(column, column)
+        right = self.to_unknowns.T @ (c - G[:, :b] @ (self.regrouping @ self.phi_urdf)) / column
+        normal[self.unseen, :], normal[:, self.unseen] = 0.0, 0.0
+        eigenvalues, vectors = np.linalg.eigh(normal)
+        kept = eigenvalues > 1e-13 * max(eigenvalues[-1], 1e-300)
+        R = np.zeros_like(normal)  # RᵀR = the scaled normal matrix
+        R[: kept.sum()] = np.sqrt(eigenvalues[kept])[:, None] * vectors[:, kept].T
+        z = np.zeros(normal.shape[0])
+        z[: kept.sum()] = (vectors[:, kept].T @ right) / np.sqrt(eigenvalues[kept])
+        self.R.value, self.z.value, self.weight.value = R / np.sqrt(rows), z / np.sqrt(rows), regularization
+        self.pinned.value = (np.diag(normal)[p:] <= 0.0).astype(float)
+        problem = _solve(self.problem)
+        u = self.u.value
+        standard = self.phi_urdf + self.scale * (u[:p] / column[:p])
+        coefficients = u[p:] / column[p:]
+        eigen = np.array(
+            [np.linalg.eigvalsh(pseudo_inertia(standard[10 * i : 10 * i + 10]))[0] for i in range(len(self.bodies))]
         )
-    active = [f"pseudo-inertia of {name}" for name, e, eps in zip(bodies, eigen, epsilon) if e <= ACTIVE * eps]
-    active += [f"{effect_names[c]} ≥ 0" for c in np.flatnonzero(nonnegative & (coefficients <= 1e-9))]
-    stacked = np.vstack([R / np.sqrt(rows), np.sqrt(regularization) * np.diag(1.0 / column)[: scale.size]])
-    plain = np.linalg.lstsq(stacked, np.concatenate([z / np.sqrt(rows), np.zeros(scale.size)]), rcond=None)[0]
-    unconstrained = phi_urdf + scale * plain[: scale.size] / column[: scale.size]
-    return ConsistentFit(
-        standard, coefficients, regrouping @ standard, eigen, active, str(problem.status), unconstrained
-    )
+        if np.any(eigen <= 0.0):
+            raise ExciteError(
+                "identification.fit",
+                f"the SDP ended {problem.status} with a pseudo-inertia "
+                f"that is not positive definite (body {self.bodies[int(np.argmin(eigen))]})",
+            )
+        epsilon = MARGIN * self.scale[0::10] * LENGTH**2
+        active = [f"pseudo-inertia of {name}" for name, e, eps in zip(self.bodies, eigen, epsilon) if e <= ACTIVE * eps]
+        active += [f"{self.names[c]} ≥ 0" for c in np.flatnonzero(self.nonnegative & (coefficients <= 1e-9))]
+        stacked = np.vstack([R / np.sqrt(rows), np.sqrt(regularization) * np.diag(1.0 / column)[:p]])
+        plain = np.linalg.lstsq(stacked, np.concatenate([z / np.sqrt(rows), np.zeros(p)]), rcond=None)[0]
+        unconstrained = self.phi_urdf + self.scale * plain[:p] / column[:p]
+        return ConsistentFit(
+            standard, coefficients, self.regrouping @ standard, eigen, active, str(problem.status), unconstrained
+        )

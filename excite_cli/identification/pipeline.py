@@ -15,12 +15,12 @@ from excite_cli.dynamics.robot import Robot, load_robot, resolve_urdf
 from excite_cli.errors import ExciteError
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.dataset import Dataset, build_datasets
-from excite_cli.identification.effects import COEFFICIENTS, PER_RUN, SHAPE_FIELDS, TWO_STAGE, Term
-from excite_cli.identification.least_squares import design, joint_weights, least_squares, predict, torque_errors
+from excite_cli.identification.effects import SHAPE_FIELDS, TWO_STAGE, Term, coefficient_names
+from excite_cli.identification.fit_choice import ConsistentModel, choose_fit
+from excite_cli.identification.least_squares import joint_weights, least_squares, predict, torque_errors
 from excite_cli.identification.measurements import load_run
 from excite_cli.identification.normal import NormalEquations, excited_rank
 from excite_cli.identification.payload import payload_parameters
-from excite_cli.identification.physical import ConsistentFit, consistent_fit
 from excite_cli.identification.preprocessing import choose_cutoff, preprocess
 from excite_cli.identification.report import Report
 from excite_cli.identification.selection import Selection, candidate_terms, select_effects
@@ -64,6 +64,31 @@ def error_ladder(val_data: Dataset, selection: Selection, joints: list[str]) -> 
         for label, terms, cv in models
     )
     return [(label, cv, float(torque_errors(measured, predicted)[2].mean())) for label, cv, predicted in fitted]
+
+
+def fold_groups(problem: IdentifyProblem, fitted: list[int]) -> np.ndarray | None:
+    """The cross-validation's groups (:class:`~excite_cli.identification.crossval.CrossValidation`)
+    of ``identification.folds_by``: the recording (file) of each configured run, each run its own
+    group, or None for time blocks. ``auto``: recordings when the fit runs come from two or more
+    files, else time blocks.
+
+    Raises:
+        ExciteError: ``recording`` or ``run`` folds with fewer than two fit recordings or runs.
+    """
+    how = problem.identification.folds_by
+    files = np.unique([str(problem.resolve(r.file)) for r in problem.data.runs], return_inverse=True)[1]
+    groups = {"auto": files, "recording": files, "run": np.arange(files.size), "time_block": None}[how]
+    count = 0 if groups is None else np.unique(groups[fitted]).size
+    if how == "auto":
+        return groups if count >= 2 else None
+    if groups is not None and count < 2:
+        raise ExciteError(
+            "identification.folds_by",
+            f"{how} folds need fit data from two or more {how}s; the fit data come from {count}",
+            how,
+            "time_block or auto",
+        )
+    return groups
 
 
 @dataclass
@@ -125,8 +150,14 @@ def prepare_data(problem: IdentifyProblem, robot: Robot, base: BaseParameters, t
     )
 
 
-def run_identification(problem: IdentifyProblem) -> tuple[Report, Robot, BaseParameters, list[np.ndarray]]:
+def run_identification(
+    problem: IdentifyProblem, consistent_beside: bool = False
+) -> tuple[Report, Robot, BaseParameters, list[np.ndarray]]:
     """The whole loop on ``problem``'s data; memory follows the decimated data.
+
+    Args:
+        consistent_beside: fit the physically consistent model even when ``identification.fit`` is
+            ``least_squares`` (the identified URDF needs it).
 
     Returns:
         The :class:`Report`, the robot, its base parameters and the base regressor rows of all
@@ -134,7 +165,8 @@ def run_identification(problem: IdentifyProblem) -> tuple[Report, Robot, BasePar
         ``optimize`` (Eq. 41).
 
     Raises:
-        ExciteError: bad data or config (see :func:`prepare_data`).
+        ExciteError: bad data or config (see :func:`prepare_data`), or a consistent fit without a
+            solution.
     """
     return_freed_memory()  # memory follows the live (decimated) data
     problem = with_overrides(problem, {"robot.base_wrench_rows": False})  # a copy: the caller's config is not changed
@@ -152,27 +184,34 @@ def run_identification(problem: IdentifyProblem) -> tuple[Report, Robot, BasePar
         declared,
         margin=1.0 / data.cutoff,
         oversampling=max(1.0, data.rate / (2.0 * data.cutoff)),
+        recordings=fold_groups(problem, data.fitted),
         fitted_offsets=set(np.unique(val_data.run).tolist()) <= set(data.fitted),
     )
-    before = predict(val_data, selection.rigid.x, [])
-    after = predict(val_data, selection.fit.x, selection.terms)
-    measured = val_data.tau.reshape(-1, val_data.n)
     labels = [r.label for r in problem.data.runs]
     offset_runs = [labels[k] for k in data.fitted]
-    consistent = (
-        fit_consistent(fit_data, selection, robot, base, cfg, offset_runs) if cfg.physical_consistency else None
-    )
-    rms_consistent = None
-    if consistent is not None:
-        predicted = predict(val_data, np.concatenate([consistent.base, consistent.effects]), selection.terms)
-        rms_consistent = torque_errors(measured, predicted)[0]
+    choice = choose_fit(selection, ConsistentModel(selection, robot, base, offset_runs), cfg, consistent_beside)
+    measured = val_data.tau.reshape(-1, val_data.n)
+    before = predict(val_data, selection.rigid.x, [])
+    plain = predict(val_data, selection.fit.x, selection.terms)
+    consistent = None
+    if choice.consistent is not None:
+        consistent = predict(
+            val_data, np.concatenate([choice.consistent.base, choice.consistent.effects]), selection.terms
+        )
+    after = consistent if choice.is_consistent else plain
+    ladder = error_ladder(val_data, selection, robot.joint_names)
+    if choice.is_consistent:  # the reported model's step: the same effects, the consistent fit
+        ladder.append((choice.name, float(choice.cv_error[choice.chosen]), torque_errors(measured, after)[2].mean()))
     report = Report(
         joints=robot.joint_names,
         base_names=base.names,
         selection=selection,
+        fit_choice=choice,
         rms_before=torque_errors(measured, before)[0],
         rms_after=torque_errors(measured, after)[0],
         rms_torque=torque_errors(measured, after)[1],
+        rms_least_squares=torque_errors(measured, plain)[0],
+        rms_consistent=None if consistent is None else torque_errors(measured, consistent)[0],
         validation=val_data,
         predicted_before=before,
         predicted_after=after,
@@ -183,51 +222,13 @@ def run_identification(problem: IdentifyProblem) -> tuple[Report, Robot, BasePar
         dropped=data.dropped,
         run_names=labels,
         offset_runs=offset_runs,
-        ladder=error_ladder(val_data, selection, robot.joint_names),
-        consistent=consistent,
-        rms_consistent=rms_consistent,
+        ladder=ladder,
     )
     return report, robot, base, [fit_data.regressor, val_data.regressor]
 
 
-def fit_consistent(
-    fit_data: Dataset, selection: Selection, robot: Robot, base: BaseParameters, cfg, offset_runs: list[str]
-) -> ConsistentFit:
-    """The physically consistent fit (:mod:`excite_cli.identification.physical`) of the selected model
-    on the fit data, with the selection's per-joint weights (WLS) or none (LS); ``offset_runs``
-    names the offsets' columns.
-
-    Raises:
-        ExciteError: the semidefinite program has no solution.
-    """
-    weights = np.ones(fit_data.tau.size) if selection.weights is None else selection.weights[fit_data.joint]
-    names = [
-        f"{name} {robot.joint_names[t.joint]}" for t in selection.terms for name in coefficient_names(t, offset_runs)
-    ]
-    return consistent_fit(
-        fit_data.regressor,
-        design(fit_data, selection.terms)[:, base.count :],
-        fit_data.tau,
-        weights,
-        base.regrouping,
-        robot.urdf_parameters(),
-        names,
-        cfg.regularization,
-        robot.body_names,
-    )
-
-
-def coefficient_names(term: Term, offset_runs: list[str]) -> list[str]:
-    """Names of a term's coefficients: those of ``COEFFICIENTS``, an offset per run as
-    ``tau0[run label]`` when the fit has several runs (``offset_runs``)."""
-    names = COEFFICIENTS[term.effect]
-    if term.effect in PER_RUN and len(offset_runs) > 1:
-        return [f"{names[0]}[{label}]" for label in offset_runs]
-    return list(names)
-
-
 def effect_values(report: Report, consistent: bool = False) -> list[tuple[Term, str, float, float]]:
-    """(term, coefficient, value, std) for every chosen effect coefficient, in order: of the selected
+    """(term, coefficient, value, std) for every chosen effect coefficient, in order: of the
     least-squares fit, or with ``consistent`` of the physically consistent one (std NaN)."""
     b = len(report.base_names)
     values = report.consistent.effects if consistent else report.selection.fit.x[b:]
@@ -246,7 +247,7 @@ def write_identified_urdf(
         ExciteError: no consistent fit in ``report``, or the file cannot be written or loaded back.
     """
     if report.consistent is None:
-        raise ExciteError("urdf_out", "needs the physically consistent fit (identification.physical_consistency)")
+        raise ExciteError("urdf_out", "needs the physically consistent fit (identification.fit)")
     source, _ = resolve_urdf(problem)
     effects = [(t.effect, c, report.joints[t.joint], v) for t, c, v, _ in effect_values(report, consistent=True)]
     write_urdf(

@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from excite_cli.identification.dataset import Dataset
+from excite_cli.identification.fit_choice import FitChoice
 from excite_cli.identification.least_squares import torque_errors
 from excite_cli.identification.physical import ConsistentFit
 from excite_cli.identification.selection import Selection
@@ -20,9 +21,13 @@ class Report:
     Attributes:
         joints: (n,) active joint names.
         base_names: (b,) base-parameter names.
-        selection: chosen effects, fits, the search's steps.
-        rms_before, rms_after: (n,) validation torque RMS error [Nm], rigid body only / with effects.
+        selection: chosen effects, the least-squares fits, the search's steps.
+        fit_choice: the fits compared by cross-validation, the chosen one, the consistent fit.
+        rms_before, rms_after: (n,) validation torque RMS error [Nm], rigid body only (least squares)
+            / the chosen fit with effects.
         rms_torque: (n,) RMS of the measured validation torques [Nm].
+        rms_least_squares, rms_consistent: (n,) validation torque RMS error [Nm] of the least-squares
+            fit with effects and of the consistent fit (None without one).
         validation: the validation samples; predicted_before, predicted_after: (N, n) [Nm] on them.
         cutoff: low-pass cut-off of every run [Hz]; cutoff_source: how it was chosen, in words.
         fit_samples, validation_samples: instants used for fitting / validation.
@@ -30,17 +35,19 @@ class Report:
         run_names: (runs,) each configured run's label (file and crop), indexed by ``Dataset.run``.
         offset_runs: the runs whose offsets the fit has (one column each), as labels.
         ladder: (step, CV error on the fit data [%], mean relative validation error [%]) for the
-            rigid body, the search's start and after each step of the kept search.
-        consistent: the physically consistent fit with the same effects, or None.
-        rms_consistent: (n,) its validation torque RMS error [Nm] (None without it).
+            rigid body, the search's start and after each step of the kept search (least squares),
+            then the consistent fit when it is the reported one.
     """
 
     joints: list[str]
     base_names: list[str]
     selection: Selection
+    fit_choice: FitChoice
     rms_before: np.ndarray
     rms_after: np.ndarray
     rms_torque: np.ndarray
+    rms_least_squares: np.ndarray
+    rms_consistent: np.ndarray | None
     validation: Dataset
     predicted_before: np.ndarray
     predicted_after: np.ndarray
@@ -52,8 +59,17 @@ class Report:
     run_names: list[str] = field(default_factory=list)
     offset_runs: list[str] = field(default_factory=list)
     ladder: list[tuple[str, float, float]] = field(default_factory=list)
-    consistent: ConsistentFit | None = None
-    rms_consistent: np.ndarray | None = None
+
+    @property
+    def consistent(self) -> ConsistentFit | None:
+        """The physically consistent fit (chosen or beside least squares), or None."""
+        return self.fit_choice.consistent
+
+    @property
+    def cv_error(self) -> float:
+        """The reported model's CV error [%] (NaN: a consistent fit that was the only candidate)."""
+        choice = self.fit_choice
+        return float(choice.cv_error[choice.chosen]) if choice.is_consistent else self.selection.cv_error
 
     @property
     def relative_before(self) -> np.ndarray:
@@ -84,3 +100,8 @@ class Report:
     def relative_consistent(self) -> np.ndarray | None:
         """(n,) RMS error / RMS torque [%] of the physically consistent fit, or None."""
         return None if self.rms_consistent is None else 100.0 * self.rms_consistent / self.rms_torque
+
+    @property
+    def relative_least_squares(self) -> np.ndarray:
+        """(n,) RMS error / RMS torque [%] of the least-squares fit with effects."""
+        return 100.0 * self.rms_least_squares / self.rms_torque

@@ -58,18 +58,19 @@ def write_identification(
         g.attrs["fit_samples"], g.attrs["validation_samples"] = report.fit_samples, report.validation_samples
         g.attrs["dropped_rows"] = "; ".join(f"{name}: {rows}" for name, rows in report.dropped) or "none"
         g.attrs["folds"], g.attrs["min_improvement"] = sel.folds, sel.min_improvement
-        g.attrs["folds_by"] = "run" if sel.by_run else "time block"
+        g.attrs["folds_by"] = sel.folds_by
         g.attrs["coulomb_velocity_rad_s"] = problem.identification.coulomb_velocity
-        g.attrs["cv_error_rigid"], g.attrs["cv_error"] = sel.cv_rigid, sel.cv_error
+        g.attrs["cv_error_rigid"], g.attrs["cv_error"] = sel.cv_rigid, report.cv_error
         g.attrs["stop_reason"] = sel.searches[sel.chosen].stop
         write_strings(g, "joint_names", report.joints)
         write_strings(g, "base_parameter_names", report.base_names)
-        consistent = report.consistent
-        g.create_dataset("base_parameters", data=sel.fit.x[:b] if consistent is None else consistent.base)
+        consistent, chosen = report.consistent, report.fit_choice.is_consistent
+        g.create_dataset("base_parameters", data=consistent.base if chosen else sel.fit.x[:b])
         g.create_dataset("base_parameters_unconstrained", data=sel.fit.x[:b])
         g.create_dataset("base_parameters_std", data=sel.fit.std[:b])
         g.create_dataset("base_parameters_rigid_only", data=sel.rigid.x)
-        g.create_dataset("physically_consistent", data=consistent is not None)
+        g.create_dataset("physically_consistent", data=chosen)
+        _write_fits(g, report)
         if consistent is not None:
             _write_consistent(g, report, robot)
         _write_effects(g, report)
@@ -183,6 +184,22 @@ def _write_search(g: h5py.Group, report: Report) -> None:
     )
 
 
+def _write_fits(g: h5py.Group, report: Report) -> None:
+    """The candidate fits of the chosen model and their cross-validated errors; the chosen one."""
+    choice = report.fit_choice
+    g.attrs["fit"], g.attrs["fit_lead"] = choice.name, choice.lead
+    table = np.zeros(len(choice.names), dtype=[("fit", STR), ("regularization", "f8"), ("cv_error", "f8")])
+    table["fit"], table["regularization"], table["cv_error"] = choice.names, choice.regularization, choice.cv_error
+    data = g.create_dataset("fits", data=table)
+    data.attrs["units"] = "cv_error in % on the selection's folds (NaN: the only candidate, not cross-validated)"
+    data.attrs["chosen"] = choice.chosen
+    for name, values, unit in (
+        ("rms_least_squares", report.rms_least_squares, "Nm"),
+        ("relative_least_squares", report.relative_least_squares, "%"),
+    ):
+        g.create_dataset(name, data=values).attrs["unit"] = unit
+
+
 def _write_validation(g: h5py.Group, report: Report) -> None:
     """Torque errors on the validation data (never fitted, never used by the selection): per joint
     and per run, and the measured and predicted torques."""
@@ -230,6 +247,7 @@ def _write_consistent(g: h5py.Group, report: Report, robot: Robot) -> None:
         "kg, kg m, kg m^2 (pinocchio order per body)"
     )
     write_strings(g, "standard_parameter_names", robot.parameter_names)
+    g.create_dataset("base_parameters_consistent", data=consistent.base)
     g.attrs["solver_status"] = consistent.status
     write_strings(g, "active_constraints", consistent.active)
     urdf = robot.urdf_parameters()

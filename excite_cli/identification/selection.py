@@ -108,7 +108,7 @@ class Selection:
         cv_joint: (n,) the chosen model's CV error per joint [%].
         searches: the search from every start; ``chosen`` indexes the one kept.
         absorbed: candidates skipped as not separately identifiable.
-        folds: K of the cross-validation; by_run: its folds are whole runs (else time blocks).
+        cross_validation: the folds every model was scored on, for scoring other fits of the model.
         min_improvement: the price of an effect (a fraction).
         normal: the fit data's normal equations (every candidate), for refitting other models.
     """
@@ -124,10 +124,19 @@ class Selection:
     searches: list[Search]
     chosen: int
     absorbed: list[Term]
-    folds: int
-    by_run: bool
+    cross_validation: CrossValidation
     min_improvement: float
     normal: NormalEquations
+
+    @property
+    def folds(self) -> int:
+        """K, the number of cross-validation folds."""
+        return self.cross_validation.folds
+
+    @property
+    def folds_by(self) -> str:
+        """What each fold holds out: ``recording`` (a whole file) or ``time block``."""
+        return "recording" if self.cross_validation.by_recording else "time block"
 
     @property
     def steps(self) -> list[Step]:
@@ -221,6 +230,7 @@ def select_effects(
     declared: list[Term],
     margin: float,
     oversampling: float = 1.0,
+    recordings: np.ndarray | None = None,
     fitted_offsets: bool = False,
 ) -> Selection:
     """The stepwise search of the module docstring on the fit data.
@@ -232,8 +242,10 @@ def select_effects(
         margin: [s] left out of a fold's fit around its held-out block (correlated samples).
         oversampling: samples per independent sample r (≥ 1) of the filtered data, for the
             standard deviations.
-        fitted_offsets: every validation run is fitted too, so its offsets are known (run folds fit
-            the held-out run's offsets; :class:`CrossValidation`).
+        recordings: the recording of each run, indexed by ``fit_data.run``: two or more make the
+            folds whole recordings; None: time blocks (:class:`CrossValidation`).
+        fitted_offsets: every validation run is fitted too, so its offsets are known (recording folds
+            fit the held-out runs' offsets).
     """
     n = fit_data.n
     candidates = [t for t in candidate_terms(cfg, n) if t not in declared and t in fit_data.blocks]
@@ -242,7 +254,7 @@ def select_effects(
     model = total.system(weights, declared)[0].shape[0]
     absorbed = [t for t in candidates if outside_fraction(total.system(weights, declared + [t])[0], model) < ABSORBED]
     candidates = [t for t in candidates if t not in absorbed]
-    cv = CrossValidation(fit_data, declared + candidates, weights, cfg.folds, margin, fitted_offsets=fitted_offsets)
+    cv = CrossValidation(fit_data, declared + candidates, weights, cfg.folds, margin, recordings, fitted_offsets)
     search = _Search(cv, candidates, declared, cfg)
     searches, seen = [], []
     for name, effects in STARTS.items():
@@ -265,8 +277,7 @@ def select_effects(
         searches=searches,
         chosen=chosen,
         absorbed=absorbed,
-        folds=cv.folds,
-        by_run=cv.by_run,
+        cross_validation=cv,
         min_improvement=cfg.min_improvement,
         normal=total,
     )

@@ -89,7 +89,7 @@ def plot_ladder(path: Path, report: Report) -> Path:
         "o-",
         color="C3",
         markersize=4,
-        label=f"cross-validated ({sel.folds} folds of the fit data by {'run' if sel.by_run else 'time block'})",
+        label=f"cross-validated ({sel.folds} folds of the fit data by {sel.folds_by})",
     )
     top.set_xticks(x, labels, rotation=60, ha="right", fontsize=7)
     top.set_ylabel("mean relative error [%]")

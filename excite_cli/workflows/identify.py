@@ -6,7 +6,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Optional
 
-from excite_cli.config import with_overrides
 from excite_cli.dynamics.robot import Robot
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.pipeline import run_identification, write_identified_urdf
@@ -32,7 +31,8 @@ def run_identify(
     problem: IdentifyProblem, target: Path, urdf_out: Optional[Path] = None, force: bool = False
 ) -> IdentifyRun:
     """Identify (:func:`run_identification`), write the report (HDF5), the residual plot and, with
-    ``urdf_out``, the identified URDF (physical consistency is then fitted too).
+    ``urdf_out``, the identified URDF (of the physically consistent fit, which is then fitted whatever
+    ``identification.fit`` says: a URDF needs physical bodies).
 
     Raises:
         ExciteError: bad paths or data (see :func:`run_identification`).
@@ -40,8 +40,7 @@ def run_identify(
     check_target(target, "output", force)
     if urdf_out is not None:
         check_target(urdf_out, "urdf_out", force)
-        problem = with_overrides(problem, {"identification.physical_consistency": True})
-    report, robot, base, regressor = run_identification(problem)
+    report, robot, base, regressor = run_identification(problem, consistent_beside=urdf_out is not None)
     write_identification(target, report, robot, base, problem, regressor)
     deviation = write_identified_urdf(problem, report, robot, base, urdf_out) if urdf_out is not None else None
     stem = target.with_suffix("")
