@@ -1,20 +1,23 @@
 """Models that hold on runs the fit never saw (simulated Panda data with known parameters): recording
 folds drop an effect present in one fit run only; on poorly exciting fit runs the fit chosen by the
 cross-validation is as good on a validation run elsewhere as the better of least squares and the
-physically consistent fit."""
+physically consistent fit; a position effect fitted on a narrower q range than the validation run's
+is held at the ends of that range."""
 
 from pathlib import Path
 
 import numpy as np
 import pytest
 from conftest import write_config
-from test_identification import JOINTS, NOISE, optimized  # noqa: F401  (module fixture)
+from test_identification import JOINTS, NOISE, app, optimized, runner  # noqa: F401  (module fixture)
 
 from excite_cli.config import load_problem
 from excite_cli.dynamics.robot import load_robot
 from excite_cli.identification.config import IdentifyProblem, SimulationConfig
+from excite_cli.identification.effects import POSITION
 from excite_cli.identification.least_squares import torque_errors
 from excite_cli.identification.pipeline import run_identification
+from excite_cli.identification.validate import validate_model
 from excite_cli.storage.results import problem_of_result, read_alphas
 from excite_cli.trajectory.fourier import FourierTrajectory
 from excite_cli.workflows.simulate import simulate_runs
@@ -99,4 +102,66 @@ def test_poorly_exciting_fit_runs_get_the_fit_that_transfers(tmp_path, optimized
     print(
         f"chosen {choice.name}: {_mean(default):.2f} %; least squares {plain:.2f} %, consistent {consistent:.2f} %; "
         f"CV {dict(zip(choice.names, np.round(choice.cv_error, 2)))}"
+    )
+
+
+def test_a_position_effect_fitted_on_a_narrower_range_is_held_at_its_ends(tmp_path, optimized):  # noqa: F811
+    """A cable-like torque 0.3 tanh((q₆ − q̄₆)/w) Nm on joint 6 that saturates outside the fit runs'
+    q range: fit runs are two optimized motions at half amplitude about their mean posture,
+    validation a third at full amplitude. With the position effects as candidates, the guard (the
+    default) holds the fitted term at the ends of the fit range instead of extrapolating it."""
+    problem = problem_of_result(optimized)
+    robot = load_robot(problem)
+    trajectory = FourierTrajectory(problem.trajectory.harmonics, problem.trajectory.base_frequency)
+    time = np.arange(2 * int(trajectory.period * 500) + 1) / 500.0
+    rng = np.random.default_rng(2)
+    motions = {k: trajectory.basis(time).evaluate(alpha) for k, alpha in read_alphas(optimized)}
+    centre = np.mean([q.mean(axis=0) for q, _, _ in motions.values()], axis=0)
+    width = 0.5 * np.abs(motions[3][0][:, 5] - centre[5]).max() * 0.6
+    runs = []
+    for k, (q, qd, qdd) in motions.items():
+        scale = 1.0 if k == 3 else 0.5
+        q, qd, qdd = centre + scale * (q - centre), scale * qd, scale * qdd
+        tau = np.array([robot.regressor(*x) @ robot.urdf_parameters() for x in zip(q, qd, qdd)])
+        tau += 0.3 * np.tanh(qd / 0.01) + rng.normal(0.0, NOISE, q.shape)
+        tau[:, 5] += 0.3 * np.tanh((q[:, 5] - centre[5]) / width)
+        runs.append(
+            {"file": _write_run(tmp_path / f"run_{k}.csv", time, q, tau), "role": "fit" if k < 3 else "validation"}
+        )
+    position = ["coulomb", "viscous", "spring", "gravity_compensator", "position_2"]
+    guarded = _identify(tmp_path, runs, "guarded", candidates=position, fit="least_squares")
+    free = _identify(tmp_path, runs, "free", candidates=position, fit="least_squares", position_guard=False)
+    plain = _identify(tmp_path, runs, "plain", candidates=["coulomb", "viscous"], fit="least_squares")
+    # the range the fit saw: the fit runs' q (filtered, so within a few mrad), narrower than the validation's
+    fit_q = np.vstack([centre + 0.5 * (motions[k][0] - centre) for k in (1, 2)])
+    np.testing.assert_allclose(guarded.q_range, np.column_stack([fit_q.min(0), fit_q.max(0)]), atol=5e-3)
+    assert free.q_range is None
+    outside = np.mean((motions[3][0][:, 5] < guarded.q_range[5, 0]) | (motions[3][0][:, 5] > guarded.q_range[5, 1]))
+    print(f"validation instants outside the fit range of joint 6: {100 * outside:.0f} %")
+    assert outside > 0.2
+    # the same selection and fit (the fit data lie inside the range), a position effect on joint 6
+    assert guarded.selection.terms == free.selection.terms
+    assert any(t.effect in POSITION and t.joint == 5 for t in guarded.selection.terms)
+    assert guarded.relative_after[5] < 0.6 * free.relative_after[5]
+    assert guarded.relative_after.mean() < free.relative_after.mean() < plain.relative_after.mean()
+    # validate holds the terms to the same range (the report stores it)
+    config = write_config(
+        tmp_path,
+        {
+            "robot": ROBOT,
+            "data": {"runs": runs, "columns": COLUMNS},
+            "identification": {"candidates": position, "fit": "least_squares"},
+        },
+        "cli.yaml",
+    )
+    result = runner.invoke(app, ["identify", str(config), "-o", str(tmp_path / "guarded.h5")])
+    assert result.exit_code == 0 and "held at their value at the ends of the fit data's q range" in result.output
+    errors = validate_model(tmp_path / "guarded.h5", load_problem(config, IdentifyProblem))
+    np.testing.assert_allclose(errors[2].relative, guarded.relative_after, rtol=1e-9)
+    print(
+        "joint 6 validation error: "
+        + ", ".join(
+            f"{name} {r.relative_after[5]:.2f} % (mean {r.relative_after.mean():.2f} %)"
+            for name, r in (("guarded", guarded), ("unguarded", free), ("no position effects", plain))
+        )
     )

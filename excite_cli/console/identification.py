@@ -9,7 +9,7 @@ from rich.table import Table
 
 from excite_cli.console.tables import titled_table
 from excite_cli.dynamics.robot import Robot
-from excite_cli.identification.effects import COEFFICIENTS
+from excite_cli.identification.effects import COEFFICIENTS, POSITION
 from excite_cli.identification.effects import UNITS as EFFECT_UNITS
 from excite_cli.identification.physical import body_properties, pseudo_inertia
 from excite_cli.identification.pipeline import effect_values
@@ -163,7 +163,18 @@ def _selection_tables(report: Report) -> list[Table | str]:
         if sel.absorbed
         else []
     )
-    return [ladder, *search(report), effects, *absorbed, params]
+    return [ladder, *search(report), effects, *absorbed, *_guarded(report), params]
+
+
+def _guarded(report: Report) -> list[str]:
+    """A line naming the q range [rad] each chosen position effect is held to, if any."""
+    joints = sorted({t.joint for t in report.selection.terms if t.effect in POSITION})
+    if not joints:
+        return []
+    if report.q_range is None:
+        return ["position effects extrapolate outside the fit data's q range (position_guard off)"]
+    ranges = ", ".join(f"{report.joints[j]} [{report.q_range[j, 0]:.3f}, {report.q_range[j, 1]:.3f}]" for j in joints)
+    return [f"position effects held at their value at the ends of the fit data's q range [rad]: {ranges}"]
 
 
 def search(report: Report, runners_up: int = 2) -> list[Table | str]:

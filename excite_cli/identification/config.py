@@ -13,8 +13,9 @@ from excite_cli.config import Problem, RobotConfig, Section
 from excite_cli.identification.effects import EFFECT_NAMES, POSITION, SHAPE_GRID
 
 Effect = Literal[EFFECT_NAMES]
-#: The default candidates: every effect but the position-dependent ones, which fitted the seen phases
-#: of the real Panda run and extrapolated badly to an unseen one (README), so they are opt-in.
+#: The default candidates: every effect but the position-dependent ones, which, even guarded to the fit
+#: data's q range, fitted the seen phases of the real Panda run and cost on unseen ones (README), so
+#: they are opt-in.
 DEFAULT_CANDIDATES = tuple(e for e in EFFECT_NAMES if e not in POSITION)
 #: Default regularization weights λ of the consistent fit, among which the cross-validation chooses.
 REGULARIZATION = (1e-5, 1e-4, 1e-3, 1e-2, 1e-1)
@@ -90,7 +91,8 @@ class PreprocessingConfig(Section):
 
 
 class IdentificationConfig(Section):
-    """LS or WLS, declared and candidate effects, the selection's cross-validation folds (what each holds
+    """LS or WLS, declared and candidate effects (position effects guarded to the fit data's q range
+    unless ``position_guard`` is off), the selection's cross-validation folds (what each holds
     out, how many time blocks) and threshold,
     friction shape velocities [rad/s] (a Stribeck or held velocity: one value, or a grid the
     selection searches), the fit (least squares, physically consistent, or the one the cross-validation
@@ -99,6 +101,7 @@ class IdentificationConfig(Section):
     method: Literal["wls", "ls"] = "wls"
     declared_effects: dict[str, list[Effect]] = Field(default_factory=dict)
     candidates: list[Effect] = Field(default_factory=lambda: list(DEFAULT_CANDIDATES))
+    position_guard: bool = True
     folds_by: Literal["auto", "recording", "run", "time_block"] = "auto"
     folds: int = Field(6, ge=3, le=50)
     min_improvement: float = Field(0.02, ge=0.0, lt=1.0)

@@ -79,10 +79,35 @@ def run_offset_columns(run: int, fitted: list[int], count: int, columns: int) ->
     return np.broadcast_to(row, (count, columns))
 
 
-def _run_columns(s: Samples, index: int, terms: list[Term], fitted: list[int], offsets: int, coulomb_velocity: float):
-    """Each term's columns of one run, filtered and decimated (offsets: indicator or mean columns),
-    one term at a time, joint by joint: yields (term, columns). A joint's full-rate signals are
-    released once its terms are done (the samples are used up)."""
+def fit_position_range(samples: list[Samples], blocks: int) -> np.ndarray:
+    """(n, 2) the lowest and highest q [rad] of each joint over the fit instants of ``samples`` (as
+    the fit sees them: filtered and decimated; see :func:`fit_instants`), the range the guard of the
+    position-dependent effects holds them to (:func:`effect_columns`); (−inf, inf) without fit
+    instants (:func:`build_datasets` refuses such data)."""
+    lo, hi = np.full(len(samples[0].q), np.inf), np.full(len(samples[0].q), -np.inf)
+    for s in samples:
+        mask = fit_instants(s.role, s.filter.kept(s.time.size), blocks)
+        if mask.any():
+            for j, q in enumerate(s.q):
+                seen = s.filter.decimate(q)[mask]
+                lo[j], hi[j] = min(lo[j], seen.min()), max(hi[j], seen.max())
+    unseen = lo > hi
+    return np.column_stack([np.where(unseen, -np.inf, lo), np.where(unseen, np.inf, hi)])
+
+
+def _run_columns(
+    s: Samples,
+    index: int,
+    terms: list[Term],
+    fitted: list[int],
+    offsets: int,
+    coulomb_velocity: float,
+    q_range: np.ndarray | None,
+):
+    """Each term's columns of one run, filtered and decimated (offsets: indicator or mean columns;
+    position effects guarded by ``q_range`` (n, 2) [rad]), one term at a time, joint by joint:
+    yields (term, columns). A joint's full-rate signals are released once its terms are done (the
+    samples are used up)."""
     kept = s.filter.kept(s.time.size)
     for j in range(len(s.q)):
         for t in (t for t in terms if t.joint == j):
@@ -92,7 +117,15 @@ def _run_columns(s: Samples, index: int, terms: list[Term], fitted: list[int], o
                     run_offset_columns(index, fitted, kept, offsets)
                     if t.effect in PER_RUN
                     else s.filter.decimate(
-                        effect_columns(t.effect, s.q[j], s.qd[j], s.qdd[j], coulomb_velocity, t.shape)
+                        effect_columns(
+                            t.effect,
+                            s.q[j],
+                            s.qd[j],
+                            s.qdd[j],
+                            coulomb_velocity,
+                            t.shape,
+                            q_range=None if q_range is None else tuple(q_range[j]),
+                        )
                     )
                 ),
             )
@@ -124,6 +157,7 @@ def build_datasets(
     payloads: list[np.ndarray | None] | None = None,
     split: bool = True,
     offset_runs: int | None = None,
+    q_range: np.ndarray | None = None,
 ) -> tuple[Dataset, Dataset, list[int]]:
     """The fit and validation datasets: regressor, the effect columns of ``terms`` and torques of the
     samples, each low-passed by its run's filter in parallel and decimated (so the filtered τ still
@@ -134,7 +168,9 @@ def build_datasets(
     dataset is empty) and offsets are the mean of ``offset_runs`` fitted runs. ``payloads``: per
     run, the standard parameters (p,) of a known payload (see
     :func:`~excite_cli.identification.payload.payload_parameters`) or None; its torque Y π is
-    filtered and decimated with the regressor and taken out of τ.
+    filtered and decimated with the regressor and taken out of τ. ``q_range``: (n, 2) [rad], the
+    fit data's q range per joint (see :func:`fit_position_range`) that guards the position-dependent
+    effects, or None (no guard).
 
     Returns:
         fit, validation and the indices of the runs with fit instants (the offsets' columns).
@@ -182,7 +218,7 @@ def build_datasets(
                 if load is not None:
                     out[side]["tau"][first : first + count] -= load[part == side]
         for t, columns in _run_columns(
-            s, index, terms, fitted, offsets, coulomb_velocity
+            s, index, terms, fitted, offsets, coulomb_velocity, q_range
         ):  # releases the run's signals
             for side in (True, False):
                 out[side]["blocks"][t][where[side]] = columns[rows[side]]

@@ -16,7 +16,9 @@ linear in its coefficients (τ_j += Σ c_k f_k(q_j, q̇_j, q̈_j)).
 | gravity_compensator | sin q, cos q | gs, gc [Nm]: first harmonic of a position-dependent torque |
 | position_2 | sin 2q, cos 2q | gs2, gc2 [Nm]: second harmonic (cogging, cables) |
 
-v_c (a smooth sign, 0.01 rad/s) is fixed. Stribeck and held friction are nonlinear in a shape
+v_c (a smooth sign, 0.01 rad/s) is fixed. The position-dependent effects (``POSITION``) are
+guarded: outside the q range the fit data covered they hold their value at its nearer end instead
+of extrapolating a spring or a harmonic fitted to a narrower motion. Stribeck and held friction are nonlinear in a shape
 parameter, their velocity: each is a family of candidates, one per value of a log-spaced grid
 (``SHAPE_GRID``), and the selection keeps at most one member per joint, the one the
 cross-validated error prefers (a profile search over the shape, scored on the fit data only).
@@ -119,6 +121,7 @@ def effect_columns(
     coulomb_velocity: float,
     shape: float | None = None,
     rigid: np.ndarray | None = None,
+    q_range: tuple[float, float] | None = None,
 ) -> np.ndarray:
     """Columns (T, k) of ``effect`` for one joint's samples q, q̇, q̈ (T,) [rad, rad/s, rad/s²] in time
     order, for one run (an offset is a single column of ones here: the dataset spreads it per run).
@@ -127,6 +130,9 @@ def effect_columns(
         coulomb_velocity: v_c of the smooth sign [rad/s].
         shape: the shape velocity [rad/s] of a ``SHAPES`` effect (Stribeck v_s, held v_h).
         rigid: (T,) the joint's rigid-body torque [Nm], needed by ``load_coulomb`` only.
+        q_range: (lo, hi) [rad], the joint's q range over the fit data: a ``POSITION`` effect's
+            columns are evaluated at q clipped to it (held at their value at the nearer end, the
+            guard against extrapolating to positions the fit never saw); None: no guard.
 
     Raises:
         KeyError: unknown effect.
@@ -136,6 +142,8 @@ def effect_columns(
         raise ValueError(f"{effect} needs the rigid-body torque")
     if effect in SHAPES and not shape:
         raise ValueError(f"{effect} needs its shape velocity {SHAPES[effect]}")
+    if effect in POSITION and q_range is not None:
+        q = np.clip(q, *q_range)
     sign = np.tanh(qd / coulomb_velocity)
     columns = {
         "coulomb": lambda: [sign],

@@ -14,7 +14,7 @@ from excite_cli.dynamics.base_parameters import BaseParameters, compute_base_par
 from excite_cli.dynamics.robot import Robot, load_robot, resolve_urdf
 from excite_cli.errors import ExciteError
 from excite_cli.identification.config import IdentifyProblem
-from excite_cli.identification.dataset import Dataset, build_datasets
+from excite_cli.identification.dataset import Dataset, build_datasets, fit_position_range
 from excite_cli.identification.effects import SHAPE_FIELDS, TWO_STAGE, Term, coefficient_names
 from excite_cli.identification.fit_choice import ConsistentModel, choose_fit
 from excite_cli.identification.least_squares import joint_weights, least_squares, predict, torque_errors
@@ -94,7 +94,9 @@ def fold_groups(problem: IdentifyProblem, fitted: list[int]) -> np.ndarray | Non
 @dataclass
 class Prepared:
     """The data ``identify`` works on: fit and validation datasets (two-stage columns included), the
-    runs with fit instants, the cut-off [Hz] and its source, rows dropped per run, decimated rate [Hz]."""
+    runs with fit instants, the cut-off [Hz] and its source, rows dropped per run, decimated rate [Hz],
+    the fit data's q range per joint (n, 2) [rad] that guards the position-dependent effects (None
+    with ``identification.position_guard`` off)."""
 
     fit: Dataset
     validation: Dataset
@@ -103,6 +105,7 @@ class Prepared:
     cutoff_source: str
     dropped: list[tuple[str, int]]
     rate: float
+    q_range: np.ndarray | None
 
 
 def prepare_data(problem: IdentifyProblem, robot: Robot, base: BaseParameters, terms: list[Term]) -> Prepared:
@@ -126,8 +129,16 @@ def prepare_data(problem: IdentifyProblem, robot: Robot, base: BaseParameters, t
     samples = [preprocess(runs.pop(0), problem.preprocessing, cutoff) for _ in range(len(runs))]
     rate = max(s.filter.rate / s.filter.step for s in samples)
     coulomb = [Term("coulomb", j) for j in range(robot.n_joints)]  # the load column's sign
+    q_range = fit_position_range(samples, problem.data.validation_blocks) if cfg.position_guard else None
     fit, val, fitted = build_datasets(
-        robot, base, samples, terms + coulomb, cfg.coulomb_velocity, problem.data.validation_blocks, payloads
+        robot,
+        base,
+        samples,
+        terms + coulomb,
+        cfg.coulomb_velocity,
+        problem.data.validation_blocks,
+        payloads,
+        q_range=q_range,
     )
     rigid_only = NormalEquations(fit, [])
     rank = excited_rank(rigid_only.system(None, [])[0])
@@ -147,6 +158,7 @@ def prepare_data(problem: IdentifyProblem, robot: Robot, base: BaseParameters, t
         source,
         dropped,
         rate,
+        q_range,
     )
 
 
@@ -223,6 +235,7 @@ def run_identification(
         run_names=labels,
         offset_runs=offset_runs,
         ladder=ladder,
+        q_range=data.q_range,
     )
     return report, robot, base, [fit_data.regressor, val_data.regressor]
 

@@ -37,6 +37,8 @@ class Report:
         ladder: (step, CV error on the fit data [%], mean relative validation error [%]) for the
             rigid body, the search's start and after each step of the kept search (least squares),
             then the consistent fit when it is the reported one.
+        q_range: (n, 2) [rad] each joint's q range over the fit data; the position-dependent
+            effects hold their value at its ends outside it (None: no guard).
     """
 
     joints: list[str]
@@ -59,6 +61,7 @@ class Report:
     run_names: list[str] = field(default_factory=list)
     offset_runs: list[str] = field(default_factory=list)
     ladder: list[tuple[str, float, float]] = field(default_factory=list)
+    q_range: np.ndarray | None = None
 
     @property
     def consistent(self) -> ConsistentFit | None:

@@ -126,6 +126,10 @@ def _write_effects(g: h5py.Group, report: Report) -> None:
     data = g.create_dataset("effects", data=effects)
     data.attrs["shape_unit"] = "rad/s (Stribeck v_s, held v_h; NaN for other effects)"
     write_strings(g, "offset_runs", report.offset_runs)
+    if report.q_range is not None:
+        g.create_dataset("fit_q_range", data=report.q_range).attrs["unit"] = (
+            "rad (lowest, highest q per joint over the fit data; position effects are held at these ends outside it)"
+        )
     write_strings(g, "absorbed_effects", [t.label(report.joints) for t in sel.absorbed])
     g.create_dataset("cv_error_joint", data=sel.cv_joint).attrs["unit"] = "% (cross-validated on the fit data)"
 

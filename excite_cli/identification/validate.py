@@ -43,7 +43,7 @@ class RunError:
 
 @dataclass
 class IdentifiedModel:
-    """The model an ``identify`` report holds (the physically consistent fit when it has one).
+    """The model an ``identify`` report holds (the fit it reports: least squares or consistent).
 
     Attributes:
         joints: (n,) active joint names; base_names: (b,) base-parameter names.
@@ -52,6 +52,8 @@ class IdentifiedModel:
         coefficients: effect coefficients, in the order of ``terms``' columns [SI].
         offset_runs: offset columns (one per fitted run, at least 1).
         cutoff: low-pass cut-off [Hz]; coulomb_velocity: smoothing velocity of sign(q̇) [rad/s].
+        q_range: (n, 2) [rad] the fit data's q range per joint that guards the position effects
+            (None: a report from before the guard).
     """
 
     joints: list[str]
@@ -63,6 +65,7 @@ class IdentifiedModel:
     offset_runs: int
     cutoff: float
     coulomb_velocity: float
+    q_range: np.ndarray | None = None
 
 
 def read_model(path: Path) -> IdentifiedModel:
@@ -97,6 +100,7 @@ def read_model(path: Path) -> IdentifiedModel:
             max(1, len(g["offset_runs"][()])) if "offset_runs" in g else 1,
             float(g.attrs["cutoff_Hz"]),
             float(g.attrs.get("coulomb_velocity_rad_s", 0.01)),
+            g["fit_q_range"][()] if "fit_q_range" in g else None,
         )
 
 
@@ -138,6 +142,7 @@ def validate_model(report: Path, problem: IdentifyProblem) -> list[RunError]:
             payload,
             split=False,
             offset_runs=model.offset_runs,
+            q_range=model.q_range,
         )
         data = data.with_load_columns(model.rigid, [t for t in terms if t.effect in TWO_STAGE])
         predicted = predict(data, np.concatenate([model.base, model.coefficients]), terms)
