@@ -15,7 +15,7 @@ from excite_cli.dynamics.robot import Robot, load_robot, resolve_urdf
 from excite_cli.errors import ExciteError
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.dataset import Dataset, build_datasets, fit_position_range
-from excite_cli.identification.effects import SHAPE_FIELDS, TWO_STAGE, Term, coefficient_names
+from excite_cli.identification.effects import POSITION, SHAPE_FIELDS, TWO_STAGE, Term, coefficient_names
 from excite_cli.identification.fit_choice import ConsistentModel, choose_fit
 from excite_cli.identification.least_squares import joint_weights, least_squares, predict, torque_errors
 from excite_cli.identification.measurements import load_run
@@ -96,7 +96,7 @@ class Prepared:
     """The data ``identify`` works on: fit and validation datasets (two-stage columns included), the
     runs with fit instants, the cut-off [Hz] and its source, rows dropped per run, decimated rate [Hz],
     the fit data's q range per joint (n, 2) [rad] that guards the position-dependent effects (None
-    with ``identification.position_guard`` off)."""
+    with ``identification.position_guard`` off or no position effect among the terms)."""
 
     fit: Dataset
     validation: Dataset
@@ -129,7 +129,8 @@ def prepare_data(problem: IdentifyProblem, robot: Robot, base: BaseParameters, t
     samples = [preprocess(runs.pop(0), problem.preprocessing, cutoff) for _ in range(len(runs))]
     rate = max(s.filter.rate / s.filter.step for s in samples)
     coulomb = [Term("coulomb", j) for j in range(robot.n_joints)]  # the load column's sign
-    q_range = fit_position_range(samples, problem.data.validation_blocks) if cfg.position_guard else None
+    guarded = cfg.position_guard and any(t.effect in POSITION for t in terms)  # the range costs a pass over q
+    q_range = fit_position_range(samples, problem.data.validation_blocks) if guarded else None
     fit, val, fitted = build_datasets(
         robot,
         base,
@@ -211,17 +212,18 @@ def run_identification(
             val_data, np.concatenate([choice.consistent.base, choice.consistent.effects]), selection.terms
         )
     after = consistent if choice.is_consistent else plain
+    rms_after, rms_torque, relative_after = torque_errors(measured, after)
     ladder = error_ladder(val_data, selection, robot.joint_names)
     if choice.is_consistent:  # the reported model's step: the same effects, the consistent fit
-        ladder.append((choice.name, float(choice.cv_error[choice.chosen]), torque_errors(measured, after)[2].mean()))
+        ladder.append((choice.name, float(choice.cv_error[choice.chosen]), relative_after.mean()))
     report = Report(
         joints=robot.joint_names,
         base_names=base.names,
         selection=selection,
         fit_choice=choice,
         rms_before=torque_errors(measured, before)[0],
-        rms_after=torque_errors(measured, after)[0],
-        rms_torque=torque_errors(measured, after)[1],
+        rms_after=rms_after,
+        rms_torque=rms_torque,
         rms_least_squares=torque_errors(measured, plain)[0],
         rms_consistent=None if consistent is None else torque_errors(measured, consistent)[0],
         validation=val_data,

@@ -38,7 +38,8 @@ class Report:
             rigid body, the search's start and after each step of the kept search (least squares),
             then the consistent fit when it is the reported one.
         q_range: (n, 2) [rad] each joint's q range over the fit data; the position-dependent
-            effects hold their value at its ends outside it (None: no guard).
+            effects hold their value at its ends outside it (None: no position effect among the
+            candidates, or ``position_guard`` off).
     """
 
     joints: list[str]
