@@ -97,6 +97,15 @@ def write_strings(group: h5py.Group, name: str, values: Sequence[str]) -> None:
     group.create_dataset(name, data=np.array(values, dtype=h5py.string_dtype()))
 
 
+def write_table(group: h5py.Group, name: str, rows: Sequence[tuple], fields: str, **attrs) -> h5py.Dataset:
+    """A compound dataset ``name`` in ``group`` of ``rows`` (tuples), its fields ``"name:type ..."``
+    (numpy type codes, ``str`` for a UTF-8 string), and ``attrs`` on it."""
+    dtype = [(f, h5py.string_dtype() if t == "str" else t) for f, t in (x.split(":") for x in fields.split())]
+    data = group.create_dataset(name, data=np.array(list(rows), dtype=dtype))
+    data.attrs.update(attrs)
+    return data
+
+
 def read_strings(group: h5py.Group, name: str) -> list[str]:
     """The strings of a dataset written by :func:`write_strings` (bytes decoded)."""
     return [v.decode() if isinstance(v, bytes) else str(v) for v in group[name][()]]

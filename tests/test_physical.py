@@ -68,6 +68,15 @@ def test_real_panda_consistent_fit_and_its_urdf(tmp_path):
         assert g["physically_consistent"][()] == chosen.startswith("consistent")
         standard, base_parameters = g["standard_parameters"][()], g["base_parameters_consistent"][()]
         consistent, unconstrained = g["relative_consistent"][()].mean(), g["relative_least_squares"][()].mean()
+        models, fits = g["models"][()], g["fits"][()]
+        winner, model = models[g["models"].attrs["chosen"]], g.attrs["model"]
+    # every model scored under every fit; the winning pair has the lowest J, and the fits table is its model's row
+    assert models.size == len(set(models["model"])) * fits.size > fits.size
+    assert winner["objective"] == models["objective"].min() and winner["fit"].decode() == chosen
+    assert winner["model"].decode() == model and model.startswith(("start of '", "end of '"))
+    mine = models[models["model"] == winner["model"]]
+    np.testing.assert_array_equal(mine["cv_error"], fits["cv_error"])
+    assert "Models and fits scored together" in run.output
     assert np.all(_eigenvalues(standard) > 0)
     assert consistent <= unconstrained + 1.0
     # the written URDF, loaded by pinocchio on its own, against the identified rigid-body torques at

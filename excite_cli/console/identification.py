@@ -107,11 +107,39 @@ def fits(report: Report) -> list[Table]:
             )
         )
     return [
+        *models(report),
         titled_table(
             "Fits of the chosen model, scored on the selection's folds",
             ("fit", "cross-validated [%]", "validation [%]"),
             rows,
             f"chosen: {choice.name}, {choice.lead:.2f} % points below the next (cross-validated)",
+        ),
+    ]
+
+
+def models(report: Report) -> list[Table]:
+    """The models compared with the fits (each search's start and end): the best fit of each and J."""
+    choice = report.fit_choice
+    if len(choice.models) < 2:
+        return []
+    rows = []
+    for k, (label, model) in enumerate(zip(choice.labels, choice.models)):
+        best = int(np.nanargmin(choice.objective[k]))
+        rows.append(
+            (
+                label + (" (chosen)" if k == choice.model else ""),
+                str(model.effects),
+                f"{choice.cv[k, 0]:.2f}" if choice.names[0] == "least squares" else "",
+                choice.names[best],
+                f"{choice.cv[k, best]:.2f}",
+                f"{choice.objective[k, best]:.4f}",
+            )
+        )
+    return [
+        titled_table(
+            "Models and fits scored together: J = log CV + effects × log(1 + min_improvement), the lowest wins",
+            ("model", "effects", "least squares CV [%]", "best fit", "its CV [%]", "J"),
+            rows,
         )
     ]
 
@@ -200,7 +228,9 @@ def search(report: Report, runners_up: int = 2) -> list[Table | str]:
         f"Selection steps from the start '{kept.start}' (gain: cut of the cross-validated error [%])",
         ("step", "move", "gain [%]", "tried", f"next best {runners_up} [gain %]"),
         rows,
-        f"stopped: {kept.stop}",
+        "kept at its start: scored with the fits, the start wins (see the models compared)"
+        if sel.at_start
+        else f"stopped: {kept.stop}",
     )
     starts = "; ".join(
         f"{s.start}: {s.cv_error:.2f} % with {len(s.terms)} effects" + (" (kept)" if k == sel.chosen else "")

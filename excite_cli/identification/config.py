@@ -96,7 +96,7 @@ class IdentificationConfig(Section):
     out, how many time blocks) and threshold,
     friction shape velocities [rad/s] (a Stribeck or held velocity: one value, or a grid the
     selection searches), the fit (least squares, physically consistent, or the one the cross-validation
-    prefers) and the consistent fit's regularization weights toward the URDF."""
+    prefers together with the model) and the consistent fit's regularization weights toward the URDF."""
 
     method: Literal["wls", "ls"] = "wls"
     declared_effects: dict[str, list[Effect]] = Field(default_factory=dict)

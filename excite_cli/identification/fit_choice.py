@@ -1,29 +1,38 @@
-"""The fit that transfers, chosen by the selection's own cross-validation.
+"""The model and the fit that transfer, chosen together by the selection's own cross-validation.
 
-Least squares of the chosen model fits the fit data best; on poorly exciting data its base
-parameters are free to take values no robot has and extrapolate badly to motions the fit did not
-see. The physically consistent fit (:mod:`~excite_cli.identification.physical`) of the same model
-keeps every body a real mass distribution and, with weight λ, near the CAD model; on well-excited
-data it costs a little. Which one transfers depends on the data set, so the candidates are scored on
-the folds that chose the effects (:class:`~excite_cli.identification.crossval.CrossValidation`:
-whole runs or time blocks, the same margins and held-out offsets): least squares (its CV error is
-the selection's) and the consistent fit at every λ of ``identification.regularization``, refitted
-on each fold's training normal equations. The lowest CV error wins (``fit: auto``); ``fit:
-least_squares`` or ``consistent`` restricts the candidates, and a single candidate is not
-cross-validated. The reported model, its validation error and the identified URDF are the
-winner's; the best consistent fit stays beside least squares in the report.
+Least squares of a model fits the fit data best; on poorly exciting data its base parameters are
+free to take values no robot has and extrapolate badly to motions the fit did not see. The
+physically consistent fit (:mod:`~excite_cli.identification.physical`) keeps every body a real mass
+distribution and, with weight λ, near the CAD model; on well-excited data it costs a little. Which
+one transfers depends on the data set, and so do the effects a model needs: the effect search runs
+under least squares (:mod:`~excite_cli.identification.selection`), where an effect may only be
+standing in for base parameters the data leave free, which the consistent fit pins. So the models
+the search passed through at its ends (each search's start and end) are scored under every
+candidate fit on the folds that chose the effects (:class:`~excite_cli.identification.crossval.
+CrossValidation`: whole runs or time blocks, the same margins and held-out offsets) with the
+search's own objective
+
+    J(M, fit) = log CV(M, fit) + p(M) · log(1 + min_improvement),
+
+p(M) the effects M adds beyond the declared ones: least squares (its CV error is the search's) and
+the consistent fit at every λ of ``identification.regularization``, refitted on each fold's
+training normal equations. The pair with the lowest J wins (``fit: auto``); ``fit: least_squares``
+or ``consistent`` restricts the fits (least squares alone keeps the search's model), and a single
+pair is not cross-validated. The reported model, its validation error and the identified URDF are
+the winner's; the best consistent fit of the winning model stays beside least squares in the report.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.dynamics.robot import Robot
 from excite_cli.identification.config import IdentificationConfig
-from excite_cli.identification.effects import coefficient_names
+from excite_cli.identification.effects import Term, coefficient_names
+from excite_cli.identification.least_squares import least_squares
 from excite_cli.identification.physical import ConsistentFit, ConsistentProgram
 from excite_cli.identification.selection import Selection
 
@@ -32,38 +41,66 @@ LEAST_SQUARES = "least squares"
 
 
 @dataclass(frozen=True)
+class Model:
+    """A model scored with the fits: the search it comes from, whether it is that search's start or
+    end, its terms and the number of effects it adds beyond the declared ones (p)."""
+
+    search: int
+    at_start: bool
+    terms: list[Term]
+    effects: int
+
+    def label(self, selection: Selection) -> str:
+        """e.g. ``end of 'Coulomb on every joint'``."""
+        return f"{'start' if self.at_start else 'end'} of '{selection.searches[self.search].start}'"
+
+
+@dataclass(frozen=True)
 class FitChoice:
-    """The fits compared and the one chosen.
+    """The models and fits compared and the pair chosen.
 
     Attributes:
-        names: (f,) each candidate: ``least squares`` or ``consistent λ=<λ>``.
+        models: (m,) each model compared (the ends and starts of the searches, each set of terms once).
+        labels: (m,) their labels, e.g. ``end of 'declared effects'``.
+        names: (f,) each candidate fit: ``least squares`` or ``consistent λ=<λ>``.
         regularization: (f,) λ of each consistent candidate (NaN for least squares).
-        cv_error: (f,) CV error [%] of each on the selection's folds (NaN: the only candidate).
-        chosen: index of the winner in ``names``.
-        consistent: the physically consistent fit on all fit data at the best consistent λ (the
-            winner's, or the one beside least squares), or None when none was asked for.
+        cv: (m, f) CV error [%] of each model under each fit on the selection's folds (NaN: the only
+            pair, not cross-validated).
+        objective: (m, f) J of each pair (module docstring).
+        model: index of the winning model in ``models``; chosen: index of its fit in ``names``.
+        consistent: the physically consistent fit of the winning model on all fit data at its best
+            consistent λ (the winner's, or the one beside least squares), or None when none was asked for.
     """
 
+    models: list[Model]
+    labels: list[str]
     names: list[str]
     regularization: np.ndarray
-    cv_error: np.ndarray
+    cv: np.ndarray
+    objective: np.ndarray
+    model: int
     chosen: int
     consistent: ConsistentFit | None
 
     @property
     def name(self) -> str:
-        """The winner's name."""
+        """The winning fit's name."""
         return self.names[self.chosen]
 
     @property
     def is_consistent(self) -> bool:
-        """Whether the winner is a physically consistent fit."""
+        """Whether the winning fit is a physically consistent one."""
         return self.name != LEAST_SQUARES
 
     @property
+    def cv_error(self) -> np.ndarray:
+        """(f,) CV error [%] of the winning model under each fit."""
+        return self.cv[self.model]
+
+    @property
     def lead(self) -> float:
-        """How much lower the winner's CV error is than the next best candidate's [% points]
-        (NaN with a single candidate)."""
+        """How much lower the winner's CV error is than the next best fit's of the same model [% points]
+        (NaN with a single fit)."""
         others = np.delete(self.cv_error, self.chosen)
         if others.size == 0 or np.all(np.isnan(others)):
             return float("nan")
@@ -71,22 +108,20 @@ class FitChoice:
 
 
 class ConsistentModel:
-    """The physically consistent fit of a selected model, on any normal equations of its unknowns
-    [Y_B, ``selection.terms``] (all fit data, or one fold's training data): one compiled program.
+    """The physically consistent fit of one model [Y_B, ``terms``] on any normal equations of its
+    unknowns (all fit data, or one fold's training data): one compiled program.
 
     Args:
-        selection: the chosen terms and the fit data's normal equations; robot, base: the URDF's
-            parameters, bodies and regrouping K.
+        terms: the model's terms; selection: the fit data's normal equations and the joints' weights.
+        robot, base: the URDF's parameters, bodies and regrouping K.
         offset_runs: the labels of the fitted runs, which name the offsets' columns.
     """
 
-    def __init__(self, selection: Selection, robot: Robot, base: BaseParameters, offset_runs: list[str]):
-        names = [
-            f"{name} {robot.joint_names[t.joint]}"
-            for t in selection.terms
-            for name in coefficient_names(t, offset_runs)
-        ]
-        reference = selection.normal.system(selection.weights, selection.terms)[0]
+    def __init__(
+        self, terms: list[Term], selection: Selection, robot: Robot, base: BaseParameters, offset_runs: list[str]
+    ):
+        names = [f"{name} {robot.joint_names[t.joint]}" for t in terms for name in coefficient_names(t, offset_runs)]
+        reference = selection.normal.system(selection.weights, terms)[0]
         self.program = ConsistentProgram(reference, base.regrouping, robot.urdf_parameters(), names, robot.body_names)
 
     def fit(self, G: np.ndarray, c: np.ndarray, rows: int, regularization: float) -> ConsistentFit:
@@ -109,48 +144,105 @@ def candidates(cfg: IdentificationConfig) -> list[float | None]:
     return plain + ([] if cfg.fit == "least_squares" else list(cfg.regularization))
 
 
+def compared_models(selection: Selection) -> list[Model]:
+    """The end and the start of every search, each set of terms once, the kept search's end first."""
+    order = [selection.chosen] + [k for k in range(len(selection.searches)) if k != selection.chosen]
+    out: list[Model] = []
+    for k in order:
+        search = selection.searches[k]
+        for at_start, terms in ((False, search.terms), (True, search.initial)):
+            if all(set(terms) != set(m.terms) for m in out):
+                out.append(Model(k, at_start, list(terms), len(terms) - selection.declared))
+    return out
+
+
+def _scores(selection: Selection, model: Model, lams: list[float | None], consistent: ConsistentModel | None):
+    """(f,) CV error [%] of ``model`` under each fit of ``lams`` (the search's own for least squares)."""
+    search, cv = selection.searches[model.search], selection.cross_validation
+    out = []
+    for lam in lams:
+        if lam is None:
+            out.append(search.initial_error if model.at_start else search.cv_error)
+            continue
+
+        def refit(k: int, lam: float = lam) -> np.ndarray:
+            return consistent.coefficients(*cv.training_system(k, model.terms), lam)
+
+        out.append(cv.error(model.terms, refit)[0])
+    return np.array(out)
+
+
+def kept_selection(selection: Selection, model: Model, oversampling: float) -> Selection:
+    """``selection`` with ``model`` as its chosen model: its terms, least-squares fit and CV errors."""
+    if model.search == selection.chosen and not model.at_start:
+        return selection
+    search = selection.searches[model.search]
+    return replace(
+        selection,
+        terms=model.terms,
+        fit=least_squares(selection.normal, model.terms, selection.weights, oversampling),
+        cv_error=search.initial_error if model.at_start else search.cv_error,
+        cv_joint=selection.cross_validation.error(model.terms)[1],
+        chosen=model.search,
+        at_start=model.at_start,
+    )
+
+
 def choose_fit(
     selection: Selection,
-    model: ConsistentModel,
+    robot: Robot,
+    base: BaseParameters,
+    offset_runs: list[str],
     cfg: IdentificationConfig,
+    oversampling: float = 1.0,
     consistent_beside: bool = False,
-) -> FitChoice:
-    """Score the candidate fits of ``cfg.fit`` on the selection's folds and fit the best consistent
-    one on all fit data (module docstring).
+) -> tuple[Selection, FitChoice]:
+    """Score every model of :func:`compared_models` under every fit of ``cfg.fit`` on the selection's
+    folds, keep the pair with the lowest J and fit the winning model's best consistent λ on all fit
+    data (module docstring).
 
     Args:
-        selection: the chosen model, its least-squares fit, weights, normal equations and folds.
-        model: its physically consistent fit.
-        cfg: ``fit`` and ``regularization`` (λ, one or several).
+        selection: the searches, the least-squares fit, weights, normal equations and folds.
+        robot, base, offset_runs: for the consistent fits (:class:`ConsistentModel`).
+        cfg: ``fit``, ``regularization`` (λ, one or several) and ``min_improvement`` (the price p pays).
+        oversampling: samples per independent sample of the fit data, for the least-squares std.
         consistent_beside: fit the consistent model (at the first λ) even when least squares is the
-            only candidate (the identified URDF needs one).
+            only fit (the identified URDF needs one).
+
+    Returns:
+        The selection with the winning model as its chosen one, and the choice.
 
     Raises:
         ExciteError: a semidefinite program has no solution.
     """
     lams = candidates(cfg)
-    cv = selection.cross_validation
-    errors = np.full(len(lams), np.nan)
-    for i, lam in enumerate(lams if len(lams) > 1 else []):
-        if lam is None:
-            errors[i] = selection.cv_error
-            continue
-
-        def refit(k: int, lam: float = lam) -> np.ndarray:
-            return model.coefficients(*cv.training_system(k, selection.terms), lam)
-
-        errors[i] = cv.error(selection.terms, refit)[0]
-    chosen = int(np.nanargmin(errors)) if len(lams) > 1 else 0
-    consistent = [(errors[i], i) for i, lam in enumerate(lams) if lam is not None]
-    best = lams[min(consistent)[1]] if consistent else (cfg.regularization[0] if consistent_beside else None)
+    models = compared_models(selection)
+    single = len(models) * len(lams) == 1 and lams[0] is not None  # nothing to compare
+    scored = any(lam is not None for lam in lams) and not single
+    programs = [ConsistentModel(m.terms, selection, robot, base, offset_runs) if scored else None for m in models]
+    cv = np.full((len(models), len(lams)), np.nan)
+    if not single:
+        cv = np.array([_scores(selection, m, lams, p) for m, p in zip(models, programs)])
+    penalty = np.log1p(cfg.min_improvement)
+    objective = np.log(np.maximum(cv, 1e-12)) + penalty * np.array([[m.effects] for m in models])
+    win, chosen = (0, 0) if single else np.unravel_index(int(np.nanargmin(objective)), objective.shape)
+    consistent = [k for k, lam in enumerate(lams) if lam is not None]
+    best = min(consistent, key=lambda k: np.nan_to_num(cv[win, k], nan=np.inf)) if consistent else None
+    lam = lams[best] if best is not None else (cfg.regularization[0] if consistent_beside else None)
     fit = None
-    if best is not None:
-        G, c, _ = selection.normal.system(selection.weights, selection.terms)
-        fit = model.fit(G, c, selection.normal.rows, best)
-    return FitChoice(
+    if lam is not None:
+        program = programs[win] or ConsistentModel(models[win].terms, selection, robot, base, offset_runs)
+        G, c, _ = selection.normal.system(selection.weights, models[win].terms)
+        fit = program.fit(G, c, selection.normal.rows, lam)
+    choice = FitChoice(
+        models=models,
+        labels=[m.label(selection) for m in models],
         names=[LEAST_SQUARES if lam is None else f"consistent λ={lam:g}" for lam in lams],
         regularization=np.array([np.nan if lam is None else lam for lam in lams]),
-        cv_error=errors,
-        chosen=chosen,
+        cv=cv,
+        objective=objective,
+        model=int(win),
+        chosen=int(chosen),
         consistent=fit,
     )
+    return kept_selection(selection, models[win], oversampling), choice

@@ -16,7 +16,7 @@ from excite_cli.errors import ExciteError
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.dataset import Dataset, build_datasets, fit_position_range
 from excite_cli.identification.effects import POSITION, SHAPE_FIELDS, TWO_STAGE, Term, coefficient_names
-from excite_cli.identification.fit_choice import ConsistentModel, choose_fit
+from excite_cli.identification.fit_choice import choose_fit
 from excite_cli.identification.least_squares import joint_weights, least_squares, predict, torque_errors
 from excite_cli.identification.measurements import load_run
 from excite_cli.identification.normal import NormalEquations, excited_rank
@@ -191,18 +191,19 @@ def run_identification(
         problem, robot, base, declared + [t for t in candidate_terms(cfg, robot.n_joints) if t not in declared]
     )
     fit_data, val_data = data.fit, data.validation
+    oversampling = max(1.0, data.rate / (2.0 * data.cutoff))
     selection = select_effects(
         fit_data,
         cfg,
         declared,
         margin=1.0 / data.cutoff,
-        oversampling=max(1.0, data.rate / (2.0 * data.cutoff)),
+        oversampling=oversampling,
         recordings=fold_groups(problem, data.fitted),
         fitted_offsets=set(np.unique(val_data.run).tolist()) <= set(data.fitted),
     )
     labels = [r.label for r in problem.data.runs]
     offset_runs = [labels[k] for k in data.fitted]
-    choice = choose_fit(selection, ConsistentModel(selection, robot, base, offset_runs), cfg, consistent_beside)
+    selection, choice = choose_fit(selection, robot, base, offset_runs, cfg, oversampling, consistent_beside)
     measured = val_data.tau.reshape(-1, val_data.n)
     before = predict(val_data, selection.rigid.x, [])
     plain = predict(val_data, selection.fit.x, selection.terms)

@@ -13,7 +13,7 @@ import numpy as np
 from excite_cli.config import effective_yaml
 from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.dynamics.robot import Robot
-from excite_cli.h5 import atomic_h5, write_strings
+from excite_cli.h5 import atomic_h5, write_strings, write_table
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.effects import COEFFICIENTS, UNITS
 from excite_cli.identification.physical import body_properties
@@ -160,43 +160,42 @@ def _write_search(g: h5py.Group, report: Report) -> None:
     g.create_dataset("candidates", data=np.array(tried, dtype=move)).attrs["units"] = (
         units + "; every move tried at each step"
     )
-    searches = np.array(
+    write_table(
+        g,
+        "searches",
         [
-            (
-                s.start,
-                ", ".join(t.label(report.joints) for t in s.terms),
-                s.cv_error,
-                s.objective,
-                len(s.steps),
-                s.stop,
-                k == sel.chosen,
-            )
+            (s.start, ", ".join(t.label(report.joints) for t in s.terms), s.cv_error, s.objective, len(s.steps), s.stop)
+            + (k == sel.chosen,)
             for k, s in enumerate(sel.searches)
         ],
-        dtype=[
-            ("start", STR),
-            ("effects", STR),
-            ("cv_error", "f8"),
-            ("objective", "f8"),
-            ("steps", "i4"),
-            ("stop_reason", STR),
-            ("chosen", "?"),
-        ],
-    )
-    g.create_dataset("searches", data=searches).attrs["units"] = (
-        "cv_error in %; objective J = log CV + p log(1 + min_improvement)"
+        "start:str effects:str cv_error:f8 objective:f8 steps:i4 stop_reason:str chosen:?",
+        units="cv_error in %; objective J = log CV + p log(1 + min_improvement)",
     )
 
 
 def _write_fits(g: h5py.Group, report: Report) -> None:
-    """The candidate fits of the chosen model and their cross-validated errors; the chosen one."""
+    """The candidate fits of the chosen model and their cross-validated errors, the chosen one; every
+    model compared under every fit, with J."""
     choice = report.fit_choice
     g.attrs["fit"], g.attrs["fit_lead"] = choice.name, choice.lead
-    table = np.zeros(len(choice.names), dtype=[("fit", STR), ("regularization", "f8"), ("cv_error", "f8")])
-    table["fit"], table["regularization"], table["cv_error"] = choice.names, choice.regularization, choice.cv_error
-    data = g.create_dataset("fits", data=table)
-    data.attrs["units"] = "cv_error in % on the selection's folds (NaN: the only candidate, not cross-validated)"
-    data.attrs["chosen"] = choice.chosen
+    write_table(
+        g,
+        "fits",
+        zip(choice.names, choice.regularization, choice.cv_error),
+        "fit:str regularization:f8 cv_error:f8",
+        units="cv_error in % of the chosen model on the selection's folds (NaN: the only pair, not cross-validated)",
+        chosen=choice.chosen,
+    )
+    rows = zip(choice.labels, choice.models, choice.cv, choice.objective)
+    write_table(
+        g,
+        "models",
+        [(label, m.effects, name, cv, J) for label, m, cvs, Js in rows for name, cv, J in zip(choice.names, cvs, Js)],
+        "model:str effects:i4 fit:str cv_error:f8 objective:f8",
+        units="cv_error in %; objective J = log CV + effects × log(1 + min_improvement); the lowest wins",
+        chosen=choice.model * len(choice.names) + choice.chosen,
+    )
+    g.attrs["model"] = choice.labels[choice.model]
     for name, values, unit in (
         ("rms_least_squares", report.rms_least_squares, "Nm"),
         ("relative_least_squares", report.relative_least_squares, "%"),

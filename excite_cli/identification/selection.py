@@ -107,6 +107,8 @@ class Selection:
         cv_rigid, cv_error: CV error [%] of the rigid-body model and of the chosen one.
         cv_joint: (n,) the chosen model's CV error per joint [%].
         searches: the search from every start; ``chosen`` indexes the one kept.
+        at_start: the kept model is that search's start, not its end (chosen with the fit,
+            :mod:`~excite_cli.identification.fit_choice`).
         absorbed: candidates skipped as not separately identifiable.
         cross_validation: the folds every model was scored on, for scoring other fits of the model.
         min_improvement: the price of an effect (a fraction).
@@ -127,6 +129,7 @@ class Selection:
     cross_validation: CrossValidation
     min_improvement: float
     normal: NormalEquations
+    at_start: bool = False
 
     @property
     def folds(self) -> int:
@@ -140,8 +143,8 @@ class Selection:
 
     @property
     def steps(self) -> list[Step]:
-        """The steps of the kept search."""
-        return self.searches[self.chosen].steps
+        """The steps of the kept search up to the kept model."""
+        return [] if self.at_start else self.searches[self.chosen].steps
 
 
 def candidate_terms(cfg: IdentificationConfig, n: int) -> list[Term]:
