@@ -14,7 +14,7 @@ from excite_cli.console import identification as identify_tables
 from excite_cli.console import tables
 from excite_cli.console.errors import spellings, word
 from excite_cli.console.progress import Bars, wide_console
-from excite_cli.errors import ExciteError, Interrupted
+from excite_cli.errors import ExciteError, Interrupted, Terminated, sigterm_as_interrupt
 from excite_cli.identification.config import IdentifyProblem, SimulationConfig
 from excite_cli.identification.validate import validate_model
 from excite_cli.optimization.criterion import OBJECTIVES
@@ -33,19 +33,24 @@ SCHEDULER = typer.Option(
 
 
 def command(name: Optional[str] = None) -> Callable:
-    """A command of ``app``: ExciteError → one line, exit 2 (no traceback); Ctrl-C → what was kept, exit 130."""
+    """A command of ``app``: ExciteError → one line, exit 2 (no traceback); Ctrl-C or SIGTERM → what
+    was kept, exit 130 or 143."""
 
     def register(function: Callable) -> Callable:
         @functools.wraps(function)
         def guarded(*args, **kwargs):
             try:
-                return function(*args, **kwargs)
+                with sigterm_as_interrupt():
+                    return function(*args, **kwargs)
             except ExciteError as exc:
                 err.print(f"[bold red]error:[/] {escape(word(exc, spelled))}", highlight=False, soft_wrap=True)
                 raise typer.Exit(2) from None
             except Interrupted as exc:
                 err.print(str(exc), highlight=False, soft_wrap=True)
-                raise typer.Exit(130) from None
+                raise typer.Exit(exc.status) from None
+            except KeyboardInterrupt as exc:
+                err.print("terminated" if isinstance(exc, Terminated) else "interrupted", highlight=False)
+                raise typer.Exit(getattr(exc, "status", 130)) from None
 
         spelled = spellings(function)
         return app.command(name)(guarded)
@@ -160,7 +165,7 @@ def verify_gradient(
     tolerance: float = typer.Option(1e-6, help="Largest relative error against central differences that passes."),
 ) -> None:
     """Analytic gradients (Eq. 49) and constraint Jacobians against finite differences; exit 1 above the tolerance."""
-    verification = run_verify(load_problem(config), result, objective or OBJECTIVES, step, seed)
+    verification = run_verify(load_problem(config), result, objective or OBJECTIVES, step, seed, tolerance)
     _say(tables.verification(verification, tolerance))
     if verification.worst > tolerance:
         raise typer.Exit(1)

@@ -1,11 +1,15 @@
 """The errors that reach the user as one line (no traceback). Each names the field at fault, the
 offending value and what is expected, so a caller (the command line, a notebook, a test) reads them
-as data; the command line alone words the field as its option (``output`` → ``--output``)."""
+as data; the command line alone words the field as its option (``output`` → ``--output``). Ctrl-C and
+SIGTERM stop a run the same way (:func:`sigterm_as_interrupt`)."""
 
 from __future__ import annotations
 
+import signal
+import threading
+from contextlib import contextmanager
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterator
 
 #: ``value`` when no single value is at fault (a missing entry, a relation between fields).
 NO_VALUE = None
@@ -61,9 +65,38 @@ class CannotWrite(ExciteError):
         self.reason = str(reason)
 
 
-class Interrupted(Exception):
-    """Ctrl-C during a run that writes as it goes; ``kept`` finished parts are in ``path``."""
+class Terminated(KeyboardInterrupt):
+    """SIGTERM (``kill``, a scheduler, a CI timeout), raised where Ctrl-C would be so that both stop a
+    run the same way; ``status`` 143 (128 + SIGTERM) instead of Ctrl-C's 130."""
 
-    def __init__(self, path, kept: int):
-        super().__init__(f"interrupted: kept {kept} finished iteration(s) in {path}")
-        self.path, self.kept = path, kept
+    status = 143
+
+
+class Interrupted(Exception):
+    """Ctrl-C or SIGTERM during a run that writes as it goes; ``kept`` finished parts are in ``path``;
+    ``status`` the exit status (130 Ctrl-C, 143 SIGTERM)."""
+
+    def __init__(self, path, kept: int, status: int = 130):
+        word = "terminated" if status == Terminated.status else "interrupted"
+        super().__init__(f"{word}: kept {kept} finished iteration(s) in {path}")
+        self.path, self.kept, self.status = path, kept, status
+
+
+@contextmanager
+def sigterm_as_interrupt() -> Iterator[None]:
+    """SIGTERM raises :class:`Terminated` (a KeyboardInterrupt) in the main thread, so it stops a run
+    as Ctrl-C does: workers stopped, partial files removed, finished work kept; a second SIGTERM
+    during that clean-up is ignored."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def terminate(signum, frame) -> None:
+        signal.signal(signal.SIGTERM, signal.SIG_IGN)
+        raise Terminated()
+
+    previous = signal.signal(signal.SIGTERM, terminate)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)

@@ -49,7 +49,7 @@ class BatchKinematics:
         for j in range(1, model.njoints):
             if j in self._column:
                 k = self._column[j]
-                S = pin.getJointJacobian(model, data, j, pin.LOCAL)[:, model.joints[j].idx_v]
+                S = pin.getJointJacobian(model, data, j, pin.LOCAL).reshape(6, model.nv)[:, model.joints[j].idx_v]
                 self.joint_of[k] = j
                 self.revolute[k] = np.linalg.norm(S[3:]) > 0.0
                 self.axes[k] = S[3:] if self.revolute[k] else S[:3]

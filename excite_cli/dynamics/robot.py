@@ -18,6 +18,7 @@ import numpy as np
 import pinocchio as pin
 
 from excite_cli.config import Problem, RobotConfig
+from excite_cli.dynamics.urdf_checks import check_urdf
 from excite_cli.errors import ExciteError
 
 #: Order of pinocchio's 10 dynamic parameters of one body (``Inertia.toDynamicParameters``).
@@ -144,7 +145,7 @@ class Robot:
             data: the caller's pinocchio Data (each consumer keeps its own; default: the robot's).
         """
         Y = pin.computeJointTorqueRegressor(self.model, data or self.data, *self.state(q, qd, qdd))
-        return Y[self.row_idx]
+        return Y.reshape(self.model.nv, -1)[self.row_idx]  # a one-joint model's comes back flat
 
     def regressor_stack(
         self, Q: np.ndarray, QD: np.ndarray, QDD: np.ndarray, data: pin.Data | None = None
@@ -162,7 +163,7 @@ class Robot:
         data = data or self.data
         qf = self.q_reference.copy()
         qf[self.q_idx] = q
-        J = pin.jacobianCenterOfMass(self.model, data, qf, False)
+        J = pin.jacobianCenterOfMass(self.model, data, qf, False).reshape(3, self.model.nv)
         return data.com[0].copy(), J[:, self.v_idx]
 
     def random_states(self, count: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -232,10 +233,11 @@ def load_robot(problem: Problem, collision: bool = False) -> Robot:
 
     Raises:
         ExciteError: missing URDF, unknown joint name, a joint that is not 1-DoF, a locked value
-            outside the joint's limits.
+            outside the joint's limits, a body or active joint that cannot be (:func:`check_urdf`).
     """
     cfg: RobotConfig = problem.robot
     path, package_dirs = resolve_urdf(problem)
+    check_urdf(path, list(cfg.active_joints))  # before urdfdom, which prints what it cannot parse
     try:
         full = pin.buildModelFromUrdf(str(path), *([pin.JointModelFreeFlyer()] if cfg.floating_base else []))
     except (RuntimeError, ValueError) as exc:

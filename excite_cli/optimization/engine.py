@@ -13,6 +13,7 @@ oversubscribe the cores, and keeps the memory it frees (:func:`~excite_cli.memor
 from __future__ import annotations
 
 import os
+import signal
 import threading
 from concurrent.futures import Executor, ProcessPoolExecutor, as_completed
 from typing import Any, Callable, Iterator, Optional, Protocol, Sequence
@@ -26,6 +27,8 @@ from excite_cli.optimization.excitation import Excitation, build_excitation
 
 #: How long to wait for a Dask scheduler to answer.
 CONNECT_TIMEOUT = "10s"
+#: Seconds a stopped worker process is given to end.
+WORKER_STOP = 5.0
 
 
 class Task(Protocol):
@@ -55,6 +58,13 @@ def run_on_worker(problem: Problem, task: Task) -> Any:
     threadpool_limits(limits=1)
     keep_freed_memory()
     return task(_worker_excitation(problem))
+
+
+def _worker_signals() -> None:
+    """A pool worker leaves stopping to the main process: Ctrl-C (sent to the whole terminal group) is
+    ignored, SIGTERM (sent by the main process when it stops) ends it at once, without a traceback."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
 class Engine:
@@ -87,12 +97,19 @@ class Engine:
                     "optimizer.scheduler", f"cannot reach the Dask scheduler at {self.scheduler}: {exc}"
                 ) from None
         elif self.workers > 1:
-            self._pool = ProcessPoolExecutor(max_workers=self.workers)
+            self._pool = ProcessPoolExecutor(max_workers=self.workers, initializer=_worker_signals)
         return self
 
-    def __exit__(self, *exc) -> None:
+    def __exit__(self, kind, *exc) -> None:
         if self._pool is not None:
-            self._pool.shutdown(cancel_futures=True)
+            # on an error or interruption the running tasks are not waited for: their processes are
+            # stopped (the executor has no public call for it before Python 3.14)
+            processes = list((self._pool._processes or {}).values()) if kind is not None else []
+            self._pool.shutdown(wait=kind is None, cancel_futures=True)
+            for process in processes:
+                process.terminate()
+            for process in processes:
+                process.join(WORKER_STOP)
         if self._client is not None:
             self._client.close()
         if self._limits is not None:

@@ -23,12 +23,15 @@ def check_target(path: Path, field: str, force: bool = False, exists_ok: bool = 
 
     Raises:
         OutputExists: the file exists and neither ``force`` nor ``exists_ok``.
-        ExciteError: ``path`` is a folder, a file is in the way of its folder, or its nearest
+        ExciteError: ``path`` is a folder or not a regular file (a device, a FIFO), a file is in the
+            way of its folder, or its nearest
             existing folder is not writable.
     """
     path = Path(path)
     if path.is_dir():
         raise ExciteError(field, f"{path} is a folder", path, "a file name")
+    if path.exists() and not path.is_file():  # a device, FIFO or socket is never replaced, even with --force
+        raise ExciteError(field, f"{path} is not a regular file", path, "a file name")
     if path.exists() and not (force or exists_ok):
         raise OutputExists(field, path)
     folder = path.parent

@@ -7,6 +7,7 @@ from pathlib import Path
 from typing import Optional
 
 from excite_cli.dynamics.robot import Robot
+from excite_cli.errors import ExciteError
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.pipeline import run_identification, write_identified_urdf
 from excite_cli.identification.report import Report
@@ -38,14 +39,16 @@ def run_identify(
         ExciteError: bad paths or data (see :func:`run_identification`).
     """
     check_target(target, "output", force)
+    stem = target.with_suffix("")
+    plots = [stem.with_name(target.stem + suffix) for suffix in ("_residuals.png", "_ladder.png")]
     if urdf_out is not None:
         check_target(urdf_out, "urdf_out", force)
+        if Path(urdf_out).resolve() in {p.resolve() for p in [target, *plots]}:
+            raise ExciteError(
+                "urdf_out", f"{urdf_out} is also the report or one of its plots", urdf_out, "another path"
+            )
     report, robot, base, regressor = run_identification(problem, consistent_beside=urdf_out is not None)
     write_identification(target, report, robot, base, problem, regressor)
     deviation = write_identified_urdf(problem, report, robot, base, urdf_out) if urdf_out is not None else None
-    stem = target.with_suffix("")
-    plots = [
-        plot_identification(stem.with_name(target.stem + "_residuals.png"), report),
-        plot_ladder(stem.with_name(target.stem + "_ladder.png"), report),
-    ]
+    plots = [plot_identification(plots[0], report), plot_ladder(plots[1], report)]
     return IdentifyRun(report, robot, target, plots, deviation)

@@ -59,7 +59,7 @@ def run_optimize(
 
     Raises:
         ExciteError: bad target, prior data or problem; a result to resume made with another config.
-        Interrupted: Ctrl-C; the finished iterations are in ``target``.
+        Interrupted: Ctrl-C or SIGTERM; the finished iterations are in ``target``, the workers stopped.
     """
     check_target(target, "output", force, exists_ok=resume)
     if resume and not target.is_file():
@@ -80,8 +80,8 @@ def run_optimize(
             results = run_sequence(
                 excitation, problem.sequence.iterations, problem.optimizer.seed, prior, progress, done, active, finished
             )
-    except KeyboardInterrupt:
-        raise Interrupted(target, len(written)) from None
+    except KeyboardInterrupt as exc:
+        raise Interrupted(target, len(written), getattr(exc, "status", 130)) from None
     return OptimizeRun(excitation, results, target, plot_result(target, excitation, results))
 
 

@@ -35,14 +35,18 @@ def run_verify(
     objectives: Sequence[str] = OBJECTIVES,
     step: float = 1e-6,
     seed: int = 0,
+    tolerance: float = 1e-6,
 ) -> Verification:
     """Every criterion's analytic gradient against finite differences at a random feasible α (and at
     the last optimum of ``result``, with the earlier iterations as C₀), and every constraint's
     Jacobian against central differences at a livelier α.
 
     Raises:
-        ExciteError: an unknown objective, a bad step, a result of another problem.
+        ExciteError: an unknown objective, a bad step or tolerance (the pass mark the caller compares
+            ``worst`` with: a positive finite number), a result of another problem.
     """
+    if not 0.0 < tolerance < np.inf:  # NaN fails too: every comparison with it would pass or fail silently
+        raise ExciteError("tolerance", f"{tolerance:g} is not a relative error", tolerance, "a number > 0")
     for name in objectives:
         if name not in OBJECTIVES:
             raise ExciteError("objective", f"'{name}' is not a criterion", name, f"one of {', '.join(OBJECTIVES)}")

@@ -1,0 +1,141 @@
+"""A robot that can be: the URDF's inertial parameters and the active joints' limits checked when the
+robot is loaded, each problem named by link or joint in one line. pinocchio takes a URDF as it is
+(a negative mass, a NaN urdfdom could not parse and left at 0, a lower limit above the upper one);
+the dynamics of such a model are meaningless (export once wrote torques of 3e92 Nm).
+
+Every link with an ``<inertial>``: the mass m and the inertia entries are finite numbers and m ≥ 0.
+Links an active joint moves (their inertia is in the regressor of the problem) also need principal
+moments I₁ ≤ I₂ ≤ I₃ about the centre of mass that are ≥ 0 and satisfy the triangle inequality
+I₁ + I₂ ≥ I₃ (both within ``TOLERANCE`` of I₃): exactly "some positive mass distribution has this
+inertia" (Traversaro, Brossette, Escande, Nori, IROS 2016). The links no active joint moves are
+not held to it: 46 of the 2149 links of example-robot-data's URDFs break it (sensor mounts of the
+PR2, fingers of the Allegro hand, Romeo's torso), and refusing a robot for a link the problem does
+not move would refuse valid work. Per active joint: the limits are numbers and lower ≤ upper. A
+``<mimic>`` joint follows another in a way the model does not represent, so it may not be active;
+the joint it follows may (the follower is then held, as the Panda's second finger is when the first
+is active).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from xml.etree import ElementTree
+
+import numpy as np
+
+from excite_cli.errors import ExciteError
+
+#: Relative tolerance of the principal-moment checks (CAD exports round their inertias).
+TOLERANCE = 1e-6
+INERTIA = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+
+
+def _number(element: ElementTree.Element, attribute: str, what: str) -> float:
+    """``attribute`` of ``element`` as a finite float (absent: 0).
+
+    Raises:
+        ExciteError: not a finite number.
+    """
+    text = element.get(attribute, "0")
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not math.isfinite(value):
+        raise ExciteError("robot.urdf", f"{what} {attribute} is '{text}'", text, "a finite number")
+    return value
+
+
+def check_inertial(link: ElementTree.Element, moved: bool = True) -> None:
+    """The inertial parameters of one URDF ``<link>`` (module docstring); ``moved``: an active joint
+    moves it (its principal moments are checked).
+
+    Raises:
+        ExciteError: naming the link and what is wrong.
+    """
+    inertial = link.find("inertial")
+    if inertial is None:
+        return
+    name = f"link '{link.get('name')}'"
+    mass = inertial.find("mass")
+    m = 0.0 if mass is None else _number(mass, "value", f"{name}: mass")
+    if m < 0.0:
+        raise ExciteError("robot.urdf", f"{name} has a negative mass ({m:g} kg)", m, "a mass ≥ 0 kg")
+    element = inertial.find("inertia")
+    if element is None:
+        return
+    ixx, ixy, ixz, iyy, iyz, izz = (_number(element, k, f"{name}: inertia") for k in INERTIA)
+    if not moved:
+        return
+    moments = np.linalg.eigvalsh(np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]]))
+    slack = TOLERANCE * max(abs(moments[2]), 1e-12)
+    if moments[0] < -slack or moments[0] + moments[1] < moments[2] - slack:
+        raise ExciteError(
+            "robot.urdf",
+            f"{name} has an inertia no body can have (principal moments {', '.join(f'{x:.4g}' for x in moments)} "
+            "kg·m²)",
+            None,
+            "moments ≥ 0 with the two smaller summing to at least the largest",
+        )
+
+
+def check_joints(root: ElementTree.Element, active: list[str]) -> None:
+    """Limits and ``<mimic>`` of the active joints (module docstring).
+
+    Raises:
+        ExciteError: naming the joint.
+    """
+    joints = {j.get("name"): j for j in root.findall("joint")}
+    for name in active:
+        joint = joints.get(name)
+        limit = None if joint is None else joint.find("limit")
+        if limit is not None and joint.get("type") != "continuous":
+            lower, upper = (_number(limit, k, f"joint '{name}': limit") for k in ("lower", "upper"))
+            if lower > upper:
+                raise ExciteError(
+                    "robot.urdf",
+                    f"joint '{name}' has lower limit {lower:g} above upper {upper:g}",
+                    None,
+                    "lower ≤ upper",
+                )
+        for k in ("effort", "velocity"):
+            if limit is not None:
+                _number(limit, k, f"joint '{name}': limit")
+    for name, joint in joints.items():
+        mimic = joint.find("mimic")
+        followed = None if mimic is None else mimic.get("joint")
+        if mimic is not None and name in active:
+            raise ExciteError(
+                "robot.active_joints",
+                f"joint '{name}' mimics '{followed}', a coupling the model does not represent",
+                name,
+                "active joints without <mimic>",
+            )
+
+
+def check_urdf(path: Path, active: list[str]) -> None:
+    """Every check of the module docstring on the URDF at ``path``.
+
+    Raises:
+        ExciteError: the file is not XML, or a link or active joint that cannot be.
+    """
+    try:
+        root = ElementTree.parse(path).getroot()
+    except (ElementTree.ParseError, OSError) as exc:
+        raise ExciteError("robot.urdf", f"cannot read {path}: {exc}") from None
+    children: dict[str, list[str]] = {}
+    moved: list[str] = []
+    below: set[str] = set()
+    for joint in root.findall("joint"):
+        parent, child = joint.find("parent"), joint.find("child")
+        if parent is not None and child is not None:
+            children.setdefault(parent.get("link"), []).append(child.get("link"))
+            moved += [child.get("link")] if joint.get("name") in active else []
+    while moved:  # every link below an active joint
+        link = moved.pop()
+        below.add(link)
+        moved += [c for c in children.get(link, []) if c not in below]
+    for link in root.findall("link"):
+        check_inertial(link, link.get("name") in below)
+    check_joints(root, active)

@@ -1,0 +1,249 @@
+"""Faults beyond bad config values (issue 20): SIGTERM during a parallel run, robots that cannot be,
+robots with one active joint. Each bad case must exit with status 2 and one line naming the field,
+print no traceback and leave no file behind; the good ones must work."""
+
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from excite_cli.cli import app
+
+runner = CliRunner()
+EXCITE = Path(sys.executable).with_name("excite")
+CONFIGS = Path(__file__).resolve().parent.parent / "configs"
+
+PENDULUM = """<?xml version="1.0"?>
+<robot name="pendulum">
+  <link name="base"/>
+  <link name="arm">
+    <inertial><origin xyz="0 0 -0.25"/><mass value="{mass}"/>
+      <inertia ixx="0.03" ixy="0" ixz="0" iyy="0.03" iyz="0" izz="{izz}"/></inertial>
+  </link>
+  <link name="tip">
+    <inertial><mass value="{tip_mass}"/><inertia ixx="{tip_ixx}" iyy="1e-4" izz="1e-4"/></inertial>
+  </link>
+  <joint name="hinge" type="revolute">
+    <parent link="base"/><child link="arm"/><axis xyz="0 1 0"/>
+    <limit lower="{lower}" upper="2.0" effort="20" velocity="{velocity}"/>
+  </joint>
+  <joint name="tip_joint" type="revolute">
+    <parent link="arm"/><child link="tip"/><origin xyz="0 0 -0.5"/><axis xyz="0 1 0"/>
+    <limit lower="-1" upper="1" effort="5" velocity="3"/>{mimic}
+  </joint>
+</robot>
+"""
+GOOD = {"mass": "1.5", "izz": "0.002", "tip_mass": "0.2", "tip_ixx": "1e-4", "lower": "-2.0", "velocity": "3"}
+
+
+def _pendulum(folder: Path, active=("hinge",), iterations=1, **urdf) -> Path:
+    """A config of the pendulum URDF (its tip held unless active), written beside it."""
+    (folder / "pendulum.urdf").write_text(PENDULUM.format(**{**GOOD, "mimic": "", **urdf}))
+    config = {
+        "robot": {"urdf": "pendulum.urdf", "active_joints": list(active)},
+        "trajectory": {"harmonics": 3, "base_frequency": 0.6283185307179586},
+        "limits": {"velocity": 1.5, "acceleration": 5.0},
+        "optimizer": {"max_iterations": 40, "restarts": 1, "workers": 1},
+        "sequence": {"iterations": iterations},
+        "output": str(folder / "out.h5"),
+    }
+    path = folder / "pendulum.yaml"
+    path.write_text(yaml.safe_dump(config))
+    return path
+
+
+def _refused(tmp_path: Path, argv: list[str], expected: str) -> None:
+    before = {p: p.stat().st_mtime_ns for p in tmp_path.rglob("*")}
+    result = runner.invoke(app, argv, env={"COLUMNS": "400"})
+    assert isinstance(result.exception, SystemExit), repr(result.exception)
+    assert result.exit_code == 2, result.output
+    lines = [line for line in result.output.splitlines() if line.strip()]
+    assert len(lines) == 1 and lines[0].startswith("error:") and expected in lines[0], result.output
+    assert {p: p.stat().st_mtime_ns for p in tmp_path.rglob("*")} == before
+
+
+URDF_CASES = [
+    ("negative-mass", {"mass": "-1.5"}, "link 'arm' has a negative mass"),
+    ("nan-mass", {"mass": "nan"}, "link 'arm': mass value is 'nan'"),
+    ("text-mass", {"mass": "heavy"}, "link 'arm': mass value is 'heavy'"),
+    ("inf-inertia", {"izz": "inf"}, "link 'arm': inertia izz is 'inf'"),
+    ("negative-moment", {"izz": "-0.01"}, "link 'arm' has an inertia no body can have"),
+    ("triangle", {"izz": "0.2"}, "link 'arm' has an inertia no body can have"),
+    ("held-link-negative-mass", {"tip_mass": "-0.2"}, "link 'tip' has a negative mass"),
+    ("moved-held-link-triangle", {"tip_ixx": "1e-2"}, "link 'tip' has an inertia no body can have"),
+    ("limits-crossed", {"lower": "3.0"}, "joint 'hinge' has lower limit 3 above upper 2"),
+    ("nan-velocity-limit", {"velocity": "nan"}, "joint 'hinge': limit velocity is 'nan'"),
+]
+
+
+@pytest.mark.parametrize("urdf", [c[1] for c in URDF_CASES], ids=[c[0] for c in URDF_CASES])
+@pytest.mark.parametrize("command", ["optimize", "verify-gradient"])
+def test_a_robot_that_cannot_be_is_refused_by_name(tmp_path, command, urdf):
+    expected = dict((tuple(c[1].items()), c[2]) for c in URDF_CASES)[tuple(urdf.items())]
+    config = _pendulum(tmp_path, **urdf)
+    _refused(tmp_path, [command, str(config)], expected)
+
+
+def test_a_link_no_active_joint_moves_may_break_the_triangle_inequality(tmp_path):
+    """Real URDFs do (the PR2's sensor mounts, Romeo's torso): only the moved links are held to it."""
+    config = _pendulum(tmp_path, active=("tip_joint",), izz="0.2")  # the arm, held, breaks it
+    result = runner.invoke(app, ["optimize", str(config)])
+    assert result.exit_code == 0, result.output
+
+
+def test_a_one_joint_pendulum_optimizes_simulates_and_identifies(tmp_path):
+    """The one-joint regressor comes back from pinocchio flat: any number of active joints ≥ 1 works.
+    Simulated Coulomb 0.3 Nm and viscous 0.2 Nm·s/rad are found within 5 %."""
+    config = _pendulum(tmp_path, iterations=2)
+    assert runner.invoke(app, ["optimize", str(config)]).exit_code == 0
+    with h5py.File(tmp_path / "out.h5") as f:
+        assert f["iterations/2/regressor"].shape[1] == 3  # m z, m x, I_yy of the arm (its tip held)
+    effects = tmp_path / "effects.yaml"
+    effects.write_text(
+        yaml.safe_dump(
+            {
+                "sample_rate": 200.0,
+                "periods": 3,
+                "torque_noise": 0.02,
+                "seed": 3,
+                "effects": {"coulomb": {"*": 0.3}, "viscous": {"*": 0.2}},
+            }
+        )
+    )
+    sim = runner.invoke(app, ["simulate", str(tmp_path / "out.h5"), str(effects), "-o", str(tmp_path / "sim")])
+    assert sim.exit_code == 0, sim.output
+    identify = {
+        "robot": {"urdf": "pendulum.urdf", "active_joints": ["hinge"]},
+        "data": {
+            "runs": [{"file": "sim/run_1.csv", "role": "fit"}, {"file": "sim/run_2.csv", "role": "validation"}],
+            "columns": {"q": ["q_hinge"], "tau": ["tau_hinge"]},
+        },
+        "output": str(tmp_path / "id.h5"),
+    }
+    (tmp_path / "id.yaml").write_text(yaml.safe_dump(identify))
+    result = runner.invoke(app, ["identify", str(tmp_path / "id.yaml")])
+    assert result.exit_code == 0, result.output
+    with h5py.File(tmp_path / "id.h5") as f:
+        effects_found = {row["coefficient"].decode(): row["value"] for row in f["identification/effects"][()]}
+        relative_after = f["identification/relative_after"][()]
+    assert effects_found["Fc"] == pytest.approx(0.3, rel=0.05) and effects_found["Fv"] == pytest.approx(0.2, rel=0.05)
+    assert relative_after[0] < 2.0
+
+
+def test_one_joint_of_a_real_arm_optimizes(tmp_path):
+    """A single active joint of the Panda, the others held at their reference."""
+    config = yaml.safe_load((CONFIGS / "smoke.yaml").read_text())
+    config["robot"]["active_joints"] = ["panda_joint4"]
+    config["sequence"]["iterations"] = 1
+    config["output"] = str(tmp_path / "one.h5")
+    (tmp_path / "one.yaml").write_text(yaml.safe_dump(config))
+    result = runner.invoke(app, ["optimize", str(tmp_path / "one.yaml")])
+    assert result.exit_code == 0, result.output
+    with h5py.File(tmp_path / "one.h5") as f:
+        assert np.isfinite(f["iterations/1"].attrs["cond_stacked"])
+
+
+def _children(pid: int) -> list[int]:
+    """Processes whose parent is ``pid`` (Linux /proc)."""
+    out = []
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            try:
+                fields = (entry / "stat").read_text().rsplit(")", 1)[1].split()
+            except OSError:
+                continue
+            if int(fields[1]) == pid:
+                out.append(int(entry.name))
+    return out
+
+
+@pytest.mark.skipif(not Path("/proc").is_dir(), reason="needs /proc to find the worker processes")
+def test_sigterm_during_a_two_worker_optimize_stops_everything_and_keeps_finished_iterations(tmp_path):
+    config = yaml.safe_load((CONFIGS / "smoke.yaml").read_text())
+    config["trajectory"]["harmonics"] = 5
+    config["optimizer"].update(max_iterations=300, restarts=2)
+    config["sequence"]["iterations"] = 6
+    config["output"] = str(tmp_path / "run.h5")
+    (tmp_path / "run.yaml").write_text(yaml.safe_dump(config))
+    process = subprocess.Popen(
+        [str(EXCITE), "optimize", str(tmp_path / "run.yaml"), "--workers", "2"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    deadline = time.monotonic() + 240
+    while not (tmp_path / "run.h5").exists() and process.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.2)
+    workers = _children(process.pid)
+    assert process.poll() is None and len(workers) >= 2, "the run ended before the first iteration was written"
+    time.sleep(0.5)
+    process.send_signal(signal.SIGTERM)
+    _, stderr = process.communicate(timeout=60)
+    assert process.returncode == 143, stderr
+    kept = int(re.search(r"terminated: kept (\d+) finished iteration", stderr).group(1))
+    time.sleep(5)
+    assert [pid for pid in workers if Path(f"/proc/{pid}").exists() and _alive(pid)] == []
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.h5", "run.yaml"]  # no .partial, no plots
+    with h5py.File(tmp_path / "run.h5") as f:
+        assert len(f["iterations"]) == kept >= 1
+    assert "Traceback" not in stderr
+
+
+def _alive(pid: int) -> bool:
+    """A process that has not ended (a zombie has: it only waits to be reaped)."""
+    try:
+        return (Path(f"/proc/{pid}") / "stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
+def test_sigterm_is_restored_after_a_command():
+    before = signal.getsignal(signal.SIGTERM)
+    runner.invoke(app, ["verify-gradient", "--help"])
+    assert signal.getsignal(signal.SIGTERM) == before
+
+
+def _identify_config(folder: Path) -> Path:
+    _pendulum(folder)
+    config = {
+        "robot": {"urdf": "pendulum.urdf", "active_joints": ["hinge"]},
+        "data": {"runs": [{"file": "run.csv"}], "columns": {"q": ["q_hinge"], "tau": ["tau_hinge"]}},
+    }
+    (folder / "id.yaml").write_text(yaml.safe_dump(config))
+    return folder / "id.yaml"
+
+
+@pytest.mark.parametrize("urdf_out", ["report.h5", "report_residuals.png", "report_ladder.png"])
+def test_the_identified_urdf_may_not_overwrite_the_report_or_its_plots(tmp_path, urdf_out):
+    config = _identify_config(tmp_path)
+    argv = ["identify", str(config), "-o", str(tmp_path / "report.h5"), "--urdf-out", str(tmp_path / urdf_out)]
+    _refused(tmp_path, argv, "is also the report or one of its plots")
+
+
+@pytest.mark.parametrize("command", ["optimize", "identify"])
+def test_an_output_that_is_not_a_regular_file_is_never_replaced(tmp_path, command):
+    fifo = tmp_path / "fifo.h5"
+    os.mkfifo(fifo)
+    config = _pendulum(tmp_path) if command == "optimize" else _identify_config(tmp_path)
+    _refused(tmp_path, [command, str(config), "-o", str(fifo), "--force"], "is not a regular file")
+    assert fifo.is_fifo()
+
+
+@pytest.mark.parametrize("tolerance", ["nan", "inf", "-1e-6", "0"])
+def test_verify_gradient_needs_a_pass_mark_that_can_fail(tmp_path, tolerance):
+    _refused(tmp_path, ["verify-gradient", str(_pendulum(tmp_path)), "--tolerance", tolerance], "tolerance")
+
+
+@pytest.mark.parametrize("command", ["optimize", "verify-gradient"])
+def test_an_active_mimic_joint_is_refused_by_name(tmp_path, command):
+    config = _pendulum(tmp_path, active=("tip_joint",), mimic='<mimic joint="hinge"/>')
+    _refused(tmp_path, [command, str(config)], "joint 'tip_joint' mimics 'hinge'")
