@@ -14,7 +14,7 @@ from excite_cli.console import identification as identify_tables
 from excite_cli.console import tables
 from excite_cli.console.errors import spellings, word
 from excite_cli.console.progress import Bars, wide_console
-from excite_cli.errors import ExciteError, Interrupted, Terminated, sigterm_as_interrupt
+from excite_cli.errors import ExciteError, Interrupted, Terminated, exit_status, sigterm_as_interrupt
 from excite_cli.identification.config import IdentifyProblem, SimulationConfig
 from excite_cli.identification.validate import validate_model
 from excite_cli.optimization.criterion import OBJECTIVES
@@ -50,7 +50,7 @@ def command(name: Optional[str] = None) -> Callable:
                 raise typer.Exit(exc.status) from None
             except KeyboardInterrupt as exc:
                 err.print("terminated" if isinstance(exc, Terminated) else "interrupted", highlight=False)
-                raise typer.Exit(getattr(exc, "status", 130)) from None
+                raise typer.Exit(exit_status(exc)) from None
 
         spelled = spellings(function)
         return app.command(name)(guarded)

@@ -72,6 +72,11 @@ class Terminated(KeyboardInterrupt):
     status = 143
 
 
+def exit_status(interrupt: KeyboardInterrupt) -> int:
+    """The exit status of an interruption: 143 for SIGTERM (:class:`Terminated`), 130 for Ctrl-C."""
+    return Terminated.status if isinstance(interrupt, Terminated) else 130
+
+
 class Interrupted(Exception):
     """Ctrl-C or SIGTERM during a run that writes as it goes; ``kept`` finished parts are in ``path``;
     ``status`` the exit status (130 Ctrl-C, 143 SIGTERM)."""

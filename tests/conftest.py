@@ -6,7 +6,9 @@ from pathlib import Path
 
 import pytest
 import yaml
+from typer.testing import CliRunner
 
+from excite_cli.cli import app
 from excite_cli.config import Problem, load_problem
 
 CONFIGS = Path(__file__).resolve().parent.parent / "configs"
@@ -65,3 +67,18 @@ def write_config(tmp_path: Path, data: dict, name: str = "problem.yaml") -> Path
     path = tmp_path / name
     path.write_text(yaml.safe_dump(data))
     return path
+
+
+def assert_refused(folder: Path, argv: list[str], expected: str) -> None:
+    """``excite argv`` exits with status 2 and one line starting ``error:`` that contains
+    ``expected``, prints no traceback, and writes or changes no file under ``folder``."""
+    before = {p: p.stat().st_mtime_ns for p in folder.rglob("*")}
+    result = CliRunner().invoke(app, argv, env={"COLUMNS": "400"})
+    assert isinstance(result.exception, SystemExit), repr(result.exception)
+    assert result.exit_code == 2, result.output
+    lines = [line for line in result.output.splitlines() if line.strip()]
+    assert len(lines) == 1 and lines[0].startswith("error:"), result.output
+    assert expected in lines[0], lines[0]
+    assert "Traceback" not in result.output
+    after = {p: p.stat().st_mtime_ns for p in folder.rglob("*")}
+    assert after == before, f"files written or changed: {sorted(set(after) ^ set(before))}"

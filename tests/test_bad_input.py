@@ -8,7 +8,7 @@ import h5py
 import numpy as np
 import pytest
 import yaml
-from conftest import UR5
+from conftest import UR5, assert_refused
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
@@ -419,15 +419,6 @@ def _reverse_time(path):
 def test_bad_input_gives_one_line_and_no_file(case, build, expected, shared, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     argv = build(tmp_path, shared)
-    before = {p: p.stat().st_mtime_ns for p in tmp_path.rglob("*")}
     protected = {k: v.read_bytes() for k, v in shared.items()}
-    result = runner.invoke(app, argv, env={"COLUMNS": "400"})
-    assert isinstance(result.exception, SystemExit), f"{case}: {result.exception!r}"
-    assert result.exit_code == 2, result.output
-    lines = [line for line in result.output.splitlines() if line.strip()]
-    assert len(lines) == 1 and lines[0].startswith("error:"), result.output
-    assert expected in lines[0], lines[0]
-    assert "Traceback" not in result.output
-    after = {p: p.stat().st_mtime_ns for p in tmp_path.rglob("*")}
-    assert after == before, f"files written or changed: {sorted(set(after) ^ set(before))}"
+    assert_refused(tmp_path, argv, expected)
     assert {k: v.read_bytes() for k, v in shared.items()} == protected

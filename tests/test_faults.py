@@ -14,6 +14,7 @@ import h5py
 import numpy as np
 import pytest
 import yaml
+from conftest import assert_refused
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
@@ -61,16 +62,6 @@ def _pendulum(folder: Path, active=("hinge",), iterations=1, **urdf) -> Path:
     return path
 
 
-def _refused(tmp_path: Path, argv: list[str], expected: str) -> None:
-    before = {p: p.stat().st_mtime_ns for p in tmp_path.rglob("*")}
-    result = runner.invoke(app, argv, env={"COLUMNS": "400"})
-    assert isinstance(result.exception, SystemExit), repr(result.exception)
-    assert result.exit_code == 2, result.output
-    lines = [line for line in result.output.splitlines() if line.strip()]
-    assert len(lines) == 1 and lines[0].startswith("error:") and expected in lines[0], result.output
-    assert {p: p.stat().st_mtime_ns for p in tmp_path.rglob("*")} == before
-
-
 URDF_CASES = [
     ("negative-mass", {"mass": "-1.5"}, "link 'arm' has a negative mass"),
     ("nan-mass", {"mass": "nan"}, "link 'arm': mass value is 'nan'"),
@@ -90,7 +81,7 @@ URDF_CASES = [
 def test_a_robot_that_cannot_be_is_refused_by_name(tmp_path, command, urdf):
     expected = dict((tuple(c[1].items()), c[2]) for c in URDF_CASES)[tuple(urdf.items())]
     config = _pendulum(tmp_path, **urdf)
-    _refused(tmp_path, [command, str(config)], expected)
+    assert_refused(tmp_path, [command, str(config)], expected)
 
 
 def test_a_link_no_active_joint_moves_may_break_the_triangle_inequality(tmp_path):
@@ -226,7 +217,7 @@ def _identify_config(folder: Path) -> Path:
 def test_the_identified_urdf_may_not_overwrite_the_report_or_its_plots(tmp_path, urdf_out):
     config = _identify_config(tmp_path)
     argv = ["identify", str(config), "-o", str(tmp_path / "report.h5"), "--urdf-out", str(tmp_path / urdf_out)]
-    _refused(tmp_path, argv, "is also the report or one of its plots")
+    assert_refused(tmp_path, argv, "is also the report or one of its plots")
 
 
 @pytest.mark.parametrize("command", ["optimize", "identify"])
@@ -234,16 +225,16 @@ def test_an_output_that_is_not_a_regular_file_is_never_replaced(tmp_path, comman
     fifo = tmp_path / "fifo.h5"
     os.mkfifo(fifo)
     config = _pendulum(tmp_path) if command == "optimize" else _identify_config(tmp_path)
-    _refused(tmp_path, [command, str(config), "-o", str(fifo), "--force"], "is not a regular file")
+    assert_refused(tmp_path, [command, str(config), "-o", str(fifo), "--force"], "is not a regular file")
     assert fifo.is_fifo()
 
 
 @pytest.mark.parametrize("tolerance", ["nan", "inf", "-1e-6", "0"])
 def test_verify_gradient_needs_a_pass_mark_that_can_fail(tmp_path, tolerance):
-    _refused(tmp_path, ["verify-gradient", str(_pendulum(tmp_path)), "--tolerance", tolerance], "tolerance")
+    assert_refused(tmp_path, ["verify-gradient", str(_pendulum(tmp_path)), "--tolerance", tolerance], "tolerance")
 
 
 @pytest.mark.parametrize("command", ["optimize", "verify-gradient"])
 def test_an_active_mimic_joint_is_refused_by_name(tmp_path, command):
     config = _pendulum(tmp_path, active=("tip_joint",), mimic='<mimic joint="hinge"/>')
-    _refused(tmp_path, [command, str(config)], "joint 'tip_joint' mimics 'hinge'")
+    assert_refused(tmp_path, [command, str(config)], "joint 'tip_joint' mimics 'hinge'")

@@ -29,6 +29,7 @@ from excite_cli.errors import ExciteError
 #: Relative tolerance of the principal-moment checks (CAD exports round their inertias).
 TOLERANCE = 1e-6
 INERTIA = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+LIMITS = ("lower", "upper", "effort", "velocity")
 
 
 def _number(element: ElementTree.Element, attribute: str, what: str) -> float:
@@ -88,20 +89,13 @@ def check_joints(root: ElementTree.Element, active: list[str]) -> None:
     """
     joints = {j.get("name"): j for j in root.findall("joint")}
     for name in active:
-        joint = joints.get(name)
-        limit = None if joint is None else joint.find("limit")
-        if limit is not None and joint.get("type") != "continuous":
-            lower, upper = (_number(limit, k, f"joint '{name}': limit") for k in ("lower", "upper"))
-            if lower > upper:
-                raise ExciteError(
-                    "robot.urdf",
-                    f"joint '{name}' has lower limit {lower:g} above upper {upper:g}",
-                    None,
-                    "lower ≤ upper",
-                )
-        for k in ("effort", "velocity"):
-            if limit is not None:
-                _number(limit, k, f"joint '{name}': limit")
+        limit = None if name not in joints else joints[name].find("limit")
+        if limit is None:
+            continue
+        lower, upper, _, _ = (_number(limit, k, f"joint '{name}': limit") for k in LIMITS)
+        if lower > upper and joints[name].get("type") != "continuous":
+            problem = f"joint '{name}' has lower limit {lower:g} above upper {upper:g}"
+            raise ExciteError("robot.urdf", problem, None, "lower ≤ upper")
     for name, joint in joints.items():
         mimic = joint.find("mimic")
         followed = None if mimic is None else mimic.get("joint")

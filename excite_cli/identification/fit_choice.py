@@ -34,7 +34,7 @@ from excite_cli.identification.config import IdentificationConfig
 from excite_cli.identification.effects import Term, coefficient_names
 from excite_cli.identification.least_squares import least_squares
 from excite_cli.identification.physical import ConsistentFit, ConsistentProgram
-from excite_cli.identification.selection import Selection
+from excite_cli.identification.selection import Selection, objective
 
 #: The name of the least-squares candidate.
 LEAST_SQUARES = "least squares"
@@ -46,13 +46,15 @@ class Model:
     end, its terms and the number of effects it adds beyond the declared ones (p)."""
 
     search: int
+    start: str
     at_start: bool
     terms: list[Term]
     effects: int
 
-    def label(self, selection: Selection) -> str:
+    @property
+    def label(self) -> str:
         """e.g. ``end of 'Coulomb on every joint'``."""
-        return f"{'start' if self.at_start else 'end'} of '{selection.searches[self.search].start}'"
+        return f"{'start' if self.at_start else 'end'} of '{self.start}'"
 
 
 @dataclass(frozen=True)
@@ -61,7 +63,6 @@ class FitChoice:
 
     Attributes:
         models: (m,) each model compared (the ends and starts of the searches, each set of terms once).
-        labels: (m,) their labels, e.g. ``end of 'declared effects'``.
         names: (f,) each candidate fit: ``least squares`` or ``consistent λ=<λ>``.
         regularization: (f,) λ of each consistent candidate (NaN for least squares).
         cv: (m, f) CV error [%] of each model under each fit on the selection's folds (NaN: the only
@@ -73,7 +74,6 @@ class FitChoice:
     """
 
     models: list[Model]
-    labels: list[str]
     names: list[str]
     regularization: np.ndarray
     cv: np.ndarray
@@ -91,6 +91,11 @@ class FitChoice:
     def is_consistent(self) -> bool:
         """Whether the winning fit is a physically consistent one."""
         return self.name != LEAST_SQUARES
+
+    @property
+    def labels(self) -> list[str]:
+        """(m,) the models' labels, e.g. ``end of 'declared effects'``."""
+        return [m.label for m in self.models]
 
     @property
     def cv_error(self) -> np.ndarray:
@@ -152,7 +157,7 @@ def compared_models(selection: Selection) -> list[Model]:
         search = selection.searches[k]
         for at_start, terms in ((False, search.terms), (True, search.initial)):
             if all(set(terms) != set(m.terms) for m in out):
-                out.append(Model(k, at_start, list(terms), len(terms) - selection.declared))
+                out.append(Model(k, search.start, at_start, list(terms), len(terms) - selection.declared))
     return out
 
 
@@ -223,9 +228,8 @@ def choose_fit(
     cv = np.full((len(models), len(lams)), np.nan)
     if not single:
         cv = np.array([_scores(selection, m, lams, p) for m, p in zip(models, programs)])
-    penalty = np.log1p(cfg.min_improvement)
-    objective = np.log(np.maximum(cv, 1e-12)) + penalty * np.array([[m.effects] for m in models])
-    win, chosen = (0, 0) if single else np.unravel_index(int(np.nanargmin(objective)), objective.shape)
+    J = objective(cv, [[m.effects] for m in models], cfg.min_improvement)
+    win, chosen = (0, 0) if single else np.unravel_index(int(np.nanargmin(J)), J.shape)
     consistent = [k for k, lam in enumerate(lams) if lam is not None]
     best = min(consistent, key=lambda k: np.nan_to_num(cv[win, k], nan=np.inf)) if consistent else None
     lam = lams[best] if best is not None else (cfg.regularization[0] if consistent_beside else None)
@@ -236,11 +240,10 @@ def choose_fit(
         fit = program.fit(G, c, selection.normal.rows, lam)
     choice = FitChoice(
         models=models,
-        labels=[m.label(selection) for m in models],
         names=[LEAST_SQUARES if lam is None else f"consistent λ={lam:g}" for lam in lams],
         regularization=np.array([np.nan if lam is None else lam for lam in lams]),
         cv=cv,
-        objective=objective,
+        objective=J,
         model=int(win),
         chosen=int(chosen),
         consistent=fit,

@@ -147,6 +147,12 @@ class Selection:
         return [] if self.at_start else self.searches[self.chosen].steps
 
 
+def objective(cv_error, effects, min_improvement: float):
+    """J = log CV + p · log(1 + min_improvement) (module docstring) of CV errors [%] with p added
+    effects; scalars or arrays that broadcast."""
+    return np.log(np.maximum(cv_error, 1e-12)) + np.asarray(effects) * np.log1p(min_improvement)
+
+
 def candidate_terms(cfg: IdentificationConfig, n: int) -> list[Term]:
     """Every candidate term: each candidate effect on each joint, one per shape of ``SHAPES`` effects."""
     return [
@@ -173,7 +179,7 @@ class _Search:
         return self.cache[key]
 
     def objective(self, terms: list[Term], error: float) -> float:
-        return float(np.log(max(error, 1e-12)) + (len(terms) - len(self.declared)) * self.penalty)
+        return float(objective(error, len(terms) - len(self.declared), self.cfg.min_improvement))
 
     def cost(self, move: str, terms: list[Term], error: float) -> float:
         """J of the model a move leads to; a shape change pays the price of an effect as well."""

@@ -24,8 +24,7 @@ def check_target(path: Path, field: str, force: bool = False, exists_ok: bool = 
     Raises:
         OutputExists: the file exists and neither ``force`` nor ``exists_ok``.
         ExciteError: ``path`` is a folder or not a regular file (a device, a FIFO), a file is in the
-            way of its folder, or its nearest
-            existing folder is not writable.
+            way of its folder, or its nearest existing folder is not writable.
     """
     path = Path(path)
     if path.is_dir():

@@ -39,8 +39,7 @@ def run_identify(
         ExciteError: bad paths or data (see :func:`run_identification`).
     """
     check_target(target, "output", force)
-    stem = target.with_suffix("")
-    plots = [stem.with_name(target.stem + suffix) for suffix in ("_residuals.png", "_ladder.png")]
+    plots = [target.with_name(target.stem + suffix) for suffix in ("_residuals.png", "_ladder.png")]
     if urdf_out is not None:
         check_target(urdf_out, "urdf_out", force)
         if Path(urdf_out).resolve() in {p.resolve() for p in [target, *plots]}:

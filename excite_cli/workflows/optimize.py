@@ -10,7 +10,7 @@ import numpy as np
 import yaml
 
 from excite_cli.config import Problem, effective_yaml
-from excite_cli.errors import ExciteError, FileNotFound, Interrupted
+from excite_cli.errors import ExciteError, FileNotFound, Interrupted, exit_status
 from excite_cli.h5 import open_h5
 from excite_cli.optimization.engine import Engine, default_workers
 from excite_cli.optimization.excitation import Excitation, build_excitation
@@ -81,7 +81,7 @@ def run_optimize(
                 excitation, problem.sequence.iterations, problem.optimizer.seed, prior, progress, done, active, finished
             )
     except KeyboardInterrupt as exc:
-        raise Interrupted(target, len(written), getattr(exc, "status", 130)) from None
+        raise Interrupted(target, len(written), exit_status(exc)) from None
     return OptimizeRun(excitation, results, target, plot_result(target, excitation, results))
 
 
