@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from excite_cli.config import load_problem
+from excite_cli.config_file import load_problem
 from excite_cli.optimization.excitation import build_excitation
 from excite_cli.optimization.verify import check_gradient
 

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from excite_cli.config import load_problem
+from excite_cli.config_file import load_problem
 from excite_cli.dynamics.robot import load_robot
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -13,7 +13,8 @@ from pathlib import Path
 
 import numpy as np
 
-from excite_cli.config import ConstraintsConfig, load_problem
+from excite_cli.config import ConstraintsConfig
+from excite_cli.config_file import load_problem
 from excite_cli.optimization.criterion import condition_number
 from excite_cli.optimization.excitation import build_excitation
 from excite_cli.optimization.sequence import run_sequence

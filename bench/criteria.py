@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from excite_cli.config import load_problem
+from excite_cli.config_file import load_problem
 from excite_cli.optimization.criterion import OBJECTIVES, condition_number
 from excite_cli.optimization.engine import Engine, default_workers
 from excite_cli.optimization.excitation import build_excitation

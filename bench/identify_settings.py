@@ -16,7 +16,7 @@ import argparse
 import time
 from pathlib import Path
 
-from excite_cli.config import load_problem
+from excite_cli.config_file import load_problem
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.pipeline import run_identification
 

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 from threadpoolctl import threadpool_info, threadpool_limits
 
-from excite_cli.config import load_problem
+from excite_cli.config_file import load_problem
 from excite_cli.memory import keep_freed_memory
 from excite_cli.optimization.excitation import build_excitation
 from excite_cli.optimization.optimizer import optimize_restart

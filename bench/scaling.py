@@ -17,7 +17,7 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from excite_cli.config import load_problem
+from excite_cli.config_file import load_problem
 from excite_cli.optimization.engine import Engine, default_workers
 from excite_cli.optimization.excitation import build_excitation
 from excite_cli.optimization.sequence import run_sequence

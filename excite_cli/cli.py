@@ -9,7 +9,7 @@ import typer
 from rich.console import Console
 from rich.markup import escape
 
-from excite_cli.config import load_problem, with_overrides
+from excite_cli.config_file import load_problem, with_overrides
 from excite_cli.console import identification as identify_tables
 from excite_cli.console import tables
 from excite_cli.console.errors import spellings, word
@@ -109,6 +109,9 @@ def optimize(
         tables.iterations(run.results, problem.optimizer.objective),
         f"wrote {run.target} and {', '.join(str(p) for p in run.plots)}",
     )
+    if run.unexciting:
+        err.print(f"[bold yellow]warning:[/] {escape(run.unexciting)}", highlight=False, soft_wrap=True)
+        raise typer.Exit(1)
 
 
 @command("compare-random")

@@ -6,15 +6,13 @@ Every field is documented in README.md ("Config reference") with its unit and de
 
 from __future__ import annotations
 
-import functools
 import math
+import re
 from pathlib import Path
 from typing import Literal, Optional, Union
 
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
-
-from excite_cli.errors import ExciteError, FileNotFound
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 PerJoint = Union[float, dict[str, float]]
 
@@ -22,6 +20,23 @@ PerJoint = Union[float, dict[str, float]]
 MAX_HARMONICS = 100
 #: Largest number of cost samples and of constraint-grid instants.
 MAX_GRID = 20000
+#: Largest number of instants of the fine re-check (constraint grid × check_refinement).
+MAX_FINE = 1_000_000
+#: Largest seed (numpy's generators take any; 32 bits is what other tools can repeat).
+MAX_SEED = 2**32 - 1
+#: A Dask scheduler address: ``[tcp:// or tls://]host:port`` (an IPv6 host in brackets).
+SCHEDULER_ADDRESS = re.compile(r"^((tcp|tls)://)?(\[[0-9a-fA-F:]+\]|[\w.-]+):\d{1,5}$")
+#: Largest number of local worker processes.
+MAX_WORKERS = 256
+
+
+class FieldProblem(ValueError):
+    """A problem a validator finds with one field of a section or of another (``field`` dotted from
+    the top of the file), reported under that field instead of the section's."""
+
+    def __init__(self, field: str, problem: str):
+        super().__init__(problem)
+        self.field, self.problem = field, problem
 
 
 class Section(BaseModel):
@@ -65,7 +80,7 @@ class LimitsConfig(Section):
     position_margin: float = Field(0.0, ge=0.0)
     velocity: Optional[PerJoint] = None
     acceleration: PerJoint
-    check_refinement: int = Field(10, ge=10)
+    check_refinement: int = Field(10, ge=10, le=1000)
 
 
 class ComConfig(Section):
@@ -135,28 +150,35 @@ class OptimizerConfig(Section):
 
     method: Literal["SLSQP", "trust-constr", "ipopt"] = "SLSQP"
     objective: Literal["log_cond", "cond", "log_det", "sigma_min"] = "log_cond"
-    max_iterations: int = Field(200, ge=1)
+    max_iterations: int = Field(200, ge=1, le=100_000)
     tolerance: float = Field(1e-6, gt=0.0)
     optimality_tolerance: float = Field(1e-3, gt=0.0)
-    seed: int = Field(0, ge=0)
-    restarts: int = Field(3, ge=1)
-    starts: Optional[int] = Field(None, ge=1)
-    screen_iterations: int = Field(30, ge=1)
-    workers: Optional[int] = Field(None, ge=1)
+    seed: int = Field(0, ge=0, le=MAX_SEED)
+    restarts: int = Field(3, ge=1, le=1000)
+    starts: Optional[int] = Field(None, ge=1, le=10_000)
+    screen_iterations: int = Field(30, ge=1, le=100_000)
+    workers: Optional[int] = Field(None, ge=1, le=MAX_WORKERS)
     scheduler: Optional[str] = None
+
+    @field_validator("scheduler")
+    @classmethod
+    def _address(cls, value: Optional[str]) -> Optional[str]:
+        if value is not None and not SCHEDULER_ADDRESS.match(value):
+            raise ValueError("expected a Dask scheduler address host:port, e.g. tcp://10.0.0.5:8786")
+        return value
 
 
 class RandomBaselineConfig(Section):
     """``compare-random``: pool size and seed of the random candidates."""
 
-    pool_size: int = Field(300, ge=1)
-    seed: int = Field(1, ge=0)
+    pool_size: int = Field(300, ge=1, le=100_000)
+    seed: int = Field(1, ge=0, le=MAX_SEED)
 
 
 class SequenceConfig(Section):
     """Sequential generation (Sec. IV-B): iterations and optional prior data file (Eq. 41)."""
 
-    iterations: int = Field(3, ge=1)
+    iterations: int = Field(3, ge=1, le=1000)
     prior: Optional[str] = None
 
 
@@ -177,16 +199,32 @@ class Problem(Section):
 
     @model_validator(mode="after")
     def _grid_fits(self) -> "Problem":
-        if self.trajectory.constraint_period > self.trajectory.duration:
-            raise ValueError(
-                "trajectory.constraint_period must not exceed the trajectory duration "
-                f"cost_samples × cost_period = {self.trajectory.duration:g} s"
+        t, refinement = self.trajectory, self.limits.check_refinement
+        if t.constraint_period > t.duration:
+            raise FieldProblem(
+                "trajectory.constraint_period",
+                f"{t.constraint_period:g} s exceeds the trajectory duration "
+                f"cost_samples × cost_period = {t.duration:g} s",
             )
-        instants = self.trajectory.duration / self.trajectory.constraint_period
-        if instants > MAX_GRID:
-            raise ValueError(
-                f"trajectory.constraint_period: the constraint grid would have {instants:.0f} instants "
-                f"(at most {MAX_GRID}; the fine check has {self.limits.check_refinement}× more)"
+        instants = t.duration / t.constraint_period
+        if instants > MAX_GRID or instants * refinement > MAX_FINE:
+            raise FieldProblem(
+                "trajectory.constraint_period",
+                f"the constraint grid would have {instants:.0f} instants (at most {MAX_GRID}) and its fine "
+                f"check {refinement}× more (at most {MAX_FINE})",
+            )
+        if t.harmonics * t.base_frequency * t.constraint_period > math.pi / 2:
+            raise FieldProblem(
+                "trajectory.base_frequency",
+                f"the highest harmonic N ω = {t.harmonics * t.base_frequency:g} rad/s has fewer than 4 "
+                f"constraint-grid instants per cycle (constraint_period {t.constraint_period:g} s): the limits "
+                "could not be checked; expected N ω × constraint_period ≤ π/2",
+            )
+        if t.base_frequency * t.duration < math.pi / 2:
+            raise FieldProblem(
+                "trajectory.base_frequency",
+                f"{t.base_frequency:g} rad/s gives the {t.duration:g} s trajectory less than a quarter of its "
+                "base period, too little to move in; expected ω × cost_samples × cost_period ≥ π/2",
             )
         return self
 
@@ -198,103 +236,6 @@ class Problem(Section):
         return self.source_path.parent / p
 
 
-def with_overrides(config: BaseModel, overrides: dict[str, object]) -> BaseModel:
-    """A validated copy of ``config`` with dotted fields replaced (command-line options), e.g.
-    ``{"sequence.iterations": 2, "optimizer.seed": 5}``; None values are left out. The original is
-    not changed, so what ran is the copy (stored as the effective config).
-
-    Raises:
-        ExciteError: an override is not valid for its field (the message names the field).
-    """
-    data = config.model_dump()
-    for dotted, value in overrides.items():
-        if value is None:
-            continue
-        *parents, last = dotted.split(".")
-        functools.reduce(dict.__getitem__, parents, data)[last] = value
-    try:
-        copy = type(config).model_validate(data)
-    except ValidationError as error:
-        raise _validation_error(Path("command line"), error) from None
-    for name in ("source_path", "source_text"):
-        if name in type(config).model_fields:
-            setattr(copy, name, getattr(config, name))
-    return copy
-
-
 def effective_yaml(config: BaseModel) -> str:
     """The validated config as YAML, every default filled in: what a run actually used."""
     return yaml.safe_dump(config.model_dump(mode="json"), sort_keys=False, allow_unicode=True)
-
-
-def _validation_error(path: Path, error: ValidationError) -> ExciteError:
-    first = error.errors()[0]
-    field = ".".join(str(part) for part in first["loc"]) or "(top level)"
-    message = first["msg"].removeprefix("Value error, ")
-    if first["type"] == "missing":
-        message = "is required but missing"
-    elif first["type"] == "extra_forbidden":
-        message = "is not a known field (check its spelling; see README 'Config reference')"
-    else:
-        message = f"{message} (got {first.get('input')!r})"
-    more = len(error.errors()) - 1
-    suffix = f" (+{more} more problem{'s' if more > 1 else ''})" if more else ""
-    return ExciteError(field, f"{message}{suffix}", first.get("input"), source=path)
-
-
-class _UniqueKeyLoader(yaml.SafeLoader):
-    """YAML's safe loader, refusing a key given twice in one mapping (YAML lets the last one win silently)."""
-
-    def construct_mapping(self, node, deep=False):
-        seen = set()
-        for key_node, _ in node.value:
-            key = self.construct_object(key_node, deep=deep)
-            if key in seen:
-                raise yaml.constructor.ConstructorError(None, None, f"duplicate key '{key}'", key_node.start_mark)
-            seen.add(key)
-        return super().construct_mapping(node, deep=deep)
-
-
-def load_problem(path: str | Path, kind: type[BaseModel] = Problem):
-    """Read and validate a YAML file as a :class:`Problem` (or another config ``kind``).
-
-    Args:
-        path: the YAML file.
-        kind: :class:`Problem`, :class:`IdentifyProblem` or :class:`SimulationConfig`.
-
-    Returns:
-        The validated config, with ``source_path`` and ``source_text`` set where it has them.
-
-    Raises:
-        ExciteError: missing file, malformed YAML or an invalid field; the message names the field.
-    """
-    path = Path(path)
-    if not path.is_file():
-        raise FileNotFound("config", path, "config file")
-    try:
-        text = path.read_text(encoding="utf-8")
-    except UnicodeDecodeError:
-        raise ExciteError("config", f"{path} is not a text (UTF-8) file", path, "a YAML config") from None
-    except OSError as exc:
-        raise ExciteError("config", f"cannot read {path}: {exc.strerror}", path) from None
-    try:
-        raw = yaml.load(text, Loader=_UniqueKeyLoader)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        raise ExciteError("config", f"{path}: malformed YAML{where}: {getattr(exc, 'problem', exc)}", path) from None
-    if not isinstance(raw, dict):
-        raise ExciteError(
-            "config",
-            f"{path}: {'empty file' if raw is None else 'not a mapping'}",
-            path,
-            "a mapping of sections (see README 'Config reference')",
-        )
-    try:
-        problem = kind.model_validate(raw)
-    except ValidationError as exc:
-        raise _validation_error(path, exc) from None
-    if hasattr(problem, "source_path"):
-        problem.source_path = path.resolve()
-        problem.source_text = text
-    return problem

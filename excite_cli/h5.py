@@ -5,8 +5,9 @@ in :mod:`excite_cli.identification.report_file`."""
 
 from __future__ import annotations
 
+import io
 import os
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from datetime import datetime, timezone
 from importlib import metadata
 from pathlib import Path
@@ -21,43 +22,82 @@ VERSIONED_PACKAGES = ("excite", "pin", "coal", "numpy", "scipy", "h5py", "exampl
 
 
 @contextmanager
-def atomic_path(path: Path, field: str = "output") -> Iterator[Path]:
-    """A temporary path ``<path>.partial`` to write to, moved onto ``path`` (``os.replace``, atomic)
-    when the block ends without error and removed otherwise, so a crash, Ctrl-C or full disk never
-    leaves a half-written ``path``; the folder of ``path`` is created.
+def atomic_paths(paths: Sequence[Path], field: str = "output") -> Iterator[list[Path]]:
+    """Temporary paths ``<path>.partial`` to write to, moved onto ``paths`` (``os.replace``) when the
+    block ends without error and removed otherwise, with any folder the block created for them, so a
+    crash, Ctrl-C or full disk never leaves a half-written file nor a part of the set.
 
     Args:
-        field: the config field or argument that named ``path``, for the message.
+        field: the config field or argument that named ``paths``, for the message.
 
     Raises:
-        CannotWrite: the file cannot be written (``OSError`` in the block or in the move).
+        CannotWrite: a file cannot be written (``OSError`` in the block or in a move).
     """
-    path = Path(path)
-    tmp = path.with_name(path.name + ".partial")
+    paths = [Path(p) for p in paths]
+    tmps = [p.with_name(p.name + ".partial") for p in paths]
+    created = [d for p in paths for d in (p.parent, *p.parent.parents) if not d.exists()]
+    done = False
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        yield tmp
-        os.replace(tmp, path)
+        for path in paths:
+            path.parent.mkdir(parents=True, exist_ok=True)
+        yield tmps
+        for tmp, path in zip(tmps, paths):
+            os.replace(tmp, path)
+        done = True
     except OSError as exc:
-        raise CannotWrite(field, path, exc.strerror or exc) from None
+        at = next((p for p, t in zip(paths, tmps) if str(t) == str(exc.filename)), paths[0])
+        raise CannotWrite(field, at, exc.strerror or exc) from None
     finally:
-        tmp.unlink(missing_ok=True)
+        for tmp in tmps:
+            tmp.unlink(missing_ok=True)
+        for folder in [] if done else sorted(set(created), key=lambda d: -len(d.parts)):
+            with suppress(OSError):
+                folder.rmdir()
 
 
 @contextmanager
-def atomic_h5(path: Path, field: str = "output") -> Iterator[h5py.File]:
-    """An HDF5 file written through :func:`atomic_path`, with its creation time (UTC, ISO 8601) and
-    the versions of the packages results depend on as root attributes.
+def atomic_path(path: Path, field: str = "output") -> Iterator[Path]:
+    """One file written through :func:`atomic_paths`: ``<path>.partial`` to write to.
+
+    Raises:
+        CannotWrite: the file cannot be written.
+    """
+    with atomic_paths([path], field) as (tmp,):
+        yield tmp
+
+
+def atomic_bytes(path: Path, data: bytes, field: str = "output") -> Path:
+    """``data`` written to ``path`` through :func:`atomic_path` and flushed to the disk (``fsync``),
+    so a full disk or a file-size limit is a :class:`CannotWrite` and never a half-written file.
 
     Raises:
         CannotWrite: the file cannot be written.
     """
     with atomic_path(path, field) as tmp:
-        with h5py.File(tmp, "w") as f:
-            f.attrs["created"] = datetime.now(timezone.utc).isoformat(timespec="seconds")
-            for name, version in package_versions().items():
-                f.attrs[f"version_{name}"] = version
-            yield f
+        with open(tmp, "wb") as f:
+            f.write(data)
+            f.flush()
+            os.fsync(f.fileno())
+    return Path(path)
+
+
+@contextmanager
+def atomic_h5(path: Path, field: str = "output") -> Iterator[h5py.File]:
+    """An HDF5 file built in memory, with its creation time (UTC, ISO 8601) and the versions of the
+    packages results depend on as root attributes, then written whole by :func:`atomic_bytes`. HDF5
+    never writes to the disk itself: its write errors (a full disk) end in a crash or in unraisable
+    errors at close, Python's in one :class:`CannotWrite`.
+
+    Raises:
+        CannotWrite: the file cannot be written.
+    """
+    buffer = io.BytesIO()
+    with h5py.File(buffer, "w") as f:
+        f.attrs["created"] = datetime.now(timezone.utc).isoformat(timespec="seconds")
+        for name, version in package_versions().items():
+            f.attrs[f"version_{name}"] = version
+        yield f
+    atomic_bytes(path, buffer.getvalue(), field)
 
 
 @contextmanager
@@ -69,7 +109,8 @@ def open_h5(path: Path, field: str = "result") -> Iterator[h5py.File]:
 
     Raises:
         FileNotFound: no file at ``path``.
-        ExciteError: the file is not HDF5.
+        ExciteError: the file is not HDF5, or reading it in the block failed (a missing or empty
+            dataset, a link that leads nowhere, a value of the wrong type: a damaged file).
     """
     path = Path(path)
     if not path.is_file():
@@ -78,7 +119,14 @@ def open_h5(path: Path, field: str = "result") -> Iterator[h5py.File]:
         with h5py.File(path, "r") as f:
             yield f
     except OSError as exc:
-        raise ExciteError(field, f"cannot read {path} as HDF5: {exc}", path, "an HDF5 file") from None
+        raise ExciteError(field, f"cannot read {path} as HDF5: {_short(exc)}", path, "an HDF5 file") from None
+    except (KeyError, RuntimeError, ValueError, TypeError, IndexError) as exc:
+        raise ExciteError(field, f"{path} is damaged or not an excite file: {_short(exc)}", path) from None
+
+
+def _short(exc: Exception) -> str:
+    """An error's words on one line, at most 160 characters."""
+    return " ".join(str(exc).split())[:160]
 
 
 def package_versions() -> dict[str, str]:

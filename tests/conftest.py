@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 from pathlib import Path
 
 import pytest
@@ -9,7 +10,8 @@ import yaml
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
-from excite_cli.config import Problem, load_problem
+from excite_cli.config import Problem
+from excite_cli.config_file import load_problem
 
 CONFIGS = Path(__file__).resolve().parent.parent / "configs"
 
@@ -82,3 +84,46 @@ def assert_refused(folder: Path, argv: list[str], expected: str) -> None:
     assert "Traceback" not in result.output
     after = {p: p.stat().st_mtime_ns for p in folder.rglob("*")}
     assert after == before, f"files written or changed: {sorted(set(after) ^ set(before))}"
+
+
+PENDULUM = """<?xml version="1.0"?>
+<robot name="pendulum">
+  <link name="base"/>
+  <link name="arm">
+    <inertial><origin xyz="0 0 -0.25"/><mass value="{mass}"/>
+      <inertia ixx="0.03" ixy="0" ixz="0" iyy="0.03" iyz="0" izz="{izz}"/></inertial>
+  </link>
+  <link name="tip">
+    <inertial><mass value="{tip_mass}"/><inertia ixx="{tip_ixx}" iyy="1e-4" izz="1e-4"/></inertial>
+  </link>
+  <joint name="hinge" type="revolute">
+    <parent link="base"/><child link="arm"/><axis xyz="0 1 0"/>
+    <limit lower="{lower}" upper="2.0" effort="20" velocity="{velocity}"/>
+  </joint>
+  <joint name="tip_joint" type="revolute">
+    <parent link="arm"/><child link="tip"/><origin xyz="0 0 -0.5"/><axis xyz="0 1 0"/>
+    <limit lower="-1" upper="1" effort="5" velocity="3"/>{mimic}
+  </joint>
+</robot>
+"""
+GOOD = {"mass": "1.5", "izz": "0.002", "tip_mass": "0.2", "tip_ixx": "1e-4", "lower": "-2.0", "velocity": "3"}
+
+
+def pendulum_config(folder: Path, active=("hinge",), iterations=1, changes: dict | None = None, **urdf) -> Path:
+    """A config of the pendulum URDF (its tip held unless active), written beside it, with dotted
+    ``changes`` (``{"trajectory.base_frequency": 1e-9}``) and URDF fields ``urdf`` (see ``GOOD``)."""
+    (folder / "pendulum.urdf").write_text(PENDULUM.format(**{**GOOD, "mimic": "", **urdf}))
+    config = {
+        "robot": {"urdf": "pendulum.urdf", "active_joints": list(active)},
+        "trajectory": {"harmonics": 3, "base_frequency": 0.6283185307179586},
+        "limits": {"velocity": 1.5, "acceleration": 5.0},
+        "optimizer": {"max_iterations": 40, "restarts": 1, "workers": 1},
+        "sequence": {"iterations": iterations},
+        "output": str(folder / "out.h5"),
+    }
+    for dotted, value in (changes or {}).items():
+        *sections, name = dotted.split(".")
+        functools.reduce(lambda d, k: d.setdefault(k, {}), sections, config)[name] = value
+    path = folder / "pendulum.yaml"
+    path.write_text(yaml.safe_dump(config))
+    return path

@@ -12,7 +12,7 @@ from conftest import UR5, assert_refused
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
-from excite_cli.config import load_problem
+from excite_cli.config_file import load_problem
 from excite_cli.dynamics.robot import load_robot
 
 runner = CliRunner()
@@ -132,7 +132,7 @@ CASES = [
         "trajectory.base_frequency",
     ),
     ("cost-period-zero", lambda t, s: _optimize_config(t, **{"trajectory.cost_period": 0.0}), "trajectory.cost_period"),
-    ("cost-samples-one", lambda t, s: _optimize_config(t, **{"trajectory.cost_samples": 1}), "trajectory.cost_samples"),
+    ("cost-samples-one", lambda t, s: _optimize_config(t, **{"trajectory.cost_samples": 1}), "cost_samples"),
     (
         "grid-longer-than-trajectory",
         lambda t, s: _optimize_config(t, **{"trajectory.constraint_period": 100.0}),

@@ -15,7 +15,7 @@ from rosbags.typesys import Stores, get_typestore
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
-from excite_cli.config import load_problem
+from excite_cli.config_file import load_problem
 from excite_cli.errors import ExciteError
 from excite_cli.identification.config import IdentifyProblem, SimulationConfig
 from excite_cli.identification.measurements import load_run

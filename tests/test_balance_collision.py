@@ -11,7 +11,7 @@ import yaml
 from conftest import CONFIGS, write_config
 
 from excite_cli.collision.capsules import capsule_placements, fit_capsule, segment_closest_points
-from excite_cli.config import load_problem
+from excite_cli.config_file import load_problem
 from excite_cli.errors import ExciteError
 from excite_cli.optimization.excitation import build_excitation
 from excite_cli.optimization.verify import constraint_jacobian_error

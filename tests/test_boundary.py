@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from conftest import CONFIGS, small
 
-from excite_cli.config import load_problem
+from excite_cli.config_file import load_problem
 from excite_cli.errors import ExciteError
 from excite_cli.optimization.excitation import build_excitation
 

@@ -7,7 +7,7 @@ from conftest import CONFIGS, UR5, write_config
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
-from excite_cli.config import load_problem
+from excite_cli.config_file import load_problem
 from excite_cli.constraints.com_region import ComRegion
 from excite_cli.identification.dataset import Dataset
 from excite_cli.identification.least_squares import least_squares

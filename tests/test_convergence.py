@@ -13,7 +13,7 @@ from scipy.optimize import nnls
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
-from excite_cli.config import load_problem
+from excite_cli.config_file import load_problem
 from excite_cli.optimization.excitation import build_excitation
 from excite_cli.optimization.optimality import (
     ACTIVE_TOLERANCE,

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import excite_cli.optimization.engine as engine_module
-from excite_cli.config import load_problem
+from excite_cli.config_file import load_problem
 from excite_cli.errors import ExciteError
 from excite_cli.optimization.engine import Engine
 from excite_cli.optimization.excitation import build_excitation

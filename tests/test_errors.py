@@ -6,7 +6,7 @@ import yaml
 from conftest import UR5, write_config
 
 from excite_cli.cli import export, validate
-from excite_cli.config import load_problem
+from excite_cli.config_file import load_problem
 from excite_cli.console.errors import spellings, word
 from excite_cli.errors import CannotWrite, ExciteError, FileNotFound, OutputExists
 from excite_cli.h5 import atomic_path, open_h5

@@ -14,7 +14,7 @@ import h5py
 import numpy as np
 import pytest
 import yaml
-from conftest import assert_refused
+from conftest import assert_refused, pendulum_config
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
@@ -22,45 +22,6 @@ from excite_cli.cli import app
 runner = CliRunner()
 EXCITE = Path(sys.executable).with_name("excite")
 CONFIGS = Path(__file__).resolve().parent.parent / "configs"
-
-PENDULUM = """<?xml version="1.0"?>
-<robot name="pendulum">
-  <link name="base"/>
-  <link name="arm">
-    <inertial><origin xyz="0 0 -0.25"/><mass value="{mass}"/>
-      <inertia ixx="0.03" ixy="0" ixz="0" iyy="0.03" iyz="0" izz="{izz}"/></inertial>
-  </link>
-  <link name="tip">
-    <inertial><mass value="{tip_mass}"/><inertia ixx="{tip_ixx}" iyy="1e-4" izz="1e-4"/></inertial>
-  </link>
-  <joint name="hinge" type="revolute">
-    <parent link="base"/><child link="arm"/><axis xyz="0 1 0"/>
-    <limit lower="{lower}" upper="2.0" effort="20" velocity="{velocity}"/>
-  </joint>
-  <joint name="tip_joint" type="revolute">
-    <parent link="arm"/><child link="tip"/><origin xyz="0 0 -0.5"/><axis xyz="0 1 0"/>
-    <limit lower="-1" upper="1" effort="5" velocity="3"/>{mimic}
-  </joint>
-</robot>
-"""
-GOOD = {"mass": "1.5", "izz": "0.002", "tip_mass": "0.2", "tip_ixx": "1e-4", "lower": "-2.0", "velocity": "3"}
-
-
-def _pendulum(folder: Path, active=("hinge",), iterations=1, **urdf) -> Path:
-    """A config of the pendulum URDF (its tip held unless active), written beside it."""
-    (folder / "pendulum.urdf").write_text(PENDULUM.format(**{**GOOD, "mimic": "", **urdf}))
-    config = {
-        "robot": {"urdf": "pendulum.urdf", "active_joints": list(active)},
-        "trajectory": {"harmonics": 3, "base_frequency": 0.6283185307179586},
-        "limits": {"velocity": 1.5, "acceleration": 5.0},
-        "optimizer": {"max_iterations": 40, "restarts": 1, "workers": 1},
-        "sequence": {"iterations": iterations},
-        "output": str(folder / "out.h5"),
-    }
-    path = folder / "pendulum.yaml"
-    path.write_text(yaml.safe_dump(config))
-    return path
-
 
 URDF_CASES = [
     ("negative-mass", {"mass": "-1.5"}, "link 'arm' has a negative mass"),
@@ -80,13 +41,13 @@ URDF_CASES = [
 @pytest.mark.parametrize("command", ["optimize", "verify-gradient"])
 def test_a_robot_that_cannot_be_is_refused_by_name(tmp_path, command, urdf):
     expected = dict((tuple(c[1].items()), c[2]) for c in URDF_CASES)[tuple(urdf.items())]
-    config = _pendulum(tmp_path, **urdf)
+    config = pendulum_config(tmp_path, **urdf)
     assert_refused(tmp_path, [command, str(config)], expected)
 
 
 def test_a_link_no_active_joint_moves_may_break_the_triangle_inequality(tmp_path):
     """Real URDFs do (the PR2's sensor mounts, Romeo's torso): only the moved links are held to it."""
-    config = _pendulum(tmp_path, active=("tip_joint",), izz="0.2")  # the arm, held, breaks it
+    config = pendulum_config(tmp_path, active=("tip_joint",), izz="0.2")  # the arm, held, breaks it
     result = runner.invoke(app, ["optimize", str(config)])
     assert result.exit_code == 0, result.output
 
@@ -94,7 +55,7 @@ def test_a_link_no_active_joint_moves_may_break_the_triangle_inequality(tmp_path
 def test_a_one_joint_pendulum_optimizes_simulates_and_identifies(tmp_path):
     """The one-joint regressor comes back from pinocchio flat: any number of active joints ≥ 1 works.
     Simulated Coulomb 0.3 Nm and viscous 0.2 Nm·s/rad are found within 5 %."""
-    config = _pendulum(tmp_path, iterations=2)
+    config = pendulum_config(tmp_path, iterations=2)
     assert runner.invoke(app, ["optimize", str(config)]).exit_code == 0
     with h5py.File(tmp_path / "out.h5") as f:
         assert f["iterations/2/regressor"].shape[1] == 3  # m z, m x, I_yy of the arm (its tip held)
@@ -204,7 +165,7 @@ def test_sigterm_is_restored_after_a_command():
 
 
 def _identify_config(folder: Path) -> Path:
-    _pendulum(folder)
+    pendulum_config(folder)
     config = {
         "robot": {"urdf": "pendulum.urdf", "active_joints": ["hinge"]},
         "data": {"runs": [{"file": "run.csv"}], "columns": {"q": ["q_hinge"], "tau": ["tau_hinge"]}},
@@ -224,17 +185,17 @@ def test_the_identified_urdf_may_not_overwrite_the_report_or_its_plots(tmp_path,
 def test_an_output_that_is_not_a_regular_file_is_never_replaced(tmp_path, command):
     fifo = tmp_path / "fifo.h5"
     os.mkfifo(fifo)
-    config = _pendulum(tmp_path) if command == "optimize" else _identify_config(tmp_path)
+    config = pendulum_config(tmp_path) if command == "optimize" else _identify_config(tmp_path)
     assert_refused(tmp_path, [command, str(config), "-o", str(fifo), "--force"], "is not a regular file")
     assert fifo.is_fifo()
 
 
 @pytest.mark.parametrize("tolerance", ["nan", "inf", "-1e-6", "0"])
 def test_verify_gradient_needs_a_pass_mark_that_can_fail(tmp_path, tolerance):
-    assert_refused(tmp_path, ["verify-gradient", str(_pendulum(tmp_path)), "--tolerance", tolerance], "tolerance")
+    assert_refused(tmp_path, ["verify-gradient", str(pendulum_config(tmp_path)), "--tolerance", tolerance], "tolerance")
 
 
 @pytest.mark.parametrize("command", ["optimize", "verify-gradient"])
 def test_an_active_mimic_joint_is_refused_by_name(tmp_path, command):
-    config = _pendulum(tmp_path, active=("tip_joint",), mimic='<mimic joint="hinge"/>')
+    config = pendulum_config(tmp_path, active=("tip_joint",), mimic='<mimic joint="hinge"/>')
     assert_refused(tmp_path, [command, str(config)], "joint 'tip_joint' mimics 'hinge'")

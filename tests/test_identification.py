@@ -13,7 +13,7 @@ from conftest import CONFIGS, write_config
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
-from excite_cli.config import load_problem
+from excite_cli.config_file import load_problem
 from excite_cli.dynamics.robot import load_robot
 from excite_cli.identification.config import DEFAULT_CANDIDATES, IdentifyProblem, PreprocessingConfig, SimulationConfig
 from excite_cli.identification.dataset import run_offset_columns

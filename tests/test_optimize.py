@@ -9,7 +9,7 @@ from conftest import UR5, write_config
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
-from excite_cli.config import load_problem
+from excite_cli.config_file import load_problem
 from excite_cli.dynamics.robot import load_robot
 from excite_cli.optimization.engine import Engine
 

@@ -14,7 +14,7 @@ from test_identification import JOINTS, SHARED, optimized  # noqa: F401  (module
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
-from excite_cli.config import load_problem
+from excite_cli.config_file import load_problem
 from excite_cli.dynamics.base_parameters import compute_base_parameters
 from excite_cli.dynamics.robot import load_robot
 from excite_cli.identification.config import IdentifyProblem

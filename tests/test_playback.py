@@ -183,7 +183,7 @@ def test_rest_to_rest_transition_is_as_short_as_the_velocity_limit_allows():
 
 
 def test_skeleton_of_the_panda_at_zero_reaches_the_flange():
-    from excite_cli.config import load_problem
+    from excite_cli.config_file import load_problem
     from excite_cli.dynamics.robot import load_robot
 
     robot = load_robot(load_problem(CONFIGS / "panda.yaml"))

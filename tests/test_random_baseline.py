@@ -12,7 +12,7 @@ from conftest import write_config
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
-from excite_cli.config import load_problem
+from excite_cli.config_file import load_problem
 from excite_cli.optimization.excitation import build_excitation
 from excite_cli.optimization.random_baseline import greedy_selection, random_candidate
 

@@ -14,7 +14,7 @@ import pytest
 from conftest import UR5, write_config
 from threadpoolctl import threadpool_limits
 
-from excite_cli.config import load_problem
+from excite_cli.config_file import load_problem
 from excite_cli.optimization.engine import Engine
 from excite_cli.optimization.excitation import build_excitation
 from excite_cli.optimization.sequence import RestartTask, run_sequence

@@ -11,7 +11,7 @@ import pytest
 from conftest import write_config
 from test_identification import JOINTS, NOISE, app, optimized, runner  # noqa: F401  (module fixture)
 
-from excite_cli.config import load_problem
+from excite_cli.config_file import load_problem
 from excite_cli.dynamics.robot import load_robot
 from excite_cli.identification.config import IdentifyProblem, SimulationConfig
 from excite_cli.identification.effects import POSITION

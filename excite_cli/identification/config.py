@@ -7,9 +7,10 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Literal, Optional, Union
 
+import numpy as np
 from pydantic import Field, NonNegativeFloat, NonNegativeInt, PositiveFloat, field_validator, model_validator
 
-from excite_cli.config import Problem, RobotConfig, Section
+from excite_cli.config import MAX_SEED, Problem, RobotConfig, Section
 from excite_cli.identification.effects import EFFECT_NAMES, POSITION, SHAPE_GRID
 
 Effect = Literal[EFFECT_NAMES]
@@ -22,6 +23,8 @@ REGULARIZATION = (1e-5, 1e-4, 1e-3, 1e-2, 1e-1)
 
 
 Column = Union[NonNegativeInt, str]
+#: Highest sample rate [Hz] (of the decimated data, of a simulated run).
+MAX_RATE = 100_000.0
 
 
 class ColumnsConfig(Section):
@@ -51,6 +54,19 @@ class PayloadConfig(Section):
     inertia: tuple[float, float, float, float, float, float] = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     frame: Optional[str] = None
 
+    @field_validator("inertia")
+    @classmethod
+    def _a_body_can_have_it(cls, inertia):
+        xx, xy, yy, xz, yz, zz = inertia
+        moments = np.linalg.eigvalsh(np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]]))
+        tolerance = 1e-9 * max(1.0, moments.max())
+        if moments.min() < -tolerance or 2 * moments.max() > moments.sum() + tolerance:
+            raise ValueError(
+                f"no body has principal moments {', '.join(f'{m:.4g}' for m in moments)} kg·m²; expected them ≥ 0 "
+                "and each at most the sum of the other two (Ixx, Ixy, Iyy, Ixz, Iyz, Izz about the centre of mass)"
+            )
+        return inertia
+
 
 class RunConfig(Section):
     """One measured run: file, optional crop [s], role (fit, validation or time blocks), a known payload."""
@@ -77,15 +93,29 @@ class DataConfig(Section):
     angle_unit: Literal["rad", "deg"] = "rad"
     torque_constants: Optional[list[float]] = None
     signs: Optional[list[float]] = None
-    validation_blocks: int = Field(4, ge=2)
+    validation_blocks: int = Field(4, ge=2, le=100)
     bad_rows: Literal["error", "drop"] = "error"
+
+    @field_validator("torque_constants")
+    @classmethod
+    def _nonzero(cls, values):
+        if values is not None and 0.0 in values:
+            raise ValueError("a torque constant of 0 Nm/A makes every torque of its joint 0; expected the motor's")
+        return values
+
+    @field_validator("signs")
+    @classmethod
+    def _plus_or_minus_one(cls, values):
+        if values is not None and any(v not in (1.0, -1.0) for v in values):
+            raise ValueError("every sign must be 1 or -1")
+        return values
 
 
 class PreprocessingConfig(Section):
     """Decimated rate [Hz] (default: min(200 Hz, the data's rate)), low-pass cut-off [Hz] (default from
     the bandwidth), filter order."""
 
-    sample_rate: Optional[float] = Field(None, gt=0.0)
+    sample_rate: Optional[float] = Field(None, gt=0.0, le=MAX_RATE)
     cutoff: Optional[float] = Field(None, gt=0.0)
     filter_order: int = Field(4, ge=1, le=10)
 
@@ -136,12 +166,12 @@ class IdentifyProblem(Section):
 class SimulationConfig(Section):
     """``excite simulate`` effects file: what the simulated robot has beyond its URDF rigid body."""
 
-    sample_rate: float = Field(1000.0, gt=0.0)
-    periods: int = Field(2, ge=1)
+    sample_rate: float = Field(1000.0, gt=0.0, le=MAX_RATE)
+    periods: int = Field(2, ge=1, le=1000)
     timestamp_jitter: float = Field(0.0, ge=0.0, lt=0.5)
     torque_noise: float = Field(0.0, ge=0.0)
     position_noise: float = Field(0.0, ge=0.0)
-    seed: int = Field(0, ge=0)
+    seed: int = Field(0, ge=0, le=MAX_SEED)
     effects: dict[Effect, dict[str, Union[float, tuple[float, float]]]] = Field(default_factory=dict)
     stribeck_velocity: float = Field(0.1, gt=0.0)
     coulomb_velocity: float = Field(0.01, gt=0.0)

@@ -23,6 +23,8 @@ import scipy.io
 from excite_cli.errors import ExciteError
 
 DELIMITERS = (",", ";", "\t")
+#: Largest CSV or text file read [bytes] (binary formats are read without this bound).
+MAX_TEXT_BYTES = 1_000_000_000
 #: A number written with a decimal comma (semicolon-separated files of European locales).
 DECIMAL_COMMA = re.compile(r"\d,\d")
 
@@ -144,12 +146,51 @@ def _columns(arrays: dict[str, np.ndarray], path: Path) -> Table:
     lengths = {c.size for c in columns}
     if not columns:
         raise ExciteError("data", f"{path.name} holds no numeric 1-D or 2-D arrays")
+    if max(lengths) == 0:
+        raise ExciteError("data", f"{path.name} has no data rows (its arrays are empty)")
     if len(lengths) > 1:
         longest = max(lengths)
         keep = [k for k, c in enumerate(columns) if c.size == longest]
         names, columns = [names[k] for k in keep], [columns[k] for k in keep]
     values = np.column_stack(columns)
     return Table(names, values, 0, np.arange(1, values.shape[0] + 1))
+
+
+def _h5_datasets(f: h5py.File) -> dict[str, np.ndarray]:
+    """The datasets at the root of ``f`` by name; links to other files are not followed, links that
+    lead nowhere (a missing target, a loop) are left out."""
+    arrays = {}
+    for name in f:
+        if isinstance(f.get(name, getlink=True), h5py.ExternalLink):
+            continue
+        try:
+            item = f[name]
+        except (KeyError, RuntimeError):
+            continue
+        if isinstance(item, h5py.Dataset):
+            arrays[name] = item[()]
+    return arrays
+
+
+def _check_text_size(path: Path) -> None:
+    """Refuse a text file too big to read as text, or whose start holds NUL bytes (a binary file or
+    a sparse file of zeros under a .csv name)."""
+    size = path.stat().st_size
+    if size > MAX_TEXT_BYTES:
+        raise ExciteError(
+            "data",
+            f"{path.name} is {size / 1e9:.1f} GB, larger than {MAX_TEXT_BYTES / 1e9:g} GB of text",
+            path,
+            "a smaller CSV or the data as NPZ, MAT or HDF5",
+        )
+    with open(path, "rb") as f:
+        if b"\0" in f.read(65536):
+            raise ExciteError(
+                "data",
+                f"{path.name} is not a text file (it holds NUL bytes; NPZ, MAT and HDF5 files need the "
+                ".npz, .mat or .h5 ending)",
+                path,
+            )
 
 
 def read_table(path: Path, drop: bool = False) -> Table:
@@ -171,9 +212,10 @@ def read_table(path: Path, drop: bool = False) -> Table:
             return _columns({k: v for k, v in scipy.io.loadmat(path).items() if not k.startswith("__")}, path)
         if suffix in (".h5", ".hdf5"):
             with h5py.File(path, "r") as f:
-                return _columns({name: f[name][()] for name in f if isinstance(f[name], h5py.Dataset)}, path)
+                return _columns(_h5_datasets(f), path)
     except (OSError, ValueError, NotImplementedError) as exc:
         raise ExciteError(
             "data", f"cannot read {path.name} as {suffix[1:].upper()}: {' '.join(str(exc).split())[:160]}"
         ) from None
+    _check_text_size(path)
     return _read_text(path, drop)

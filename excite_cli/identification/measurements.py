@@ -134,6 +134,8 @@ def load_run(run: RunConfig, data: DataConfig, problem: IdentifyProblem, n: int)
         s = np.asarray(data.signs, dtype=float)
         q, qd, qdd, tau = (None if x is None else x * s for x in (q, qd, qdd, tau))
     keep = ok if run.crop is None else ok & (time >= run.crop[0]) & (time <= run.crop[1])
+    if keep.sum() < 2 and run.crop is None:
+        raise ExciteError("data", f"{path.name} has fewer than 2 usable rows")
     if keep.sum() < 2:
         raise ExciteError(
             "data.runs.crop", f"{run.crop} leaves no samples of {path.name} ({time[0]:g} to {time[-1]:g} s)"

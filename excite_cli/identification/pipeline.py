@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from excite_cli.config import with_overrides
+from excite_cli.config_file import with_overrides
 from excite_cli.dynamics.base_parameters import BaseParameters, compute_base_parameters
 from excite_cli.dynamics.robot import Robot, load_robot, resolve_urdf
 from excite_cli.errors import ExciteError

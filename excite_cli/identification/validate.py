@@ -17,7 +17,7 @@ from typing import Optional
 
 import numpy as np
 
-from excite_cli.config import with_overrides
+from excite_cli.config_file import with_overrides
 from excite_cli.dynamics.base_parameters import compute_base_parameters
 from excite_cli.dynamics.robot import load_robot
 from excite_cli.errors import ExciteError

@@ -68,8 +68,8 @@ def _worker_signals() -> None:
 
 
 class Engine:
-    """Runs tasks serially (``workers`` 1), in a local process pool of ``workers`` processes, or on
-    the Dask scheduler at ``scheduler``.
+    """Runs tasks serially (``workers`` 1), in a local process pool of ``workers`` processes (at most
+    as many as the first parallel run has tasks), or on the Dask scheduler at ``scheduler``.
 
     Use as a context manager: this process runs with one BLAS thread inside it (and keeps freed
     memory), and the pool or client is closed on exit.
@@ -92,12 +92,10 @@ class Engine:
 
             try:
                 self._client = Client(self.scheduler, timeout=CONNECT_TIMEOUT)
-            except (OSError, TimeoutError) as exc:
+            except (OSError, TimeoutError, ValueError) as exc:
                 raise ExciteError(
                     "optimizer.scheduler", f"cannot reach the Dask scheduler at {self.scheduler}: {exc}"
                 ) from None
-        elif self.workers > 1:
-            self._pool = ProcessPoolExecutor(max_workers=self.workers, initializer=_worker_signals)
         return self
 
     def __exit__(self, kind, *exc) -> None:
@@ -114,11 +112,6 @@ class Engine:
             self._client.close()
         if self._limits is not None:
             self._limits.restore_original_limits()
-
-    @property
-    def parallel(self) -> bool:
-        """Whether tasks run in other processes (a pool or a cluster)."""
-        return self._pool is not None or self._client is not None
 
     def run(
         self,
@@ -141,7 +134,7 @@ class Engine:
         return [results[task.index] for task in tasks]
 
     def _completed(self, tasks: Sequence[Task], progress: Optional[Callable]) -> Iterator[tuple[Task, Any]]:
-        if not self.parallel or len(tasks) == 1:  # one task gains nothing from another process
+        if (self._client is None and self.workers == 1) or len(tasks) == 1:  # no gain from other processes
             for task in tasks:
                 yield task, task(self.excitation, progress)
             return
@@ -153,6 +146,8 @@ class Engine:
             for future in dask_completed(list(futures)):
                 yield futures[future], future.result()
             return
+        if self._pool is None:  # sized by the work: more processes than tasks would only start and wait
+            self._pool = ProcessPoolExecutor(max_workers=min(self.workers, len(tasks)), initializer=_worker_signals)
         pool_futures = {self._pool.submit(run_on_worker, problem, task): task for task in tasks}
         for future in as_completed(pool_futures):
             yield pool_futures[future], future.result()

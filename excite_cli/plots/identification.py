@@ -12,6 +12,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from excite_cli.identification.report import Report  # noqa: E402
+from excite_cli.plots.figure import save_figure  # noqa: E402
 
 
 def _end_to_end(time: np.ndarray, run: np.ndarray) -> np.ndarray:
@@ -66,9 +67,7 @@ def plot_identification(path: Path, report: Report) -> Path:
     for a in axes[-1]:
         a.set_xlabel("time [s]")
     fig.tight_layout()
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, 100)
 
 
 def plot_ladder(path: Path, report: Report) -> Path:
@@ -115,6 +114,4 @@ def plot_ladder(path: Path, report: Report) -> Path:
     bottom.legend(fontsize=7)
     bottom.grid(alpha=0.3)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, 110)

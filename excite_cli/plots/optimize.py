@@ -15,6 +15,7 @@ import numpy as np  # noqa: E402
 from excite_cli.constraints import ComRegion, SelfCollision  # noqa: E402
 from excite_cli.optimization.excitation import Excitation  # noqa: E402
 from excite_cli.optimization.sequence import IterationResult  # noqa: E402
+from excite_cli.plots.figure import save_figure  # noqa: E402
 from excite_cli.plots.skeleton import capsule_segments, skeleton  # noqa: E402
 
 
@@ -95,9 +96,7 @@ def plot_trajectories(
     labels.append("limits (dashed)")
     axes[0, -1].legend(handles, labels, fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, 110)
 
 
 def plot_condition_numbers(path: Path, results: Sequence[IterationResult]) -> Path:
@@ -119,9 +118,7 @@ def plot_condition_numbers(path: Path, results: Sequence[IterationResult]) -> Pa
     ax.grid(alpha=0.3, which="both")
     ax.legend()
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, 110)
 
 
 def _stadium(a: np.ndarray, b: np.ndarray, radius: float, points: int = 12) -> np.ndarray:
@@ -183,9 +180,7 @@ def plot_postures(
                 ax.set_yticks([])
                 ax.set_title(f"iteration {r.index}, {view}, t = {t:.1f} s", fontsize=7)
     fig.tight_layout()
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, 100)
 
 
 def plot_constraint_tracks(
@@ -229,9 +224,7 @@ def plot_constraint_tracks(
         for a in axes[:, col]:
             a.grid(alpha=0.3)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, 110)
 
 
 def plot_comparison(path: Path, random_table, optimized_table) -> Path:
@@ -252,6 +245,4 @@ def plot_comparison(path: Path, random_table, optimized_table) -> Path:
         ax.grid(alpha=0.3, axis="y")
         ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, 110)

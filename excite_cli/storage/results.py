@@ -12,10 +12,10 @@ from typing import Sequence
 
 import h5py
 import numpy as np
-import yaml
 from pydantic import ValidationError
 
 from excite_cli.config import Problem, effective_yaml
+from excite_cli.config_file import parse_yaml
 from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.errors import ExciteError
 from excite_cli.h5 import atomic_h5, open_h5, read_strings, write_strings
@@ -202,8 +202,8 @@ def problem_of_result(path: Path) -> Problem:
             )
         text, origin = str(f.attrs["config"]), str(f.attrs.get("config_path", ""))
     try:
-        problem = Problem.model_validate(yaml.safe_load(text))
-    except (yaml.YAMLError, ValidationError):
+        problem = Problem.model_validate(parse_yaml(text, str(path), "result"))
+    except (ExciteError, ValidationError):
         raise ExciteError(
             "result",
             f"the stored config of {path} is not a valid optimize problem (not an excite optimize result?)",
@@ -212,15 +212,6 @@ def problem_of_result(path: Path) -> Problem:
     problem.source_path = Path(origin) if origin else None
     problem.source_text = text
     return problem
-
-
-def read_last_alpha(path: Path) -> tuple[int, np.ndarray]:
-    """Index k and Fourier coefficients α (n, 2N+1) of the last iteration of an excite result.
-
-    Raises:
-        ExciteError: missing or unreadable file, or no finished iteration in it.
-    """
-    return read_alphas(path)[-1]
 
 
 def read_iterations(
@@ -270,10 +261,18 @@ def read_alphas(path: Path) -> list[tuple[int, np.ndarray]]:
     """(k, α (n, 2N+1)) of every iteration of an excite result, in order.
 
     Raises:
-        ExciteError: missing or unreadable file, or no iteration in it.
+        ExciteError: missing or unreadable file, no iteration in it, or coefficients that are not
+            (active joints, 2N + 1) finite numbers (a damaged file).
     """
+    trajectory = problem_of_result(path).trajectory
     with open_h5(path) as f:
         keys = sorted(f["iterations"].keys(), key=int) if "iterations" in f else []
         if not keys:
             raise ExciteError("result", f"{path} has no finished iteration", path)
-        return [(int(k), f["iterations"][k]["alpha"][()]) for k in keys]
+        alphas = [(int(k), np.asarray(f["iterations"][k]["alpha"][()], dtype=float)) for k in keys]
+        joints = len(read_strings(f["robot"], "joint_names"))
+    shape = (joints, 2 * trajectory.harmonics + 1)
+    for k, alpha in alphas:
+        if alpha.shape != shape or not np.all(np.isfinite(alpha)):
+            raise ExciteError("result", f"{path}: iteration {k} has no valid Fourier coefficients {shape}", path)
+    return alphas

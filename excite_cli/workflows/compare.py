@@ -17,7 +17,7 @@ from excite_cli.optimization.optimizer import ProgressHook
 from excite_cli.optimization.random_baseline import draw_pool, greedy_selection, pool_convergence
 from excite_cli.optimization.sequence import describe
 from excite_cli.plots.optimize import plot_comparison
-from excite_cli.storage.paths import check_target
+from excite_cli.storage.paths import check_target, output_lock
 from excite_cli.storage.results import read_table, results_table, write_result
 from excite_cli.workflows.optimize import engine_for, run_optimize
 
@@ -65,12 +65,13 @@ def run_compare_random(
         progress: the optimize progress (when it runs); draws: called with (kept, drawn).
 
     Raises:
-        ExciteError: bad paths, a result of another problem, too few feasible candidates.
+        ExciteError: bad paths, a result of another problem, too few feasible candidates, another
+            run writing ``target``.
     """
     base = Path(problem.output)
     target = check_target(target or base.with_name(base.stem + "_random.h5"), "output", force)
     excitation = build_excitation(problem)
-    with engine_for(problem, excitation) as engine:
+    with output_lock(target, "output"), engine_for(problem, excitation) as engine:
         if optimized is None:  # run here: its table is in memory
             run = run_optimize(
                 problem, base.with_name(base.stem + "_optimized.h5"), force, progress=progress, engine=engine

@@ -13,7 +13,7 @@ from excite_cli.identification.pipeline import run_identification, write_identif
 from excite_cli.identification.report import Report
 from excite_cli.identification.report_file import write_identification
 from excite_cli.plots.identification import plot_identification, plot_ladder
-from excite_cli.storage.paths import check_target
+from excite_cli.storage.paths import check_target, output_lock
 
 
 @dataclass
@@ -36,7 +36,8 @@ def run_identify(
     ``identification.fit`` says: a URDF needs physical bodies).
 
     Raises:
-        ExciteError: bad paths or data (see :func:`run_identification`).
+        ExciteError: bad paths or data (see :func:`run_identification`); another run writing
+            ``target`` (:func:`output_lock`).
     """
     check_target(target, "output", force)
     plots = [target.with_name(target.stem + suffix) for suffix in ("_residuals.png", "_ladder.png")]
@@ -46,8 +47,9 @@ def run_identify(
             raise ExciteError(
                 "urdf_out", f"{urdf_out} is also the report or one of its plots", urdf_out, "another path"
             )
-    report, robot, base, regressor = run_identification(problem, consistent_beside=urdf_out is not None)
-    write_identification(target, report, robot, base, problem, regressor)
-    deviation = write_identified_urdf(problem, report, robot, base, urdf_out) if urdf_out is not None else None
-    plots = [plot_identification(plots[0], report), plot_ladder(plots[1], report)]
+    with output_lock(target, "output"):
+        report, robot, base, regressor = run_identification(problem, consistent_beside=urdf_out is not None)
+        write_identification(target, report, robot, base, problem, regressor)
+        deviation = write_identified_urdf(problem, report, robot, base, urdf_out) if urdf_out is not None else None
+        plots = [plot_identification(plots[0], report), plot_ladder(plots[1], report)]
     return IdentifyRun(report, robot, target, plots, deviation)

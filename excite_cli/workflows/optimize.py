@@ -10,6 +10,7 @@ import numpy as np
 import yaml
 
 from excite_cli.config import Problem, effective_yaml
+from excite_cli.config_file import parse_yaml
 from excite_cli.errors import ExciteError, FileNotFound, Interrupted, exit_status
 from excite_cli.h5 import open_h5
 from excite_cli.optimization.engine import Engine, default_workers
@@ -17,9 +18,12 @@ from excite_cli.optimization.excitation import Excitation, build_excitation
 from excite_cli.optimization.optimizer import ProgressHook
 from excite_cli.optimization.sequence import IterationResult, run_sequence
 from excite_cli.plots.optimize import plot_result
-from excite_cli.storage.paths import check_target
+from excite_cli.storage.paths import check_target, output_lock
 from excite_cli.storage.results import read_iterations, read_prior, write_result
 
+#: The largest cond(C) of a result that identifies something: above it, noise in the torques is
+#: amplified a million times into the base parameters (Eq. 5 bounds the relative error by cond(C)).
+MAX_USEFUL_COND = 1e6
 RESUMABLE_CHANGES = ("sequence.iterations", "optimizer.workers", "optimizer.scheduler")
 
 
@@ -37,6 +41,20 @@ class OptimizeRun:
     results: list[IterationResult]
     target: Path
     plots: list[Path]
+
+    @property
+    def unexciting(self) -> str:
+        """Why the trajectories identify nothing, "" when they do: the stacked regressor of the last
+        iteration has cond(C) above :data:`MAX_USEFUL_COND` (rank-deficient or nearly: no motion, or
+        limits that leave none)."""
+        cond = self.results[-1].cond_stacked
+        if cond <= MAX_USEFUL_COND:
+            return ""
+        return (
+            f"cond(C) {cond:.3g} after iteration {self.results[-1].index}: the trajectories do not excite every "
+            f"base parameter (expected cond(C) ≤ {MAX_USEFUL_COND:g}; are the limits or the frequency leaving "
+            "room to move?)"
+        )
 
 
 def run_optimize(
@@ -58,7 +76,8 @@ def run_optimize(
         engine: where restarts run (default: :func:`engine_for`).
 
     Raises:
-        ExciteError: bad target, prior data or problem; a result to resume made with another config.
+        ExciteError: bad target, prior data or problem; a result to resume made with another config;
+            another run writing ``target`` (:func:`output_lock`).
         Interrupted: Ctrl-C or SIGTERM; the finished iterations are in ``target``, the workers stopped.
     """
     check_target(target, "output", force, exists_ok=resume)
@@ -75,25 +94,36 @@ def run_optimize(
         if on_iteration:
             on_iteration(result)
 
-    try:
-        with engine or engine_for(problem, excitation) as active:
-            results = run_sequence(
-                excitation, problem.sequence.iterations, problem.optimizer.seed, prior, progress, done, active, finished
-            )
-    except KeyboardInterrupt as exc:
-        raise Interrupted(target, len(written), exit_status(exc)) from None
-    return OptimizeRun(excitation, results, target, plot_result(target, excitation, results))
+    with output_lock(target, "output"):
+        try:
+            with engine or engine_for(problem, excitation) as active:
+                results = run_sequence(
+                    excitation,
+                    problem.sequence.iterations,
+                    problem.optimizer.seed,
+                    prior,
+                    progress,
+                    done,
+                    active,
+                    finished,
+                )
+        except KeyboardInterrupt as exc:
+            raise Interrupted(target, len(written), exit_status(exc)) from None
+        return OptimizeRun(excitation, results, target, plot_result(target, excitation, results))
 
 
 def _resumable(target: Path, excitation: Excitation, prior: Optional[np.ndarray]) -> list[IterationResult]:
     """The iterations of ``target`` if it was made with the same config (see ``RESUMABLE_CHANGES``)."""
     with open_h5(target, "resume") as f:
-        stored = yaml.safe_load(str(f.attrs.get("config", ""))) or {}
+        stored = parse_yaml(str(f.attrs.get("config", "")), str(target), "resume") or {}
     current = yaml.safe_load(effective_yaml(excitation.problem))
+    if not isinstance(stored, dict):
+        raise ExciteError("resume", f"{target} has no valid stored config (not an excite optimize result?)", target)
     for dotted in RESUMABLE_CHANGES:
         section, name = dotted.split(".")
         for config in (stored, current):
-            config.get(section, {}).pop(name, None)
+            if isinstance(config.get(section), dict):
+                config[section].pop(name, None)
     if stored != current:
         differing = sorted(k for k in set(stored) | set(current) if stored.get(k) != current.get(k))
         raise ExciteError(

@@ -13,12 +13,15 @@ import numpy as np
 
 from excite_cli.dynamics.robot import Robot, load_robot
 from excite_cli.errors import ExciteError
-from excite_cli.h5 import atomic_path
+from excite_cli.h5 import atomic_paths
 from excite_cli.identification.config import SimulationConfig
 from excite_cli.identification.effects import COEFFICIENTS, SHAPE_FIELDS, effect_columns
 from excite_cli.storage.paths import check_folder
 from excite_cli.storage.results import problem_of_result, read_alphas
 from excite_cli.trajectory.fourier import FourierTrajectory
+
+#: Most samples in one simulated run.
+MAX_SAMPLES = 10_000_000
 
 
 def effect_torques(
@@ -50,8 +53,8 @@ def effect_torques(
 def simulate_runs(
     result: Path, sim: SimulationConfig, out_dir: Path, prefix: str = "run", force: bool = False
 ) -> list[Path]:
-    """Write one CSV per iteration of ``result`` into ``out_dir``; everything is computed (and every
-    error raised) before the first file is written.
+    """Write one CSV per iteration of ``result`` into ``out_dir``; all files or none are written
+    (:func:`atomic_paths`).
 
     Args:
         result: an ``optimize`` (or ``compare-random``) HDF5 result.
@@ -64,7 +67,7 @@ def simulate_runs(
 
     Raises:
         ExciteError: not a result, an unknown joint or a wrong coefficient count in the effects,
-            non-finite effect values, files in the way.
+            non-finite effect values, more than MAX_SAMPLES samples per run, files in the way.
     """
     problem = problem_of_result(result)
     problem.robot.base_wrench_rows = False
@@ -74,9 +77,15 @@ def simulate_runs(
     alphas = read_alphas(result)
     check_folder(out_dir, [f"{prefix}_{k}.csv" for k, _ in alphas], "output_dir", force)
     header = ["time"] + [f"q_{j}" for j in robot.joint_names] + [f"tau_{j}" for j in robot.joint_names]
+    count = int(round(sim.periods * trajectory.period * sim.sample_rate)) + 1
+    if count > MAX_SAMPLES:
+        raise ExciteError(
+            "periods",
+            f"{sim.periods} period(s) of {trajectory.period:g} s at {sim.sample_rate:g} Hz are {count:,} samples "
+            f"per run; expected at most {MAX_SAMPLES:,} (fewer periods or a lower sample_rate)",
+        )
     tables = {}
     for k, alpha in alphas:
-        count = int(round(sim.periods * trajectory.period * sim.sample_rate)) + 1
         time = np.arange(count) / sim.sample_rate
         time[1:-1] += rng.uniform(-sim.timestamp_jitter, sim.timestamp_jitter, count - 2) / sim.sample_rate
         q, qd, qdd = trajectory.basis(time).evaluate(alpha)
@@ -86,11 +95,8 @@ def simulate_runs(
         tables[k] = np.column_stack([time, q + rng.normal(0.0, sim.position_noise, q.shape), tau])
         if not np.all(np.isfinite(tables[k])):
             raise ExciteError("effects", "a value makes non-finite torques (NaN or inf in the effects file?)")
-    out_dir.mkdir(parents=True, exist_ok=True)
-    written = []
-    for k, table in tables.items():
-        path = out_dir / f"{prefix}_{k}.csv"
-        with atomic_path(path, "output_dir") as tmp:
+    written = [out_dir / f"{prefix}_{k}.csv" for k in tables]
+    with atomic_paths(written, "output_dir") as tmps:
+        for tmp, table in zip(tmps, tables.values()):
             np.savetxt(tmp, table, delimiter=",", header=",".join(header), comments="", fmt="%.10g")
-        written.append(path)
     return written

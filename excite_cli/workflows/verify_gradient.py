@@ -8,7 +8,7 @@ from typing import Optional, Sequence
 
 import numpy as np
 
-from excite_cli.config import Problem
+from excite_cli.config import MAX_SEED, Problem
 from excite_cli.errors import ExciteError
 from excite_cli.optimization.criterion import OBJECTIVES
 from excite_cli.optimization.excitation import build_excitation
@@ -50,8 +50,8 @@ def run_verify(
     for name in objectives:
         if name not in OBJECTIVES:
             raise ExciteError("objective", f"'{name}' is not a criterion", name, f"one of {', '.join(OBJECTIVES)}")
-    if seed < 0:
-        raise ExciteError("seed", "must be ≥ 0", seed, "an integer ≥ 0")
+    if not 0 <= seed <= MAX_SEED:
+        raise ExciteError("seed", f"{seed} is out of range", seed, f"an integer from 0 to {MAX_SEED}")
     if not 1e-12 <= step <= 1e-2:
         raise ExciteError(
             "step", f"{step:g} is not a finite-difference step for coefficients in rad", step, "1e-12 to 1e-2"

@@ -1,0 +1,27 @@
+"""A figure written as a PNG file whole or not at all (rendered in memory, then :func:`atomic_bytes`)."""
+
+from __future__ import annotations
+
+import io
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+from excite_cli.h5 import atomic_bytes  # noqa: E402
+
+
+def save_figure(fig: plt.Figure, path: Path, dpi: int) -> Path:
+    """``fig`` as a PNG at ``path`` (``dpi`` dots per inch), then closed; ``path`` returned.
+
+    Raises:
+        CannotWrite: the file cannot be written (a full disk, a folder without write permission).
+    """
+    buffer = io.BytesIO()
+    try:
+        fig.savefig(buffer, format="png", dpi=dpi)
+    finally:
+        plt.close(fig)
+    return atomic_bytes(path, buffer.getvalue(), "output")

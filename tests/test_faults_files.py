@@ -1,0 +1,432 @@
+"""Faults of the machine and of the files a user gives (issue 20): a full disk, problems with no
+motion in them, numbers without bounds, hostile YAML, HDF5, NPZ and CSV files, two runs on one
+output. A bad case exits with status 2 and one line naming the field or file, prints no traceback
+and leaves no file behind or changed; each runs under a timeout."""
+
+import os
+import resource
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+import yaml
+from conftest import assert_refused, pendulum_config
+from typer.testing import CliRunner
+
+from excite_cli.cli import app
+from excite_cli.config_file import load_problem
+from excite_cli.identification.config import IdentifyProblem
+from excite_cli.identification.files import read_table
+from excite_cli.storage.paths import output_lock
+
+runner = CliRunner()
+EXCITE = Path(sys.executable).with_name("excite")
+EFFECTS = {"sample_rate": 100.0, "periods": 1, "torque_noise": 0.01, "seed": 1, "effects": {"viscous": {"*": 0.2}}}
+
+
+@pytest.fixture(scope="module")
+def pendulum_run(tmp_path_factory) -> Path:
+    """A folder with a two-iteration pendulum result ``out.h5``, its simulated runs ``sim/run_k.csv``
+    and an identify config ``id.yaml`` of them."""
+    folder = tmp_path_factory.mktemp("pendulum")
+    config = pendulum_config(folder, iterations=2)
+    assert runner.invoke(app, ["optimize", str(config)]).exit_code == 0
+    (folder / "effects.yaml").write_text(yaml.safe_dump(EFFECTS))
+    argv = ["simulate", str(folder / "out.h5"), str(folder / "effects.yaml"), "-o", str(folder / "sim")]
+    assert runner.invoke(app, argv).exit_code == 0
+    identify = {
+        "robot": {"urdf": "pendulum.urdf", "active_joints": ["hinge"]},
+        "data": {
+            "runs": [{"file": "sim/run_1.csv", "role": "fit"}, {"file": "sim/run_2.csv", "role": "validation"}],
+            "columns": {"q": ["q_hinge"], "tau": ["tau_hinge"]},
+        },
+    }
+    (folder / "id.yaml").write_text(yaml.safe_dump(identify))
+    return folder
+
+
+def _copy(source: Path, folder: Path) -> Path:
+    """``source``'s files copied into ``folder`` (the commands run on the copy)."""
+    shutil.copytree(source, folder, dirs_exist_ok=True)
+    return folder
+
+
+def _run(argv: list[str], cwd: Path, file_size: int | None = None, timeout: float = 240) -> subprocess.CompletedProcess:
+    """``excite argv`` in a process of its own, its files limited to ``file_size`` bytes (a full disk)."""
+
+    def limit() -> None:
+        if file_size is not None:
+            resource.setrlimit(resource.RLIMIT_FSIZE, (file_size, file_size))
+
+    return subprocess.run(
+        [str(EXCITE), *argv], cwd=cwd, preexec_fn=limit, capture_output=True, text=True, timeout=timeout
+    )
+
+
+def _one_error_line(process: subprocess.CompletedProcess, expected: str, status: int = 2) -> None:
+    assert process.returncode == status, process.stderr
+    assert "Traceback" not in process.stderr + process.stdout
+    errors = [line for line in process.stderr.splitlines() if line.startswith("error:")]
+    assert len(errors) == 1 and expected in errors[0], process.stderr
+
+
+# --- a full disk (RLIMIT_FSIZE: every write beyond the limit fails with EFBIG) -----------------------
+
+DISK_FULL = {
+    "optimize": (["optimize", "pendulum.yaml", "-o", "new/result.h5"], "new/result.h5"),
+    "identify": (["identify", "id.yaml", "-o", "new/report.h5"], "new/report.h5"),
+    "simulate": (["simulate", "out.h5", "effects.yaml", "-o", "new/sim"], "new/sim/run_1.csv"),
+    "export": (["export", "out.h5", "-o", "new/play.csv"], "new/play.csv"),
+    "compare-random": (
+        ["compare-random", "pendulum.yaml", "--optimized", "out.h5", "--pool", "4", "-o", "new/random.h5"],
+        "new/random.h5",
+    ),
+}
+
+
+@pytest.mark.parametrize("command", list(DISK_FULL))
+def test_a_full_disk_is_one_line_and_leaves_nothing(pendulum_run, tmp_path, command):
+    folder = _copy(pendulum_run, tmp_path / "run")
+    argv, written = DISK_FULL[command]
+    before = sorted(p.relative_to(folder) for p in folder.rglob("*"))
+    _one_error_line(_run(argv, folder, file_size=2000), f"cannot write {written}: File too large")
+    assert sorted(p.relative_to(folder) for p in folder.rglob("*")) == before  # no file, no .partial, no folder
+
+
+def test_a_disk_that_fills_up_at_the_plots_keeps_the_result(pendulum_run, tmp_path):
+    folder = _copy(pendulum_run, tmp_path / "run")
+    result = folder / "out.h5"
+    process = _run(["optimize", "pendulum.yaml", "-o", "again.h5"], folder, file_size=result.stat().st_size + 4096)
+    _one_error_line(process, "cannot write again_trajectories.png: File too large")
+    with h5py.File(folder / "again.h5") as f:
+        assert len(f["iterations"]) == 2
+    assert not [p.name for p in folder.iterdir() if p.name.startswith("again_") or p.suffix == ".partial"]
+
+
+# --- problems with no motion in them ---------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "changes, expected",
+    [
+        ({"trajectory.base_frequency": 1e-9}, "less than a quarter of its base period"),
+        ({"trajectory.base_frequency": 1e6}, "fewer than 4 constraint-grid instants per cycle"),
+        ({"trajectory.constraint_period": 2.0}, "fewer than 4 constraint-grid instants per cycle"),
+    ],
+    ids=["frequency-1e-9", "frequency-1e6", "coarse-grid"],
+)
+def test_a_frequency_with_no_motion_is_refused_before_the_run(tmp_path, changes, expected):
+    config = pendulum_config(tmp_path, changes={"trajectory.harmonics": 5, **changes})
+    assert_refused(tmp_path, ["optimize", str(config)], expected)
+
+
+def test_limits_that_leave_no_motion_end_in_a_warning_and_status_1(tmp_path):
+    """An acceleration limit of 1e-9 rad/s²: the optimizer returns a trajectory that barely moves.
+    It is kept (the user may look at it) but the run says so and fails."""
+    config = pendulum_config(tmp_path, changes={"limits.acceleration": 1e-9, "limits.velocity": 1e-9})
+    result = runner.invoke(app, ["optimize", str(config)])
+    assert result.exit_code == 1, result.output
+    assert "warning: cond(C)" in result.output and "do not excite every base parameter" in result.output
+    with h5py.File(tmp_path / "out.h5") as f:
+        assert f["iterations/1"].attrs["cond_stacked"] > 1e6
+
+
+def test_a_well_posed_pendulum_passes_the_excitation_check(pendulum_run):
+    with h5py.File(pendulum_run / "out.h5") as f:
+        assert f["iterations/2"].attrs["cond_stacked"] < 1e3
+
+
+# --- numbers without bounds ------------------------------------------------------------------------
+
+BOUNDS = [
+    ("max-iterations", {"optimizer.max_iterations": 10**12}, "optimizer.max_iterations"),
+    ("seed-huge", {"optimizer.seed": 2**70}, "optimizer.seed"),
+    ("restarts", {"optimizer.restarts": 10**9}, "optimizer.restarts"),
+    ("starts", {"optimizer.starts": 10**9}, "optimizer.starts"),
+    ("screen-iterations", {"optimizer.screen_iterations": 10**9}, "optimizer.screen_iterations"),
+    ("workers-config", {"optimizer.workers": 100000}, "optimizer.workers"),
+    ("check-refinement", {"limits.check_refinement": 10**9}, "limits.check_refinement"),
+    ("fine-grid", {"limits.check_refinement": 1000, "trajectory.constraint_period": 0.001}, "its fine check"),
+    ("iterations", {"sequence.iterations": 10**9}, "sequence.iterations"),
+    ("pool-size", {"random_baseline.pool_size": 10**12}, "random_baseline.pool_size"),
+    ("baseline-seed", {"random_baseline.seed": 2**64}, "random_baseline.seed"),
+    ("scheduler-garbage", {"optimizer.scheduler": "garbage"}, "expected a Dask scheduler address"),
+    ("scheduler-no-port", {"optimizer.scheduler": "tcp://"}, "optimizer.scheduler"),
+]
+
+
+@pytest.mark.parametrize("changes, expected", [c[1:] for c in BOUNDS], ids=[c[0] for c in BOUNDS])
+def test_a_number_beyond_its_bound_is_refused_by_name(tmp_path, changes, expected):
+    config = pendulum_config(tmp_path, changes=changes)
+    assert_refused(tmp_path, ["optimize", str(config)], expected)
+
+
+@pytest.mark.parametrize(
+    "command, option",
+    [
+        ("optimize", ["--workers", "100000"]),
+        ("optimize", ["--seed", str(2**70)]),
+        ("optimize", ["--scheduler", "::::"]),
+        ("compare-random", ["--pool", str(10**12)]),
+        ("verify-gradient", ["--seed", str(2**70)]),
+    ],
+)
+def test_a_command_line_number_beyond_its_bound_is_refused_by_name(tmp_path, command, option):
+    assert_refused(tmp_path, [command, str(pendulum_config(tmp_path)), *option], option[0].lstrip("-"))
+
+
+SIMULATION_BOUNDS = [
+    ("rate", {"sample_rate": 1e12}, "sample_rate"),
+    ("periods", {"periods": 10**9}, "periods"),
+    ("samples", {"periods": 1000, "sample_rate": 90000.0}, "samples per run"),
+    ("seed", {"seed": 2**70}, "seed"),
+]
+
+
+@pytest.mark.parametrize("changes, expected", [c[1:] for c in SIMULATION_BOUNDS], ids=[c[0] for c in SIMULATION_BOUNDS])
+def test_a_simulation_beyond_its_bounds_is_refused_by_name(pendulum_run, tmp_path, changes, expected):
+    (tmp_path / "effects.yaml").write_text(yaml.safe_dump({**EFFECTS, **changes}))
+    argv = ["simulate", str(pendulum_run / "out.h5"), str(tmp_path / "effects.yaml"), "-o", str(tmp_path / "sim")]
+    assert_refused(tmp_path, argv, expected)
+
+
+IDENTIFY_FIELDS = [
+    ("zero-torque-constant", {"data": {"torque_constants": [0.0]}}, "data.torque_constants"),
+    ("zero-sign", {"data": {"signs": [0.0]}}, "every sign must be 1 or -1"),
+    ("blocks", {"data": {"validation_blocks": 10**9}}, "data.validation_blocks"),
+    ("rate", {"preprocessing": {"sample_rate": 1e12}}, "preprocessing.sample_rate"),
+    (
+        "payload-not-a-body",
+        {"data": {"runs": [{"file": "sim/run_1.csv", "payload": {"mass": 1.0, "inertia": [1, 0, 1, 0, 0, -1]}}]}},
+        "no body has principal moments",
+    ),
+    (
+        "payload-triangle",
+        {"data": {"runs": [{"file": "sim/run_1.csv", "payload": {"mass": 1.0, "inertia": [1, 0, 1, 0, 0, 3]}}]}},
+        "each at most the sum of the other two",
+    ),
+]
+
+
+@pytest.mark.parametrize("changes, expected", [c[1:] for c in IDENTIFY_FIELDS], ids=[c[0] for c in IDENTIFY_FIELDS])
+def test_an_identify_field_no_robot_can_have_is_refused_by_name(pendulum_run, tmp_path, changes, expected):
+    folder = _copy(pendulum_run, tmp_path / "run")
+    config = yaml.safe_load((folder / "id.yaml").read_text())
+    for section, values in changes.items():
+        config[section] = {**config.get(section, {}), **values}
+    (folder / "id.yaml").write_text(yaml.safe_dump(config))
+    assert_refused(folder, ["identify", str(folder / "id.yaml"), "-o", str(folder / "report.h5")], expected)
+
+
+# --- hostile or odd YAML ----------------------------------------------------------------------------
+
+BOMB = "a: &a [x, x, x, x, x, x, x, x, x, x]\n" + "".join(
+    f"{b}: &{b} [{', '.join([f'*{a}'] * 10)}]\n" for a, b in zip("abcdefg", "bcdefgh")
+)
+
+
+@pytest.mark.parametrize(
+    "text, expected",
+    [
+        (BOMB, "its aliases expand to more than 1,000,000 values"),
+        ("robot: &r [*r]\n", "its aliases expand to more than"),
+        ("a: " + "[" * 20000 + "]" * 20000 + "\n", "nested more than 64 levels deep"),
+        ("a:\n" + "".join("  " * k + "b:\n" for k in range(1, 200)), "nested more than 64 levels deep"),
+        ("robot: 1\nrobot: 2\n", "duplicate key 'robot'"),
+        ("robot: !!python/object/apply:os.system ['true']\n", "malformed YAML"),
+    ],
+    ids=["alias-bomb", "recursive-alias", "deep-flow", "deep-block", "duplicate-key", "python-tag"],
+)
+@pytest.mark.parametrize("command", ["optimize", "identify", "simulate"])
+def test_a_hostile_yaml_file_is_one_short_line(pendulum_run, tmp_path, command, text, expected):
+    (tmp_path / "bad.yaml").write_text(text)
+    argv = {
+        "optimize": ["optimize", str(tmp_path / "bad.yaml")],
+        "identify": ["identify", str(tmp_path / "bad.yaml")],
+        "simulate": ["simulate", str(pendulum_run / "out.h5"), str(tmp_path / "bad.yaml"), "-o", str(tmp_path / "s")],
+    }[command]
+    assert_refused(tmp_path, argv, expected)
+    assert len(runner.invoke(app, argv).output) < 500
+
+
+def test_a_yaml_file_bigger_than_a_config_is_refused(tmp_path):
+    (tmp_path / "big.yaml").write_text("# " + "x" * 11_000_000 + "\n")
+    assert_refused(tmp_path, ["optimize", str(tmp_path / "big.yaml")], "larger than 10 MB")
+
+
+def test_yaml_merge_keys_are_accepted_and_an_explicit_key_wins(pendulum_run):
+    """``<<: *run`` (YAML 1.1 merge keys) was refused as malformed: runs sharing a payload, capsules
+    sharing a radius are written this way."""
+    text = (pendulum_run / "id.yaml").read_text()
+    data = yaml.safe_load(text)
+    data["data"]["runs"] = "RUNS"
+    runs = (
+        "\n    - &fit {file: sim/run_1.csv, role: fit, payload: {mass: 0.5}}"
+        "\n    - {<<: *fit, file: sim/run_2.csv, role: validation}"
+    )
+    merged = yaml.safe_dump(data).replace(" RUNS", runs)
+    path = pendulum_run / "merged.yaml"
+    path.write_text(merged)
+    try:
+        problem = load_problem(path, IdentifyProblem)
+    finally:
+        path.unlink()
+    second = problem.data.runs[1]
+    assert (second.file, second.role, second.payload.mass) == ("sim/run_2.csv", "validation", 0.5)
+
+
+def test_a_key_given_twice_beside_a_merge_is_still_refused(tmp_path):
+    (tmp_path / "twice.yaml").write_text("base: &b {x: 1}\nrobot: {<<: *b, urdf: a, urdf: b}\n")
+    assert_refused(tmp_path, ["optimize", str(tmp_path / "twice.yaml")], "duplicate key 'urdf'")
+
+
+# --- hostile or odd data files ----------------------------------------------------------------------
+
+
+def _identify_on(folder: Path, data_file: str) -> list[str]:
+    config = yaml.safe_load((folder / "id.yaml").read_text())
+    config["data"]["runs"] = [{"file": data_file}]
+    (folder / "odd.yaml").write_text(yaml.safe_dump(config))
+    return ["identify", str(folder / "odd.yaml"), "-o", str(folder / "report.h5")]
+
+
+def _columns(folder: Path) -> dict[str, np.ndarray]:
+    table = np.loadtxt(folder / "sim" / "run_1.csv", delimiter=",", skiprows=1)
+    return {"time": table[:, 0], "q_hinge": table[:, 1], "tau_hinge": table[:, 2]}
+
+
+def _write_h5(path: Path, arrays: dict[str, np.ndarray], links: dict[str, h5py.SoftLink | h5py.ExternalLink]) -> None:
+    with h5py.File(path, "w") as f:
+        for name, values in {**arrays, **links}.items():
+            f[name] = values
+
+
+def test_links_in_an_hdf5_data_file_that_lead_nowhere_are_left_out(pendulum_run, tmp_path):
+    """A soft-link loop and an external link to a missing file (a traceback before); links to other
+    files are never followed."""
+    links = {"a": h5py.SoftLink("/b"), "b": h5py.SoftLink("/a"), "x": h5py.ExternalLink("missing.h5", "/d")}
+    _write_h5(tmp_path / "data.h5", _columns(pendulum_run), links)
+    assert sorted(read_table(tmp_path / "data.h5").names) == ["q_hinge", "tau_hinge", "time"]
+
+
+@pytest.mark.parametrize("suffix", [".h5", ".npz"])
+def test_a_data_file_of_empty_arrays_is_refused(pendulum_run, tmp_path, suffix):
+    folder = _copy(pendulum_run, tmp_path / "run")
+    empty = {name: np.zeros(0) for name in ("time", "q_hinge", "tau_hinge")}
+    if suffix == ".h5":
+        _write_h5(folder / "empty.h5", empty, {})
+    else:
+        np.savez(folder / "empty.npz", **empty)
+    assert_refused(folder, _identify_on(folder, f"empty{suffix}"), f"empty{suffix} has no data rows")
+
+
+def test_a_data_file_of_one_row_is_refused(pendulum_run, tmp_path):
+    folder = _copy(pendulum_run, tmp_path / "run")
+    (folder / "one.csv").write_text("time,q_hinge,tau_hinge\n0,0.1,0.2\n")
+    assert_refused(folder, _identify_on(folder, "one.csv"), "one.csv has fewer than 2 usable rows")
+
+
+def test_a_2_gb_sparse_csv_is_refused_at_once(pendulum_run, tmp_path):
+    folder = _copy(pendulum_run, tmp_path / "run")
+    with open(folder / "sparse.csv", "wb") as f:
+        f.truncate(2 * 1024**3)
+    assert_refused(folder, _identify_on(folder, "sparse.csv"), "larger than 1 GB of text")
+
+
+def test_a_csv_of_nul_bytes_is_refused(pendulum_run, tmp_path):
+    folder = _copy(pendulum_run, tmp_path / "run")
+    with open(folder / "zeros.csv", "wb") as f:
+        f.truncate(50_000_000)
+    assert_refused(folder, _identify_on(folder, "zeros.csv"), "holds NUL bytes")
+
+
+# --- damaged results and reports ---------------------------------------------------------------------
+
+
+def _loop(f):
+    del f["iterations/1/alpha"]
+    f["iterations/1/alpha"], f["x"] = h5py.SoftLink("/x"), h5py.SoftLink("/iterations/1/alpha")
+
+
+def _external(f):
+    del f["iterations"]
+    f["iterations"] = h5py.ExternalLink("missing.h5", "/iterations")
+
+
+def _empty(f):
+    del f["iterations/1/alpha"]
+    f["iterations/1/alpha"] = np.zeros(0)
+
+
+def _not_a_config(f):
+    f.attrs["config"] = "- a list\n- not a config\n"
+
+
+def _bomb(f):
+    f.attrs["config"] = BOMB
+
+
+def _text_where_a_number_belongs(f):
+    f["iterations/1"].attrs["wall_time_s"] = "soon"
+
+
+DAMAGE = {
+    "link-loop": (_loop, "is damaged or not an excite file"),
+    "external-link": (_external, "is damaged or not an excite file"),
+    "empty-alpha": (_empty, ""),
+    "config-a-list": (_not_a_config, "config"),
+    "config-alias-bomb": (_bomb, ""),
+    "text-for-a-number": (_text_where_a_number_belongs, ""),
+}
+DAMAGED_USE = {
+    "simulate": lambda d: ["simulate", str(d / "bad.h5"), str(d / "effects.yaml"), "-o", str(d / "sim2")],
+    "export": lambda d: ["export", str(d / "bad.h5"), "-o", str(d / "play.csv")],
+    "resume": lambda d: ["optimize", str(d / "pendulum.yaml"), "-o", str(d / "bad.h5"), "--resume"],
+}
+
+
+@pytest.mark.parametrize("damage", list(DAMAGE))
+@pytest.mark.parametrize("use", list(DAMAGED_USE))
+def test_a_damaged_result_is_one_line(pendulum_run, tmp_path, damage, use):
+    folder = _copy(pendulum_run, tmp_path / "run")
+    shutil.copy(folder / "out.h5", folder / "bad.h5")
+    change, expected = DAMAGE[damage]
+    with h5py.File(folder / "bad.h5", "a") as f:
+        change(f)
+    if use in ("simulate", "export") and damage == "text-for-a-number":
+        assert runner.invoke(app, DAMAGED_USE[use](folder)).exit_code == 0  # they do not read wall times
+        return
+    assert_refused(folder, DAMAGED_USE[use](folder), expected or "bad.h5")
+
+
+def test_a_damaged_report_is_one_line(pendulum_run, tmp_path):
+    with h5py.File(tmp_path / "report.h5", "w") as f:
+        f["identification/effects"] = h5py.SoftLink("/identification/effects")
+    argv = ["validate", str(tmp_path / "report.h5"), str(pendulum_run / "id.yaml")]
+    assert_refused(tmp_path, argv, "is damaged or not an excite file")
+
+
+# --- two runs, one output ----------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("command", ["optimize", "identify"])
+def test_an_output_another_run_is_writing_is_refused(pendulum_run, tmp_path, command):
+    folder = _copy(pendulum_run, tmp_path / "run")
+    config = "pendulum.yaml" if command == "optimize" else "id.yaml"
+    with output_lock(folder / "busy.h5", "output"):
+        argv = [command, str(folder / config), "-o", str(folder / "busy.h5"), "--force"]
+        assert_refused(folder, argv, f"is being written by another excite run (process {os.getpid()})")
+    assert not (folder / "busy.h5.lock").exists()
+
+
+def test_a_lock_left_by_a_killed_run_is_taken_over(pendulum_run, tmp_path):
+    folder = _copy(pendulum_run, tmp_path / "run")
+    (folder / "again.h5.lock").write_text("99999999\n")  # no process holds it
+    assert (
+        runner.invoke(app, ["optimize", str(folder / "pendulum.yaml"), "-o", str(folder / "again.h5")]).exit_code == 0
+    )
+    assert (folder / "again.h5").is_file() and not (folder / "again.h5.lock").exists()
