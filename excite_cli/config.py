@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Literal, Optional, Union
 
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+from pydantic import BaseModel, ConfigDict, Field, PositiveFloat, field_validator, model_validator
 
 PerJoint = Union[float, dict[str, float]]
 
@@ -75,12 +75,15 @@ class TrajectoryConfig(Section):
 
 
 class LimitsConfig(Section):
-    """Joint limits (Eq. 51): position margin [rad], velocity [rad/s], acceleration [rad/s²], check refinement."""
+    """Joint limits (Eq. 51): position margin [rad], velocity [rad/s], acceleration [rad/s²], check
+    refinement; joint torques [Nm] (``urdf``: the URDF's effort limits, a scale factor of those, or
+    {joint: Nm}; none by default)."""
 
     position_margin: float = Field(0.0, ge=0.0)
     velocity: Optional[PerJoint] = None
     acceleration: PerJoint
     check_refinement: int = Field(10, ge=10, le=1000)
+    torque: Optional[Union[Literal["urdf"], PositiveFloat, dict[str, PositiveFloat]]] = None
 
 
 class ComConfig(Section):

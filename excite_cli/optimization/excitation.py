@@ -16,6 +16,7 @@ from excite_cli.constraints import Constraint, JointLimits, SelfCollision
 from excite_cli.constraints.com_region import com_region_from_config
 from excite_cli.constraints.joint_limits import joint_limit_bounds
 from excite_cli.constraints.lse import GRID_MARGIN
+from excite_cli.constraints.torque_limits import TorqueLimits, torque_limit
 from excite_cli.dynamics.base_parameters import BaseParameters, compute_base_parameters
 from excite_cli.dynamics.robot import Robot, load_robot
 from excite_cli.errors import ExciteError
@@ -135,6 +136,8 @@ def build_excitation(problem: Problem) -> Excitation:
     limits = JointLimits(*joint_limit_bounds(problem.limits, robot), grid_basis)
     boundary = _boundary_conditions(problem, trajectory, limits, home_posture(robot, limits))
     constraints: list[Constraint] = [limits]
+    if problem.limits.torque is not None:
+        constraints.append(TorqueLimits(robot, grid_basis, torque_limit(problem.limits.torque, robot)))
     if ccfg.com is not None:
         constraints.append(com_region_from_config(ccfg.com, robot, grid_basis))
     if ccfg.self_collision is not None:
@@ -190,6 +193,7 @@ def _check_home_posture(excitation: Excitation) -> None:
     static = excitation.static()
     fields = {
         "joint_limits": "robot.home_posture",
+        "torque_limits": "limits.torque",
         "com_region": "constraints.com",
         "self_collision": "constraints.self_collision",
     }

@@ -191,38 +191,40 @@ def plot_constraint_tracks(
     polygon=None,
     margin: float | None = None,
 ) -> Path:
-    """Per iteration: the CoM ground track against its region (Eq. 52) and the smallest capsule
-    distance over time against the margin (Eq. 53), in cm; written to ``path`` (PNG).
+    """Per iteration: the CoM ground track against its region (Eq. 52), the smallest capsule
+    distance over time against the margin (Eq. 53), in cm, and each joint's torque as a fraction of
+    its limit; written to ``path`` (PNG).
 
     Args:
         centre: (2,) region centre [m]; radius [m] or polygon (K, 2) relative to it [m].
         margin: capsule safety margin [m].
     """
-    fig, axes = plt.subplots(2, len(results), figsize=(4.2 * len(results), 7.5), squeeze=False)
+    kinds = [k for k in ("com_xy", "min_capsule_distance", "torque_use") if any(k in r.tracks for r in results)]
+    fig, axes = plt.subplots(len(kinds), len(results), figsize=(4.2 * len(results), 3.7 * len(kinds)), squeeze=False)
     for col, r in enumerate(results):
-        ax = axes[0, col]
-        if "com_xy" in r.tracks and centre is not None:
-            xy = (r.tracks["com_xy"] - centre) * 100
-            ax.plot(xy[:, 0], xy[:, 1], linewidth=0.8, label="CoM track")
-            if radius is not None:
-                ax.add_patch(plt.Circle((0, 0), radius * 100, fill=False, color="r", label="region"))
-            if polygon is not None:
-                ax.add_patch(plt.Polygon(polygon * 100, fill=False, color="r", label="region"))
-            ax.set_aspect("equal")
-            ax.set_xlabel("x − centre [cm]")
-            ax.set_ylabel("y − centre [cm]")
+        axes[0, col].set_title(f"iteration {r.index}")
+        for ax, kind in zip(axes[:, col], kinds):
+            ax.grid(alpha=0.3)
+            if kind not in r.tracks:
+                continue
+            if kind == "com_xy" and centre is not None:
+                xy = (r.tracks["com_xy"] - centre) * 100
+                ax.plot(xy[:, 0], xy[:, 1], linewidth=0.8, label="CoM track")
+                if radius is not None:
+                    ax.add_patch(plt.Circle((0, 0), radius * 100, fill=False, color="r", label="region"))
+                if polygon is not None:
+                    ax.add_patch(plt.Polygon(polygon * 100, fill=False, color="r", label="region"))
+                ax.set(aspect="equal", xlabel="x − centre [cm]", ylabel="y − centre [cm]")
+            elif kind == "min_capsule_distance":
+                ax.plot(r.time, r.tracks[kind] * 100, linewidth=0.8, label="smallest distance")
+                if margin is not None:
+                    ax.axhline(margin * 100, color="r", linestyle="--", label="margin")
+                ax.set(xlabel="time [s]", ylabel="capsule distance [cm]")
+            elif kind == "torque_use":
+                ax.plot(r.time, r.tracks[kind], linewidth=0.7)
+                ax.axhline(1.0, color="r", linestyle="--", label="limit")
+                ax.set(xlabel="time [s]", ylabel="|τ| / τ_max per joint")
             ax.legend(fontsize=7)
-        ax.set_title(f"iteration {r.index}")
-        ax = axes[1, col]
-        if "min_capsule_distance" in r.tracks:
-            ax.plot(r.time, r.tracks["min_capsule_distance"] * 100, linewidth=0.8, label="smallest distance")
-            if margin is not None:
-                ax.axhline(margin * 100, color="r", linestyle="--", label="margin")
-            ax.set_xlabel("time [s]")
-            ax.set_ylabel("capsule distance [cm]")
-            ax.legend(fontsize=7)
-        for a in axes[:, col]:
-            a.grid(alpha=0.3)
     fig.tight_layout()
     return save_figure(fig, path, 110)
 
