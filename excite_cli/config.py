@@ -121,11 +121,51 @@ class SelfCollisionConfig(Section):
     margin: float = Field(0.01, ge=0.0)
 
 
+class WorldShapeConfig(Section):
+    """A shape fixed in the world frame the robot's capsules keep ``margin`` [m] from: a half-space
+    (``point`` on its plane, ``normal`` towards the robot's side: a floor, a table top), a sphere
+    (``centre``, ``radius``) or a capsule (``start``, ``end``, ``radius``), all in metres."""
+
+    name: str
+    type: Literal["half_space", "sphere", "capsule"]
+    point: Optional[tuple[float, float, float]] = None
+    normal: Optional[tuple[float, float, float]] = None
+    centre: Optional[tuple[float, float, float]] = None
+    start: Optional[tuple[float, float, float]] = None
+    end: Optional[tuple[float, float, float]] = None
+    radius: Optional[float] = Field(None, gt=0.0)
+    margin: float = Field(0.02, ge=0.0)
+
+    @model_validator(mode="after")
+    def _fields_of_its_type(self) -> "WorldShapeConfig":
+        needs = {
+            "half_space": ("point", "normal"),
+            "sphere": ("centre", "radius"),
+            "capsule": ("start", "end", "radius"),
+        }
+        missing = [f for f in needs[self.type] if getattr(self, f) is None]
+        if missing:
+            raise ValueError(f"a {self.type} needs {', '.join(missing)}")
+        if self.type == "half_space" and not 0.0 < math.hypot(*self.normal) < math.inf:
+            raise ValueError("the normal of a half_space must not be zero")
+        return self
+
+
+class EnvironmentConfig(Section):
+    """The world around the robot (issue 19): shapes its capsules (``auto``: fitted to the URDF's
+    collision meshes, or given) keep away from, minus ``ignore_links``."""
+
+    shapes: list[WorldShapeConfig] = Field(min_length=1)
+    capsules: Union[Literal["auto"], list[CapsuleConfig]] = "auto"
+    ignore_links: list[str] = Field(default_factory=list)
+
+
 class ConstraintsConfig(Section):
-    """Optional balance and self-collision constraints."""
+    """Optional balance, self-collision and world constraints."""
 
     com: Optional[ComConfig] = None
     self_collision: Optional[SelfCollisionConfig] = None
+    environment: Optional[EnvironmentConfig] = None
 
 
 class OptimizerConfig(Section):

@@ -5,6 +5,7 @@ from __future__ import annotations
 import functools
 from pathlib import Path
 
+import numpy as np
 import pytest
 import yaml
 from typer.testing import CliRunner
@@ -127,3 +128,24 @@ def pendulum_config(folder: Path, active=("hinge",), iterations=1, changes: dict
     path = folder / "pendulum.yaml"
     path.write_text(yaml.safe_dump(config))
     return path
+
+
+def exported_motion(path: Path, joints: list[str]) -> tuple:
+    """q, q̇, q̈ (T, n) [rad, rad/s, rad/s²] of the joints of an ``excite export`` CSV, read here."""
+    lines = [line for line in path.read_text().splitlines() if not line.startswith("#")]
+    header, table = lines[0].split(","), np.loadtxt(lines[1:], delimiter=",")
+    units = {"q": "rad", "qd": "rad_s", "qdd": "rad_s2"}
+    return tuple(table[:, [header.index(f"{x}_{j}_{u}") for j in joints]] for x, u in units.items())
+
+
+def constraint_jacobian_error(constraint, alpha: np.ndarray, step: float = 1e-6) -> float:
+    """Largest difference between ``constraint``'s Jacobian at α and central differences of its
+    values, relative to the largest difference."""
+    jacobian = constraint.evaluate(alpha)[1]
+    flat, differences = alpha.ravel(), np.empty_like(jacobian)
+    for k in range(flat.size):
+        e = np.zeros_like(flat)
+        e[k] = step
+        plus, minus = (constraint.evaluate((flat + s * e).reshape(alpha.shape))[0] for s in (1, -1))
+        differences[:, k] = (plus - minus) / (2 * step)
+    return float(np.abs(jacobian - differences).max() / np.abs(differences).max())

@@ -5,7 +5,9 @@ import h5py
 import numpy as np
 import pinocchio as pin
 import pytest
+import yaml
 from conftest import CONFIGS
+from rosbags.typesys import Stores, get_typestore
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
@@ -124,6 +126,42 @@ def test_export_npz_has_the_same_samples(panda_runs, tmp_path):
     data = np.load(tmp_path / "a.npz")
     assert list(data["joint_names"])[0] == "panda_joint1" and data["q"].shape == data["tau"].shape
     assert np.allclose(np.diff(data["time"]), 5e-3)
+
+
+def test_export_ros2_is_a_follow_joint_trajectory_goal_ros_accepts(panda_runs, tmp_path):
+    """The YAML goal has the fields of trajectory_msgs/JointTrajectory(Point) as ROS 2 defines them
+    (rosbags' message store, Humble), builds such a message and serializes to CDR; its samples are
+    the NPZ export's and the default file ends in .yaml."""
+    argv = ["export", str(panda_runs["rest"]), "-k", "1", "--rate", "50"]
+    assert runner.invoke(app, [*argv, "--format", "ros2"]).exit_code == 0
+    assert runner.invoke(app, [*argv, "--format", "npz", "-o", str(tmp_path / "a.npz")]).exit_code == 0
+    written = panda_runs["rest"].with_name(panda_runs["rest"].stem + "_iteration1_50Hz.yaml")
+    goal = yaml.safe_load(written.read_text())["trajectory"]
+    reference = np.load(tmp_path / "a.npz")
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    point_fields = [name for name, _ in store.fielddefs["trajectory_msgs/msg/JointTrajectoryPoint"][1]]
+    assert set(goal["points"][0]) == set(point_fields)
+    assert goal["joint_names"] == list(reference["joint_names"])
+    assert np.allclose([p["positions"] for p in goal["points"]], reference["q"], atol=1e-9)
+    assert np.allclose([p["effort"] for p in goal["points"]], reference["tau"], atol=1e-8)
+    times = [p["time_from_start"]["sec"] + 1e-9 * p["time_from_start"]["nanosec"] for p in goal["points"]]
+    assert np.allclose(times, reference["time"], atol=1e-9)
+    Point, Duration = (
+        store.types["trajectory_msgs/msg/JointTrajectoryPoint"],
+        store.types["builtin_interfaces/msg/Duration"],
+    )
+    points = [
+        Point(
+            **{k: np.asarray(v, dtype=float) for k, v in p.items() if k != "time_from_start"},
+            time_from_start=Duration(**p["time_from_start"]),
+        )
+        for p in goal["points"][:3]
+    ]
+    Header, Time = store.types["std_msgs/msg/Header"], store.types["builtin_interfaces/msg/Time"]
+    message = store.types["trajectory_msgs/msg/JointTrajectory"](
+        header=Header(stamp=Time(sec=0, nanosec=0), frame_id=""), joint_names=goal["joint_names"], points=points
+    )
+    assert len(store.serialize_cdr(message, "trajectory_msgs/msg/JointTrajectory")) > 0
 
 
 @pytest.mark.parametrize(

@@ -9,7 +9,7 @@ import numpy as np
 import pinocchio as pin
 
 from excite_cli.collision.geometry import link_points, links_with_geometry
-from excite_cli.config import SelfCollisionConfig
+from excite_cli.config import EnvironmentConfig, SelfCollisionConfig
 from excite_cli.dynamics.kinematics import BatchKinematics
 from excite_cli.dynamics.robot import Robot
 from excite_cli.errors import ExciteError
@@ -52,9 +52,11 @@ def fit_capsule(points: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
     return max(radius, 1e-4), centre + bottom * axis, centre + top * axis
 
 
-def capsules_from_config(cfg: SelfCollisionConfig, robot: Robot) -> list[Capsule]:
-    """Capsules of ``constraints.self_collision``: the given ones, or one fitted per link with
-    collision geometry (``auto``), minus ``ignore_links``.
+def capsules_from_config(
+    cfg: SelfCollisionConfig | EnvironmentConfig, robot: Robot, field: str = "constraints.self_collision"
+) -> list[Capsule]:
+    """Capsules of ``constraints.self_collision`` (or ``constraints.environment``, ``field``): the
+    given ones, or one fitted per link with collision geometry (``auto``), minus ``ignore_links``.
 
     Raises:
         ExciteError: an unknown link name.
@@ -62,7 +64,7 @@ def capsules_from_config(cfg: SelfCollisionConfig, robot: Robot) -> list[Capsule
     frames = {f.name: f for f in robot.model.frames}
     for name in cfg.ignore_links:
         if name not in frames:
-            raise ExciteError("constraints.self_collision.ignore_links", f"'{name}' is not a link of the robot")
+            raise ExciteError(f"{field}.ignore_links", f"'{name}' is not a link of the robot")
     capsules = []
     if cfg.capsules == "auto":
         for link in links_with_geometry(robot):
@@ -73,7 +75,7 @@ def capsules_from_config(cfg: SelfCollisionConfig, robot: Robot) -> list[Capsule
         return capsules
     for spec in cfg.capsules:
         if spec.link not in frames:
-            raise ExciteError("constraints.self_collision.capsules", f"'{spec.link}' is not a link of the robot")
+            raise ExciteError(f"{field}.capsules", f"'{spec.link}' is not a link of the robot")
         frame = frames[spec.link]
         to_joint = frame.placement
         capsules.append(

@@ -17,6 +17,7 @@ from excite_cli.constraints.com_region import com_region_from_config
 from excite_cli.constraints.joint_limits import joint_limit_bounds
 from excite_cli.constraints.lse import GRID_MARGIN
 from excite_cli.constraints.torque_limits import TorqueLimits, torque_limit
+from excite_cli.constraints.world_collision import WorldCollision, world_shapes
 from excite_cli.dynamics.base_parameters import BaseParameters, compute_base_parameters
 from excite_cli.dynamics.robot import Robot, load_robot
 from excite_cli.errors import ExciteError
@@ -121,7 +122,9 @@ def build_excitation(problem: Problem) -> Excitation:
         ExciteError: bad robot or limits input (see :func:`load_robot`, :func:`joint_limit_bounds`).
     """
     ccfg = problem.constraints
-    robot = load_robot(problem, collision=bool(ccfg.self_collision or (ccfg.com and ccfg.com.support_links)))
+    robot = load_robot(
+        problem, collision=bool(ccfg.self_collision or ccfg.environment or (ccfg.com and ccfg.com.support_links))
+    )
     base = compute_base_parameters(robot)
     tcfg = problem.trajectory
     if tcfg.cost_samples * robot.n_rows < base.count:
@@ -144,6 +147,9 @@ def build_excitation(problem: Problem) -> Excitation:
         capsules = capsules_from_config(ccfg.self_collision, robot)
         pairs = capsule_pairs(ccfg.self_collision, robot, capsules)
         constraints.append(SelfCollision(robot, grid_basis, capsules, pairs, ccfg.self_collision.margin))
+    if ccfg.environment is not None:
+        capsules = capsules_from_config(ccfg.environment, robot, "constraints.environment")
+        constraints.append(WorldCollision(robot, grid_basis, capsules, world_shapes(ccfg.environment)))
     excitation = Excitation(
         problem=problem,
         robot=robot,
@@ -196,6 +202,7 @@ def _check_home_posture(excitation: Excitation) -> None:
         "torque_limits": "limits.torque",
         "com_region": "constraints.com",
         "self_collision": "constraints.self_collision",
+        "world_collision": "constraints.environment",
     }
     for c in excitation.constraints:
         check = c.check(static, excitation.grid_basis)

@@ -191,15 +191,17 @@ def plot_constraint_tracks(
     polygon=None,
     margin: float | None = None,
 ) -> Path:
-    """Per iteration: the CoM ground track against its region (Eq. 52), the smallest capsule
-    distance over time against the margin (Eq. 53), in cm, and each joint's torque as a fraction of
-    its limit; written to ``path`` (PNG).
+    """Per iteration, for the constraints the run has: the CoM ground track against its region
+    (Eq. 52), the smallest capsule distance over time against the margin (Eq. 53) and the smallest
+    distance to the world, in cm, and each joint's torque as a fraction of its limit; written to
+    ``path`` (PNG).
 
     Args:
         centre: (2,) region centre [m]; radius [m] or polygon (K, 2) relative to it [m].
         margin: capsule safety margin [m].
     """
-    kinds = [k for k in ("com_xy", "min_capsule_distance", "torque_use") if any(k in r.tracks for r in results)]
+    names = ("com_xy", "min_capsule_distance", "min_world_distance", "torque_use")
+    kinds = [k for k in names if any(k in r.tracks for r in results)]
     fig, axes = plt.subplots(len(kinds), len(results), figsize=(4.2 * len(results), 3.7 * len(kinds)), squeeze=False)
     for col, r in enumerate(results):
         axes[0, col].set_title(f"iteration {r.index}")
@@ -220,6 +222,9 @@ def plot_constraint_tracks(
                 if margin is not None:
                     ax.axhline(margin * 100, color="r", linestyle="--", label="margin")
                 ax.set(xlabel="time [s]", ylabel="capsule distance [cm]")
+            elif kind == "min_world_distance":
+                ax.plot(r.time, r.tracks[kind] * 100, linewidth=0.8, label="smallest distance to the world")
+                ax.set(xlabel="time [s]", ylabel="distance to the world [cm]")
             elif kind == "torque_use":
                 ax.plot(r.time, r.tracks[kind], linewidth=0.7)
                 ax.axhline(1.0, color="r", linestyle="--", label="limit")

@@ -27,7 +27,8 @@ MAX_RATE = 100_000.0
 MAX_PERIODS = 1000
 #: Most samples in one file (about 1.3 GB of CSV with 7 joints).
 MAX_SAMPLES = 20_000_000
-FORMATS = ("csv", "npz")
+#: File formats and their file-name endings (``ros2``: a FollowJointTrajectory goal as YAML).
+FORMATS = {"csv": "csv", "npz": "npz", "ros2": "yaml"}
 
 
 @dataclass(frozen=True)
@@ -127,8 +128,9 @@ def columns(joint_names: list[str]) -> list[str]:
 
 
 def write_export(path: Path, export: Export, fmt: str = "csv") -> Path:
-    """Write ``export`` as CSV (``#`` comment lines, then one header row of :func:`columns`) or NPZ
-    (arrays ``time``, ``q``, ``qd``, ``qdd``, ``tau``, ``joint_names``, ``columns``), atomically.
+    """Write ``export`` as CSV (``#`` comment lines, then one header row of :func:`columns`), NPZ
+    (arrays ``time``, ``q``, ``qd``, ``qdd``, ``tau``, ``joint_names``, ``columns``) or a ROS 2
+    FollowJointTrajectory goal (:func:`ros2_goal`), atomically.
 
     Raises:
         ExciteError: an unknown format or a file that cannot be written.
@@ -136,19 +138,11 @@ def write_export(path: Path, export: Export, fmt: str = "csv") -> Path:
     if fmt not in FORMATS:
         raise ExciteError("format", f"must be one of {', '.join(FORMATS)} (got {fmt!r})")
     path = Path(path)
-    table = np.column_stack([export.time, export.q, export.qd, export.qdd, export.tau])
-    names = columns(export.joint_names)
     with atomic_path(path, "output") as tmp:
         if fmt == "csv":
-            comments = [
-                f"excite export: iteration {export.iteration}, {export.rate:g} Hz, {export.periods} period(s)",
-                "segments: " + "; ".join(f"{n} {t0:.3f}-{t0 + d:.3f} s" for n, t0, d in export.segments),
-                "tau: feed-forward RNEA torque of the URDF model",
-                f"largest constraint violation (normalized, <= 0 satisfied): {export.max_violation:.3g}",
-            ]
-            with open(tmp, "w") as f:
-                f.write("".join(f"# {line}\n" for line in comments))
-                np.savetxt(f, table, delimiter=",", header=",".join(names), comments="", fmt="%.10g")
+            _write_csv(tmp, export)
+        elif fmt == "ros2":
+            tmp.write_text(ros2_goal(export), encoding="utf-8")
         else:
             with open(tmp, "wb") as f:
                 np.savez(
@@ -159,9 +153,49 @@ def write_export(path: Path, export: Export, fmt: str = "csv") -> Path:
                     qdd=export.qdd,
                     tau=export.tau,
                     joint_names=np.array(export.joint_names),
-                    columns=np.array(names),
+                    columns=np.array(columns(export.joint_names)),
                 )
     return path
+
+
+def _write_csv(path: Path, export: Export) -> None:
+    table = np.column_stack([export.time, export.q, export.qd, export.qdd, export.tau])
+    comments = [
+        f"excite export: iteration {export.iteration}, {export.rate:g} Hz, {export.periods} period(s)",
+        "segments: " + "; ".join(f"{n} {t0:.3f}-{t0 + d:.3f} s" for n, t0, d in export.segments),
+        "tau: feed-forward RNEA torque of the URDF model",
+        f"largest constraint violation (normalized, <= 0 satisfied): {export.max_violation:.3g}",
+    ]
+    with open(path, "w") as f:
+        f.write("".join(f"# {line}\n" for line in comments))
+        np.savetxt(f, table, delimiter=",", header=",".join(columns(export.joint_names)), comments="", fmt="%.10g")
+
+
+def ros2_goal(export: Export) -> str:
+    """``export`` as the YAML of a ``control_msgs/action/FollowJointTrajectory`` goal: its
+    ``trajectory`` (``trajectory_msgs/msg/JointTrajectory``) with the URDF's joint names and one
+    point per sample (``positions`` [rad], ``velocities`` [rad/s], ``accelerations`` [rad/s²],
+    ``effort`` [Nm]: the feed-forward torque, ``time_from_start`` as sec and nanosec), e.g. for
+    ``ros2 action send_goal /<controller>/follow_joint_trajectory
+    control_msgs/action/FollowJointTrajectory "$(cat FILE)"`` at a rate the command line can hold."""
+
+    def numbers(row: np.ndarray) -> str:
+        return "[" + ", ".join(f"{x:.10g}" for x in row) + "]"
+
+    nanoseconds = np.round(export.time * 1e9).astype(np.int64)
+    lines = [
+        f"# excite export: iteration {export.iteration}, {export.rate:g} Hz, {export.periods} period(s)",
+        "trajectory:",
+        f"  joint_names: [{', '.join(export.joint_names)}]",
+        "  points:",
+    ]
+    for k, ns in enumerate(nanoseconds):
+        lines.append(
+            f"  - {{positions: {numbers(export.q[k])}, velocities: {numbers(export.qd[k])}, "
+            f"accelerations: {numbers(export.qdd[k])}, effort: {numbers(export.tau[k])}, "
+            f"time_from_start: {{sec: {ns // 10**9}, nanosec: {ns % 10**9}}}}}"
+        )
+    return "\n".join(lines) + "\n"
 
 
 def export_to_file(
@@ -174,7 +208,8 @@ def export_to_file(
     force: bool = False,
 ) -> tuple[Export, Path]:
     """:func:`export_trajectory` written by :func:`write_export` to ``output`` (default
-    ``<result>_iteration<K>_<rate>Hz.<fmt>`` beside the result); a given ``output`` is checked first.
+    ``<result>_iteration<K>_<rate>Hz.<ending>``, the ending of :data:`FORMATS`, beside the result); a
+    given ``output`` is checked first.
 
     Raises:
         ExciteError: see both, and a bad or existing (without ``force``) output path.
@@ -184,5 +219,5 @@ def export_to_file(
     if output is not None:
         check_target(output, "output", force)
     export = export_trajectory(result, iteration, rate, periods)
-    target = output or result.with_name(f"{result.stem}_iteration{export.iteration}_{rate:g}Hz.{fmt}")
+    target = output or result.with_name(f"{result.stem}_iteration{export.iteration}_{rate:g}Hz.{FORMATS[fmt]}")
     return export, write_export(check_target(target, "output", force), export, fmt)

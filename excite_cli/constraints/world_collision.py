@@ -1,0 +1,156 @@
+"""The world around the robot (issue 19): every robot capsule keeps a margin from shapes fixed in
+the world frame: half-spaces (a floor, a table top), spheres and capsules.
+
+Distances are closed forms over all (instant, capsule, shape) at once: to a half-space with unit
+normal n through point o, a segment's closest point is the end point of least height h = n·(x − o),
+d = h − r; to a sphere or a world capsule, the closest points of the two segments
+(:func:`segment_closest_points`, a sphere being a segment of length 0), d = |c₂ − c₁| − r₁ − r₂.
+d varies as ∂d = nᵀ J_x ∂q along the normal n from the world shape to the robot's point x
+(:meth:`BatchKinematics.distance_rates`); per (capsule, shape), s_t = (margin − d_t)/L is aggregated
+over the grid like the self-collision pairs. Capsules on links no active joint moves are left out:
+their distances cannot change (the base bolted on the table).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from excite_cli.collision.capsules import Capsule, segment_closest_points, segment_ends
+from excite_cli.config import EnvironmentConfig
+from excite_cli.constraints.constraint import Constraint, FineCheck
+from excite_cli.constraints.lse import ACCEPT_MARGIN, smooth_max
+from excite_cli.constraints.self_collision import LENGTH_SCALE
+from excite_cli.dynamics.kinematics import BatchKinematics
+from excite_cli.dynamics.robot import Robot
+from excite_cli.trajectory.fourier import FourierBasis
+
+
+@dataclass(frozen=True)
+class WorldShape:
+    """A shape fixed in the world frame.
+
+    Attributes:
+        name: its name in the config, for messages.
+        kind: ``half_space``, ``sphere`` or ``capsule``.
+        start: (3,) a point on the plane, the sphere's centre or the capsule's first end [m].
+        end: (3,) the plane's unit normal (towards the robot's side) or the capsule's second end
+            [m] (the centre again for a sphere).
+        radius: [m], 0 for a half-space.
+        margin: distance every robot capsule keeps [m].
+    """
+
+    name: str
+    kind: str
+    start: np.ndarray
+    end: np.ndarray
+    radius: float
+    margin: float
+
+
+def world_shapes(cfg: EnvironmentConfig) -> list[WorldShape]:
+    """The shapes of ``constraints.environment`` (their fields checked by the config)."""
+    shapes = []
+    for s in cfg.shapes:
+        if s.type == "half_space":
+            normal = np.asarray(s.normal, dtype=float)
+            shapes.append(
+                WorldShape(s.name, s.type, np.asarray(s.point, float), normal / np.linalg.norm(normal), 0.0, s.margin)
+            )
+        elif s.type == "sphere":
+            centre = np.asarray(s.centre, dtype=float)
+            shapes.append(WorldShape(s.name, s.type, centre, centre, s.radius, s.margin))
+        else:
+            shapes.append(
+                WorldShape(s.name, s.type, np.asarray(s.start, float), np.asarray(s.end, float), s.radius, s.margin)
+            )
+    return shapes
+
+
+class WorldCollision(Constraint):
+    """One aggregated inequality per (moving robot capsule, world shape).
+
+    Args:
+        robot: the robot.
+        basis: Fourier basis on the constraint grid.
+        capsules: the robot's capsules (those no active joint moves are left out).
+        shapes: the world shapes.
+    """
+
+    name = "world_collision"
+    grid_margin = ACCEPT_MARGIN
+    track_units = {"min_world_distance": "m"}
+
+    def __init__(self, robot: Robot, basis: FourierBasis, capsules: list[Capsule], shapes: list[WorldShape]):
+        self.kinematics = BatchKinematics(robot)
+        ancestors = self.kinematics.ancestors
+        self.basis, self.shapes = basis, shapes
+        self.capsules = [c for c in capsules if ancestors[c.joint].any()]
+        self.pairs = [(c, s) for c in range(len(self.capsules)) for s in range(len(shapes))]
+        self._capsule = np.array([c for c, _ in self.pairs], dtype=int)
+        self._shape = np.array([s for _, s in self.pairs], dtype=int)
+        self._radii = np.array([self.capsules[c].radius for c in self._capsule])
+        self._margin = np.array([shapes[s].margin for s in self._shape])
+        self._moves = (
+            ancestors[[self.capsules[c].joint for c in self._capsule]].astype(float).reshape(-1, robot.n_joints)
+        )
+
+    def _closest(self, Q: np.ndarray) -> tuple[np.ndarray, ...]:
+        """At the configurations Q (T, n): distances d (T, P) [m], the robot's closest points (3, T, P),
+        the unit normals (3, T, P) from the world shape to them, and the joint placements."""
+        start, end, R, p = segment_ends(self.kinematics, self.capsules, Q)
+        a, b = start[..., self._capsule], end[..., self._capsule]
+        d, point, normal = np.empty(a.shape[1:]), np.empty_like(a), np.empty_like(a)
+        for k, shape in enumerate(self.shapes):
+            cols = self._shape == k
+            ak, bk = a[..., cols], b[..., cols]
+            if shape.kind == "half_space":
+                n, o = shape.end[:, None, None], shape.start[:, None, None]
+                ha, hb = (((x - o) * n).sum(axis=0) for x in (ak, bk))
+                point[..., cols] = np.where(ha <= hb, ak, bk)
+                d[:, cols] = np.minimum(ha, hb) - self._radii[cols]
+                normal[..., cols] = np.broadcast_to(n, ak.shape)
+            else:
+                c1, c2 = segment_closest_points(shape.start[:, None, None], shape.end[:, None, None], ak, bk)
+                gap = c2 - c1
+                length = np.sqrt((gap**2).sum(axis=0))
+                point[..., cols], normal[..., cols] = c2, gap / np.maximum(length, 1e-12)
+                d[:, cols] = length - shape.radius - self._radii[cols]
+        return d, point, normal, R, p
+
+    def evaluate(self, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """One aggregated value per (capsule, shape) (P,) and the Jacobian (P, α.size)."""
+        n, m = alpha.shape
+        P = len(self.pairs)
+        if not P:
+            return np.zeros(0), np.zeros((0, n * m))
+        d, point, normal, R, p = self._closest(self.basis.q @ alpha.T)
+        g, w = smooth_max((self._margin - d) / LENGTH_SCALE, axis=0)  # (P,), (T, P)
+        rates = self.kinematics.distance_rates(R, p, point, normal * (-w / LENGTH_SCALE))  # (T, P, n)
+        J = (self.basis.q.T @ rates.reshape(d.shape[0], P * n)).reshape(m, P, n) * self._moves
+        return g, J.transpose(1, 2, 0).reshape(P, n * m)
+
+    def track(self, alpha: np.ndarray, basis: FourierBasis) -> dict[str, np.ndarray]:
+        """``min_world_distance``: (T,) the smallest distance over (capsule, shape) at each instant [m]."""
+        if not self.pairs:
+            return {}
+        return {"min_world_distance": self._closest(basis.q @ alpha.T)[0].min(axis=1)}
+
+    def check_samples(self, time: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> FineCheck:
+        """The (capsule, shape) that comes closest to its margin over the postures q (T, n) [rad]."""
+        if not self.pairs:
+            return FineCheck(max_violation=-np.inf, details={}, where="no moving capsule")
+        d = self._closest(q)[0]
+        slack = (self._margin - d) / LENGTH_SCALE
+        t, k = np.unravel_index(np.argmax(slack), slack.shape)
+        link, shape = self.capsules[self._capsule[k]].link, self.shapes[self._shape[k]]
+        return FineCheck(
+            max_violation=float(slack[t, k]),
+            details={
+                "min_world_distance_m": float(d.min()),
+                "closest_world_pair": f"{link}–{shape.name}",
+                "closest_world_time_s": float(time[t]),
+            },
+            where=f"link {link} {d[t, k] * 100:.2f} cm from {shape.name} (margin {shape.margin * 100:.1f} cm)",
+        )
