@@ -19,7 +19,7 @@ from excite_cli.identification.config import IdentifyProblem, SimulationConfig
 from excite_cli.identification.validate import validate_model
 from excite_cli.optimization.criterion import OBJECTIVES
 from excite_cli.storage.export import FORMATS, export_to_file
-from excite_cli.workflows import run_compare_random, run_identify, run_optimize, run_verify, simulate_runs
+from excite_cli.workflows import run_compare_random, run_identify, run_optimize, run_verify, run_view, simulate_runs
 
 app = typer.Typer(add_completion=False, no_args_is_help=True)
 out, err = wide_console(), wide_console(stderr=True)
@@ -27,9 +27,7 @@ FORCE = typer.Option(False, "--force", help="Replace existing output files.")
 WORKERS = typer.Option(
     None, "--workers", help="Local processes for restarts and draws (optimizer.workers; default: the cores)."
 )
-SCHEDULER = typer.Option(
-    None, "--scheduler", help="Dask scheduler address, e.g. tcp://host:8786 (optimizer.scheduler)."
-)
+SCHEDULER = typer.Option(None, "--scheduler", help="Dask scheduler, e.g. tcp://host:8786 (optimizer.scheduler).")
 
 
 def command(name: Optional[str] = None) -> Callable:
@@ -214,6 +212,18 @@ def export(
     """Write a trajectory as a robot plays it: home → P periods → home, at the controller's rate, with torques."""
     exported, target = export_to_file(result, iteration, rate, periods, fmt, output, force)
     _say(tables.export_lines(exported, rate), f"wrote {target}")
+
+
+@command()
+def view(
+    result: Path = typer.Argument(..., help="An optimize (or compare-random) HDF5 result."),
+    iteration: Optional[int] = typer.Option(None, "--iteration", "-k", help="Iteration (default: the last)."),
+    rate: float = typer.Option(30.0, "--rate", help="Frames per second."),
+    force: bool = FORCE,
+    output: Optional[Path] = typer.Option(None, "--output", "-o", help="HTML file (default: beside the result)."),
+) -> None:
+    """The motion as the robot would play it, in 3D, in one HTML file any browser opens (no server)."""
+    _say(f"wrote {run_view(result, iteration, output, rate, force)}")
 
 
 @command()

@@ -5,5 +5,6 @@ from excite_cli.workflows.identify import run_identify
 from excite_cli.workflows.optimize import run_optimize
 from excite_cli.workflows.simulate import simulate_runs
 from excite_cli.workflows.verify_gradient import run_verify
+from excite_cli.workflows.view import run_view
 
-__all__ = ["run_compare_random", "run_identify", "run_optimize", "run_verify", "simulate_runs"]
+__all__ = ["run_compare_random", "run_identify", "run_optimize", "run_verify", "run_view", "simulate_runs"]

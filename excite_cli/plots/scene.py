@@ -1,0 +1,93 @@
+"""The motion as a 3D scene in one self-contained HTML file (meshcat's static export, three.js
+inside): the robot's collision meshes (pinocchio's meshcat visualizer) moving through the played
+samples and the world shapes of ``constraints.environment``. Open it in any browser, no server; the
+animation plays on open and from the scene's menu ("Animations")."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from excite_cli.constraints.world_collision import WorldShape
+from excite_cli.dynamics.robot import Robot
+from excite_cli.h5 import atomic_bytes
+
+#: Side [m] and thickness of the slab that draws a half-space.
+SLAB = (3.0, 0.01)
+
+
+def write_scene(path: Path, robot: Robot, q: np.ndarray, rate: float, shapes: list[WorldShape]) -> Path:
+    """An HTML file at ``path`` that plays the postures q (S, n) [rad] at ``rate`` [Hz] on the robot's
+    collision meshes, beside ``shapes``.
+
+    Raises:
+        CannotWrite: the file cannot be written.
+    """
+    import meshcat  # 0.7 s to import: only when a scene is written, not at every command's start
+    from meshcat.animation import Animation
+    from pinocchio.visualize import MeshcatVisualizer
+
+    with contextlib.redirect_stdout(io.StringIO()):  # the server prints its URL
+        viewer = meshcat.Visualizer()
+    try:
+        model, geometry = robot.model, robot.collision_model
+        visualizer = MeshcatVisualizer(model, geometry, geometry)
+        visualizer.initViewer(viewer=viewer)
+        visualizer.loadViewerModel(rootNodeName="robot")
+        for shape in shapes:
+            _draw_shape(viewer[f"world/{shape.name}"], shape)
+        data, placements = model.createData(), pin.GeometryData(geometry)
+        nodes = [visualizer.getViewerNodeName(g, pin.GeometryType.VISUAL) for g in geometry.geometryObjects]
+        animation = Animation(default_framerate=rate)
+        for k, posture in enumerate(q):
+            configuration = robot.q_reference.copy()
+            configuration[robot.q_idx] = posture
+            if k == 0:  # the scene before the animation starts (and in a viewer that does not play it)
+                visualizer.display(configuration)
+            pin.forwardKinematics(model, data, configuration)
+            pin.updateGeometryPlacements(model, data, geometry, placements)
+            with animation.at_frame(viewer, k) as frame:
+                for node, placement in zip(nodes, placements.oMg):
+                    frame[node].set_transform(placement.homogeneous)
+        viewer.set_animation(animation, play=True, repetitions=0)
+        html = viewer.static_html()
+    finally:
+        viewer.window.server_proc.kill()
+        viewer.window.server_proc.wait()
+    return atomic_bytes(path, html.encode("utf-8"))
+
+
+def _draw_shape(node, shape: WorldShape) -> None:
+    """A world shape in grey: a thin slab for a half-space, a sphere, a capsule as a cylinder with
+    two spheres."""
+    import meshcat.geometry as mg
+    import meshcat.transformations as tf
+
+    material = mg.MeshLambertMaterial(color=0x999999, opacity=0.6, transparent=True)
+    if shape.kind == "half_space":
+        side, thick = SLAB
+        node.set_object(mg.Box([side, side, thick]), material)
+        rotation = pin.Quaternion.FromTwoVectors(np.array([0.0, 0.0, 1.0]), shape.end).matrix()
+        node.set_transform(_placement(rotation, shape.start - shape.end * thick / 2))
+        return
+    node["a"].set_object(mg.Sphere(shape.radius), material)
+    node["a"].set_transform(tf.translation_matrix(shape.start))
+    if shape.kind == "sphere":
+        return
+    node["b"].set_object(mg.Sphere(shape.radius), material)
+    node["b"].set_transform(tf.translation_matrix(shape.end))
+    axis = shape.end - shape.start
+    node["body"].set_object(mg.Cylinder(float(np.linalg.norm(axis)), shape.radius), material)
+    rotation = pin.Quaternion.FromTwoVectors(np.array([0.0, 1.0, 0.0]), axis / np.linalg.norm(axis)).matrix()
+    node["body"].set_transform(_placement(rotation, (shape.start + shape.end) / 2))
+
+
+def _placement(rotation: np.ndarray, translation: np.ndarray) -> np.ndarray:
+    """(4, 4) homogeneous transform."""
+    out = np.eye(4)
+    out[:3, :3], out[:3, 3] = rotation, translation
+    return out
