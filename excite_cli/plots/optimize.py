@@ -13,6 +13,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from excite_cli.constraints import ComRegion, SelfCollision  # noqa: E402
+from excite_cli.constraints.world_collision import WorldCollision, WorldShape  # noqa: E402
 from excite_cli.optimization.excitation import Excitation  # noqa: E402
 from excite_cli.optimization.sequence import IterationResult  # noqa: E402
 from excite_cli.plots.figure import save_figure  # noqa: E402
@@ -25,7 +26,8 @@ def plot_result(target: Path, excitation: Excitation, results: Sequence[Iteratio
     stem = target.with_suffix("")
     com = next((c for c in excitation.constraints if isinstance(c, ComRegion)), None)
     collision = next((c for c in excitation.constraints if isinstance(c, SelfCollision)), None)
-    capsules = collision.capsules if collision else []
+    world = next((c for c in excitation.constraints if isinstance(c, WorldCollision)), None)
+    capsules = collision.capsules if collision else world.capsules if world else []
     limits = excitation.limits
     plots = [
         plot_trajectories(
@@ -42,6 +44,7 @@ def plot_result(target: Path, excitation: Excitation, results: Sequence[Iteratio
             lambda q: (skeleton(excitation.robot, q), capsule_segments(excitation.robot, capsules, q)),
             [c.radius for c in capsules],
             excitation.home,
+            world.shapes if world else [],
         ),
     ]
     if any(r.tracks for r in results):
@@ -134,7 +137,13 @@ def _stadium(a: np.ndarray, b: np.ndarray, radius: float, points: int = 12) -> n
 
 
 def plot_postures(
-    path: Path, results: Sequence[IterationResult], draw, radii: Sequence[float], home: np.ndarray, columns: int = 6
+    path: Path,
+    results: Sequence[IterationResult],
+    draw,
+    radii: Sequence[float],
+    home: np.ndarray,
+    shapes: Sequence[WorldShape] = (),
+    columns: int = 6,
 ) -> Path:
     """A strip of postures over one period per iteration, front view (from +x, the robot's left on the
     right) and side view (from −y, forward to the right), like the paper's Fig. 2; the home posture
@@ -144,6 +153,7 @@ def plot_postures(
         draw: ``draw(q)`` → (skeleton (L, 2, 3), capsule segments (C, 2, 3)) [m] at the posture q (n,) [rad].
         radii: (C,) capsule radii [m].
         home: (n,) home posture [rad].
+        shapes: world shapes, drawn in grey (a half-space as its plane's trace, filled on the far side).
         columns: postures per iteration, at t = kT/columns.
     """
     views = (("front", 1, -1.0), ("side", 0, 1.0))  # horizontal world axis, its sign
@@ -175,12 +185,45 @@ def plot_postures(
                 horizontal = sign * points[:, axis]
                 ax.set_xlim(horizontal.min() - pad, horizontal.max() + pad)
                 ax.set_ylim(points[:, 2].min() - pad, points[:, 2].max() + pad)
+                for shape in shapes:
+                    _draw_shape(ax, shape, axis, sign)
                 ax.set_aspect("equal")
                 ax.set_xticks([])
                 ax.set_yticks([])
                 ax.set_title(f"iteration {r.index}, {view}, t = {t:.1f} s", fontsize=7)
     fig.tight_layout()
     return save_figure(fig, path, 100)
+
+
+def _draw_shape(ax, shape: WorldShape, axis: int, sign: float) -> None:
+    """A world shape in a view whose horizontal is world axis ``axis`` times ``sign`` and vertical z."""
+
+    def h(x: np.ndarray) -> np.ndarray:
+        return np.array([sign * x[axis], x[2]])
+
+    if shape.kind != "half_space":
+        outline = _stadium(h(shape.start), h(shape.end), shape.radius)
+        ax.fill(outline[:, 0], outline[:, 1], color="0.5", alpha=0.4, linewidth=0)
+        return
+    normal, point = h(shape.end), h(shape.start)
+    if np.linalg.norm(normal) < 1e-9:  # the plane is the view's own: nothing to draw
+        return
+    x0, x1 = ax.get_xlim()
+    y0, y1 = ax.get_ylim()
+    direction = np.array([-normal[1], normal[0]]) / np.linalg.norm(normal)
+    span = 2 * max(x1 - x0, y1 - y0)
+    a, b = point - span * direction, point + span * direction
+    behind = -normal / np.linalg.norm(normal) * span
+    ax.fill(
+        [a[0], b[0], b[0] + behind[0], a[0] + behind[0]],
+        [a[1], b[1], b[1] + behind[1], a[1] + behind[1]],
+        color="0.5",
+        alpha=0.3,
+        linewidth=0,
+    )
+    ax.plot([a[0], b[0]], [a[1], b[1]], color="0.4", linewidth=0.8)
+    ax.set_xlim(x0, x1)
+    ax.set_ylim(y0, y1)
 
 
 def plot_constraint_tracks(
