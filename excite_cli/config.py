@@ -124,16 +124,19 @@ class SelfCollisionConfig(Section):
 class WorldShapeConfig(Section):
     """A shape fixed in the world frame the robot's capsules keep ``margin`` [m] from: a half-space
     (``point`` on its plane, ``normal`` towards the robot's side: a floor, a table top), a sphere
-    (``centre``, ``radius``) or a capsule (``start``, ``end``, ``radius``), all in metres."""
+    (``centre``, ``radius``), a capsule (``start``, ``end``, ``radius``) or a box (``centre``, side
+    lengths ``size``, turned by ``rpy`` [rad] about x, y, z), all in metres."""
 
     name: str
-    type: Literal["half_space", "sphere", "capsule"]
+    type: Literal["half_space", "sphere", "capsule", "box"]
     point: Optional[tuple[float, float, float]] = None
     normal: Optional[tuple[float, float, float]] = None
     centre: Optional[tuple[float, float, float]] = None
     start: Optional[tuple[float, float, float]] = None
     end: Optional[tuple[float, float, float]] = None
     radius: Optional[float] = Field(None, gt=0.0)
+    size: Optional[tuple[PositiveFloat, PositiveFloat, PositiveFloat]] = None
+    rpy: tuple[float, float, float] = (0.0, 0.0, 0.0)
     margin: float = Field(0.02, ge=0.0)
 
     @model_validator(mode="after")
@@ -142,6 +145,7 @@ class WorldShapeConfig(Section):
             "half_space": ("point", "normal"),
             "sphere": ("centre", "radius"),
             "capsule": ("start", "end", "radius"),
+            "box": ("centre", "size"),
         }
         missing = [f for f in needs[self.type] if getattr(self, f) is None]
         if missing:

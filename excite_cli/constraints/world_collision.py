@@ -1,10 +1,11 @@
 """The world around the robot (issue 19): every robot capsule keeps a margin from shapes fixed in
-the world frame: half-spaces (a floor, a table top), spheres and capsules.
+the world frame: half-spaces (a floor, a table top), spheres, capsules and boxes.
 
 Distances are closed forms over all (instant, capsule, shape) at once: to a half-space with unit
 normal n through point o, a segment's closest point is the end point of least height h = n·(x − o),
 d = h − r; to a sphere or a world capsule, the closest points of the two segments
-(:func:`segment_closest_points`, a sphere being a segment of length 0), d = |c₂ − c₁| − r₁ − r₂.
+(:func:`segment_closest_points`, a sphere being a segment of length 0), d = |c₂ − c₁| − r₁ − r₂;
+to a box, coal's distance, nearest points and normal (negative inside).
 d varies as ∂d = nᵀ J_x ∂q along the normal n from the world shape to the robot's point x
 (:meth:`BatchKinematics.distance_rates`); per (capsule, shape), s_t = (margin − d_t)/L is aggregated
 over the grid like the self-collision pairs. Capsules on links no active joint moves are left out:
@@ -13,11 +14,13 @@ their distances cannot change (the base bolted on the table).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
+import coal
 import numpy as np
+import pinocchio as pin
 
-from excite_cli.collision.capsules import Capsule, segment_closest_points, segment_ends
+from excite_cli.collision.capsules import Capsule, capsule_frames, segment_closest_points, segment_ends
 from excite_cli.config import EnvironmentConfig
 from excite_cli.constraints.constraint import Constraint, FineCheck
 from excite_cli.constraints.lse import ACCEPT_MARGIN, smooth_max
@@ -37,8 +40,10 @@ class WorldShape:
         start: (3,) a point on the plane, the sphere's centre or the capsule's first end [m].
         end: (3,) the plane's unit normal (towards the robot's side) or the capsule's second end
             [m] (the centre again for a sphere).
-        radius: [m], 0 for a half-space.
+        radius: [m], 0 for a half-space or a box.
         margin: distance every robot capsule keeps [m].
+        size: (3,) a box's side lengths [m] (its centre is ``start`` and ``end``).
+        rotation: (3, 3) a box's orientation in the world frame.
     """
 
     name: str
@@ -47,6 +52,8 @@ class WorldShape:
     end: np.ndarray
     radius: float
     margin: float
+    size: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    rotation: np.ndarray = field(default_factory=lambda: np.eye(3))
 
 
 def world_shapes(cfg: EnvironmentConfig) -> list[WorldShape]:
@@ -58,9 +65,10 @@ def world_shapes(cfg: EnvironmentConfig) -> list[WorldShape]:
             shapes.append(
                 WorldShape(s.name, s.type, np.asarray(s.point, float), normal / np.linalg.norm(normal), 0.0, s.margin)
             )
-        elif s.type == "sphere":
-            centre = np.asarray(s.centre, dtype=float)
-            shapes.append(WorldShape(s.name, s.type, centre, centre, s.radius, s.margin))
+        elif s.type in ("sphere", "box"):
+            centre, rotation = np.asarray(s.centre, dtype=float), pin.rpy.rpyToMatrix(*s.rpy)
+            size = np.asarray(s.size if s.size else (0.0, 0.0, 0.0), dtype=float)
+            shapes.append(WorldShape(s.name, s.type, centre, centre, s.radius or 0.0, s.margin, size, rotation))
         else:
             shapes.append(
                 WorldShape(s.name, s.type, np.asarray(s.start, float), np.asarray(s.end, float), s.radius, s.margin)
@@ -92,6 +100,7 @@ class WorldCollision(Constraint):
         self._shape = np.array([s for _, s in self.pairs], dtype=int)
         self._radii = np.array([self.capsules[c].radius for c in self._capsule])
         self._margin = np.array([shapes[s].margin for s in self._shape])
+        self._solids = [coal.Capsule(c.radius, float(np.linalg.norm(c.end - c.start))) for c in self.capsules]
         self._moves = (
             ancestors[[self.capsules[c].joint for c in self._capsule]].astype(float).reshape(-1, robot.n_joints)
         )
@@ -105,7 +114,9 @@ class WorldCollision(Constraint):
         for k, shape in enumerate(self.shapes):
             cols = self._shape == k
             ak, bk = a[..., cols], b[..., cols]
-            if shape.kind == "half_space":
+            if shape.kind == "box":
+                d[:, cols], point[..., cols], normal[..., cols] = self._to_box(shape, R, p, np.flatnonzero(cols))
+            elif shape.kind == "half_space":
                 n, o = shape.end[:, None, None], shape.start[:, None, None]
                 ha, hb = (((x - o) * n).sum(axis=0) for x in (ak, bk))
                 point[..., cols] = np.where(ha <= hb, ak, bk)
@@ -118,6 +129,25 @@ class WorldCollision(Constraint):
                 point[..., cols], normal[..., cols] = c2, gap / np.maximum(length, 1e-12)
                 d[:, cols] = length - shape.radius - self._radii[cols]
         return d, point, normal, R, p
+
+    def _to_box(self, box: WorldShape, R: np.ndarray, p: np.ndarray, pairs: np.ndarray) -> tuple[np.ndarray, ...]:
+        """coal's distances (T, K) [m] of the pairs ``pairs`` (K,) to ``box``, the nearest points on
+        the robot (3, T, K) and the unit normals from the box to them, from joint placements."""
+        rotations, centres = capsule_frames(R, p, self.capsules)
+        solid, placement = coal.Box(*box.size), coal.Transform3s(box.rotation, box.start)
+        T, K = R.shape[0], pairs.size
+        d, point, normal = np.empty((T, K)), np.empty((3, T, K)), np.empty((3, T, K))
+        for k, c in enumerate(self._capsule[pairs]):
+            for t in range(T):
+                result = coal.DistanceResult()
+                placed = coal.Transform3s(rotations[t, c], centres[t, c])
+                coal.distance(self._solids[c], placed, solid, placement, coal.DistanceRequest(), result)
+                d[t, k], point[:, t, k], normal[:, t, k] = (
+                    result.min_distance,
+                    result.getNearestPoint1(),
+                    -result.normal,
+                )
+        return d, point, normal
 
     def evaluate(self, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """One aggregated value per (capsule, shape) (P,) and the Jacobian (P, α.size)."""

@@ -17,6 +17,7 @@ from excite_cli.constraints.world_collision import WorldCollision, WorldShape  #
 from excite_cli.optimization.excitation import Excitation  # noqa: E402
 from excite_cli.optimization.sequence import IterationResult  # noqa: E402
 from excite_cli.plots.figure import save_figure  # noqa: E402
+from excite_cli.plots.shapes import draw_shape, stadium  # noqa: E402
 from excite_cli.plots.skeleton import capsule_segments, skeleton  # noqa: E402
 
 
@@ -124,18 +125,6 @@ def plot_condition_numbers(path: Path, results: Sequence[IterationResult]) -> Pa
     return save_figure(fig, path, 110)
 
 
-def _stadium(a: np.ndarray, b: np.ndarray, radius: float, points: int = 12) -> np.ndarray:
-    """(2·points + 2, 2) outline of the 2-D capsule around the segment [a, b] (its projection)."""
-    d = b - a
-    angle = np.arctan2(d[1], d[0]) if np.linalg.norm(d) > 1e-12 else 0.0
-    arc = np.linspace(-np.pi / 2, np.pi / 2, points)
-    ends = [
-        b + radius * np.column_stack([np.cos(angle + arc), np.sin(angle + arc)]),
-        a + radius * np.column_stack([np.cos(angle + np.pi + arc), np.sin(angle + np.pi + arc)]),
-    ]
-    return np.vstack(ends)
-
-
 def plot_postures(
     path: Path,
     results: Sequence[IterationResult],
@@ -171,7 +160,7 @@ def plot_postures(
                 for a, b in home_bones:
                     ax.plot([sign * a[axis], sign * b[axis]], [a[2], b[2]], color="0.8", linewidth=1.0)
                 for (a, b), radius in zip(capsules, radii):
-                    outline = _stadium(np.array([sign * a[axis], a[2]]), np.array([sign * b[axis], b[2]]), radius)
+                    outline = stadium(np.array([sign * a[axis], a[2]]), np.array([sign * b[axis], b[2]]), radius)
                     ax.fill(outline[:, 0], outline[:, 1], color="tab:blue", alpha=0.15, linewidth=0)
                 for a, b in bones:
                     ax.plot(
@@ -186,44 +175,13 @@ def plot_postures(
                 ax.set_xlim(horizontal.min() - pad, horizontal.max() + pad)
                 ax.set_ylim(points[:, 2].min() - pad, points[:, 2].max() + pad)
                 for shape in shapes:
-                    _draw_shape(ax, shape, axis, sign)
+                    draw_shape(ax, shape, axis, sign)
                 ax.set_aspect("equal")
                 ax.set_xticks([])
                 ax.set_yticks([])
                 ax.set_title(f"iteration {r.index}, {view}, t = {t:.1f} s", fontsize=7)
     fig.tight_layout()
     return save_figure(fig, path, 100)
-
-
-def _draw_shape(ax, shape: WorldShape, axis: int, sign: float) -> None:
-    """A world shape in a view whose horizontal is world axis ``axis`` times ``sign`` and vertical z."""
-
-    def h(x: np.ndarray) -> np.ndarray:
-        return np.array([sign * x[axis], x[2]])
-
-    if shape.kind != "half_space":
-        outline = _stadium(h(shape.start), h(shape.end), shape.radius)
-        ax.fill(outline[:, 0], outline[:, 1], color="0.5", alpha=0.4, linewidth=0)
-        return
-    normal, point = h(shape.end), h(shape.start)
-    if np.linalg.norm(normal) < 1e-9:  # the plane is the view's own: nothing to draw
-        return
-    x0, x1 = ax.get_xlim()
-    y0, y1 = ax.get_ylim()
-    direction = np.array([-normal[1], normal[0]]) / np.linalg.norm(normal)
-    span = 2 * max(x1 - x0, y1 - y0)
-    a, b = point - span * direction, point + span * direction
-    behind = -normal / np.linalg.norm(normal) * span
-    ax.fill(
-        [a[0], b[0], b[0] + behind[0], a[0] + behind[0]],
-        [a[1], b[1], b[1] + behind[1], a[1] + behind[1]],
-        color="0.5",
-        alpha=0.3,
-        linewidth=0,
-    )
-    ax.plot([a[0], b[0]], [a[1], b[1]], color="0.4", linewidth=0.8)
-    ax.set_xlim(x0, x1)
-    ax.set_ylim(y0, y1)
 
 
 def plot_constraint_tracks(

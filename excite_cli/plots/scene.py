@@ -62,12 +62,16 @@ def write_scene(path: Path, robot: Robot, q: np.ndarray, rate: float, shapes: li
 
 
 def _draw_shape(node, shape: WorldShape) -> None:
-    """A world shape in grey: a thin slab for a half-space, a sphere, a capsule as a cylinder with
-    two spheres."""
+    """A world shape in grey: a thin slab for a half-space, a box, a sphere, a capsule as a cylinder
+    with two spheres."""
     import meshcat.geometry as mg
     import meshcat.transformations as tf
 
     material = mg.MeshLambertMaterial(color=0x999999, opacity=0.6, transparent=True)
+    if shape.kind == "box":
+        node.set_object(mg.Box(list(shape.size)), material)
+        node.set_transform(_placement(shape.rotation, shape.start))
+        return
     if shape.kind == "half_space":
         side, thick = SLAB
         node.set_object(mg.Box([side, side, thick]), material)
