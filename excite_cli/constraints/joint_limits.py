@@ -140,8 +140,13 @@ class JointLimits(Constraint):
         return alpha
 
 
-def _per_joint(field: str, value: PerJoint | None, default: np.ndarray, robot: Robot) -> np.ndarray:
-    """(n,) positive limits from a scalar, a {joint: value} map (others from ``default``) or None."""
+def per_joint(field: str, value: PerJoint | None, default: np.ndarray, robot: Robot) -> np.ndarray:
+    """(n,) positive limits of the config field ``field`` from a scalar, a {joint: value} map (the
+    others from ``default``) or None (all from ``default``).
+
+    Raises:
+        ExciteError: an unknown joint, or a joint left without a positive finite limit.
+    """
     out = default.astype(float).copy()
     if isinstance(value, dict):
         for name, v in value.items():
@@ -175,6 +180,6 @@ def joint_limit_bounds(cfg: LimitsConfig, robot: Robot) -> tuple[np.ndarray, np.
             raise ExciteError(
                 "limits.position_margin", f"{cfg.position_margin:g} rad leaves no range for joint '{name}'"
             )
-    velocity = _per_joint("limits.velocity", cfg.velocity, robot.velocity_limit, robot)
-    acceleration = _per_joint("limits.acceleration", cfg.acceleration, np.full(robot.n_joints, np.nan), robot)
+    velocity = per_joint("limits.velocity", cfg.velocity, robot.velocity_limit, robot)
+    acceleration = per_joint("limits.acceleration", cfg.acceleration, np.full(robot.n_joints, np.nan), robot)
     return np.stack([lower, -velocity, -acceleration]), np.stack([upper, velocity, acceleration])

@@ -15,9 +15,9 @@ import pinocchio as pin
 
 from excite_cli.config import PerJoint
 from excite_cli.constraints.constraint import Constraint, FineCheck
+from excite_cli.constraints.joint_limits import per_joint
 from excite_cli.constraints.lse import ACCEPT_MARGIN, smooth_max
 from excite_cli.dynamics.robot import Robot
-from excite_cli.errors import ExciteError
 from excite_cli.trajectory.fourier import FourierBasis
 
 
@@ -90,15 +90,6 @@ def torque_limit(value: PerJoint | str, robot: Robot) -> np.ndarray:
         ExciteError: an unknown joint, or a joint left without a positive finite limit.
     """
     urdf = robot.model.effortLimit[robot.v_idx].astype(float)
-    limit = urdf.copy()
     if isinstance(value, dict):
-        for name, v in value.items():
-            if name not in robot.joint_names:
-                raise ExciteError("limits.torque", f"'{name}' is not an active joint")
-            limit[robot.joint_names.index(name)] = v
-    elif value != "urdf":
-        limit = urdf * float(value)
-    for name, v in zip(robot.joint_names, limit):
-        if not (np.isfinite(v) and v > 0):
-            raise ExciteError("limits.torque", f"joint '{name}' has no positive torque limit (got {v:g} Nm)")
-    return limit
+        return per_joint("limits.torque", value, urdf, robot)
+    return per_joint("limits.torque", None, urdf * (1.0 if value == "urdf" else float(value)), robot)

@@ -111,11 +111,13 @@ class WorldCollision(Constraint):
         start, end, R, p = segment_ends(self.kinematics, self.capsules, Q)
         a, b = start[..., self._capsule], end[..., self._capsule]
         d, point, normal = np.empty(a.shape[1:]), np.empty_like(a), np.empty_like(a)
+        frames = None  # capsule placements, for the boxes
         for k, shape in enumerate(self.shapes):
             cols = self._shape == k
             ak, bk = a[..., cols], b[..., cols]
             if shape.kind == "box":
-                d[:, cols], point[..., cols], normal[..., cols] = self._to_box(shape, R, p, np.flatnonzero(cols))
+                frames = frames or capsule_frames(R, p, self.capsules)
+                d[:, cols], point[..., cols], normal[..., cols] = self._to_box(shape, *frames, np.flatnonzero(cols))
             elif shape.kind == "half_space":
                 n, o = shape.end[:, None, None], shape.start[:, None, None]
                 ha, hb = (((x - o) * n).sum(axis=0) for x in (ak, bk))
@@ -130,12 +132,14 @@ class WorldCollision(Constraint):
                 d[:, cols] = length - shape.radius - self._radii[cols]
         return d, point, normal, R, p
 
-    def _to_box(self, box: WorldShape, R: np.ndarray, p: np.ndarray, pairs: np.ndarray) -> tuple[np.ndarray, ...]:
+    def _to_box(
+        self, box: WorldShape, rotations: np.ndarray, centres: np.ndarray, pairs: np.ndarray
+    ) -> tuple[np.ndarray, ...]:
         """coal's distances (T, K) [m] of the pairs ``pairs`` (K,) to ``box``, the nearest points on
-        the robot (3, T, K) and the unit normals from the box to them, from joint placements."""
-        rotations, centres = capsule_frames(R, p, self.capsules)
+        the robot (3, T, K) and the unit normals from the box to them, from the capsules' placements
+        (rotations (T, C, 3, 3), centres (T, C, 3), :func:`capsule_frames`)."""
         solid, placement = coal.Box(*box.size), coal.Transform3s(box.rotation, box.start)
-        T, K = R.shape[0], pairs.size
+        T, K = rotations.shape[0], pairs.size
         d, point, normal = np.empty((T, K)), np.empty((3, T, K)), np.empty((3, T, K))
         for k, c in enumerate(self._capsule[pairs]):
             for t in range(T):
