@@ -35,7 +35,7 @@ def write_scene(path: Path, robot: Robot, q: np.ndarray, rate: float, shapes: li
         viewer = meshcat.Visualizer()
     try:
         model, geometry = robot.model, robot.collision_model
-        visualizer = MeshcatVisualizer(model, geometry, geometry)
+        visualizer = MeshcatVisualizer(model, None, geometry)  # the meshes once, as visuals
         visualizer.initViewer(viewer=viewer)
         visualizer.loadViewerModel(rootNodeName="robot")
         for shape in shapes:
