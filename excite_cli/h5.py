@@ -22,10 +22,34 @@ VERSIONED_PACKAGES = ("excite", "pin", "coal", "numpy", "scipy", "h5py", "exampl
 
 
 @contextmanager
+def new_folders(paths: Sequence[Path], field: str = "output") -> Iterator[None]:
+    """The folders of ``paths``, created as needed for the block; those it created that are empty
+    when the block ends (an error, or nothing written into them) are removed again.
+
+    Raises:
+        CannotWrite: a folder cannot be created.
+    """
+    parents = [Path(p).parent for p in paths]
+    created = sorted({d for f in parents for d in (f, *f.parents) if not d.exists()}, key=lambda d: -len(d.parts))
+    try:
+        for path, folder in zip(paths, parents):
+            try:
+                folder.mkdir(parents=True, exist_ok=True)
+            except OSError as exc:
+                raise CannotWrite(field, Path(path), exc.strerror or exc) from None
+        yield
+    finally:
+        for folder in created:
+            with suppress(OSError):
+                folder.rmdir()
+
+
+@contextmanager
 def atomic_paths(paths: Sequence[Path], field: str = "output") -> Iterator[list[Path]]:
     """Temporary paths ``<path>.partial`` to write to, moved onto ``paths`` (``os.replace``) when the
-    block ends without error and removed otherwise, with any folder the block created for them, so a
-    crash, Ctrl-C or full disk never leaves a half-written file nor a part of the set.
+    block ends without error and removed otherwise, with any folder made for them
+    (:func:`new_folders`), so a crash, Ctrl-C or full disk never leaves a half-written file nor a
+    part of the set.
 
     Args:
         field: the config field or argument that named ``paths``, for the message.
@@ -35,24 +59,18 @@ def atomic_paths(paths: Sequence[Path], field: str = "output") -> Iterator[list[
     """
     paths = [Path(p) for p in paths]
     tmps = [p.with_name(p.name + ".partial") for p in paths]
-    created = [d for p in paths for d in (p.parent, *p.parent.parents) if not d.exists()]
-    done = False
     try:
-        for path in paths:
-            path.parent.mkdir(parents=True, exist_ok=True)
-        yield tmps
-        for tmp, path in zip(tmps, paths):
-            os.replace(tmp, path)
-        done = True
+        with new_folders(paths, field):
+            try:
+                yield tmps
+                for tmp, path in zip(tmps, paths):
+                    os.replace(tmp, path)
+            finally:
+                for tmp in tmps:
+                    tmp.unlink(missing_ok=True)
     except OSError as exc:
         at = next((p for p, t in zip(paths, tmps) if str(t) == str(exc.filename)), paths[0])
         raise CannotWrite(field, at, exc.strerror or exc) from None
-    finally:
-        for tmp in tmps:
-            tmp.unlink(missing_ok=True)
-        for folder in [] if done else sorted(set(created), key=lambda d: -len(d.parts)):
-            with suppress(OSError):
-                folder.rmdir()
 
 
 @contextmanager

@@ -30,6 +30,38 @@ LENGTH_SCALE = 0.05
 CONFIRM = 1e-3
 
 
+def aggregated_distances(
+    kinematics: BatchKinematics,
+    basis: FourierBasis,
+    margin: float | np.ndarray,
+    d: np.ndarray,
+    points: np.ndarray,
+    normals: np.ndarray,
+    R: np.ndarray,
+    p: np.ndarray,
+    moves: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Per pair, s_t = (margin − d_t)/L aggregated over the grid instants by a log-sum-exp, and its
+    Jacobian in α: ∂g/∂q(t) = Σ (∂g/∂d) nᵀJ_x, with ∂g/∂d = −w/L folded into the normals.
+
+    Args:
+        kinematics, basis: the constraint's batched kinematics and grid basis (T instants).
+        margin: (P,) or scalar [m]; d: (T, P) distances [m].
+        points, normals: (3, T, P) the point x whose motion changes d and the unit normal n along
+            which it does (:meth:`BatchKinematics.distance_rates`); R, p: the joint placements.
+        moves: (P, n) the sign with which each active joint moves the pair's distance (0: not at all).
+
+    Returns:
+        g (P,) and its Jacobian (P, α.size), α flattened row-major.
+    """
+    P, n = moves.shape
+    m = basis.q.shape[1]
+    g, w = smooth_max((margin - d) / LENGTH_SCALE, axis=0)  # (P,), (T, P)
+    rates = kinematics.distance_rates(R, p, points, normals * (-w / LENGTH_SCALE))  # (T, P, n)
+    J = (basis.q.T @ rates.reshape(d.shape[0], P * n)).reshape(m, P, n) * moves
+    return g, J.transpose(1, 2, 0).reshape(P, n * m)
+
+
 class SelfCollision(Constraint):
     """Eq. 53 on the constraint grid, one aggregated inequality per capsule pair.
 
@@ -89,12 +121,9 @@ class SelfCollision(Constraint):
         P = len(self.pairs)
         if not P:
             return np.zeros(0), np.zeros((0, n * m))
-        d, c1, normal, R, p = self._closest(self.basis.q @ alpha.T)
-        g, w = smooth_max((self.margin - d) / LENGTH_SCALE, axis=0)  # (P,), (T, P)
-        # ∂g/∂q(t) = Σ_p (∂g/∂d) ∂d/∂q, with ∂g/∂d = −w/L folded into the normals
-        rates = self.kinematics.distance_rates(R, p, c1, normal * (-w / LENGTH_SCALE))  # (T, P, n)
-        J = (self.basis.q.T @ rates.reshape(d.shape[0], P * n)).reshape(m, P, n) * self._moves
-        return g, J.transpose(1, 2, 0).reshape(P, n * m)
+        return aggregated_distances(
+            self.kinematics, self.basis, self.margin, *self._closest(self.basis.q @ alpha.T), self._moves
+        )
 
     track_units = {"min_capsule_distance": "m"}
 

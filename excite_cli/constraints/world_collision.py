@@ -23,8 +23,8 @@ import pinocchio as pin
 from excite_cli.collision.capsules import Capsule, capsule_frames, segment_closest_points, segment_ends
 from excite_cli.config import EnvironmentConfig
 from excite_cli.constraints.constraint import Constraint, FineCheck
-from excite_cli.constraints.lse import ACCEPT_MARGIN, smooth_max
-from excite_cli.constraints.self_collision import LENGTH_SCALE
+from excite_cli.constraints.lse import ACCEPT_MARGIN
+from excite_cli.constraints.self_collision import LENGTH_SCALE, aggregated_distances
 from excite_cli.dynamics.kinematics import BatchKinematics
 from excite_cli.dynamics.robot import Robot
 from excite_cli.trajectory.fourier import FourierBasis
@@ -159,11 +159,8 @@ class WorldCollision(Constraint):
         P = len(self.pairs)
         if not P:
             return np.zeros(0), np.zeros((0, n * m))
-        d, point, normal, R, p = self._closest(self.basis.q @ alpha.T)
-        g, w = smooth_max((self._margin - d) / LENGTH_SCALE, axis=0)  # (P,), (T, P)
-        rates = self.kinematics.distance_rates(R, p, point, normal * (-w / LENGTH_SCALE))  # (T, P, n)
-        J = (self.basis.q.T @ rates.reshape(d.shape[0], P * n)).reshape(m, P, n) * self._moves
-        return g, J.transpose(1, 2, 0).reshape(P, n * m)
+        closest = self._closest(self.basis.q @ alpha.T)
+        return aggregated_distances(self.kinematics, self.basis, self._margin, *closest, self._moves)
 
     def track(self, alpha: np.ndarray, basis: FourierBasis) -> dict[str, np.ndarray]:
         """``min_world_distance``: (T,) the smallest distance over (capsule, shape) at each instant [m]."""

@@ -6,11 +6,12 @@ from __future__ import annotations
 
 import fcntl
 import os
-from contextlib import contextmanager, suppress
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Iterator
 
 from excite_cli.errors import CannotWrite, ExciteError, OutputExists
+from excite_cli.h5 import new_folders
 
 
 def check_target(path: Path, field: str, force: bool = False, exists_ok: bool = False) -> Path:
@@ -66,7 +67,7 @@ def output_lock(path: Path, field: str) -> Iterator[None]:
     """Hold ``<path>.lock`` (an exclusive ``flock``, with this process's id inside) while the block
     runs, so a second run writing ``path`` stops at once instead of replacing the first one's result.
     The lock file is removed when the block ends; one left by a killed run is taken over (the system
-    releases its lock). Folders created for it and left empty are removed.
+    releases its lock). Folders made for it and left empty are removed (:func:`new_folders`).
 
     Raises:
         ExciteError: another process holds the lock (its id in the message).
@@ -74,34 +75,30 @@ def output_lock(path: Path, field: str) -> Iterator[None]:
     """
     path = Path(path)
     lock = path.with_name(path.name + ".lock")
-    created = [d for d in (path.parent, *path.parent.parents) if not d.exists()]
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)
-    except OSError as exc:
-        raise CannotWrite(field, lock, exc.strerror or exc) from None
-    held = False
-    try:
+    with new_folders([lock], field):
         try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            held = os.fstat(fd).st_ino == os.stat(lock).st_ino  # not a lock file its holder just removed
-        except OSError:
-            pass
-        if not held:
-            holder = os.pread(fd, 32, 0).decode(errors="replace").strip() or "?"
-            raise ExciteError(
-                field,
-                f"{path} is being written by another excite run (process {holder})",
-                path,
-                "another output path, or that run to end",
-            )
-        os.ftruncate(fd, 0)
-        os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
-        yield
-    finally:
-        if held:
-            lock.unlink(missing_ok=True)
-        os.close(fd)
-        for folder in created:
-            with suppress(OSError):
-                folder.rmdir()
+            fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)
+        except OSError as exc:
+            raise CannotWrite(field, lock, exc.strerror or exc) from None
+        held = False
+        try:
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                held = os.fstat(fd).st_ino == os.stat(lock).st_ino  # not a lock file its holder just removed
+            except OSError:
+                pass
+            if not held:
+                holder = os.pread(fd, 32, 0).decode(errors="replace").strip() or "?"
+                raise ExciteError(
+                    field,
+                    f"{path} is being written by another excite run (process {holder})",
+                    path,
+                    "another output path, or that run to end",
+                )
+            os.ftruncate(fd, 0)
+            os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+            yield
+        finally:
+            if held:
+                lock.unlink(missing_ok=True)
+            os.close(fd)
