@@ -1,6 +1,6 @@
 """Which criterion gives the best identification? Trajectories optimized with each objective
 (cond, log_cond, log_det = D-optimality, sigma_min = E-optimality) on a problem (default
-configs/panda.yaml, first iteration), then identified on simulated measurements.
+configs/panda_joint_limits.yaml, first iteration), then identified on simulated measurements.
 
 Simulation: one period sampled at 200 Hz, torques from pinocchio's RNEA with the URDF inertias plus
 white noise (0.05 Nm); base parameters by least squares with the base regressor; 200 noise draws.
@@ -66,4 +66,4 @@ def main(config: Path) -> None:
 
 
 if __name__ == "__main__":
-    main(Path(sys.argv[1]) if len(sys.argv) > 1 else ROOT / "configs" / "panda.yaml")
+    main(Path(sys.argv[1]) if len(sys.argv) > 1 else ROOT / "configs" / "panda_joint_limits.yaml")

@@ -6,7 +6,7 @@ cond(C) after each iteration, the base-independent excitation ē of the last one
 stop reason and KKT residual per iteration, and the wall time; then the median and the worst.
 
     .venv/bin/python bench/seeds.py configs/g1_arms.yaml --iterations 1 --seeds 0 1 2 3 4
-    .venv/bin/python bench/seeds.py configs/panda.yaml --seeds 0 1 2 3 4 --threads default
+    .venv/bin/python bench/seeds.py configs/panda_joint_limits.yaml --seeds 0 1 2 3 4 --threads default
 """
 
 from __future__ import annotations

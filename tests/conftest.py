@@ -55,7 +55,7 @@ def g1_problem() -> Problem:
 
 @pytest.fixture
 def panda_problem() -> Problem:
-    return load_problem(CONFIGS / "panda.yaml")
+    return load_problem(CONFIGS / "panda_joint_limits.yaml")
 
 
 @pytest.fixture

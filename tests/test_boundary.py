@@ -10,7 +10,7 @@ from excite_cli.optimization.excitation import build_excitation
 
 
 def _excitation(boundary="rest", ends_at_home=False, duration=None, harmonics=4):
-    problem = small(load_problem(CONFIGS / "panda.yaml"), harmonics=harmonics)
+    problem = small(load_problem(CONFIGS / "panda_joint_limits.yaml"), harmonics=harmonics)
     problem.trajectory.boundary = boundary
     problem.trajectory.ends_at_home = ends_at_home
     if duration is not None:  # a duration that is not a whole period: four distinct rest rows

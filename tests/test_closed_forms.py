@@ -37,7 +37,7 @@ def test_weighted_least_squares_and_standard_deviations_match_the_closed_form():
 
 
 def test_com_polygon_region():
-    excitation = build_excitation(load_problem(CONFIGS / "panda.yaml"))
+    excitation = build_excitation(load_problem(CONFIGS / "panda_joint_limits.yaml"))
     robot = excitation.robot
     com = robot.com(excitation.home)[0][:2]
     square = lambda half: com + half * np.array([[1, 1], [-1, 1], [-1, -1], [1, -1]])  # noqa: E731

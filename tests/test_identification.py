@@ -244,7 +244,7 @@ def test_offsets_per_run_and_a_known_payload(tmp_path, optimized):
             tmp_path,
             prefix,
         )
-    robot = load_robot(load_problem(CONFIGS / "panda.yaml"))
+    robot = load_robot(load_problem(CONFIGS / "panda_joint_limits.yaml"))
     loaded = robot.model.copy()
     frame = loaded.frames[loaded.getFrameId("panda_hand")]
     xx, xy, yy, xz, yz, zz = payload["inertia"]
@@ -418,43 +418,30 @@ def test_real_panda_run(tmp_path):
     assert report.relative_after.mean() < 6.0  # blocks split: 25.4 % rigid body, 3.9 % measured
 
 
-def _phase_split(cutoff):
+@pytest.mark.skipif(not (SHARED / "exciting_traj_1.csv").exists(), reason="shared Panda data not present")
+def test_real_panda_unseen_phase_holds_with_the_defaults():
+    """Issues 10 and 21: on a phase of the period that neither the fit nor the selection saw, the
+    defaults give ≤ 6 % (rigid body alone > 25 %); the reported model is the pair (model, fit) with
+    the lowest J of those the cross-validation scored. How little other cut-offs change this is
+    measured by bench/identify_settings.py (README), too slow for the tests (three full runs)."""
     problem = load_problem(HERE.parent / "configs" / "panda_identify_phase.yaml", IdentifyProblem)
     problem.data.runs = [
         run.model_copy(update={"file": str(SHARED / "exciting_traj_1.csv")}) for run in problem.data.runs
     ]
-    problem.preprocessing.cutoff = cutoff
-    return run_identification(problem)[0]
-
-
-@pytest.mark.skipif(not (SHARED / "exciting_traj_1.csv").exists(), reason="shared Panda data not present")
-def test_real_panda_unseen_phase_holds_across_cutoffs():
-    """Issues 10 and 21: on a phase of the period that neither the fit nor the selection saw, the
-    defaults give ≤ 6 %, a 5 Hz cut-off ≤ 9 %, and 2 × the default stays within 2 points; the
-    reported model is the pair (model, fit) with the lowest J of those the cross-validation scored."""
-    default = _phase_split(None)
-    reports = {"default": default, "5 Hz": _phase_split(5.0), "2x default": _phase_split(2.0 * default.cutoff)}
-    errors = {name: r.relative_after.mean() for name, r in reports.items()}
-    assert errors["default"] <= 6.0 and errors["5 Hz"] <= 9.0, errors
-    assert max(errors.values()) - min(errors.values()) <= 2.0, errors
-    for report in reports.values():
-        assert report.relative_before.mean() > 25.0  # rigid body alone
-        sel = report.selection
-        # exactly the selected model: its CV error is the search's there, its validation error the ladder's end
-        kept = sel.searches[sel.chosen]
-        assert sel.cv_error == pytest.approx(kept.initial_error if sel.at_start else kept.cv_error, rel=1e-12)
-        assert report.ladder[-1][2] == pytest.approx(report.relative_after.mean(), rel=1e-9)
-        # the model and fit with the lowest J of every pair scored
-        choice = report.fit_choice
-        assert choice.objective[choice.model, choice.chosen] == np.nanmin(choice.objective)
-        assert set(choice.models[choice.model].terms) == set(sel.terms)
-        # friction on every joint whatever the cut-off
-        friction = ("coulomb", "load_coulomb", "viscous", "held", "stribeck")
-        assert {t.joint for t in sel.terms if t.effect in friction} == set(range(7))
-    # the chosen effects change little: joints 2-7 keep theirs, joint 1's friction may change description
-    chosen = {name: {(t.effect, t.joint) for t in r.selection.terms} for name, r in reports.items()}
-    for name in ("5 Hz", "2x default"):
-        assert len(chosen[name] & chosen["default"]) / len(chosen[name] | chosen["default"]) >= 0.5, chosen
+    report = run_identification(problem)[0]
+    assert report.relative_after.mean() <= 6.0 and report.relative_before.mean() > 25.0
+    sel = report.selection
+    # exactly the selected model: its CV error is the search's there, its validation error the ladder's end
+    kept = sel.searches[sel.chosen]
+    assert sel.cv_error == pytest.approx(kept.initial_error if sel.at_start else kept.cv_error, rel=1e-12)
+    assert report.ladder[-1][2] == pytest.approx(report.relative_after.mean(), rel=1e-9)
+    # the model and fit with the lowest J of every pair scored
+    choice = report.fit_choice
+    assert choice.objective[choice.model, choice.chosen] == np.nanmin(choice.objective)
+    assert set(choice.models[choice.model].terms) == set(sel.terms)
+    # friction on every joint
+    friction = ("coulomb", "load_coulomb", "viscous", "held", "stribeck")
+    assert {t.joint for t in sel.terms if t.effect in friction} == set(range(7))
 
 
 @pytest.mark.skipif(not (SHARED / "exciting_traj_1.csv").exists(), reason="shared Panda data not present")

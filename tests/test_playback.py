@@ -33,10 +33,10 @@ def _fourier_rates(alpha, omega, t):
 
 @pytest.fixture(scope="module")
 def panda_runs(tmp_path_factory):
-    """`excite optimize configs/panda.yaml` (boundary rest) and with boundary periodic, both screening
+    """`excite optimize configs/panda_joint_limits.yaml` (boundary rest) and with boundary periodic, both screening
     4 starts instead of the shipped 16 (the test's time)."""
     tmp = tmp_path_factory.mktemp("panda")
-    shipped = (CONFIGS / "panda.yaml").read_text()
+    shipped = (CONFIGS / "panda_joint_limits.yaml").read_text()
     assert "starts: 16" in shipped
     configs = {"rest": tmp / "rest.yaml", "periodic": tmp / "periodic.yaml"}
     configs["rest"].write_text(shipped.replace("starts: 16", "starts: 4"))
@@ -91,7 +91,7 @@ def test_export_at_1khz_plays_from_home_to_home_with_rnea_torques(panda_runs, tm
         assert np.abs(qd[row]).max() < 1e-9 and np.abs(qdd[row]).max() < 1e-9
         assert np.abs(q[row][[0, 1, 2, 4, 6]]).max() < 1e-9
     assert np.allclose(q[0], q[-1], atol=1e-9)
-    # the limits of configs/panda.yaml from the URDF, checked on every exported sample
+    # the limits of configs/panda_joint_limits.yaml from the URDF, checked on every exported sample
     full = pin.buildModelFromUrdf(str(example_robot_data_root() / PANDA_URDF))
     lower, upper = full.lowerPositionLimit[:n] + 0.1, full.upperPositionLimit[:n] - 0.1
     assert np.all(q >= lower - 1e-9) and np.all(q <= upper + 1e-9)
@@ -224,7 +224,7 @@ def test_skeleton_of_the_panda_at_zero_reaches_the_flange():
     from excite_cli.config_file import load_problem
     from excite_cli.dynamics.robot import load_robot
 
-    robot = load_robot(load_problem(CONFIGS / "panda.yaml"))
+    robot = load_robot(load_problem(CONFIGS / "panda_joint_limits.yaml"))
     points = skeleton(robot, np.zeros(7)).reshape(-1, 3)
     # Panda kinematics at q = 0 (Franka's DH table): flange at x = 0.088 m, z = 0.333 + 0.316 + 0.384 − 0.107 m
     assert np.min(np.linalg.norm(points - [0.088, 0.0, 0.926], axis=1)) < 1e-6

@@ -76,6 +76,8 @@ def capsules_from_config(
     for spec in cfg.capsules:
         if spec.link not in frames:
             raise ExciteError(f"{field}.capsules", f"'{spec.link}' is not a link of the robot")
+        if spec.link in cfg.ignore_links:
+            continue
         frame = frames[spec.link]
         to_joint = frame.placement
         capsules.append(

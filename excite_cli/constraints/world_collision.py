@@ -76,8 +76,40 @@ def world_shapes(cfg: EnvironmentConfig) -> list[WorldShape]:
     return shapes
 
 
+def distance_bound(robot: Robot, capsule: Capsule, shape: WorldShape) -> float:
+    """A lower bound [m] on the distance between ``capsule`` and ``shape`` at every posture.
+
+    Every point of the capsule's segment stays within the reach R of the origin p₀ of the first
+    active joint that moves it (p₀ is fixed: no active joint is above it): R = the lengths of the
+    joint offsets below it plus the farther segment end (rotations keep lengths). So d ≥ D(p₀) − R −
+    radius, D the distance from p₀ to the half-space's plane, the sphere or capsule's segment minus
+    its radius, or the box's centre minus its half-diagonal. −inf when a joint below p₀ is not
+    revolute (its offset is not bounded by a length).
+    """
+    model = robot.model
+    active = {int(model.getJointId(n)) for n in robot.joint_names}
+    chain = [j for j in model.supports[capsule.joint] if j > 0]
+    below = chain[next(k for k, j in enumerate(chain) if j in active) :]
+    if any(not model.joints[j].shortname().startswith("JointModelR") for j in below):
+        return -np.inf
+    data = model.createData()
+    pin.forwardKinematics(model, data, robot.q_reference)
+    origin = data.oMi[below[0]].translation
+    reach = sum(float(np.linalg.norm(model.jointPlacements[j].translation)) for j in below[1:])
+    reach += max(float(np.linalg.norm(capsule.start)), float(np.linalg.norm(capsule.end))) + capsule.radius
+    if shape.kind == "half_space":
+        away = float(shape.end @ (origin - shape.start))
+    elif shape.kind == "box":
+        away = float(np.linalg.norm(origin - shape.start) - np.linalg.norm(shape.size) / 2.0)
+    else:
+        closest = segment_closest_points(shape.start, shape.end, origin, origin)[0]
+        away = float(np.linalg.norm(origin - closest)) - shape.radius
+    return away - reach
+
+
 class WorldCollision(Constraint):
-    """One aggregated inequality per (moving robot capsule, world shape).
+    """One aggregated inequality per (moving robot capsule, world shape) that can come within the
+    shape's margin (:func:`distance_bound`).
 
     Args:
         robot: the robot.
@@ -95,7 +127,10 @@ class WorldCollision(Constraint):
         ancestors = self.kinematics.ancestors
         self.basis, self.shapes = basis, shapes
         self.capsules = [c for c in capsules if ancestors[c.joint].any()]
-        self.pairs = [(c, s) for c in range(len(self.capsules)) for s in range(len(shapes))]
+        bounds = [[distance_bound(robot, c, s) for s in shapes] for c in self.capsules]
+        self.pairs = [
+            (c, s) for c in range(len(self.capsules)) for s in range(len(shapes)) if bounds[c][s] <= shapes[s].margin
+        ]
         self._capsule = np.array([c for c, _ in self.pairs], dtype=int)
         self._shape = np.array([s for _, s in self.pairs], dtype=int)
         self._radii = np.array([self.capsules[c].radius for c in self._capsule])

@@ -149,7 +149,9 @@ def build_excitation(problem: Problem) -> Excitation:
         constraints.append(SelfCollision(robot, grid_basis, capsules, pairs, ccfg.self_collision.margin))
     if ccfg.environment is not None:
         capsules = capsules_from_config(ccfg.environment, robot, "constraints.environment")
-        constraints.append(WorldCollision(robot, grid_basis, capsules, world_shapes(ccfg.environment)))
+        world = WorldCollision(robot, grid_basis, capsules, world_shapes(ccfg.environment))
+        if world.pairs:  # else no moving capsule can come within a shape's margin
+            constraints.append(world)
     excitation = Excitation(
         problem=problem,
         robot=robot,
