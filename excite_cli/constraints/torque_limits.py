@@ -47,14 +47,15 @@ class TorqueLimits(Constraint):
     def _derivatives(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """τ (T, n) [Nm] and its derivatives (3, T, n, n) in q, q̇, q̈ of the active joints."""
         r, d = self.robot, self.data
-        ix = np.ix_(r.v_idx, r.v_idx)
-        tau, derivatives = np.empty(q.shape), np.empty((3, *q.shape, q.shape[1]))
+        nv = r.model.nv
+        tau, full = np.empty((q.shape[0], nv)), np.empty((3, q.shape[0], nv, nv))
         for t, x in enumerate(zip(q, qd, qdd)):
             pin.computeRNEADerivatives(r.model, d, *r.state(*x))
-            mass = np.triu(d.M) + np.triu(d.M, 1).T  # pinocchio fills the upper triangle only
-            tau[t] = d.tau[r.v_idx]
-            derivatives[:, t] = d.dtau_dq[ix], d.dtau_dv[ix], mass[ix]
-        return tau, derivatives
+            tau[t], full[0, t], full[1, t], full[2, t] = d.tau, d.dtau_dq, d.dtau_dv, d.M
+        upper = np.triu(full[2])  # pinocchio fills the upper triangle of M only
+        full[2] = upper + np.triu(upper, 1).transpose(0, 2, 1)
+        active = np.asarray(r.v_idx)
+        return tau[:, active], full[:, :, active[:, None], active[None, :]]
 
     def evaluate(self, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """2n aggregated values (side × joint) and their Jacobian (2n, α.size)."""
