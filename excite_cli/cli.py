@@ -107,8 +107,8 @@ def optimize(
         tables.iterations(run.results, problem.optimizer.objective),
         f"wrote {run.target} and {', '.join(str(p) for p in run.plots)}",
     )
-    if run.unexciting:
-        err.print(f"[bold yellow]warning:[/] {escape(run.unexciting)}", highlight=False, soft_wrap=True)
+    if run.warning:
+        err.print(f"[bold yellow]warning:[/] {escape(run.warning)}", highlight=False, soft_wrap=True)
         raise typer.Exit(1)
 
 

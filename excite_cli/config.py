@@ -9,12 +9,14 @@ from __future__ import annotations
 import math
 import re
 from pathlib import Path
-from typing import Literal, Optional, Union
+from typing import Annotated, Literal, Optional, Union
 
 import yaml
 from pydantic import BaseModel, ConfigDict, Field, PositiveFloat, field_validator, model_validator
 
 PerJoint = Union[float, dict[str, float]]
+#: A fraction in (0, 1).
+Fraction = Annotated[float, Field(gt=0.0, lt=1.0)]
 
 #: Largest number of harmonics N (the paper uses 5-10; the memory grows with N × grid instants).
 MAX_HARMONICS = 100
@@ -77,13 +79,15 @@ class TrajectoryConfig(Section):
 class LimitsConfig(Section):
     """Joint limits (Eq. 51): position margin [rad], velocity [rad/s], acceleration [rad/s²], check
     refinement; joint torques [Nm] (``urdf``: the URDF's effort limits, a scale factor of those, or
-    {joint: Nm}; none by default)."""
+    {joint: Nm}; none by default); the fraction of its torque limit each joint (or the joints named)
+    must reach somewhere in the motion (none by default)."""
 
     position_margin: float = Field(0.0, ge=0.0)
     velocity: Optional[PerJoint] = None
     acceleration: PerJoint
     check_refinement: int = Field(10, ge=10, le=1000)
     torque: Optional[Union[Literal["urdf"], PositiveFloat, dict[str, PositiveFloat]]] = None
+    min_torque_use: Optional[Union[Fraction, dict[str, Fraction]]] = None
 
 
 class ComConfig(Section):

@@ -35,12 +35,15 @@ class Constraint(ABC):
         grid_margin: normalized margin the exact grid samples must keep for α to be accepted; it
             covers the overshoot between grid instants.
         track_units: the unit of each series :meth:`track` returns, by name.
+        needs_motion: whether only a moving trajectory can satisfy it (standing still at the home
+            posture and the random starts need not; the solver moves into it).
     """
 
     name: str
     basis: FourierBasis
     grid_margin: float = 0.0
     track_units: dict[str, str] = {}
+    needs_motion: bool = False
 
     @abstractmethod
     def evaluate(self, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -12,12 +12,14 @@ from __future__ import annotations
 
 import numpy as np
 import pinocchio as pin
+from scipy.special import logsumexp, softmax
 
 from excite_cli.config import PerJoint
 from excite_cli.constraints.constraint import Constraint, FineCheck
 from excite_cli.constraints.joint_limits import per_joint
-from excite_cli.constraints.lse import ACCEPT_MARGIN, smooth_max
+from excite_cli.constraints.lse import ACCEPT_MARGIN, GRID_MARGIN, SHARPNESS, smooth_max
 from excite_cli.dynamics.robot import Robot
+from excite_cli.errors import ExciteError
 from excite_cli.trajectory.fourier import FourierBasis
 
 
@@ -81,6 +83,68 @@ class TorqueLimits(Constraint):
     def track(self, alpha: np.ndarray, basis: FourierBasis) -> dict[str, np.ndarray]:
         """``torque_use``: (T, n) |τ|/τ_max on ``basis``'s instants."""
         return {"torque_use": np.abs(self.torques(*basis.evaluate(alpha))) / self.limit}
+
+
+class TorqueUse(TorqueLimits):
+    """Minimum torque use (FloBaRoID's ``minTorqueUtilization``): each joint i with a fraction f_i > 0
+    reaches |τ_i(t)| ≥ f_i τ_max,i at some instant of the constraint grid, so that its torque rises
+    above the sensor noise. One inequality per such joint on a smooth maximum that never exceeds the
+    true one: m_i = (1/β) log Σ_t,± exp(±β τ_i(t)/τ_max,i) − log(2T)/β ≤ max_t |τ_i(t)|/τ_max,i, and
+    g_i = f_i + δ − m_i ≤ 0 (``lse.py``'s β and δ).
+
+    A motion must exist to meet it: standing still at the home posture and the random starts need
+    not (:attr:`needs_motion`); the solver moves into it.
+
+    Args:
+        robot, basis, limit: as :class:`TorqueLimits`.
+        fraction: (n,) f of each active joint, 0 where none is asked.
+    """
+
+    name = "min_torque_use"
+    needs_motion = True
+
+    def __init__(self, robot: Robot, basis: FourierBasis, limit: np.ndarray, fraction: np.ndarray):
+        super().__init__(robot, basis, limit)
+        self.fraction = np.asarray(fraction, dtype=float)
+        self.joints = np.flatnonzero(self.fraction > 0)
+
+    def evaluate(self, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """One value per joint with a fraction (k,) and the Jacobian (k, α.size)."""
+        n, m = alpha.shape
+        tau, derivatives = self._derivatives(*(B @ alpha.T for B in self._orders))
+        j, limit = self.joints, self.limit[self.joints]
+        z = tau[:, j] / limit
+        both = SHARPNESS * np.stack([z, -z])  # (2, T, k)
+        soft = (logsumexp(both, axis=(0, 1)) - np.log(2 * z.shape[0])) / SHARPNESS
+        w = softmax(both, axis=(0, 1))
+        weights = -(w[0] - w[1]) / limit  # ∂g/∂τ (T, k)
+        J = sum(np.einsum("ti,tij,tc->ijc", weights, D[:, j], B) for D, B in zip(derivatives, self._orders))
+        return self.fraction[j] + GRID_MARGIN - soft, J.reshape(j.size, n * m)
+
+    def check_samples(self, time: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> FineCheck:
+        """The joint that falls shortest of its fraction: f_i − max_t |τ_i|/τ_max,i (≤ 0 when met)."""
+        reached = (np.abs(self.torques(q, qd, qdd)) / self.limit).max(axis=0)[self.joints]
+        asked = self.fraction[self.joints]
+        k = int(np.argmax(asked - reached))
+        joint, shortfall = self.robot.joint_names[self.joints[k]], float(asked[k] - reached[k])
+        where = f"joint {joint} reaches {reached[k]:.3f} of its torque limit at most (asked: {asked[k]:g})"
+        return FineCheck(max_violation=shortfall, details={"min_torque_use_shortfall": shortfall}, where=where)
+
+
+def torque_use_fraction(value: float | dict[str, float], robot: Robot) -> np.ndarray:
+    """(n,) fraction of ``limits.min_torque_use`` per active joint: every joint's, or the named ones' (0 elsewhere).
+
+    Raises:
+        ExciteError: an unknown joint.
+    """
+    if not isinstance(value, dict):
+        return np.full(robot.n_joints, float(value))
+    fraction = np.zeros(robot.n_joints)
+    for name, f in value.items():
+        if name not in robot.joint_names:
+            raise ExciteError("limits.min_torque_use", f"'{name}' is not an active joint")
+        fraction[robot.joint_names.index(name)] = f
+    return fraction
 
 
 def torque_limit(value: PerJoint | str, robot: Robot) -> np.ndarray:

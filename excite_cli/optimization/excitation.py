@@ -16,7 +16,7 @@ from excite_cli.constraints import Constraint, JointLimits, SelfCollision
 from excite_cli.constraints.com_region import com_region_from_config
 from excite_cli.constraints.joint_limits import joint_limit_bounds
 from excite_cli.constraints.lse import GRID_MARGIN
-from excite_cli.constraints.torque_limits import TorqueLimits, torque_limit
+from excite_cli.constraints.torque_limits import TorqueLimits, TorqueUse, torque_limit, torque_use_fraction
 from excite_cli.constraints.world_collision import WorldCollision, world_shapes
 from excite_cli.dynamics.base_parameters import BaseParameters, compute_base_parameters
 from excite_cli.dynamics.robot import Robot, load_robot
@@ -89,9 +89,9 @@ class Excitation:
         return self.limits.random_start(self.trajectory.n_coefficients, rng, fill, self.home, self.boundary.wave_space)
 
     def random_start(self, rng: np.random.Generator) -> np.ndarray:
-        """Random α (n, 2N+1) about the home posture that every constraint and the boundary
-        conditions accept: random Fourier coefficients filling 50-90 % of the joint limits, shrunk
-        until the other constraints hold.
+        """Random α (n, 2N+1) about the home posture that every constraint (but those that need
+        motion) and the boundary conditions accept: random Fourier coefficients filling 50-90 % of
+        the joint limits, shrunk until the other constraints hold.
 
         The drawn oscillation coefficients are rounded to ``START_DECIMALS`` decimals [rad] and moved
         back into the oscillations that meet the boundary conditions (by loops that do not depend on
@@ -103,7 +103,7 @@ class Excitation:
         waves = self.boundary.wave_space
         alpha[:, 1:] = np.einsum("jm,mr,kr->jk", np.round(alpha[:, 1:], START_DECIMALS), waves, waves, optimize=False)
         for _ in range(40):
-            if all(c.accepts(alpha) for c in self.constraints):
+            if all(c.accepts(alpha) for c in self.constraints if not c.needs_motion):
                 return alpha
             alpha[:, 1:] *= 0.7
         return self.static()
@@ -141,6 +141,10 @@ def build_excitation(problem: Problem) -> Excitation:
     constraints: list[Constraint] = [limits]
     if problem.limits.torque is not None:
         constraints.append(TorqueLimits(robot, grid_basis, torque_limit(problem.limits.torque, robot)))
+    if problem.limits.min_torque_use is not None:
+        fraction = torque_use_fraction(problem.limits.min_torque_use, robot)
+        limit = torque_limit(problem.limits.torque or "urdf", robot)
+        constraints.append(TorqueUse(robot, grid_basis, limit, fraction))
     if ccfg.com is not None:
         constraints.append(com_region_from_config(ccfg.com, robot, grid_basis))
     if ccfg.self_collision is not None:
@@ -206,7 +210,7 @@ def _check_home_posture(excitation: Excitation) -> None:
         "self_collision": "constraints.self_collision",
         "world_collision": "constraints.environment",
     }
-    for c in excitation.constraints:
+    for c in (c for c in excitation.constraints if not c.needs_motion):
         check = c.check(static, excitation.grid_basis)
         if check.max_violation > -c.grid_margin:
             raise ExciteError(

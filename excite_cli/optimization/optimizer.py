@@ -49,7 +49,8 @@ class RestartResult:
         stop: why it ended (:func:`~excite_cli.optimization.optimality.stop_reason`).
         end: which point was kept: ``projected`` (the feasible point nearest the last iterate),
             ``inside`` (the best iterate inside every constraint), ``bisection`` (towards the start),
-            or ``start``.
+            ``start``, or ``none`` (no end point met a constraint that needs motion; ``alpha`` is
+            the start and ``objective`` inf).
     """
 
     index: int
@@ -202,7 +203,8 @@ def optimize_restart(
         criterion: the criterion (value and gradient).
         constraints: all constraints (values and Jacobians, exact checks, repairs).
         options: method, iterations, tolerances.
-        start: (n, 2N+1) α that every constraint and the boundary conditions accept.
+        start: (n, 2N+1) α that the boundary conditions and every constraint but those that need
+            motion accept.
         boundary: the boundary conditions and the optimizer's coordinates.
         index: the restart's number (passed to ``progress`` and kept in the result).
         progress: called after every solver iteration with the objective at the iterate.
@@ -237,11 +239,13 @@ def optimize_restart(
     scored = [
         (criterion.value(alpha), k, name, alpha)
         for k, (name, alpha) in enumerate(ends)
-        if name in ("start", "projected") or _accepted(constraints, alpha)
-    ]  # both already accepted
-    value, _, end, alpha = min(scored, key=lambda item: item[:2])
+        if name == "projected" or _accepted(constraints, alpha)
+    ]  # the projection is already accepted
+    # only a constraint that needs motion rejects the start: when no end point meets it, none is kept
+    value, _, end, alpha = min(scored, key=lambda item: item[:2]) if scored else (np.inf, 0, "none", start)
     optimality = problem.optimality(alpha)
     stop = stop_reason(optimality, [f for f, _ in history], run.limit, run.failed, options.optimality_tolerance)
+    stop = stop if scored else "infeasible"
     return RestartResult(
         index,
         alpha,

@@ -43,10 +43,17 @@ class OptimizeRun:
     plots: list[Path]
 
     @property
-    def unexciting(self) -> str:
-        """Why the trajectories identify nothing, "" when they do: the stacked regressor of the last
-        iteration has cond(C) above :data:`MAX_USEFUL_COND` (rank-deficient or nearly: no motion, or
-        limits that leave none)."""
+    def warning(self) -> str:
+        """Why the result should not be run, "" when nothing: an iteration the fine check rejects
+        (a constraint no restart could meet, such as ``limits.min_torque_use``), or the stacked
+        regressor of the last iteration with cond(C) above :data:`MAX_USEFUL_COND` (rank-deficient
+        or nearly: no motion, or limits that leave none)."""
+        for result in self.results:
+            if result.max_violation > 0:
+                return (
+                    f"iteration {result.index} violates its constraints on the fine grid (largest normalized "
+                    f"violation {result.max_violation:.3g}); no restart met them: do not run it"
+                )
         cond = self.results[-1].cond_stacked
         if cond <= MAX_USEFUL_COND:
             return ""
