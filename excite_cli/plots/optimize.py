@@ -13,7 +13,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from excite_cli.constraints import ComRegion, SelfCollision  # noqa: E402
-from excite_cli.constraints.world_collision import WorldCollision, WorldShape  # noqa: E402
+from excite_cli.constraints.world_collision import WorldCollision, WorldShape, world_shapes  # noqa: E402
 from excite_cli.optimization.excitation import Excitation  # noqa: E402
 from excite_cli.optimization.sequence import IterationResult  # noqa: E402
 from excite_cli.plots.figure import save_figure  # noqa: E402
@@ -29,6 +29,7 @@ def plot_result(target: Path, excitation: Excitation, results: Sequence[Iteratio
     collision = next((c for c in excitation.constraints if isinstance(c, SelfCollision)), None)
     world = next((c for c in excitation.constraints if isinstance(c, WorldCollision)), None)
     capsules = collision.capsules if collision else world.capsules if world else []
+    environment = excitation.problem.constraints.environment
     limits = excitation.limits
     plots = [
         plot_trajectories(
@@ -45,7 +46,7 @@ def plot_result(target: Path, excitation: Excitation, results: Sequence[Iteratio
             lambda q: (skeleton(excitation.robot, q), capsule_segments(excitation.robot, capsules, q)),
             [c.radius for c in capsules],
             excitation.home,
-            world.shapes if world else [],
+            world_shapes(environment) if environment else [],  # those out of reach too
         ),
     ]
     if any(r.tracks for r in results):
