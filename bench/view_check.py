@@ -1,5 +1,5 @@
 """Does `excite view` show the robot in a browser? Writes the scene of a result and the same scene
-without the robot's meshes, takes a screenshot of each in headless Chromium (WebGL by SwiftShader)
+without the robot's meshes (the world shapes in both), takes a screenshot of each in headless Chromium (WebGL by SwiftShader)
 and counts the pixels where they differ: the robot. Exit status 1 below ``MIN_PIXELS``.
 
 Run: `make view-check` (installs Debian's chromium when missing, as root; see README) or
@@ -19,6 +19,7 @@ import matplotlib.image
 import numpy as np
 import pinocchio as pin
 
+from excite_cli.constraints.world_collision import world_shapes
 from excite_cli.dynamics.robot import load_robot
 from excite_cli.plots.scene import write_scene
 from excite_cli.storage.export import export_trajectory
@@ -48,9 +49,10 @@ def main(result: Path) -> int:
     scene = run_view(result, output=result.with_name(result.stem + "_view.html"), rate=10.0, force=True)
     problem = problem_of_result(result)
     robot = replace(load_robot(problem, collision=True), collision_model=pin.GeometryModel())
-    empty = write_scene(
-        result.with_name(result.stem + "_view_empty.html"), robot, export_trajectory(result, rate=10.0).q, 10.0, []
-    )
+    environment = problem.constraints.environment  # drawn in both: only the robot's pixels differ
+    shapes = world_shapes(environment) if environment else []
+    played = export_trajectory(result, rate=10.0).q
+    empty = write_scene(result.with_name(result.stem + "_view_empty.html"), robot, played, 10.0, shapes)
     changed = int((np.abs(screenshot(browser, scene) - screenshot(browser, empty)).max(axis=2) > 0.1).sum())
     print(f"{scene}: {changed} pixels show the robot (at least {MIN_PIXELS}); screenshot {scene.with_suffix('.png')}")
     return 0 if changed >= MIN_PIXELS else 1
