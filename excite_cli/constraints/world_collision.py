@@ -56,10 +56,10 @@ class WorldShape:
     rotation: np.ndarray = field(default_factory=lambda: np.eye(3))
 
 
-def world_shapes(cfg: EnvironmentConfig) -> list[WorldShape]:
-    """The shapes of ``constraints.environment`` (their fields checked by the config)."""
+def world_shapes(cfg: EnvironmentConfig | None) -> list[WorldShape]:
+    """The shapes of ``constraints.environment`` (their fields checked by the config); none without one."""
     shapes = []
-    for s in cfg.shapes:
+    for s in cfg.shapes if cfg else []:
         if s.type == "half_space":
             normal = np.asarray(s.normal, dtype=float)
             shapes.append(

@@ -29,7 +29,6 @@ def plot_result(target: Path, excitation: Excitation, results: Sequence[Iteratio
     collision = next((c for c in excitation.constraints if isinstance(c, SelfCollision)), None)
     world = next((c for c in excitation.constraints if isinstance(c, WorldCollision)), None)
     capsules = collision.capsules if collision else world.capsules if world else []
-    environment = excitation.problem.constraints.environment
     limits = excitation.limits
     plots = [
         plot_trajectories(
@@ -46,7 +45,7 @@ def plot_result(target: Path, excitation: Excitation, results: Sequence[Iteratio
             lambda q: (skeleton(excitation.robot, q), capsule_segments(excitation.robot, capsules, q)),
             [c.radius for c in capsules],
             excitation.home,
-            world_shapes(environment) if environment else [],  # those out of reach too
+            world_shapes(excitation.problem.constraints.environment),  # those out of reach too
         ),
     ]
     if any(r.tracks for r in results):

@@ -41,6 +41,5 @@ def run_view(
         output or result.with_name(f"{result.stem}_iteration{played.iteration}.html"), "output", force
     )
     problem = problem_of_result(result)
-    environment = problem.constraints.environment
     robot = load_robot(problem, collision=True)
-    return write_scene(target, robot, played.q, rate, world_shapes(environment) if environment else [])
+    return write_scene(target, robot, played.q, rate, world_shapes(problem.constraints.environment))
