@@ -70,13 +70,13 @@ def _draw_shape(node, shape: WorldShape) -> None:
     material = mg.MeshLambertMaterial(color=0x999999, opacity=0.6, transparent=True)
     if shape.kind == "box":
         node.set_object(mg.Box(list(shape.size)), material)
-        node.set_transform(_placement(shape.rotation, shape.start))
+        node.set_transform(pin.SE3(shape.rotation, shape.start).homogeneous)
         return
     if shape.kind == "half_space":
         side, thick = SLAB
         node.set_object(mg.Box([side, side, thick]), material)
         rotation = pin.Quaternion.FromTwoVectors(np.array([0.0, 0.0, 1.0]), shape.end).matrix()
-        node.set_transform(_placement(rotation, shape.start - shape.end * thick / 2))
+        node.set_transform(pin.SE3(rotation, shape.start - shape.end * thick / 2).homogeneous)
         return
     node["a"].set_object(mg.Sphere(shape.radius), material)
     node["a"].set_transform(tf.translation_matrix(shape.start))
@@ -87,11 +87,4 @@ def _draw_shape(node, shape: WorldShape) -> None:
     axis = shape.end - shape.start
     node["body"].set_object(mg.Cylinder(float(np.linalg.norm(axis)), shape.radius), material)
     rotation = pin.Quaternion.FromTwoVectors(np.array([0.0, 1.0, 0.0]), axis / np.linalg.norm(axis)).matrix()
-    node["body"].set_transform(_placement(rotation, (shape.start + shape.end) / 2))
-
-
-def _placement(rotation: np.ndarray, translation: np.ndarray) -> np.ndarray:
-    """(4, 4) homogeneous transform."""
-    out = np.eye(4)
-    out[:3, :3], out[:3, 3] = rotation, translation
-    return out
+    node["body"].set_transform(pin.SE3(rotation, (shape.start + shape.end) / 2).homogeneous)
