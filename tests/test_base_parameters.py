@@ -1,9 +1,15 @@
 """Base parameters (Eq. 2): Y_B φ_B must reproduce pinocchio's RNEA torques at fresh random states."""
 
+import os
+import platform
+import subprocess
+import sys
+
 import numpy as np
 import pytest
+from conftest import CONFIGS
 
-from excite_cli.dynamics.base_parameters import compute_base_parameters
+from excite_cli.dynamics.base_parameters import base_from_regressor, compute_base_parameters, pivoted_columns
 from excite_cli.dynamics.robot import load_robot
 
 
@@ -42,3 +48,60 @@ def test_names_say_what_is_regrouped(panda_problem):
     base = compute_base_parameters(load_robot(panda_problem))
     assert len(base.names) == base.count
     assert any("+" in name or " - " in name for name in base.names)
+
+
+def _random_regressor(robot, seed=0):
+    return robot.regressor_stack(*robot.random_states(40, np.random.default_rng(seed)))
+
+
+@pytest.mark.parametrize("name", ["g1_problem", "panda_problem", "ur5_problem"])
+def test_the_base_does_not_depend_on_the_order_of_rows_or_columns(name, request):
+    # Ties (the G1's two arms, the regrouping rules) are broken by the parameters' order, not by
+    # where a column sits or by rounding: permuted rows and columns give the same parameters.
+    robot = load_robot(request.getfixturevalue(name))
+    W, names = _random_regressor(robot), robot.parameter_names
+    base = base_from_regressor(W, names)
+    rng = np.random.default_rng(1)
+    rows, columns = rng.permutation(W.shape[0]), rng.permutation(W.shape[1])
+    by_rows = base_from_regressor(W[rows], names)
+    by_columns = base_from_regressor(W[:, columns], [names[k] for k in columns], order=columns)
+    assert by_rows.names == base.names
+    assert sorted(columns[by_columns.independent]) == sorted(base.independent)
+    assert sorted(by_columns.names) == sorted(base.names)
+
+
+def test_tied_columns_go_to_the_first_parameter():
+    # Two columns of equal norm in exact arithmetic (the mirror of each other): the first in the
+    # parameter order wins, wherever it sits.
+    rng = np.random.default_rng(3)
+    a, c = rng.standard_normal(30), rng.standard_normal(30)
+    W = np.column_stack([a, -a, c])
+    assert sorted(pivoted_columns(W, np.array([0, 1, 2]))) == [0, 2]
+    assert sorted(pivoted_columns(W, np.array([1, 0, 2]))) == [1, 2]
+    assert sorted(pivoted_columns(W[:, [1, 0, 2]], np.array([1, 0, 2]))) == [1, 2]  # column 1 there is parameter 0
+
+
+_BASE_NAMES = (
+    "import sys, hashlib; from excite_cli.config_file import load_problem; "
+    "from excite_cli.dynamics.robot import load_robot; "
+    "from excite_cli.dynamics.base_parameters import compute_base_parameters; "
+    "b = compute_base_parameters(load_robot(load_problem(sys.argv[1]))); "
+    "print(hashlib.sha256(('|'.join(b.names)).encode() + b.regrouping.tobytes()).hexdigest())"
+)
+
+
+@pytest.mark.skipif(platform.machine() != "x86_64", reason="OpenBLAS core types named here are x86_64's")
+@pytest.mark.parametrize("config", ["g1_arms.yaml", "panda.yaml", "ur5.yaml"])
+def test_the_base_is_the_same_with_every_blas_kernel_and_thread_count(config):
+    # Plain pivoted QR gave three bases of the G1 on one machine (AVX-512 with 1 or 2 threads, AVX2).
+    digests = set()
+    for env in ({}, {"OPENBLAS_NUM_THREADS": "1"}, {"OPENBLAS_CORETYPE": "Haswell"}, {"OPENBLAS_CORETYPE": "Prescott"}):
+        run = subprocess.run(
+            [sys.executable, "-c", _BASE_NAMES, str(CONFIGS / config)],
+            env={**os.environ, **env},
+            capture_output=True,
+            text=True,
+            check=True,
+        )
+        digests.add(run.stdout.strip())
+    assert len(digests) == 1

@@ -79,3 +79,28 @@ def test_unreachable_scheduler_is_named(excitation, monkeypatch):
     with pytest.raises(ExciteError, match="optimizer.scheduler: cannot reach the Dask scheduler at tcp://127.0.0.1:9"):
         with Engine(excitation, scheduler="tcp://127.0.0.1:9"):
             pass
+
+
+def test_workers_optimize_in_the_main_process_base(excitation):
+    # The base is computed once and shipped: a base whose columns are in another order than any
+    # process would compute (a stand-in for the base another BLAS kernel picked) is the one the
+    # workers' criterion uses, so a restart's value is the main process's at the returned α.
+    import dataclasses
+
+    base = excitation.base
+    order = np.random.default_rng(0).permutation(base.count)
+    shuffled = dataclasses.replace(
+        base,
+        composition_matrix=base.composition_matrix[:, order],
+        regrouping=base.regrouping[order],
+        names=[base.names[k] for k in order],
+        independent=base.independent[order],
+    )
+    other = dataclasses.replace(excitation, base=shuffled)
+    prior = other.criterion().regressor(other.random_start(np.random.default_rng(3)))
+    tasks = [RestartTask(1, r, 5, prior, iterations=5) for r in range(2)]
+    with Engine(other, workers=2) as engine:
+        runs = engine.run(tasks)
+    for run in runs:
+        assert run.objective == pytest.approx(other.criterion(prior).value(run.alpha), rel=1e-12)
+        assert run.objective != pytest.approx(excitation.criterion(prior).value(run.alpha), rel=1e-6)

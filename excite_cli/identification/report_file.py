@@ -48,6 +48,10 @@ def write_identification(
         group = f.create_group("robot")
         write_strings(group, "joint_names", robot.joint_names)
         write_strings(group, "base_parameter_names", base.names)
+        write_strings(group, "base_independent_parameters", [robot.parameter_names[k] for k in base.independent])
+        group.create_dataset("regrouping_matrix", data=base.regrouping).attrs["description"] = (
+            "K (b x p): phi_B = K phi"
+        )
         _write_regressor(f, regressor, b)
         g = f.create_group("identification")
         g.attrs["method"], g.attrs["cutoff_Hz"], g.attrs["cutoff_source"] = (

@@ -11,7 +11,7 @@ torque's RMS [%].
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Optional
 
@@ -116,10 +116,10 @@ def validate_model(report: Path, problem: IdentifyProblem) -> list[RunError]:
     problem = with_overrides(problem, {"robot.base_wrench_rows": False})  # a copy: the caller's config is not changed
     robot = load_robot(problem)
     base = compute_base_parameters(robot)
-    if model.joints != robot.joint_names or model.base_names != base.names:
-        raise ExciteError(
-            "report", f"{report} was identified for other joints or base parameters than the config's robot"
-        )
+    if model.joints != robot.joint_names:
+        raise ExciteError("report", f"{report} was identified for other joints than the config's robot")
+    order = base.column_order(model.base_names, "report", report)  # the same base, maybe in another order
+    model = replace(model, base_names=base.names, base=model.base[order], rigid=model.rigid[order])
     terms = [Term(e, robot.joint_names.index(j), s) for e, j, s in model.terms]
     needed = terms + [Term("coulomb", j) for j in range(robot.n_joints)]
     errors = []

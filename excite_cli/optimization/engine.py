@@ -5,7 +5,8 @@ The restarts of an iteration (:class:`~excite_cli.optimization.sequence.RestartT
 of ``compare-random`` (:class:`~excite_cli.optimization.random_baseline.DrawTask`) are tasks: each has an index
 and its own seed, and is called with the problem's :class:`~excite_cli.optimization.excitation.Excitation`, so
 its result does not depend on where or in which order it runs. Pool and cluster workers build the
-excitation from the validated problem once and keep it (one per worker thread). Every process that
+excitation from the validated problem and the main process's base parameters once and keep it (one
+per worker thread): no worker computes a base of its own. Every process that
 runs tasks uses one BLAS thread, since the matrices are small and parallel workers would otherwise
 oversubscribe the cores, and keeps the memory it frees (:func:`~excite_cli.memory.keep_freed_memory`).
 """
@@ -21,6 +22,7 @@ from typing import Any, Callable, Iterator, Optional, Protocol, Sequence
 from threadpoolctl import threadpool_limits
 
 from excite_cli.config import Problem
+from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.errors import ExciteError
 from excite_cli.memory import keep_freed_memory
 from excite_cli.optimization.excitation import Excitation, build_excitation
@@ -43,21 +45,21 @@ class Task(Protocol):
 _local = threading.local()
 
 
-def _worker_excitation(problem: Problem) -> Excitation:
-    """The excitation of ``problem`` in this worker (thread), built on first use."""
-    key = (str(problem.source_path), problem.model_dump_json())
+def _worker_excitation(problem: Problem, base: BaseParameters) -> Excitation:
+    """The excitation of ``problem`` in ``base`` in this worker (thread), built on first use."""
+    key = (str(problem.source_path), problem.model_dump_json(), base.names)
     cache = getattr(_local, "cache", None)
     if cache is None or cache[0] != key:
-        _local.cache = cache = (key, build_excitation(problem))
+        _local.cache = cache = (key, build_excitation(problem, base))
     return cache[1]
 
 
-def run_on_worker(problem: Problem, task: Task) -> Any:
-    """``task`` in a pool or cluster worker, with the worker's own excitation and, from then on, one
-    BLAS thread in the worker's process (a worker is there to run tasks)."""
+def run_on_worker(problem: Problem, base: BaseParameters, task: Task) -> Any:
+    """``task`` in a pool or cluster worker, with the worker's own excitation in the main process's
+    ``base`` and, from then on, one BLAS thread in the worker's process (a worker is there to run tasks)."""
     threadpool_limits(limits=1)
     keep_freed_memory()
-    return task(_worker_excitation(problem))
+    return task(_worker_excitation(problem, base))
 
 
 def _worker_signals() -> None:
@@ -138,17 +140,17 @@ class Engine:
             for task in tasks:
                 yield task, task(self.excitation, progress)
             return
-        problem = self.excitation.problem
+        problem, base = self.excitation.problem, self.excitation.base
         if self._client is not None:
             from dask.distributed import as_completed as dask_completed
 
-            futures = {self._client.submit(run_on_worker, problem, task, pure=False): task for task in tasks}
+            futures = {self._client.submit(run_on_worker, problem, base, task, pure=False): task for task in tasks}
             for future in dask_completed(list(futures)):
                 yield futures[future], future.result()
             return
         if self._pool is None:  # sized by the work: more processes than tasks would only start and wait
             self._pool = ProcessPoolExecutor(max_workers=min(self.workers, len(tasks)), initializer=_worker_signals)
-        pool_futures = {self._pool.submit(run_on_worker, problem, task): task for task in tasks}
+        pool_futures = {self._pool.submit(run_on_worker, problem, base, task): task for task in tasks}
         for future in as_completed(pool_futures):
             yield pool_futures[future], future.result()
 

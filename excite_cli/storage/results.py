@@ -35,9 +35,17 @@ UNITS = {
 
 
 def results_table(results: Sequence[IterationResult]) -> np.ndarray:
-    """Table I as a structured array: iteration, cond_own, cond_stacked, excitation_own,
-    excitation_stacked (ē [N·m], :mod:`excite_cli.optimization.information`)."""
-    fields = ("cond_own", "cond_stacked", "excitation_own", "excitation_stacked")
+    """Table I as a structured array: iteration, cond_own, cond_stacked (on the base columns, the
+    paper's), scaled_cond_own, scaled_cond_stacked (cond(C L)) and excitation_own, excitation_stacked
+    (ē [N·m]), which do not depend on the choice of base columns (:mod:`excite_cli.optimization.information`)."""
+    fields = (
+        "cond_own",
+        "cond_stacked",
+        "scaled_cond_own",
+        "scaled_cond_stacked",
+        "excitation_own",
+        "excitation_stacked",
+    )
     table = np.zeros(len(results), dtype=[("iteration", "i4")] + [(name, "f8") for name in fields])
     for row, r in zip(table, results):
         row["iteration"] = r.index
@@ -75,8 +83,8 @@ def write_result(
             _write_iteration(iterations.create_group(str(r.index)), r)
         table = f.create_dataset("table", data=results_table(results))
         table.attrs["description"] = (
-            "Table I: cond of each iteration's regressor and of the stacked regressor, and their "
-            "base-independent excitation e [N m] (README 'Output')"
+            "Table I: cond of each iteration's regressor and of the stacked regressor on the base columns, "
+            "their cond(C L) and excitation e [N m], which do not depend on the base columns (README 'Output')"
         )
 
 
@@ -85,6 +93,7 @@ def _write_robot(group: h5py.Group, excitation: Excitation) -> None:
     write_strings(group, "joint_names", robot.joint_names)
     write_strings(group, "parameter_names", robot.parameter_names)
     write_strings(group, "base_parameter_names", base.names)
+    write_strings(group, "base_independent_parameters", [robot.parameter_names[k] for k in base.independent])
     group.create_dataset("composition_matrix", data=base.composition_matrix).attrs["description"] = (
         "X (p x b): Y_B = Y X (Eq. 2)"
     )
@@ -103,6 +112,8 @@ def _write_iteration(group: h5py.Group, r: IterationResult) -> None:
         group.create_dataset(name, data=series).attrs["unit"] = r.track_units[name]
     group.attrs["cond_own"] = r.cond_own
     group.attrs["cond_stacked"] = r.cond_stacked
+    group.attrs["scaled_cond_own"] = r.scaled_cond_own
+    group.attrs["scaled_cond_stacked"] = r.scaled_cond_stacked
     group.attrs["excitation_own_Nm"] = r.excitation_own
     group.attrs["excitation_stacked_Nm"] = r.excitation_stacked
     group.attrs["max_violation"] = r.max_violation
@@ -172,21 +183,25 @@ def read_prior(path: Path, base: BaseParameters) -> np.ndarray:
             raise ExciteError("sequence.prior", f"{path} has neither /iterations nor /regressor")
         names = read_strings(f["robot"], "base_parameter_names") if "robot/base_parameter_names" in f else None
     if prior.ndim != 2 or prior.shape[1] != base.count:
+        shape = "x".join(str(n) for n in prior.shape)
         raise ExciteError(
             "sequence.prior",
-            f"{path} has {prior.shape[-1]} regressor columns, the problem's robot has "
-            f"{base.count} base parameters (prior data of another robot or joint set?)",
-        )
-    if names is not None and names != base.names:
-        differ = next(k for k, (a, b) in enumerate(zip(names, base.names)) if a != b)
-        raise ExciteError(
-            "sequence.prior",
-            f"{path} has the same number of base parameters ({base.count}) but other ones "
-            f"(number {differ + 1} is '{names[differ]}', the problem's is '{base.names[differ]}')",
+            f"{path} has regressor rows of shape {shape}; the problem's robot needs (rows, {base.count}), one "
+            f"column per base parameter (prior data of another robot or joint set?)",
         )
     if not np.all(np.isfinite(prior)):
         raise ExciteError("sequence.prior", f"{path} contains NaN or infinite values")
-    return prior
+    return prior if names is None else prior[:, base.column_order(names, "sequence.prior", path)]
+
+
+def check_base(f: h5py.File, base: BaseParameters, field: str, path: Path) -> None:
+    """Refuse a result whose stored base parameters (``/robot/base_parameter_names``) are not ``base``'s.
+
+    Raises:
+        ExciteError: (``field``) other base parameters (another robot, joint set or base).
+    """
+    if "robot/base_parameter_names" in f:
+        base.column_order(read_strings(f["robot"], "base_parameter_names"), field, path)
 
 
 def problem_of_result(path: Path) -> Problem:
@@ -228,6 +243,7 @@ def read_iterations(
     with open_h5(path, field) as f:
         if "iterations" not in f:
             raise ExciteError(field, f"{path} is not an excite optimize result (no /iterations)")
+        check_base(f, excitation.base, field, path)
         for key in sorted(f["iterations"].keys(), key=int):
             g = f["iterations"][key]
             alpha = g["alpha"][()]

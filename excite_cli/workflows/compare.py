@@ -18,7 +18,7 @@ from excite_cli.optimization.random_baseline import draw_pool, greedy_selection,
 from excite_cli.optimization.sequence import describe
 from excite_cli.plots.optimize import plot_comparison
 from excite_cli.storage.paths import check_target, output_lock
-from excite_cli.storage.results import read_table, results_table, write_result
+from excite_cli.storage.results import check_base, read_table, results_table, write_result
 from excite_cli.workflows.optimize import engine_for, run_optimize
 
 
@@ -155,3 +155,5 @@ def _check_same_problem(path: Path, excitation: Excitation) -> None:
             path,
             "a result of the same robot joints and harmonics",
         )
+    with open_h5(path, "optimized") as f:
+        check_base(f, excitation.base, "optimized", path)
