@@ -104,7 +104,7 @@ def optimize(
     with Bars(err) as bars:
         run = run_optimize(problem, output or Path(problem.output), force, resume, *bars.iterations(problem))
     _say(
-        tables.iterations(run.results, problem.optimizer.objective),
+        tables.iterations(run.results, problem.optimizer),
         f"wrote {run.target} and {', '.join(str(p) for p in run.plots)}",
     )
     if run.warning:

@@ -16,7 +16,7 @@ def _feasible_alpha(excitation, seed=0):
 
 
 @pytest.mark.parametrize("name", ["g1_problem", "panda_problem", "ur5_problem"])
-@pytest.mark.parametrize("objective", ["cond", "log_cond", "log_det", "sigma_min"])
+@pytest.mark.parametrize("objective", ["cond", "log_cond", "log_det", "sigma_min", "log_trace_inverse"])
 def test_gradient_matches_finite_differences(name, objective, request):
     problem = small(request.getfixturevalue(name))
     problem.optimizer.objective = objective
@@ -26,6 +26,41 @@ def test_gradient_matches_finite_differences(name, objective, request):
     _, analytic = criterion.value_and_gradient(alpha)
     fd = finite_difference_gradient(criterion, alpha, step=1e-6, central=True)
     assert np.linalg.norm(analytic - fd) / np.linalg.norm(fd) < 1e-6
+
+
+@pytest.mark.parametrize("name", ["g1_problem", "ur5_problem"])
+@pytest.mark.parametrize("objective", ["log_cond", "sigma_min", "log_trace_inverse"])
+def test_gradient_of_the_scaled_criterion_matches_finite_differences(name, objective, request):
+    problem = small(request.getfixturevalue(name))
+    problem.optimizer.objective, problem.optimizer.scaling = objective, "urdf"
+    excitation = build_excitation(problem)
+    prior = excitation.criterion().regressor(_feasible_alpha(excitation, seed=4))
+    criterion = excitation.criterion(prior)
+    assert criterion.frame is not None
+    check = check_gradient(criterion, _feasible_alpha(excitation, seed=7), repeats=1)
+    assert check.error_central < 1e-6
+
+
+def test_scaled_condition_number_is_that_of_the_scaled_standard_regressor_in_any_base(ur5_problem):
+    # cond(C L) = ratio of the extreme nonzero singular values of Y D, Y the standard regressor
+    # (independent of any base) and D the URDF's parameter magnitudes; another base (C T, T⁻¹K)
+    # gives the same value, while the paper's cond(C) changes.
+    import dataclasses
+
+    from excite_cli.optimization.information import parameter_magnitudes, scaled_frame
+
+    excitation = build_excitation(small(ur5_problem))
+    robot, base = excitation.robot, excitation.base
+    Q, QD, QDD = excitation.cost_basis.evaluate(_feasible_alpha(excitation, 2))
+    Y = robot.regressor_stack(Q, QD, QDD)
+    d = parameter_magnitudes(robot)
+    s = np.linalg.svd(Y * d, compute_uv=False)[: base.count]
+    C = Y[:, base.independent]
+    assert excitation.scaled_condition_number(C) == pytest.approx(s[0] / s[-1], rel=1e-8)
+    T = np.eye(base.count) + 0.3 * np.random.default_rng(1).standard_normal((base.count, base.count))
+    other = dataclasses.replace(base, regrouping=np.linalg.solve(T, base.regrouping))
+    assert condition_number(C @ T @ scaled_frame(other, d)) == pytest.approx(s[0] / s[-1], rel=1e-8)
+    assert abs(condition_number(C @ T) / condition_number(C) - 1) > 0.01
 
 
 def test_gradient_with_prior_rows_and_base_wrench_rows(g1_problem):
@@ -139,3 +174,25 @@ def test_gradient_with_a_prismatic_joint(panda_problem):
     assert not criterion._dynamics.shift_free and len(criterion._dynamics._models) == 3
     fd = finite_difference_gradient(criterion, alpha, step=1e-7, central=True)
     assert np.linalg.norm(analytic - fd) / np.linalg.norm(fd) < 1e-6
+
+
+@pytest.mark.parametrize("name, base_rows, prismatic", [("g1_problem", True, False), ("panda_problem", False, True)])
+def test_passes_per_row_equal_passes_per_parameter(name, base_rows, prismatic, request):
+    """Full-rank weights (D-optimality) take a virtual parameter per instant and row, rows of disjoint
+    subtrees in one pass: the same derivatives as one pass per parameter vector with row weights."""
+    problem = small(request.getfixturevalue(name), harmonics=3, samples=6)
+    problem.robot.base_wrench_rows = base_rows
+    if prismatic:
+        problem.robot.active_joints = [*problem.robot.active_joints[:3], "panda_finger_joint1"]
+        problem.robot.locked_joints.pop("panda_finger_joint1", None)
+        problem.limits.position_margin = 0.002
+    robot = build_excitation(problem).robot
+    dynamics = VirtualDynamics(robot)
+    rng = np.random.default_rng(0)
+    Q, QD, QDD = robot.random_states(6, rng)
+    phis, weights = rng.standard_normal((robot.n_parameters, 4)), rng.standard_normal((4, 6, robot.n_rows))
+    expected = dynamics.weighted_derivatives(phis, weights, Q, QD, QDD)
+    per_row = dynamics.row_derivatives(np.einsum("rtk,pr->tkp", weights, phis), Q, QD, QDD)
+    for a, b in zip(per_row, expected):
+        np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-9 * np.abs(b).max())
+    assert len(dynamics.slots) == (6 + 7 if base_rows else robot.n_rows)  # the G1's arms share passes

@@ -9,6 +9,7 @@ import numpy as np
 from rich.markup import escape
 from rich.table import Table
 
+from excite_cli.config import OptimizerConfig
 from excite_cli.optimization.sequence import IterationResult
 from excite_cli.storage.export import Export
 from excite_cli.workflows.compare import Comparison
@@ -26,10 +27,11 @@ def titled_table(title: str, columns: Sequence[str], rows: Sequence[Sequence[str
     return table
 
 
-def iterations(results: Sequence[IterationResult], objective: str = "log_cond") -> list[Table]:
+def iterations(results: Sequence[IterationResult], optimizer: OptimizerConfig | None = None) -> list[Table]:
     """Table I (cond per iteration, violations, CoM and capsule figures, transitions, time, stop
-    reason of the kept restart) and every restart's convergence (start and end value, first-order
-    optimality, active constraints, solver iterations, stop reason)."""
+    reason of the kept restart) and every restart's convergence (start and end value of the criterion
+    ``optimizer.objective`` and ``scaling`` optimized, first-order optimality, active constraints,
+    solver iterations, stop reason)."""
     extra = [
         (key, label)
         for key, label in (("com_max_excursion_m", "CoM [cm]"), ("min_capsule_distance_m", "dist [cm]"))
@@ -48,6 +50,7 @@ def iterations(results: Sequence[IterationResult], objective: str = "log_cond") 
                 str(r.index),
                 f"{r.cond_own:.1f}",
                 f"{r.cond_stacked:.1f}",
+                f"{r.scaled_cond_stacked:.4g}",
                 f"{r.excitation_stacked:.3g}",
                 f"{r.max_violation:+.1e}",
                 *[f"{100 * float(r.checks[key]):.2f}" for key, _ in extra],
@@ -62,6 +65,7 @@ def iterations(results: Sequence[IterationResult], objective: str = "log_cond") 
             "iter",
             "cond(C(i))",
             "cond(C)",
+            "cond(CL)",
             "ē(C) [Nm]",
             "max viol.",
             *[label for _, label in extra],
@@ -70,11 +74,24 @@ def iterations(results: Sequence[IterationResult], objective: str = "log_cond") 
             "stop",
         ),
         rows,
-        "ē: excitation that does not depend on the choice of base columns (geometric mean of the singular "
-        "values of the URDF-scaled regressor); in/out: quintic transitions from and to the home posture at "
+        "cond(C): on the base columns (the paper's); cond(CL) and ē: condition number and excitation "
+        "(geometric mean of the singular values) of the URDF-scaled regressor, which do not depend on the "
+        "choice of base columns; in/out: quintic transitions from and to the home posture at "
         "rest (checked on the fine grid); stop: why the kept restart ended",
     )
-    shown, label = (np.exp, "cond(C)") if objective == "log_cond" else ((lambda v: v), objective)
+    convergence = _restarts(results, optimizer or OptimizerConfig())
+    return [table, convergence] if convergence.row_count else [table]
+
+
+def _restarts(results: Sequence[IterationResult], optimizer: OptimizerConfig) -> Table:
+    """Every restart of every iteration: start and end value of the criterion optimized, KKT
+    residual, active constraints, solver iterations, end point, stop reason."""
+    matrix = "CL" if optimizer.scaling == "urdf" else "C"
+    shown, label = (
+        (np.exp, f"cond({matrix})")
+        if optimizer.objective == "log_cond"
+        else ((lambda v: v), f"{optimizer.objective}({matrix})")
+    )
     restarts = [
         (
             str(r.index),
@@ -90,7 +107,7 @@ def iterations(results: Sequence[IterationResult], objective: str = "log_cond") 
         for r in results
         for s in r.restarts
     ]
-    convergence = titled_table(
+    return titled_table(
         "Restarts",
         (
             "iter",
@@ -108,7 +125,6 @@ def iterations(results: Sequence[IterationResult], objective: str = "log_cond") 
         "end point: the feasible point nearest the solver's last iterate (projected), the best iterate "
         "inside (inside), towards the start (bisection) or the start",
     )
-    return [table, convergence] if restarts else [table]
 
 
 def comparison(c: Comparison) -> list[Table]:

@@ -14,6 +14,13 @@ analytic RNEA derivatives with inertias φ_r. Two things make it cheap:
   φ_s + φ_r needs no separate shift pass. M_j = m_s × (bodies in j's subtree), so every body keeps a
   net mass m_s. A moving prismatic joint breaks this; then one extra pass with φ_s alone, weighted
   by −Σ_r w_r, removes the shift.
+
+A criterion that needs many eigenvectors (D- or A-optimality: all b) has per-instant weights of
+full rank. Then the passes are better taken per regressor row: Σ_k ∂τ_k(x_t; φ_{t,k})/∂x_t with a
+virtual parameter per instant and row (:meth:`VirtualDynamics.row_derivatives`). τ_k depends only on
+the bodies that joint k carries (its subtree), so rows whose subtrees do not meet (a humanoid's left
+and right arms) share one pass: the passes per instant are as many as the deepest chain has rows,
+7 for the G1's arms instead of b = 90.
 """
 
 from __future__ import annotations
@@ -55,6 +62,9 @@ class VirtualDynamics:
         self._unit_shift = self._shift_per_mass(revolute) @ self._subtree_sizes()
         self._models: list[pin.Model] = []
         self._datas: list[pin.Data] = []
+        self.slots = self._row_slots()
+        self._row_model = pin.Model(model)
+        self._row_data = self._row_model.createData()
 
     def weighted_derivatives(
         self, phis: np.ndarray, weights: np.ndarray, Q: np.ndarray, QD: np.ndarray, QDD: np.ndarray
@@ -86,6 +96,71 @@ class VirtualDynamics:
                 derivatives[:, t] = pin.computeRNEADerivatives(model, data, q[t], v[t], a[t])
             grads += np.einsum("tv,ktvw->ktw", w, derivatives)
         return grads[0][:, self.v_idx], grads[1][:, self.v_idx], grads[2][:, self.v_idx]
+
+    def row_derivatives(
+        self, phis: np.ndarray, Q: np.ndarray, QD: np.ndarray, QDD: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Σ_k ∂τ_k(x_t; φ_{t,k})/∂(q_t, q̇_t, q̈_t) over the regressor rows k, for each instant: one
+        virtual parameter vector per instant and row, rows whose subtrees do not meet in one pass.
+
+        Args:
+            phis: (T, n_rows, p) standard inertial parameters φ_{t,k} in the robot's order (any values).
+            Q, QD, QDD: (T, n) active joints' positions [rad], velocities [rad/s], accelerations [rad/s²].
+
+        Returns:
+            Three (T, n) arrays: the derivatives in q, q̇ and q̈ of the active joints.
+        """
+        model, data, nv = self._row_model, self._row_data, self.model.nv
+        T = Q.shape[0]
+        q = np.tile(self.q_reference, (T, 1))
+        v, a = np.zeros((T, nv)), np.zeros((T, nv))
+        q[:, self.q_idx], v[:, self.v_idx], a[:, self.v_idx] = Q, QD, QDD
+        blocks = phis.reshape(T, phis.shape[1], -1, 10)[:, :, self.blocks]  # (T, rows, bodies, 10)
+        shift = (1.0 + 2.0 * np.abs(blocks[..., 0]).max()) * self._unit_shift.reshape(-1, 10)
+        grads = np.zeros((3, T, nv))
+        for rows, bodies, weights in self.slots:
+            for t in range(T):
+                params = shift.copy()
+                params[bodies] += blocks[t, rows, bodies]
+                for j, body in enumerate(params, start=1):
+                    model.inertias[j] = pin.Inertia.FromDynamicParameters(body)
+                for k, derivative in enumerate(pin.computeRNEADerivatives(model, data, q[t], v[t], a[t])):
+                    grads[k, t] += weights @ derivative
+        if not self.shift_free:  # the shift's own derivatives, once per instant and row
+            for j, body in enumerate(shift, start=1):
+                model.inertias[j] = pin.Inertia.FromDynamicParameters(body)
+            rows = sum(weights for _, _, weights in self.slots)
+            for t in range(T):
+                for k, derivative in enumerate(pin.computeRNEADerivatives(model, data, q[t], v[t], a[t])):
+                    grads[k, t] -= rows @ derivative
+        return grads[0][:, self.v_idx], grads[1][:, self.v_idx], grads[2][:, self.v_idx]
+
+    def _row_slots(self) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+        """Regressor rows grouped so that no two rows of a group share a body of their subtrees: per
+        group, the rows (r,), each body's row among them ((r',) rows and bodies, indexing a (rows,
+        bodies) array), and the group's row weights (nv,)."""
+        model = self.model
+        subtree = np.zeros((model.nv, model.njoints - 1), dtype=bool)  # bodies each velocity index carries
+        for j in range(1, model.njoints):
+            k = j
+            while k > 0:
+                joint = model.joints[k]
+                subtree[joint.idx_v : joint.idx_v + joint.nv, j - 1] = True
+                k = model.parents[k]
+        groups: list[list[int]] = []
+        for r, index in enumerate(self.row_idx):
+            free = next((g for g in groups if not (subtree[[self.row_idx[x] for x in g]] & subtree[index]).any()), None)
+            if free is None:
+                groups.append([r])
+            else:
+                free.append(r)
+        slots = []
+        for g in groups:
+            rows, bodies = np.nonzero(subtree[[self.row_idx[x] for x in g]])
+            weights = np.zeros(model.nv)
+            weights[[self.row_idx[x] for x in g]] = 1.0
+            slots.append((np.array(g)[rows], bodies, weights))
+        return slots
 
     def _virtual_models(self, phis: np.ndarray) -> tuple[list[pin.Model], list[pin.Data]]:
         """Model copies with inertias φ_s + φ_r, r < R, and one with φ_s alone unless ``shift_free``."""

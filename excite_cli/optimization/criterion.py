@@ -12,6 +12,11 @@ Fourier basis (Eq. 49).
 
 D- and E-optimality have gradients of the same form, Σ_r a_r (C v_r) v_rᵀ over eigenvectors v_r of
 CᵀC (:func:`objective_terms`): −log σ_min needs one pass, −log det(CᵀC)/b all b.
+
+With a frame L (b, b) every criterion is that of C L instead of C (``optimizer.scaling: urdf``, the
+regressor in a basis of the identifiable subspace that does not depend on the choice of base columns,
+:func:`~excite_cli.optimization.information.scaled_frame`); with eigenvectors ṽ_r of LᵀCᵀCL the
+gradient in C is Σ_r a_r (C L ṽ_r)(L ṽ_r)ᵀ, so the passes take the virtual parameters X L ṽ_r.
 """
 
 from __future__ import annotations
@@ -40,9 +45,11 @@ def condition_number(C: np.ndarray) -> float:
 
 
 #: The criteria of ``optimizer.objective``: the condition number (Eq. 5) or its log, D-optimality
-#: (−log det(CᵀC) / b, the mean log eigenvalue of the information matrix, maximized) and
-#: E-optimality (−log σ_min(C), the smallest singular value maximized), after the paper's ref. [20].
-OBJECTIVES = ("cond", "log_cond", "log_det", "sigma_min")
+#: (−log det(CᵀC) / b, the mean log eigenvalue of the information matrix, maximized),
+#: E-optimality (−log σ_min(C), the smallest singular value maximized), after the paper's ref. [20],
+#: and A-optimality (½ log(tr((CᵀC)⁻¹) / b), the log of the RMS of 1/σ_i: least squares' RMS parameter
+#: error per unit of torque noise, minimized; Pukelsheim, Optimal Design of Experiments, 1993).
+OBJECTIVES = ("cond", "log_cond", "log_det", "sigma_min", "log_trace_inverse")
 
 
 def objective_terms(objective: str, eigenvalues: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
@@ -71,6 +78,9 @@ def objective_terms(objective: str, eigenvalues: np.ndarray) -> tuple[float, np.
         return float(-0.5 * np.log(lam[0])), np.array([0]), np.array([-1.0 / lam[0]])
     if objective == "log_det":
         return float(-np.log(lam).sum() / lam.size), np.arange(lam.size), -2.0 / (lam.size * lam)
+    if objective == "log_trace_inverse":
+        inverse = 1.0 / lam
+        return float(0.5 * np.log(inverse.mean())), np.arange(lam.size), -(inverse**2) / inverse.sum()
     raise ExciteError("optimizer.objective", f"unknown '{objective}', expected one of {', '.join(OBJECTIVES)}")
 
 
@@ -85,6 +95,7 @@ class Criterion:
         basis: Fourier basis at the T cost samples.
         prior: C₀, (m₁, b) rows stacked above the trajectory's regressor (Eq. 41), or an empty array.
         objective: one of ``OBJECTIVES``.
+        frame: L (b, b): the criterion is that of C L (module docstring); None: of C, the paper's.
     """
 
     robot: Robot
@@ -92,6 +103,7 @@ class Criterion:
     basis: FourierBasis
     prior: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
     objective: str = "log_cond"
+    frame: np.ndarray | None = None
     _dynamics: VirtualDynamics = field(init=False, repr=False)
     _data: pin.Data = field(init=False, repr=False)
     _prior_gram: np.ndarray = field(init=False, repr=False)
@@ -107,6 +119,10 @@ class Criterion:
         self._dynamics = VirtualDynamics(self.robot)
         self._data = self.robot.model.createData()  # this criterion's own, so no result depends on other users
         self._prior_gram = self.prior.T @ self.prior
+
+    def framed(self, C: np.ndarray) -> np.ndarray:
+        """C L (M, b) with the criterion's frame L, or C without one."""
+        return C if self.frame is None else C @ self.frame
 
     def regressor(self, alpha: np.ndarray) -> np.ndarray:
         """Ŷ_B of the trajectory α (n, 2N+1): (T·n_rows, b) (Eq. 3 with Y_B = Y X)."""
@@ -124,7 +140,7 @@ class Criterion:
         C = self.stacked(self.regressor(alpha))
         if C.shape[0] < C.shape[1]:
             return float("inf")
-        s = np.linalg.svd(C, compute_uv=False)
+        s = np.linalg.svd(self.framed(C), compute_uv=False)
         return objective_terms(self.objective, s[::-1] ** 2)[0]
 
     def value_and_gradient(self, alpha: np.ndarray) -> tuple[float, np.ndarray]:
@@ -136,10 +152,17 @@ class Criterion:
         Q, QD, QDD = self.basis.evaluate(alpha)
         own = self._regressor(Q, QD, QDD)
         # eigenpairs of the b×b Gram matrix CᵀC = C₀ᵀC₀ + ŶᵀŶ give σ² and v; C v = σ u (Eqs. 8, 16)
-        eig, V = np.linalg.eigh(self._prior_gram + own.T @ own)
+        gram = self._prior_gram + own.T @ own
+        eig, V = np.linalg.eigh(gram if self.frame is None else self.frame.T @ gram @ self.frame)
         value, used, coefficients = objective_terms(self.objective, eig)
+        directions = V[:, used] if self.frame is None else self.frame @ V[:, used]  # v_r, or L ṽ_r
+        T, rows = Q.shape[0], self.robot.n_rows
+        if used.size > len(self._dynamics.slots):  # fewer passes with a virtual parameter per instant and row
+            phis = np.zeros((T, rows, self.robot.n_parameters))
+            phis[:, :, self.base.independent] = ((own @ directions) * coefficients @ directions.T).reshape(T, rows, -1)
+            return value, self.basis.chain(*self._dynamics.row_derivatives(phis, Q, QD, QDD))
         phis = np.zeros((self.robot.n_parameters, used.size))
-        phis[self.base.independent] = V[:, used]  # X v_r
+        phis[self.base.independent] = directions  # X v_r
         # row weights a_r (Ŷ_B v_r) at each instant
-        weights = ((own @ V[:, used]) * coefficients).T.reshape(used.size, Q.shape[0], self.robot.n_rows)
+        weights = ((own @ directions) * coefficients).T.reshape(used.size, T, rows)
         return value, self.basis.chain(*self._dynamics.weighted_derivatives(phis, weights, Q, QD, QDD))

@@ -21,8 +21,8 @@ from excite_cli.constraints.world_collision import WorldCollision, world_shapes
 from excite_cli.dynamics.base_parameters import BaseParameters, compute_base_parameters
 from excite_cli.dynamics.robot import Robot, load_robot
 from excite_cli.errors import ExciteError
-from excite_cli.optimization.criterion import Criterion
-from excite_cli.optimization.information import excitation_level, parameter_magnitudes
+from excite_cli.optimization.criterion import Criterion, condition_number
+from excite_cli.optimization.information import excitation_level, parameter_magnitudes, scaled_frame
 from excite_cli.trajectory.boundary import BoundaryConditions, boundary_rows
 from excite_cli.trajectory.fourier import FourierBasis, FourierTrajectory, sample_times
 
@@ -44,6 +44,8 @@ class Excitation:
         limits: joint limits (Eq. 51).
         constraints: all constraints handed to the optimizer (joint limits first).
         boundary: boundary conditions (rest or periodic) and the optimizer's coordinates.
+        scaled_frame: L (b, b): C L is the regressor in a basis that does not depend on the choice
+            of base columns (:func:`~excite_cli.optimization.information.scaled_frame`).
     """
 
     problem: Problem
@@ -56,21 +58,32 @@ class Excitation:
     limits: JointLimits
     constraints: list[Constraint]
     boundary: BoundaryConditions
+    scaled_frame: np.ndarray
 
-    def criterion(self, prior: np.ndarray | None = None, objective: str | None = None) -> Criterion:
-        """The criterion of ``objective`` (default ``optimizer.objective``) with C₀ = ``prior`` (m₁, b) (Eq. 41)."""
+    def criterion(
+        self, prior: np.ndarray | None = None, objective: str | None = None, scaling: str | None = None
+    ) -> Criterion:
+        """The criterion of ``objective`` (default ``optimizer.objective``) with C₀ = ``prior`` (m₁, b)
+        (Eq. 41), of C (``scaling`` ``none``) or of C L (``urdf``; default ``optimizer.scaling``)."""
+        scaling = scaling or self.problem.optimizer.scaling
         return Criterion(
             self.robot,
             self.base,
             self.cost_basis,
             prior=np.zeros((0, self.base.count)) if prior is None else prior,
             objective=objective or self.problem.optimizer.objective,
+            frame=self.scaled_frame if scaling == "urdf" else None,
         )
 
     def excitation_level(self, C: np.ndarray) -> float:
         """ē(C) [N·m] of base-regressor rows C (M, b), the excitation figure that does not depend on
         the choice of base columns (:mod:`excite_cli.optimization.information`)."""
         return excitation_level(C, self.base, parameter_magnitudes(self.robot))
+
+    def scaled_condition_number(self, C: np.ndarray) -> float:
+        """cond(C L) of base-regressor rows C (M, b): the condition number that does not depend on
+        the choice of base columns (:mod:`excite_cli.optimization.information`)."""
+        return condition_number(C @ self.scaled_frame)
 
     @property
     def home(self) -> np.ndarray:
@@ -115,8 +128,13 @@ def home_posture(robot: Robot, limits: JointLimits) -> np.ndarray:
     return np.clip(robot.home, limits.centre[0] - inner, limits.centre[0] + inner)
 
 
-def build_excitation(problem: Problem) -> Excitation:
+def build_excitation(problem: Problem, base: BaseParameters | None = None) -> Excitation:
     """Load the robot and set up bases and constraints for ``problem``.
+
+    Args:
+        problem: the validated config.
+        base: the robot's base parameters when already computed (a worker gets the main process's,
+            so that every process optimizes in the same base); default: computed here.
 
     Raises:
         ExciteError: bad robot or limits input (see :func:`load_robot`, :func:`joint_limit_bounds`).
@@ -125,7 +143,7 @@ def build_excitation(problem: Problem) -> Excitation:
     robot = load_robot(
         problem, collision=bool(ccfg.self_collision or ccfg.environment or (ccfg.com and ccfg.com.support_links))
     )
-    base = compute_base_parameters(robot)
+    base = base or compute_base_parameters(robot)
     tcfg = problem.trajectory
     if tcfg.cost_samples * robot.n_rows < base.count:
         raise ExciteError(
@@ -167,6 +185,7 @@ def build_excitation(problem: Problem) -> Excitation:
         limits=limits,
         constraints=constraints,
         boundary=boundary,
+        scaled_frame=scaled_frame(base, parameter_magnitudes(robot)),
     )
     _check_home_posture(excitation)
     return excitation

@@ -13,6 +13,13 @@ is the torque a trajectory's samples carry per relative change of a parameter, o
 the b directions the data can identify: a larger ē is more excitation, whichever base columns the
 optimizer worked with. log ē is the D-optimal criterion (``optimizer.objective: log_det``, the
 paper's ref. [20]) up to a constant.
+
+The same singular values are those of C L, L (b, b) the Cholesky factor of K D² Kᵀ: with
+N = (K D)ᵀ L⁻ᵀ (p, b) an orthonormal basis of the identifiable subspace of the scaled parameters
+D⁻¹φ, Y D N = C K D Dᵀ Kᵀ L⁻ᵀ = C L. Another base (C T, T⁻¹K) has the factor T⁻¹L Q with Q
+orthogonal, so C L Q: the same singular values. cond(C L) is therefore a condition number that does
+not depend on which columns form the base (``optimizer.scaling: urdf``): the ratio of the best to
+the worst determined direction of the standard parameters, each measured in its URDF magnitude.
 """
 
 from __future__ import annotations
@@ -51,3 +58,15 @@ def excitation_level(C: np.ndarray, base: BaseParameters, magnitudes: np.ndarray
         return 0.0
     K = base.regrouping * magnitudes
     return float(np.exp((logdet + np.linalg.slogdet(K @ K.T)[1]) / (2 * base.count)))
+
+
+def scaled_frame(base: BaseParameters, magnitudes: np.ndarray) -> np.ndarray:
+    """L (b, b), lower triangular with L Lᵀ = K D² Kᵀ (module docstring): C L is the regressor in an
+    orthonormal basis of the identifiable subspace of the URDF-scaled standard parameters.
+
+    Args:
+        base: the base parameters (regrouping K, (b, p)).
+        magnitudes: (p,) parameter magnitudes d (:func:`parameter_magnitudes`).
+    """
+    K = base.regrouping * magnitudes
+    return np.linalg.cholesky(K @ K.T)

@@ -25,7 +25,9 @@ class IterationResult:
         alpha: (n, 2N+1) Fourier coefficients.
         time: (T_grid,) constraint grid [s]; q, qd, qdd: (T_grid, n) [rad, rad/s, rad/s²] on it.
         regressor: C⁽ᵏ⁾, (T·n_rows, b) base regressor at the cost samples.
-        cond_own: cond(C⁽ᵏ⁾); cond_stacked: cond([C₀; C⁽ᵏ⁾]) (Table I).
+        cond_own: cond(C⁽ᵏ⁾); cond_stacked: cond([C₀; C⁽ᵏ⁾]) (Table I), on the base columns.
+        scaled_cond_own, scaled_cond_stacked: cond(C L) of the same, the condition number that does
+            not depend on the choice of base columns (:mod:`excite_cli.optimization.information`).
         excitation_own, excitation_stacked: ē of the same [N·m], the excitation figure that does
             not depend on the choice of base columns (:mod:`excite_cli.optimization.information`).
         max_violation: largest normalized constraint violation on the fine grid (≤ 0: satisfied).
@@ -48,6 +50,8 @@ class IterationResult:
     cond_own: float
     cond_stacked: float
     max_violation: float
+    scaled_cond_own: float = np.nan
+    scaled_cond_stacked: float = np.nan
     excitation_own: float = 0.0
     excitation_stacked: float = 0.0
     checks: dict[str, float | str] = field(default_factory=dict)
@@ -124,6 +128,7 @@ def describe(
     """The :class:`IterationResult` of trajectory α (n, 2N+1) stacked under ``prior`` (m, b): its
     regressor, condition numbers, samples on the constraint grid and every constraint's fine check."""
     own = excitation.criterion().regressor(alpha)
+    stacked = np.vstack([prior, own])
     checks = [c.check(alpha, excitation.fine_basis) for c in excitation.constraints]
     details = {key: value for c in checks for key, value in c.details.items()}
     details.update(transition_checks(excitation, alpha))
@@ -137,9 +142,11 @@ def describe(
         qdd=qdd,
         regressor=own,
         cond_own=condition_number(own),
-        cond_stacked=condition_number(np.vstack([prior, own])),
+        cond_stacked=condition_number(stacked),
+        scaled_cond_own=excitation.scaled_condition_number(own),
+        scaled_cond_stacked=excitation.scaled_condition_number(stacked),
         excitation_own=excitation.excitation_level(own),
-        excitation_stacked=excitation.excitation_level(np.vstack([prior, own])),
+        excitation_stacked=excitation.excitation_level(stacked),
         max_violation=max(c.max_violation for c in checks),
         checks=details,
         tracks={
