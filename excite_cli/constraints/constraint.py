@@ -49,6 +49,11 @@ class Constraint(ABC):
     def evaluate(self, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Values g (m,) and Jacobian ∂g/∂α (m, α.size), α flattened row-major."""
 
+    def values(self, alpha: np.ndarray) -> np.ndarray:
+        """Values g (m,) alone (what a line search's trial points need); constraints whose Jacobian
+        costs much more than their values compute them without it."""
+        return self.evaluate(alpha)[0]
+
     @abstractmethod
     def check_samples(self, time: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> FineCheck:
         """Exact (not aggregated) check of sampled motion: ``time`` (T,) [s], q, q̇, q̈ (T, n) [rad, rad/s,

@@ -125,6 +125,12 @@ class SelfCollision(Constraint):
             self.kinematics, self.basis, self.margin, *self._closest(self.basis.q @ alpha.T), self._moves
         )
 
+    def values(self, alpha: np.ndarray) -> np.ndarray:
+        """The aggregated values of :meth:`evaluate` (P,) without the Jacobian."""
+        if not self.pairs:
+            return np.zeros(0)
+        return smooth_max((self.margin - self._closest(self.basis.q @ alpha.T)[0]) / LENGTH_SCALE, axis=0)[0]
+
     track_units = {"min_capsule_distance": "m"}
 
     def track(self, alpha: np.ndarray, basis: FourierBasis) -> dict[str, np.ndarray]:

@@ -59,12 +59,20 @@ class TorqueLimits(Constraint):
         active = np.asarray(r.v_idx)
         return tau[:, active], full[:, :, active[:, None], active[None, :]]
 
+    def _aggregated(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Per side and joint, |τ|/τ_max − 1 aggregated over the grid (2, n), and the weights (2, T, n)."""
+        z = tau / self.limit
+        return smooth_max(np.stack([z - 1.0, -z - 1.0]), axis=1)
+
+    def values(self, alpha: np.ndarray) -> np.ndarray:
+        """The 2n values of :meth:`evaluate` from RNEA alone, without the derivatives."""
+        return self._aggregated(self.torques(*(B @ alpha.T for B in self._orders)))[0].ravel()
+
     def evaluate(self, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """2n aggregated values (side × joint) and their Jacobian (2n, α.size)."""
         n, m = alpha.shape
         tau, derivatives = self._derivatives(*(B @ alpha.T for B in self._orders))
-        z = tau / self.limit
-        g, w = smooth_max(np.stack([z - 1.0, -z - 1.0]), axis=1)  # (2, n), (2, T, n)
+        g, w = self._aggregated(tau)  # (2, n), (2, T, n)
         weights = w * np.array([1.0, -1.0])[:, None, None] / self.limit  # ∂g/∂τ (2, T, n)
         J = sum(np.einsum("kti,tij,tc->kijc", weights, D, B) for D, B in zip(derivatives, self._orders))
         return g.ravel(), J.reshape(2 * n, n * m)
@@ -108,14 +116,23 @@ class TorqueUse(TorqueLimits):
         self.fraction = np.asarray(fraction, dtype=float)
         self.joints = np.flatnonzero(self.fraction > 0)
 
+    def _soft(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """β ± τ_i/τ_max,i of the asked joints (2, T, k), and their smooth maxima m_i (k,)."""
+        z = tau[:, self.joints] / self.limit[self.joints]
+        both = SHARPNESS * np.stack([z, -z])
+        return both, (logsumexp(both, axis=(0, 1)) - np.log(2 * z.shape[0])) / SHARPNESS
+
+    def values(self, alpha: np.ndarray) -> np.ndarray:
+        """The k values of :meth:`evaluate` from RNEA alone, without the derivatives."""
+        soft = self._soft(self.torques(*(B @ alpha.T for B in self._orders)))[1]
+        return self.fraction[self.joints] + GRID_MARGIN - soft
+
     def evaluate(self, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """One value per joint with a fraction (k,) and the Jacobian (k, α.size)."""
         n, m = alpha.shape
         tau, derivatives = self._derivatives(*(B @ alpha.T for B in self._orders))
         j, limit = self.joints, self.limit[self.joints]
-        z = tau[:, j] / limit
-        both = SHARPNESS * np.stack([z, -z])  # (2, T, k)
-        soft = (logsumexp(both, axis=(0, 1)) - np.log(2 * z.shape[0])) / SHARPNESS
+        both, soft = self._soft(tau)  # (2, T, k), (k,)
         w = softmax(both, axis=(0, 1))
         weights = -(w[0] - w[1]) / limit  # ∂g/∂τ (T, k)
         J = sum(np.einsum("ti,tij,tc->ijc", weights, D[:, j], B) for D, B in zip(derivatives, self._orders))

@@ -108,8 +108,9 @@ def repair(
 
 
 class _Evaluations:
-    """The solver's callbacks in its variables z: the objective and the stacked constraints, each
-    evaluated once per point; remembers the best point whose aggregated constraints all hold.
+    """The solver's callbacks in its variables z: the objective, its gradient, the stacked constraint
+    values and their Jacobian, each computed once per point and only when asked for (a line search's
+    trial points need values only); remembers the best point whose aggregated constraints all hold.
 
     Attributes:
         best_value: the lowest objective at such a point (``start_value`` until one is seen).
@@ -121,42 +122,62 @@ class _Evaluations:
     ):
         self.criterion, self.all, self.boundary = criterion, constraints, boundary
         self.best_value, self.best_inside = start_value, None
-        self._constraints: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
-        self._objective: dict[bytes, tuple[float, np.ndarray]] = {}
+        self._last: dict[str, tuple[bytes, object]] = {}
 
-    def constraints(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Stacked values g (m,) and Jacobian in z."""
+    def _once(self, name: str, z: np.ndarray, compute: Callable[[], object]):
+        """``compute()``, or what it gave at the same z the last time ``name`` was asked for."""
         key = z.tobytes()
-        if key not in self._constraints:
-            self._constraints.clear()
-            g, J = _stack(self.all, self.boundary.to_alpha(z))
-            self._constraints[key] = (g, self.boundary.chain(J))
-        return self._constraints[key]
+        if name not in self._last or self._last[name][0] != key:
+            self._last[name] = (key, compute())
+        return self._last[name][1]
+
+    def value(self, z: np.ndarray) -> float:
+        """The criterion at z."""
+
+        def compute() -> float:
+            alpha = self.boundary.to_alpha(z)
+            value = self.criterion.value(alpha)
+            if (
+                value < (self.best_value if self.best_inside is not None else np.inf)
+                and self.constraint_values(z).max() <= 0.0
+            ):
+                self.best_value, self.best_inside = value, alpha.copy()
+            return value
+
+        return self._once("value", z, compute)
+
+    def gradient(self, z: np.ndarray) -> np.ndarray:
+        """The criterion's gradient in z (n_z,)."""
+        return self._once(
+            "gradient",
+            z,
+            lambda: self.boundary.chain(self.criterion.value_and_gradient(self.boundary.to_alpha(z))[1].ravel()),
+        )
+
+    def constraint_values(self, z: np.ndarray) -> np.ndarray:
+        """Stacked constraint values g (m,)."""
+        alpha = self.boundary.to_alpha(z)
+        return self._once("values", z, lambda: np.concatenate([c.values(alpha) for c in self.all]))
+
+    def constraint_jacobian(self, z: np.ndarray) -> np.ndarray:
+        """Their Jacobian in z (m, n_z)."""
+        alpha = self.boundary.to_alpha(z)
+        return self._once(
+            "jacobian", z, lambda: self.boundary.chain(np.vstack([c.evaluate(alpha)[1] for c in self.all]))
+        )
 
     def objective(self, z: np.ndarray) -> tuple[float, np.ndarray]:
         """The criterion and its gradient in z."""
-        key = z.tobytes()
-        if key not in self._objective:
-            self._objective.clear()
-            alpha = self.boundary.to_alpha(z)
-            value, grad = self.criterion.value_and_gradient(alpha)
-            if (
-                value < (self.best_value if self.best_inside is not None else np.inf)
-                and self.constraints(z)[0].max() <= 0.0
-            ):
-                self.best_value, self.best_inside = value, alpha.copy()
-            self._objective[key] = (value, self.boundary.chain(grad.ravel()))
-        return self._objective[key]
+        return self.value(z), self.gradient(z)
+
+    def constraints(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Stacked values g (m,) and Jacobian in z."""
+        return self.constraint_values(z), self.constraint_jacobian(z)
 
     def optimality(self, alpha: np.ndarray) -> Optimality:
         """First-order optimality at α (n, 2N+1), in the variables z."""
         z = self.boundary.to_variables(alpha)
-        return kkt_optimality(self.objective(z)[1], *self.constraints(z))
-
-
-def _stack(constraints: Sequence[Constraint], alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    parts = [c.evaluate(alpha) for c in constraints]
-    return np.concatenate([g for g, _ in parts]), np.vstack([J for _, J in parts])
+        return kkt_optimality(self.gradient(z), *self.constraints(z))
 
 
 def project(problem: _Evaluations, z: np.ndarray, iterations: int = PROJECTION_ITERATIONS) -> Optional[np.ndarray]:
@@ -170,7 +191,11 @@ def project(problem: _Evaluations, z: np.ndarray, iterations: int = PROJECTION_I
         jac=True,
         method="SLSQP",
         constraints=[
-            {"type": "ineq", "fun": lambda y: -problem.constraints(y)[0], "jac": lambda y: -problem.constraints(y)[1]}
+            {
+                "type": "ineq",
+                "fun": lambda y: -problem.constraint_values(y),
+                "jac": lambda y: -problem.constraint_jacobian(y),
+            }
         ],
         options={"maxiter": iterations, "ftol": 1e-12},
     )
@@ -216,7 +241,7 @@ def optimize_restart(
     history: list[tuple[float, float]] = []
 
     def on_iterate(z: np.ndarray) -> None:
-        history.append((problem.objective(z)[0], float(problem.constraints(z)[0].max())))
+        history.append((problem.value(z), float(problem.constraint_values(z).max())))
         if progress is not None:
             progress(index, len(history), history[-1][0])
 
@@ -228,6 +253,8 @@ def optimize_restart(
         options.tolerance,
         on_iterate,
     )
+    if len(history) < run.iterations:  # a solver that ends inside an iteration calls back no more: its last iterate
+        on_iterate(run.z)
     ends = [("start", start)]
     projected = project(problem, run.z)
     if projected is not None:

@@ -30,11 +30,16 @@ IterateHook = Callable[[np.ndarray], None]
 
 
 class NLP(Protocol):
-    """The problem a solver sees: f(z) with its gradient, g(z) (m,) with its Jacobian (m, z.size)."""
+    """The problem a solver sees: f(z) and its gradient (z.size,), g(z) (m,) and its Jacobian
+    (m, z.size), each asked for on its own (a line search's trial points need values only)."""
 
-    def objective(self, z: np.ndarray) -> tuple[float, np.ndarray]: ...
+    def value(self, z: np.ndarray) -> float: ...
 
-    def constraints(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]: ...
+    def gradient(self, z: np.ndarray) -> np.ndarray: ...
+
+    def constraint_values(self, z: np.ndarray) -> np.ndarray: ...
+
+    def constraint_jacobian(self, z: np.ndarray) -> np.ndarray: ...
 
 
 @dataclass(frozen=True)
@@ -81,12 +86,12 @@ def solve(
 
 def _slsqp(nlp: NLP, z0: np.ndarray, max_iterations: int, tolerance: float, on_iterate: IterateHook) -> SolverRun:
     result = minimize(
-        nlp.objective,
+        nlp.value,
         z0,
-        jac=True,
+        jac=nlp.gradient,
         method="SLSQP",
         constraints=[
-            {"type": "ineq", "fun": lambda z: -nlp.constraints(z)[0], "jac": lambda z: -nlp.constraints(z)[1]}
+            {"type": "ineq", "fun": lambda z: -nlp.constraint_values(z), "jac": lambda z: -nlp.constraint_jacobian(z)}
         ],
         options={"maxiter": max_iterations, "ftol": tolerance},
         callback=lambda z, *_: on_iterate(z),
@@ -98,13 +103,11 @@ def _slsqp(nlp: NLP, z0: np.ndarray, max_iterations: int, tolerance: float, on_i
 def _trust_constr(
     nlp: NLP, z0: np.ndarray, max_iterations: int, tolerance: float, on_iterate: IterateHook
 ) -> SolverRun:
-    constraint = NonlinearConstraint(
-        lambda z: nlp.constraints(z)[0], -np.inf, 0.0, jac=lambda z: nlp.constraints(z)[1], hess=BFGS()
-    )
+    constraint = NonlinearConstraint(nlp.constraint_values, -np.inf, 0.0, jac=nlp.constraint_jacobian, hess=BFGS())
     result = minimize(
-        nlp.objective,
+        nlp.value,
         z0,
-        jac=True,
+        jac=nlp.gradient,
         hess=BFGS(),
         method="trust-constr",
         constraints=[constraint],
@@ -129,16 +132,16 @@ def _ipopt(nlp: NLP, z0: np.ndarray, max_iterations: int, tolerance: float, on_i
     class _Callbacks:
         def objective(self, z):
             last[0] = z
-            return nlp.objective(z)[0]
+            return nlp.value(z)
 
         def gradient(self, z):
-            return nlp.objective(z)[1]
+            return nlp.gradient(z)
 
         def constraints(self, z):
-            return nlp.constraints(z)[0]
+            return nlp.constraint_values(z)
 
         def jacobian(self, z):
-            return nlp.constraints(z)[1].ravel()
+            return nlp.constraint_jacobian(z).ravel()
 
         def intermediate(self, _mode, iteration, *_):
             if iteration > 0:  # IPOPT evaluates f last at the trial point it accepts
@@ -146,7 +149,7 @@ def _ipopt(nlp: NLP, z0: np.ndarray, max_iterations: int, tolerance: float, on_i
                 on_iterate(last[0])
             return True
 
-    m = nlp.constraints(z0)[0].size
+    m = nlp.constraint_values(z0).size
     problem = cyipopt.Problem(
         n=z0.size, m=m, problem_obj=_Callbacks(), lb=None, ub=None, cl=np.full(m, -1e20), cu=np.zeros(m)
     )
