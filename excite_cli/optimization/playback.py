@@ -10,7 +10,8 @@ both ends (so the played motion is C² everywhere). With s = t/D ∈ [0, 1] and 
 
 with h = q₁ − (c₀ + c₁ + c₂), e = Dq̇₁ − (c₁ + 2c₂), f = D²q̈₁ − 2c₂ (Hermite interpolation). Rest to
 rest it is the minimum-jerk profile, peak speed 15Δ/(8D) and peak acceleration 10Δ/(√3 D²); D is the
-shortest multiple of ``RESOLUTION`` for which every sample keeps the joint limits (Eq. 51).
+shortest multiple of ``RESOLUTION`` for which every sample keeps the joint limits (Eq. 51) and the
+torque limits, where the problem has them.
 """
 
 from __future__ import annotations
@@ -87,16 +88,20 @@ class Transition:
         return q, qd, qdd
 
 
-def plan_transition(start: np.ndarray, end: np.ndarray, limits: JointLimits, name: str) -> Transition | None:
+def plan_transition(
+    start: np.ndarray, end: np.ndarray, limits: JointLimits, name: str, torque: Constraint | None = None
+) -> Transition | None:
     """The shortest quintic from ``start`` to ``end`` ((3, n) states) whose samples keep the joint
-    limits with the optimizer's acceptance margin; None when the states are the same.
+    limits and, when given, the ``torque`` limits with the optimizer's acceptance margin (a slower
+    transition needs less torque); None when the states are the same. When no duration keeps the
+    torque limits (gravity alone exceeds them on the way), the shortest that keeps the joint limits.
 
     The search starts at the rest-to-rest bound max_j(15|Δ_j|/(8 v_j), (10|Δ_j|/(√3 a_j))^½) with
     the limits tightened by the grid margin, and lengthens by 10 % steps.
 
     Raises:
-        ExciteError: no duration up to ``LONGEST`` keeps the limits (only possible when an end is
-            not at rest).
+        ExciteError: no duration up to ``LONGEST`` keeps the joint limits (only possible when an end
+            is not at rest).
     """
     if np.abs(end - start).max() <= SAME_STATE:
         return None
@@ -109,13 +114,18 @@ def plan_transition(start: np.ndarray, end: np.ndarray, limits: JointLimits, nam
         float(np.sqrt(np.max(10.0 * delta / (np.sqrt(3.0) * acceleration)))),
         RESOLUTION,
     )
-    duration = shortest
+    duration, within_limits = shortest, None
     while duration <= LONGEST:
         transition = Transition(start, end, float(np.ceil(duration / RESOLUTION - 1e-9) * RESOLUTION), name)
         t = np.linspace(0.0, transition.duration, PLANNING_SAMPLES)
-        if limits.check_samples(t, *transition.evaluate(t)).max_violation <= -ACCEPT_MARGIN / 2:
-            return transition
+        samples = transition.evaluate(t)
+        if limits.check_samples(t, *samples).max_violation <= -ACCEPT_MARGIN / 2:
+            if torque is None or torque.check_samples(t, *samples).max_violation <= -ACCEPT_MARGIN / 2:
+                return transition
+            within_limits = within_limits or transition
         duration *= 1.1
+    if within_limits is not None:
+        return within_limits
     raise ExciteError(name, f"no quintic of up to {LONGEST:g} s keeps the joint limits")
 
 
@@ -163,12 +173,13 @@ def plan_playback(excitation: Excitation, alpha: np.ndarray, periods: int = 1) -
     trajectory = FourierSegment(excitation.trajectory, alpha, excitation.problem.trajectory.duration)
     first, last = trajectory.state(0.0), trajectory.state(trajectory.duration)
     limits = excitation.limits
-    pieces: list[Segment | None] = [plan_transition(home, first, limits, "transition in")]
+    torque = next((c for c in excitation.constraints if c.name == "torque_limits"), None)
+    pieces: list[Segment | None] = [plan_transition(home, first, limits, "transition in", torque)]
     for p in range(periods):
         pieces.append(trajectory)
         if p < periods - 1:
-            pieces.append(plan_transition(last, first, limits, "link"))
-    pieces.append(plan_transition(last, home, limits, "transition out"))
+            pieces.append(plan_transition(last, first, limits, "link", torque))
+    pieces.append(plan_transition(last, home, limits, "transition out", torque))
     return Playback(tuple(s for s in pieces if s is not None))
 
 
