@@ -1,69 +1,137 @@
-"""Which criterion gives the best identification? Trajectories optimized with each objective
-(cond, log_cond, log_det = D-optimality, sigma_min = E-optimality) on a problem (default
-configs/panda_joint_limits.yaml, first iteration), then identified on simulated measurements.
+"""Which criterion identifies best? Each criterion's sequential trajectories identified in the loop.
 
-Simulation: one period sampled at 200 Hz, torques from pinocchio's RNEA with the URDF inertias plus
-white noise (0.05 Nm); base parameters by least squares with the base regressor; 200 noise draws.
-Printed per criterion: cond(C), the excitation ē that does not depend on the base columns
-(:mod:`excite_cli.optimization.information`; log ē is the D-optimal criterion up to a constant), and over the base parameters the median and largest standard
-deviation of the estimates, and the median relative standard deviation (std / |φ_B|, parameters with
-|φ_B| > 1e-3), with the largest bias (mean estimate − truth) as a check that the estimates are unbiased.
+For each criterion (``optimizer.objective`` with ``optimizer.scaling``) the config's sequence is
+optimized (its iterations, restarts and screening; one process per core), and so is a random
+baseline (the same number of random feasible starts, each the start the optimizer would draw).
+Then, for 5 noise seeds:
 
-Run: `.venv/bin/python bench/criteria.py [CONFIG]`. Prints a table; asserts nothing.
+- measurements: every trajectory of the sequence sampled at 100 Hz over its duration, torques from
+  pinocchio's RNEA with the URDF's inertias plus white noise of 2 % of each joint's RMS torque on the
+  unseen motion (a sensor's noise does not depend on the motion, so every criterion gets the same);
+- identification: weighted least squares of the base parameters on all of them (weights 1/σ_j);
+- parameter error: the RMS over the b identifiable directions of L⁻¹(β̂ − β), the error in an
+  orthonormal basis of the identifiable subspace of the standard parameters each scaled by its URDF
+  magnitude (:mod:`excite_cli.optimization.information`; a value of 1 is an error as large as the
+  parameters themselves), and the largest such direction error;
+- torque error: the identified model's torques on an unseen motion (a random feasible trajectory of
+  the same problem, seed 12345, not in any sequence) against the true ones, relative RMS per joint,
+  mean over joints.
+
+Printed per criterion: cond(C) on the base columns and cond(C L) (the condition number that does
+not depend on the base columns) after the last iteration, ē, the mean errors over the noise seeds
+and the optimization's wall time.
+
+Run: `.venv/bin/python bench/criteria.py [CONFIG ...] [--criteria OBJECTIVE:SCALING ...] [--seeds S ...]`
+(default the G1 arms and the Panda with joint limits, every criterion and random, seed 0; figures are
+means over the seeds). Asserts nothing.
 """
 
 from __future__ import annotations
 
-import sys
+import argparse
+import time
 from pathlib import Path
 
 import numpy as np
 
 from excite_cli.config_file import load_problem
-from excite_cli.optimization.criterion import OBJECTIVES, condition_number
+from excite_cli.optimization.criterion import condition_number
 from excite_cli.optimization.engine import Engine, default_workers
 from excite_cli.optimization.excitation import build_excitation
-from excite_cli.optimization.sequence import run_sequence
+from excite_cli.optimization.sequence import RestartTask, run_sequence
 
 ROOT = Path(__file__).resolve().parent.parent
-NOISE = 0.05  # Nm
-RATE = 200.0  # Hz
-DRAWS = 200
+CRITERIA = (
+    ("log_cond", "none"),
+    ("log_cond", "urdf"),
+    ("sigma_min", "urdf"),
+    ("log_det", "none"),
+    ("log_trace_inverse", "none"),
+    ("log_trace_inverse", "urdf"),
+)
+DEFAULT_CONFIGS = [ROOT / "configs" / "g1_arms.yaml", ROOT / "configs" / "panda_joint_limits.yaml"]
+RATE = 100.0  # Hz
+NOISE = 0.02  # of each joint's RMS torque on the unseen motion
+SEEDS = 5
+UNSEEN_SEED = 12345
 
 
-def identification_spread(
-    excitation, alpha: np.ndarray, rng: np.random.Generator
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Estimates' standard deviation and bias (b,), and the true base parameters (b,)."""
+def samples(excitation, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Base regressor (T·n, b) and RNEA torques (T, n) of α sampled at ``RATE`` over its duration."""
     robot = excitation.robot
     basis = excitation.trajectory.basis(np.arange(0.0, excitation.problem.trajectory.duration, 1.0 / RATE))
     Q, QD, QDD = basis.evaluate(alpha)
     Y = robot.regressor_stack(Q, QD, QDD)[:, excitation.base.independent]
-    tau = np.concatenate([robot.torques(*x) for x in zip(Q, QD, QDD)])
-    truth = excitation.base.from_standard(robot.urdf_parameters())
-    noisy = tau[None, :] + rng.normal(0.0, NOISE, (DRAWS, tau.size))
-    estimates = np.linalg.lstsq(Y, noisy.T, rcond=None)[0].T  # (draws, b)
-    return estimates.std(axis=0), estimates.mean(axis=0) - truth, truth
+    return Y, np.array([robot.torques(*x) for x in zip(Q, QD, QDD)])
 
 
-def main(config: Path) -> None:
-    print(
-        f"{'objective':<10} {'cond(C)':>8} {'e [Nm]':>8} {'median std':>11} {'largest std':>12} {'median rel. std':>16} {'largest bias':>13}"
-    )
-    for objective in OBJECTIVES:
-        problem = load_problem(config)
-        problem.optimizer.objective = objective
-        excitation = build_excitation(problem)
-        with Engine(excitation, min(default_workers(), problem.optimizer.restarts)) as engine:
-            result = run_sequence(excitation, 1, problem.optimizer.seed, engine=engine)[0]
-        std, bias, truth = identification_spread(excitation, result.alpha, np.random.default_rng(0))
-        relevant = np.abs(truth) > 1e-3
-        print(
-            f"{objective:<10} {condition_number(result.regressor):>8.1f} {result.excitation_own:>8.4g} {np.median(std):>11.2e} {std.max():>12.2e} "
-            f"{np.median(std[relevant] / np.abs(truth[relevant])):>16.2%} {np.abs(bias).max():>13.1e}",
-            flush=True,
-        )
+def in_the_loop(excitation, alphas: list[np.ndarray], unseen: np.ndarray) -> tuple[float, float, float]:
+    """Mean over noise seeds of the RMS and largest scaled parameter error, and the unseen torque error."""
+    truth = excitation.base.from_standard(excitation.robot.urdf_parameters())
+    Y_unseen, tau_unseen = samples(excitation, unseen)
+    sigma = NOISE * np.sqrt((tau_unseen**2).mean(axis=0))  # (n,)
+    data = [samples(excitation, a) for a in alphas]
+    Y = np.vstack([y for y, _ in data])
+    tau = np.vstack([t for _, t in data])
+    weights = np.tile(1.0 / sigma, tau.shape[0])
+    inverse_frame = np.linalg.inv(excitation.scaled_frame)
+    rms, worst, torque = [], [], []
+    for seed in range(SEEDS):
+        noisy = tau + np.random.default_rng(seed).normal(0.0, 1.0, tau.shape) * sigma
+        estimate = np.linalg.lstsq(Y * weights[:, None], noisy.ravel() * weights, rcond=None)[0]
+        error = inverse_frame @ (estimate - truth)
+        rms.append(np.sqrt(np.mean(error**2)))
+        worst.append(np.abs(error).max())
+        predicted = (Y_unseen @ estimate).reshape(tau_unseen.shape)
+        torque.append(np.mean(np.sqrt(((predicted - tau_unseen) ** 2).mean(axis=0) / (tau_unseen**2).mean(axis=0))))
+    return float(np.mean(rms)), float(np.mean(worst)), float(np.mean(torque))
+
+
+def run(config: Path, objective: str, scaling: str, seed: int) -> tuple:
+    """The sequence of one criterion (or the random starts) with optimizer seed ``seed``, its figures
+    and its wall time."""
+    problem = load_problem(config)
+    problem.optimizer.objective, problem.optimizer.scaling, problem.optimizer.seed = objective, scaling, seed
+    excitation = build_excitation(problem)
+    begin = time.perf_counter()
+    iterations = problem.sequence.iterations
+    if objective == "random":
+        prior = np.zeros((0, excitation.base.count))
+        alphas = [excitation.random_start(RestartTask(k, 1, seed, prior).rng()) for k in range(1, iterations + 1)]
+    else:
+        workers = min(default_workers(), problem.optimizer.screened or problem.optimizer.restarts)
+        with Engine(excitation, workers) as engine:
+            alphas = [r.alpha for r in run_sequence(excitation, iterations, seed, engine=engine)]
+    wall = time.perf_counter() - begin
+    C = np.vstack([excitation.criterion(objective="log_cond", scaling="none").regressor(a) for a in alphas])
+    unseen = excitation.random_start(np.random.default_rng(UNSEEN_SEED))
+    figures = (condition_number(C), excitation.scaled_condition_number(C), excitation.excitation_level(C))
+    return (*figures, *in_the_loop(excitation, alphas, unseen), wall)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("configs", type=Path, nargs="*", default=DEFAULT_CONFIGS)
+    parser.add_argument("--criteria", nargs="+", default=[f"{o}:{s}" for o, s in CRITERIA] + ["random:none"])
+    parser.add_argument("--seeds", type=int, nargs="+", default=[0])
+    args = parser.parse_args()
+    header = f"{'criterion':<22} {'cond(C)':>8} {'cond(CL)':>9} {'e [Nm]':>8} {'param err RMS':>14} {'worst dir.':>11} {'unseen torque':>14} {'wall [s]':>9}"
+    for config in args.configs:
+        print(f"\n{config.name}, optimizer seeds {args.seeds} (means)\n{header}")
+        for criterion in args.criteria:
+            objective, scaling = criterion.split(":")
+            rows = np.array([run(config, objective, scaling, seed) for seed in args.seeds])
+            cond, scaled, level, rms, worst, torque, wall = rows.mean(axis=0)
+            label = objective if objective in ("random", "log_det") else f"{objective}, {scaling}"
+            print(
+                f"{label:<22} {cond:>8.1f} {scaled:>9.0f} {level:>8.4f} {rms:>14.2%} {worst:>11.1%} {torque:>14.3%} {wall:>9.0f}",
+                flush=True,
+            )
+            if len(args.seeds) > 1:
+                print(
+                    f"{'  per seed':<22} param err {' '.join(f'{x:.2%}' for x in rows[:, 3])}; torque {' '.join(f'{x:.3%}' for x in rows[:, 5])}"
+                )
 
 
 if __name__ == "__main__":
-    main(Path(sys.argv[1]) if len(sys.argv) > 1 else ROOT / "configs" / "panda_joint_limits.yaml")
+    main()
