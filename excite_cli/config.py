@@ -200,7 +200,7 @@ class OptimizerConfig(Section):
         )
 
     method: Literal["SLSQP", "trust-constr", "ipopt"] = "SLSQP"
-    objective: Literal["log_cond", "cond", "log_det", "sigma_min", "log_trace_inverse"] = "log_cond"
+    objective: Literal["log_cond", "cond", "log_det", "sigma_min", "log_trace_inverse"] = "log_det"
     scaling: Literal["none", "urdf"] = "none"
     max_iterations: int = Field(200, ge=1, le=100_000)
     tolerance: float = Field(1e-6, gt=0.0)

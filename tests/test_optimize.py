@@ -19,7 +19,7 @@ runner = CliRunner()
 def _data(iterations=2):
     data = copy.deepcopy(UR5)
     data["trajectory"].update(harmonics=3, cost_samples=20, cost_period=0.4, constraint_period=0.05)
-    data["optimizer"] = {"max_iterations": 60, "restarts": 1, "seed": 3}
+    data["optimizer"] = {"objective": "log_cond", "max_iterations": 60, "restarts": 1, "seed": 3}  # the paper's
     data["sequence"] = {"iterations": iterations}
     return data
 

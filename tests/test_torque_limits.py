@@ -110,6 +110,7 @@ def _smoke(tmp_path, name: str, min_torque_use) -> tuple[int, str]:
     """Run the smoke problem (one iteration) with ``limits.min_torque_use``; exit code and output."""
     config = yaml.safe_load((CONFIGS / "smoke.yaml").read_text())
     config["limits"]["min_torque_use"] = min_torque_use
+    config["optimizer"]["objective"] = "log_cond"  # the paper's cond: joint 1 then barely uses its torque
     config["sequence"]["iterations"] = 1
     config["output"] = str(tmp_path / f"{name}.h5")
     (tmp_path / f"{name}.yaml").write_text(yaml.safe_dump(config))
