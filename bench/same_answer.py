@@ -24,7 +24,6 @@ import time
 from pathlib import Path
 
 import h5py
-import numpy as np
 from threadpoolctl import threadpool_info
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -54,7 +53,7 @@ def main() -> None:
     parser.add_argument("config", type=Path, nargs="?", default=ROOT / "configs" / "g1_arms.yaml")
     parser.add_argument("--iterations", type=int, default=1)
     args = parser.parse_args()
-    import numpy  # noqa: F401  (loads OpenBLAS, so threadpoolctl sees it)
+    import numpy  # noqa: F401, loads OpenBLAS so that threadpoolctl sees it
 
     print("BLAS:", ", ".join(f"{i['internal_api']} {i['version']} {i['architecture']}" for i in threadpool_info()))
     base = {k: v for k, v in os.environ.items() if k not in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS")}
