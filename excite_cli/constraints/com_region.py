@@ -10,6 +10,7 @@ a log-sum-exp over the constraint grid; the gradient comes from pinocchio's CoM 
 from __future__ import annotations
 
 import numpy as np
+import pinocchio as pin
 from scipy.spatial import ConvexHull, QhullError
 
 from excite_cli.collision.geometry import world_points
@@ -88,8 +89,14 @@ class ComRegion(Constraint):
 
     def _com(self, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(T, 2) ground projections [m] and (T, 2, n) their Jacobians."""
-        samples = [self.robot.com(q, self._data) for q in Q]
-        return np.array([p[:2] for p, _ in samples]), np.array([J[:2] for _, J in samples])
+        r, data = self.robot, self._data
+        configurations = np.tile(r.q_reference, (len(Q), 1))
+        configurations[:, r.q_idx] = Q
+        P, J = np.empty((len(Q), 2)), np.empty((len(Q), 2, r.n_joints))
+        for t, q in enumerate(configurations):  # Robot.com's pinocchio calls, without its per-call set-up
+            J[t] = pin.jacobianCenterOfMass(r.model, data, q, False).reshape(3, r.model.nv)[:2, r.v_idx]
+            P[t] = data.com[0][:2]
+        return P, J
 
     def _normalized(self, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """s (T, K) and ∂s/∂p (T, K, 2)."""

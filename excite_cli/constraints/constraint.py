@@ -52,7 +52,19 @@ class Constraint(ABC):
     def values(self, alpha: np.ndarray) -> np.ndarray:
         """Values g (m,) alone (what a line search's trial points need); constraints whose Jacobian
         costs much more than their values compute them without it."""
-        return self.evaluate(alpha)[0]
+        return self._evaluated(alpha)[0]
+
+    def jacobian(self, alpha: np.ndarray) -> np.ndarray:
+        """Jacobian ∂g/∂α (m, α.size) of :meth:`evaluate`, computed once per point with the values."""
+        return self._evaluated(alpha)[1]
+
+    def _evaluated(self, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`evaluate` at α, or what it gave at the same α the last time (a solver asks for the
+        values and then the Jacobian at the same point)."""
+        key = alpha.tobytes()
+        if getattr(self, "_last", (None,))[0] != key:
+            self._last = (key, self.evaluate(alpha))
+        return self._last[1]
 
     @abstractmethod
     def check_samples(self, time: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> FineCheck:

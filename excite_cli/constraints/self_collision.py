@@ -108,6 +108,13 @@ class SelfCollision(Constraint):
         """At the configurations Q (T, n): distances d (T, P) [m], the closest points c₁ (3, T, P) of
         each pair's first segment, the unit normals (3, T, P) from c₁ to c₂, and the joint placements
         (:meth:`BatchKinematics.placements`)."""
+        key = Q.tobytes()  # the values and then the Jacobian at the same point: computed once
+        if getattr(self, "_last_closest", (None,))[0] != key:
+            self._last_closest = (key, self._closest_points(Q))
+        return self._last_closest[1]
+
+    def _closest_points(self, Q: np.ndarray) -> tuple[np.ndarray, ...]:
+        """:meth:`_closest`, computed."""
         start, end, R, p = segment_ends(self.kinematics, self.capsules, Q)
         i, j = self._first, self._second
         c1, c2 = segment_closest_points(start[..., i], end[..., i], start[..., j], end[..., j])

@@ -143,6 +143,13 @@ class WorldCollision(Constraint):
     def _closest(self, Q: np.ndarray) -> tuple[np.ndarray, ...]:
         """At the configurations Q (T, n): distances d (T, P) [m], the robot's closest points (3, T, P),
         the unit normals (3, T, P) from the world shape to them, and the joint placements."""
+        key = Q.tobytes()  # the values and then the Jacobian at the same point: computed once
+        if getattr(self, "_last_closest", (None,))[0] != key:
+            self._last_closest = (key, self._closest_points(Q))
+        return self._last_closest[1]
+
+    def _closest_points(self, Q: np.ndarray) -> tuple[np.ndarray, ...]:
+        """:meth:`_closest`, computed."""
         start, end, R, p = segment_ends(self.kinematics, self.capsules, Q)
         a, b = start[..., self._capsule], end[..., self._capsule]
         d, point, normal = np.empty(a.shape[1:]), np.empty_like(a), np.empty_like(a)

@@ -162,9 +162,7 @@ class _Evaluations:
     def constraint_jacobian(self, z: np.ndarray) -> np.ndarray:
         """Their Jacobian in z (m, n_z)."""
         alpha = self.boundary.to_alpha(z)
-        return self._once(
-            "jacobian", z, lambda: self.boundary.chain(np.vstack([c.evaluate(alpha)[1] for c in self.all]))
-        )
+        return self._once("jacobian", z, lambda: self.boundary.chain(np.vstack([c.jacobian(alpha) for c in self.all])))
 
     def objective(self, z: np.ndarray) -> tuple[float, np.ndarray]:
         """The criterion and its gradient in z."""

@@ -11,6 +11,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.collections import LineCollection, PolyCollection  # noqa: E402
 
 from excite_cli.constraints import ComRegion, SelfCollision  # noqa: E402
 from excite_cli.constraints.world_collision import WorldCollision, WorldShape, world_shapes  # noqa: E402
@@ -157,20 +158,13 @@ def plot_postures(
             t = r.time[picks[i][c]]
             for v, (view, axis, sign) in enumerate(views):
                 ax = axes[2 * i + v, c]
-                for a, b in home_bones:
-                    ax.plot([sign * a[axis], sign * b[axis]], [a[2], b[2]], color="0.8", linewidth=1.0)
-                for (a, b), radius in zip(capsules, radii):
-                    outline = stadium(np.array([sign * a[axis], a[2]]), np.array([sign * b[axis], b[2]]), radius)
-                    ax.fill(outline[:, 0], outline[:, 1], color="tab:blue", alpha=0.15, linewidth=0)
-                for a, b in bones:
-                    ax.plot(
-                        [sign * a[axis], sign * b[axis]],
-                        [a[2], b[2]],
-                        color="k",
-                        linewidth=1.2,
-                        marker="o",
-                        markersize=1.5,
-                    )
+                ax.add_collection(LineCollection(_in_view(home_bones, axis, sign), colors="0.8", linewidths=1.0))
+                outlines = [stadium(a, b, radius) for (a, b), radius in zip(_in_view(capsules, axis, sign), radii)]
+                ax.add_collection(PolyCollection(outlines, facecolors="tab:blue", alpha=0.15, linewidths=0))
+                segments = _in_view(bones, axis, sign)
+                ax.add_collection(LineCollection(segments, colors="k", linewidths=1.2))
+                ends = segments.reshape(-1, 2)
+                ax.plot(ends[:, 0], ends[:, 1], "o", color="k", markersize=1.5)
                 horizontal = sign * points[:, axis]
                 ax.set_xlim(horizontal.min() - pad, horizontal.max() + pad)
                 ax.set_ylim(points[:, 2].min() - pad, points[:, 2].max() + pad)
@@ -182,6 +176,13 @@ def plot_postures(
                 ax.set_title(f"iteration {r.index}, {view}, t = {t:.1f} s", fontsize=7)
     fig.tight_layout()
     return save_figure(fig, path, 100)
+
+
+def _in_view(segments: np.ndarray, axis: int, sign: float) -> np.ndarray:
+    """3-D segments (S, 2, 3) [m] in a view whose horizontal is world axis ``axis`` times ``sign``
+    and vertical z: (S, 2, 2)."""
+    segments = np.asarray(segments, dtype=float).reshape(-1, 2, 3)
+    return np.stack([sign * segments[..., axis], segments[..., 2]], axis=-1)
 
 
 def plot_constraint_tracks(
