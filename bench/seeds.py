@@ -2,7 +2,8 @@
 
 For each (seed, threads) it runs the command line in a fresh process (``OPENBLAS_NUM_THREADS`` /
 ``OMP_NUM_THREADS`` set to the thread count, or left unset for the library's default) and prints
-cond(C) after each iteration, the base-independent excitation ē of the last one, the kept restart's
+cond(C) after each iteration, cond(CL) and the excitation ē of the last one (which do not depend on
+the choice of base columns), the kept restart's
 stop reason and KKT residual per iteration, and the wall time; then the median and the worst.
 
     .venv/bin/python bench/seeds.py configs/g1_arms.yaml --iterations 1 --seeds 0 1 2 3 4
@@ -46,6 +47,7 @@ def run(config: Path, seed: int, threads: str, iterations: int | None, folder: P
         kept = [g["restarts"][str(g["restarts"].attrs["kept"])].attrs for g in groups]
         return {
             "cond": list(table["cond_stacked"]),
+            "scaled": float(table["scaled_cond_stacked"][-1]),
             "excitation": float(table["excitation_stacked"][-1]),
             "stop": [str(a["stop"]) for a in kept],
             "kkt": [float(a["kkt_residual"]) for a in kept],
@@ -65,26 +67,28 @@ def main() -> None:
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         print(
-            "| seed | BLAS threads | cond(C) after each iteration | ē [Nm] | stop (kept restart) | KKT residual | max violation "
-            "(grid / transitions) | wall [s] |"
+            "| seed | BLAS threads | cond(C) after each iteration | cond(CL) | ē [Nm] | stop (kept restart) | KKT residual "
+            "| max violation (grid / transitions) | wall [s] |"
         )
-        print("|---|---|---|---|---|---|---|---|")
+        print("|---|---|---|---|---|---|---|---|---|")
         for seed in args.seeds:
             for threads in args.threads:
                 r = run(args.config.resolve(), seed, threads, args.iterations, Path(tmp))
                 rows.append(r)
                 print(
-                    f"| {seed} | {threads} | {' / '.join(f'{c:.2f}' for c in r['cond'])} | {r['excitation']:.4g} | "
+                    f"| {seed} | {threads} | {' / '.join(f'{c:.2f}' for c in r['cond'])} | {r['scaled']:.0f} | {r['excitation']:.4g} | "
                     f"{'; '.join(r['stop'])} | {' / '.join(f'{k:.1e}' for k in r['kkt'])} | "
                     f"{r['max_violation']:+.1e} / {r['transitions']:+.1e} | {r['wall']:.1f} |",
                     flush=True,
                 )
     last = np.array([r["cond"][-1] for r in rows])
+    level = np.array([r["excitation"] for r in rows])
     walls = np.array([r["wall"] for r in rows])
     print(
         f"\nlast cond(C): median {np.median(last):.2f}, worst {last.max():.2f}, best {last.min():.2f} "
-        f"(worst within {100 * (last.max() / last.min() - 1):.1f} % of the best); wall: median {np.median(walls):.1f} s, "
-        f"worst {walls.max():.1f} s"
+        f"(worst within {100 * (last.max() / last.min() - 1):.1f} % of the best); last ē: median {np.median(level):.4g}, "
+        f"worst {level.min():.4g} (within {100 * (1 - level.min() / level.max()):.1f} % of the best); "
+        f"wall: median {np.median(walls):.1f} s, worst {walls.max():.1f} s"
     )
 
 
