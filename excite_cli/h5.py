@@ -1,7 +1,7 @@
 """Files written whole or not at all, and the HDF5 helpers every excite file uses (h5py): opening
 for reading with one clear error, atomic writing with creation time and package versions, string
 datasets. The optimize-result schema is in :mod:`excite_cli.storage.results`, the identify report's
-in :mod:`excite_cli.identification.report_file`."""
+in :mod:`excite_cli.identification.reporting.report_file`."""
 
 from __future__ import annotations
 

@@ -18,8 +18,8 @@ from excite_cli.cli import app
 from excite_cli.config_file import load_problem
 from excite_cli.errors import ExciteError
 from excite_cli.identification.config import IdentifyProblem, SimulationConfig
-from excite_cli.identification.measurements import load_run
-from excite_cli.identification.pipeline import effect_values, run_identification
+from excite_cli.identification.measured.measurements import load_run
+from excite_cli.identification.pipeline import run_identification
 from excite_cli.workflows.simulate import simulate_runs
 
 JOINTS = [f"panda_joint{k}" for k in range(1, 8)]
@@ -116,7 +116,7 @@ def test_a_bag_identifies_the_simulated_friction(simulated):
     tmp, table = simulated
     bag = write_bag(tmp / "identify_bag", table, "mcap")
     report = run_identification(_config(tmp, next(bag.glob("*.mcap")).relative_to(tmp).as_posix()))[0]
-    found = {report.joints[t.joint]: v for t, _, v, _ in effect_values(report) if t.effect == "coulomb"}
+    found = {report.joints[t.joint]: v for t, _, v, _ in report.effect_values() if t.effect == "coulomb"}
     assert set(found) == set(JOINTS) and all(abs(v - 0.4) < 0.06 for v in found.values())
 
 

@@ -9,9 +9,9 @@ from typer.testing import CliRunner
 from excite_cli.cli import app
 from excite_cli.config_file import load_problem
 from excite_cli.constraints.com_region import ComRegion
-from excite_cli.identification.dataset import Dataset
-from excite_cli.identification.least_squares import least_squares
-from excite_cli.identification.normal import NormalEquations
+from excite_cli.identification.fitting.dataset import Dataset
+from excite_cli.identification.fitting.least_squares import least_squares
+from excite_cli.identification.fitting.normal import NormalEquations
 from excite_cli.optimization.engine import Engine
 from excite_cli.optimization.excitation import build_excitation
 from excite_cli.optimization.random_baseline import DrawTask, draw_pool

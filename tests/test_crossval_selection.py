@@ -4,11 +4,11 @@ synthetic model with known effects (two joints, a 3-parameter regressor, two run
 import numpy as np
 import pytest
 
+from excite_cli.identification.choice.crossval import CrossValidation, fold_assignment
+from excite_cli.identification.choice.selection import _Search, candidate_terms, select_effects
 from excite_cli.identification.config import IdentificationConfig
-from excite_cli.identification.crossval import CrossValidation, fold_assignment
-from excite_cli.identification.dataset import Dataset, run_offset_columns
 from excite_cli.identification.effects import Term, effect_columns
-from excite_cli.identification.selection import _Search, candidate_terms, select_effects
+from excite_cli.identification.fitting.dataset import Dataset, run_offset_columns
 
 RATE, N_RUN, B = 200.0, 2400, 3
 PHI = np.array([1.5, -0.7, 0.4])

@@ -10,7 +10,7 @@ import scipy.io
 
 from excite_cli.errors import ExciteError
 from excite_cli.identification.config import IdentifyProblem
-from excite_cli.identification.measurements import load_run
+from excite_cli.identification.measured.measurements import load_run
 
 JOINTS = [f"panda_joint{k}" for k in range(1, 8)]
 T = 400

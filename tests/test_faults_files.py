@@ -20,7 +20,7 @@ from typer.testing import CliRunner
 from excite_cli.cli import app
 from excite_cli.config_file import load_problem
 from excite_cli.identification.config import IdentifyProblem
-from excite_cli.identification.files import read_table
+from excite_cli.identification.measured.files import read_table
 from excite_cli.storage.paths import output_lock
 
 runner = CliRunner()

@@ -17,11 +17,11 @@ from excite_cli.config_file import load_problem
 from excite_cli.dynamics.robot import load_robot
 from excite_cli.h5 import read_strings, write_strings
 from excite_cli.identification.config import DEFAULT_CANDIDATES, IdentifyProblem, PreprocessingConfig, SimulationConfig
-from excite_cli.identification.dataset import run_offset_columns
 from excite_cli.identification.effects import COEFFICIENTS, EFFECT_NAMES, POSITION, SHAPE_FIELDS, SHAPES, effect_columns
-from excite_cli.identification.measurements import Run, load_run
-from excite_cli.identification.pipeline import effect_values, run_identification
-from excite_cli.identification.preprocessing import MIN_CUTOFF, Filter, choose_cutoff
+from excite_cli.identification.fitting.dataset import run_offset_columns
+from excite_cli.identification.measured.measurements import Run, load_run
+from excite_cli.identification.measured.preprocessing import MIN_CUTOFF, Filter, choose_cutoff
+from excite_cli.identification.pipeline import run_identification
 from excite_cli.identification.validate import validate_model
 from excite_cli.trajectory.fourier import FourierTrajectory
 from excite_cli.workflows.simulate import simulate_runs
@@ -162,7 +162,7 @@ def _simulate_and_identify(tmp: Path, optimized: Path, effects: dict, candidates
 
 def _found(report) -> dict:
     """{(effect, coefficient, joint): (value, std, shape)} of the report's effects."""
-    return {(t.effect, c, report.joints[t.joint]): (v, s, t.shape) for t, c, v, s in effect_values(report)}
+    return {(t.effect, c, report.joints[t.joint]): (v, s, t.shape) for t, c, v, s in report.effect_values()}
 
 
 def test_undeclared_friction_and_armature_are_found(tmp_path, optimized):
@@ -535,7 +535,7 @@ def test_shipped_simulated_runs_give_back_their_undeclared_friction():
     assert {(t.effect, report.joints[t.joint]) for t in report.selection.terms} == {
         (e, j) for e in ("coulomb", "viscous") for j in JOINTS
     }
-    for term, _, value, std in effect_values(report):
+    for term, _, value, std in report.effect_values():
         assert value == pytest.approx({"coulomb": 0.6, "viscous": 0.4}[term.effect], rel=0.15), term
     assert report.relative_before.mean() > 30.0 and report.relative_after.mean() < 5.0
 

@@ -18,7 +18,7 @@ from excite_cli.config_file import load_problem
 from excite_cli.dynamics.base_parameters import compute_base_parameters
 from excite_cli.dynamics.robot import load_robot
 from excite_cli.identification.config import IdentifyProblem
-from excite_cli.identification.physical import pseudo_inertia
+from excite_cli.identification.fitting.physical import pseudo_inertia
 from excite_cli.identification.pipeline import run_identification
 from excite_cli.storage.results import problem_of_result, read_alphas
 from excite_cli.trajectory.fourier import FourierTrajectory

@@ -15,7 +15,7 @@ from excite_cli.config_file import load_problem
 from excite_cli.dynamics.robot import load_robot
 from excite_cli.identification.config import IdentifyProblem, SimulationConfig
 from excite_cli.identification.effects import POSITION
-from excite_cli.identification.least_squares import torque_errors
+from excite_cli.identification.fitting.least_squares import torque_errors
 from excite_cli.identification.pipeline import run_identification
 from excite_cli.identification.validate import validate_model
 from excite_cli.storage.results import problem_of_result, read_alphas

@@ -9,12 +9,11 @@ from rich.table import Table
 
 from excite_cli.console.tables import titled_table
 from excite_cli.dynamics.robot import Robot
+from excite_cli.identification.choice.selection import MOVE_SIGNS
 from excite_cli.identification.effects import COEFFICIENTS, POSITION
 from excite_cli.identification.effects import UNITS as EFFECT_UNITS
-from excite_cli.identification.physical import body_properties, pseudo_inertia
-from excite_cli.identification.pipeline import effect_values
-from excite_cli.identification.report import Report
-from excite_cli.identification.selection import MOVE_SIGNS
+from excite_cli.identification.fitting.physical import body_properties, pseudo_inertia
+from excite_cli.identification.reporting.report import Report
 from excite_cli.identification.validate import RunError
 
 
@@ -172,7 +171,7 @@ def _selection_tables(report: Report) -> list[Table | str]:
                 f"{std:.2g}",
                 *((f"{consistent.effects[k]:.5g}",) if consistent else ()),
             )
-            for k, (t, name, value, std) in enumerate(effect_values(report))
+            for k, (t, name, value, std) in enumerate(report.effect_values())
         ],
     )
     params = titled_table(

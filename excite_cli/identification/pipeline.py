@@ -13,18 +13,18 @@ from excite_cli.config_file import with_overrides
 from excite_cli.dynamics.base_parameters import BaseParameters, compute_base_parameters
 from excite_cli.dynamics.robot import Robot, load_robot, resolve_urdf
 from excite_cli.errors import ExciteError
+from excite_cli.identification.choice.fit_choice import choose_fit
+from excite_cli.identification.choice.selection import Selection, candidate_terms, select_effects
 from excite_cli.identification.config import IdentifyProblem
-from excite_cli.identification.dataset import Dataset, build_datasets, fit_position_range
-from excite_cli.identification.effects import POSITION, SHAPE_FIELDS, TWO_STAGE, Term, coefficient_names
-from excite_cli.identification.fit_choice import choose_fit
-from excite_cli.identification.least_squares import joint_weights, least_squares, predict, torque_errors
-from excite_cli.identification.measurements import load_run
-from excite_cli.identification.normal import NormalEquations, excited_rank
-from excite_cli.identification.payload import payload_parameters
-from excite_cli.identification.preprocessing import choose_cutoff, preprocess
-from excite_cli.identification.report import Report
-from excite_cli.identification.selection import Selection, candidate_terms, select_effects
-from excite_cli.identification.urdf_out import urdf_deviation, write_urdf
+from excite_cli.identification.effects import POSITION, SHAPE_FIELDS, TWO_STAGE, Term
+from excite_cli.identification.fitting.dataset import Dataset, build_datasets, fit_position_range
+from excite_cli.identification.fitting.least_squares import joint_weights, least_squares, predict, torque_errors
+from excite_cli.identification.fitting.normal import NormalEquations, excited_rank
+from excite_cli.identification.measured.measurements import load_run
+from excite_cli.identification.measured.payload import payload_parameters
+from excite_cli.identification.measured.preprocessing import choose_cutoff, preprocess
+from excite_cli.identification.reporting.report import Report
+from excite_cli.identification.reporting.urdf_out import urdf_deviation, write_urdf
 from excite_cli.memory import return_freed_memory
 
 
@@ -67,7 +67,7 @@ def error_ladder(val_data: Dataset, selection: Selection, joints: list[str]) -> 
 
 
 def fold_groups(problem: IdentifyProblem, fitted: list[int]) -> np.ndarray | None:
-    """The cross-validation's groups (:class:`~excite_cli.identification.crossval.CrossValidation`)
+    """The cross-validation's groups (:class:`~excite_cli.identification.choice.crossval.CrossValidation`)
     of ``identification.folds_by``: the recording (file) of each configured run, each run its own
     group, or None for time blocks. ``auto``: recordings when the fit runs come from two or more
     files, else time blocks.
@@ -243,20 +243,10 @@ def run_identification(
     return report, robot, base, [fit_data.regressor, val_data.regressor]
 
 
-def effect_values(report: Report, consistent: bool = False) -> list[tuple[Term, str, float, float]]:
-    """(term, coefficient, value, std) for every chosen effect coefficient, in order: of the
-    least-squares fit, or with ``consistent`` of the physically consistent one (std NaN)."""
-    b = len(report.base_names)
-    values = report.consistent.effects if consistent else report.selection.fit.x[b:]
-    stds = np.full(values.size, np.nan) if consistent else report.selection.fit.std[b:]
-    names = [(term, name) for term in report.selection.terms for name in coefficient_names(term, report.offset_runs)]
-    return [(term, name, float(v), float(s)) for (term, name), v, s in zip(names, values, stds)]
-
-
 def write_identified_urdf(
     problem: IdentifyProblem, report: Report, robot: Robot, base: BaseParameters, target: Path
 ) -> float:
-    """Write the URDF of the physically consistent fit (:mod:`excite_cli.identification.urdf_out`) and
+    """Write the URDF of the physically consistent fit (:mod:`excite_cli.identification.reporting.urdf_out`) and
     return the largest deviation [Nm] of its RNEA from the identified rigid-body torques.
 
     Raises:
@@ -265,7 +255,7 @@ def write_identified_urdf(
     if report.consistent is None:
         raise ExciteError("urdf_out", "needs the physically consistent fit (identification.fit)")
     source, _ = resolve_urdf(problem)
-    effects = [(t.effect, c, report.joints[t.joint], v) for t, c, v, _ in effect_values(report, consistent=True)]
+    effects = [(t.effect, c, report.joints[t.joint], v) for t, c, v, _ in report.effect_values(consistent=True)]
     write_urdf(
         source,
         target,

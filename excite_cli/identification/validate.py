@@ -23,12 +23,12 @@ from excite_cli.dynamics.robot import load_robot
 from excite_cli.errors import ExciteError
 from excite_cli.h5 import open_h5, read_strings
 from excite_cli.identification.config import IdentifyProblem
-from excite_cli.identification.dataset import build_datasets
 from excite_cli.identification.effects import TWO_STAGE, Term
-from excite_cli.identification.least_squares import predict, torque_errors
-from excite_cli.identification.measurements import load_run
-from excite_cli.identification.payload import payload_parameters
-from excite_cli.identification.preprocessing import preprocess
+from excite_cli.identification.fitting.dataset import build_datasets
+from excite_cli.identification.fitting.least_squares import predict, torque_errors
+from excite_cli.identification.measured.measurements import load_run
+from excite_cli.identification.measured.payload import payload_parameters
+from excite_cli.identification.measured.preprocessing import preprocess
 
 
 @dataclass(frozen=True)

@@ -11,7 +11,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from excite_cli.identification.report import Report  # noqa: E402
+from excite_cli.identification.reporting.report import Report  # noqa: E402
 from excite_cli.plots.figure import save_figure  # noqa: E402
 
 

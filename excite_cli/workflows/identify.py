@@ -10,8 +10,8 @@ from excite_cli.dynamics.robot import Robot
 from excite_cli.errors import ExciteError
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.pipeline import run_identification, write_identified_urdf
-from excite_cli.identification.report import Report
-from excite_cli.identification.report_file import write_identification
+from excite_cli.identification.reporting.report import Report
+from excite_cli.identification.reporting.report_file import write_identification
 from excite_cli.plots.identification import plot_identification, plot_ladder
 from excite_cli.storage.paths import check_target, output_lock
 

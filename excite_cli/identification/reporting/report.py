@@ -7,11 +7,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from excite_cli.identification.dataset import Dataset
-from excite_cli.identification.fit_choice import FitChoice
-from excite_cli.identification.least_squares import torque_errors
-from excite_cli.identification.physical import ConsistentFit
-from excite_cli.identification.selection import Selection
+from excite_cli.identification.choice.fit_choice import FitChoice
+from excite_cli.identification.choice.selection import Selection
+from excite_cli.identification.effects import Term, coefficient_names
+from excite_cli.identification.fitting.dataset import Dataset
+from excite_cli.identification.fitting.least_squares import torque_errors
+from excite_cli.identification.fitting.physical import ConsistentFit
 
 
 @dataclass
@@ -109,3 +110,12 @@ class Report:
     def relative_least_squares(self) -> np.ndarray:
         """(n,) RMS error / RMS torque [%] of the least-squares fit with effects."""
         return 100.0 * self.rms_least_squares / self.rms_torque
+
+    def effect_values(self, consistent: bool = False) -> list[tuple[Term, str, float, float]]:
+        """(term, coefficient, value, std) for every chosen effect coefficient, in order: of the
+        least-squares fit, or with ``consistent`` of the physically consistent one (std NaN)."""
+        b = len(self.base_names)
+        values = self.consistent.effects if consistent else self.selection.fit.x[b:]
+        stds = np.full(values.size, np.nan) if consistent else self.selection.fit.std[b:]
+        names = [(term, name) for term in self.selection.terms for name in coefficient_names(term, self.offset_runs)]
+        return [(term, name, float(v), float(s)) for (term, name), v, s in zip(names, values, stds)]

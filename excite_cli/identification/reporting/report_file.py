@@ -16,9 +16,8 @@ from excite_cli.dynamics.robot import Robot
 from excite_cli.h5 import atomic_h5, write_strings, write_table
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.effects import COEFFICIENTS, UNITS
-from excite_cli.identification.physical import body_properties
-from excite_cli.identification.pipeline import effect_values
-from excite_cli.identification.report import Report
+from excite_cli.identification.fitting.physical import body_properties
+from excite_cli.identification.reporting.report import Report
 
 STR = h5py.string_dtype()
 
@@ -105,7 +104,7 @@ def _term_fields(term, joints: list[str]) -> tuple[str, str, float]:
 def _write_effects(g: h5py.Group, report: Report) -> None:
     """The chosen effects in the order they were added, declared ones flagged, with units, and what
     was absorbed."""
-    sel, rows = report.selection, effect_values(report)
+    sel, rows = report.selection, report.effect_values()
     effects = np.zeros(
         len(rows),
         dtype=[

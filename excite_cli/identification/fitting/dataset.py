@@ -11,7 +11,7 @@ from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.dynamics.robot import Robot
 from excite_cli.errors import ExciteError
 from excite_cli.identification.effects import COEFFICIENTS, PER_RUN, TWO_STAGE, Term, effect_columns
-from excite_cli.identification.preprocessing import Samples
+from excite_cli.identification.measured.preprocessing import Samples
 
 
 @dataclass(frozen=True)
@@ -167,7 +167,7 @@ def build_datasets(
     :meth:`Dataset.with_load_columns`). Without ``split`` every instant is validation data (the fit
     dataset is empty) and offsets are the mean of ``offset_runs`` fitted runs. ``payloads``: per
     run, the standard parameters (p,) of a known payload (see
-    :func:`~excite_cli.identification.payload.payload_parameters`) or None; its torque Y π is
+    :func:`~excite_cli.identification.measured.payload.payload_parameters`) or None; its torque Y π is
     filtered and decimated with the regressor and taken out of τ. ``q_range``: (n, 2) [rad], the
     fit data's q range per joint (see :func:`fit_position_range`) that guards the position-dependent
     effects, or None (no guard).

@@ -22,7 +22,7 @@ from scipy import signal
 
 from excite_cli.errors import ExciteError
 from excite_cli.identification.config import PreprocessingConfig
-from excite_cli.identification.measurements import Run
+from excite_cli.identification.measured.measurements import Run
 
 #: Decimated rate [Hz] when ``preprocessing.sample_rate`` is not set (data slower than this keep their rate).
 DEFAULT_SAMPLE_RATE = 200.0

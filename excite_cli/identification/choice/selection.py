@@ -1,5 +1,5 @@
 """Tracing the residual to the effects the rigid-body model lacks: a stepwise search over effect
-terms scored by blocked cross-validation of the fit data (:mod:`~excite_cli.identification.crossval`).
+terms scored by blocked cross-validation of the fit data (:mod:`~excite_cli.identification.choice.crossval`).
 The validation data (``validation`` runs, odd time blocks) take no part: they stay untouched for
 the reported error.
 
@@ -29,12 +29,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from excite_cli.identification.choice.crossval import CrossValidation
 from excite_cli.identification.config import IdentificationConfig
-from excite_cli.identification.crossval import CrossValidation
-from excite_cli.identification.dataset import Dataset
 from excite_cli.identification.effects import REQUIRES, SHAPE_FIELDS, Term
-from excite_cli.identification.least_squares import Fit, joint_weights, least_squares
-from excite_cli.identification.normal import ABSORBED, NormalEquations, outside_fraction
+from excite_cli.identification.fitting.dataset import Dataset
+from excite_cli.identification.fitting.least_squares import Fit, joint_weights, least_squares
+from excite_cli.identification.fitting.normal import ABSORBED, NormalEquations, outside_fraction
 
 #: How a move is written: added, removed, shape changed.
 MOVE_SIGNS = {"add": "+", "remove": "−", "shape": "~"}
@@ -108,7 +108,7 @@ class Selection:
         cv_joint: (n,) the chosen model's CV error per joint [%].
         searches: the search from every start; ``chosen`` indexes the one kept.
         at_start: the kept model is that search's start, not its end (chosen with the fit,
-            :mod:`~excite_cli.identification.fit_choice`).
+            :mod:`~excite_cli.identification.choice.fit_choice`).
         absorbed: candidates skipped as not separately identifiable.
         cross_validation: the folds every model was scored on, for scoring other fits of the model.
         min_improvement: the price of an effect (a fraction).

@@ -1,6 +1,6 @@
 """ROS bags as labs record them, read with the ``rosbags`` library (no ROS installation): a ROS 1
 ``.bag``, or a ROS 2 bag (its folder, or its ``.db3`` SQLite3 or ``.mcap`` file). The
-``sensor_msgs/JointState`` messages of one topic become a :class:`~excite_cli.identification.files.Table`
+``sensor_msgs/JointState`` messages of one topic become a :class:`~excite_cli.identification.measured.files.Table`
 with the columns ``time`` (the header stamp [s]; the recording time where the stamp is 0) and, per
 joint, ``position/<joint>``, ``velocity/<joint>``, ``effort/<joint>`` (those the messages fill).
 
@@ -18,7 +18,7 @@ from rosbags.highlevel import AnyReader, AnyReaderError
 from rosbags.typesys import Stores, get_typestore
 
 from excite_cli.errors import ExciteError
-from excite_cli.identification.files import Table
+from excite_cli.identification.measured.files import Table
 
 BAG_SUFFIXES = (".bag", ".db3", ".mcap")
 FIELDS = ("position", "velocity", "effort")

@@ -8,7 +8,7 @@ excitation even the phases they cover), so they are one fold. Each run's offset 
 held-out run's is what the report would use on it: with ``fitted_offsets`` (every validation run is
 also fitted, so the report knows its offset) it is fitted to the held-out run, one constant per
 joint; otherwise the mean of the training runs' offsets, as a run the fit never saw gets in the
-report (:func:`~excite_cli.identification.dataset.run_offset_columns`).
+report (:func:`~excite_cli.identification.fitting.dataset.run_offset_columns`).
 
 **Time blocks** for a single recording: the fit instants of every run are cut into K contiguous
 time blocks; fold k holds out the k-th block
@@ -21,7 +21,7 @@ block, K times, and the error of every fit instant counts once:
     CV(M) = mean over joints j of  sqrt(Σ_k SSE_kj(M) / N) / RMS(τ_j)  × 100 %,
 
 the same figure (mean relative RMS torque error) that the report gives on the validation data.
-Every fold's normal equations are sums of per-joint pieces (:mod:`~excite_cli.identification.normal`),
+Every fold's normal equations are sums of per-joint pieces (:mod:`~excite_cli.identification.fitting.normal`),
 so the training system of fold k is the total minus the block and its margin: a model costs K solves
 of its own size, whatever the number of samples.
 """
@@ -32,9 +32,9 @@ from typing import Callable
 
 import numpy as np
 
-from excite_cli.identification.dataset import Dataset
 from excite_cli.identification.effects import PER_RUN, Term
-from excite_cli.identification.normal import NormalEquations, solve
+from excite_cli.identification.fitting.dataset import Dataset
+from excite_cli.identification.fitting.normal import NormalEquations, solve
 
 
 def fold_assignment(

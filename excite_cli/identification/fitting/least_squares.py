@@ -7,7 +7,7 @@ fixed for every fit of one identification (the effect selection's and the final 
 reported model is the one that was scored. The estimates' standard deviations come from
 σ² (AᵀWA)⁻¹, scaled by √r: after the parallel low-pass at f_c, samples at f_s carry only about
 2 f_c T independent values (r = f_s / (2 f_c), the oversampling). Every fit goes through the
-per-joint normal equations of :mod:`excite_cli.identification.normal` (no design matrix is formed).
+per-joint normal equations of :mod:`excite_cli.identification.fitting.normal` (no design matrix is formed).
 """
 
 from __future__ import annotations
@@ -16,9 +16,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from excite_cli.identification.dataset import Dataset
 from excite_cli.identification.effects import Term
-from excite_cli.identification.normal import NormalEquations, covariance_diagonal, solve, sse
+from excite_cli.identification.fitting.dataset import Dataset
+from excite_cli.identification.fitting.normal import NormalEquations, covariance_diagonal, solve, sse
 
 
 @dataclass(frozen=True)

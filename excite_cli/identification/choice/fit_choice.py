@@ -2,13 +2,13 @@
 
 Least squares of a model fits the fit data best; on poorly exciting data its base parameters are
 free to take values no robot has and extrapolate badly to motions the fit did not see. The
-physically consistent fit (:mod:`~excite_cli.identification.physical`) keeps every body a real mass
+physically consistent fit (:mod:`~excite_cli.identification.fitting.physical`) keeps every body a real mass
 distribution and, with weight λ, near the CAD model; on well-excited data it costs a little. Which
 one transfers depends on the data set, and so do the effects a model needs: the effect search runs
-under least squares (:mod:`~excite_cli.identification.selection`), where an effect may only be
+under least squares (:mod:`~excite_cli.identification.choice.selection`), where an effect may only be
 standing in for base parameters the data leave free, which the consistent fit pins. So the models
 the search passed through at its ends (each search's start and end) are scored under every
-candidate fit on the folds that chose the effects (:class:`~excite_cli.identification.crossval.
+candidate fit on the folds that chose the effects (:class:`~excite_cli.identification.choice.crossval.
 CrossValidation`: whole runs or time blocks, the same margins and held-out offsets) with the
 search's own objective
 
@@ -30,11 +30,11 @@ import numpy as np
 
 from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.dynamics.robot import Robot
+from excite_cli.identification.choice.selection import Selection, objective
 from excite_cli.identification.config import IdentificationConfig
 from excite_cli.identification.effects import Term, coefficient_names
-from excite_cli.identification.least_squares import least_squares
-from excite_cli.identification.physical import ConsistentFit, ConsistentProgram
-from excite_cli.identification.selection import Selection, objective
+from excite_cli.identification.fitting.least_squares import least_squares
+from excite_cli.identification.fitting.physical import ConsistentFit, ConsistentProgram
 
 #: The name of the least-squares candidate.
 LEAST_SQUARES = "least squares"

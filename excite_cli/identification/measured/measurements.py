@@ -1,4 +1,4 @@
-"""Measured runs in (any format of :mod:`excite_cli.identification.files`), mapped to time, q, (q̇,
+"""Measured runs in (any format of :mod:`excite_cli.identification.measured.files`), mapped to time, q, (q̇,
 q̈) and τ (or motor current × torque constants), in SI units and the robot's sign conventions, with
 unusable rows stopped on or dropped and counted."""
 
@@ -11,9 +11,9 @@ from typing import Optional
 import numpy as np
 
 from excite_cli.errors import ExciteError, FileNotFound
-from excite_cli.identification.bags import bag_columns, is_bag, read_bag
 from excite_cli.identification.config import ColumnsConfig, DataConfig, IdentifyProblem, RunConfig
-from excite_cli.identification.files import Table, read_table
+from excite_cli.identification.measured.bags import bag_columns, is_bag, read_bag
+from excite_cli.identification.measured.files import Table, read_table
 
 
 @dataclass(frozen=True)
@@ -77,7 +77,7 @@ def _usable(time: np.ndarray, signals: dict[str, np.ndarray]) -> tuple[np.ndarra
 
 def load_run(run: RunConfig, data: DataConfig, problem: IdentifyProblem, n: int) -> Run:
     """Read, convert and validate one run (CSV with or without header, NPZ, MAT or HDF5, see
-    :mod:`excite_cli.identification.files`; a ROS bag, see :mod:`excite_cli.identification.bags`).
+    :mod:`excite_cli.identification.measured.files`; a ROS bag, see :mod:`excite_cli.identification.measured.bags`).
 
     Args:
         run: the run's entry of ``data.runs``.

@@ -18,8 +18,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg
 
-from excite_cli.identification.dataset import Dataset
 from excite_cli.identification.effects import Term
+from excite_cli.identification.fitting.dataset import Dataset
 
 #: A candidate block keeps less than this fraction of its squared norm outside the model's span:
 #: not separately identifiable (above the ~1e-10 rounding floor of squared normal equations).

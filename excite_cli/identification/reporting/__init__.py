@@ -1,0 +1,1 @@
+"""Reporting: the identify report as one record, its HDF5 file, the identified URDF."""
