@@ -24,7 +24,7 @@ JOINTS = [f"panda_joint{k}" for k in range(1, 8)]
 
 def simulated_run(rows: int, rate: float = 1000.0) -> dict[str, np.ndarray]:
     """time (rows,), q and tau (rows, 7) of a slow multi-sine excitation of the Panda."""
-    robot = load_robot(load_problem(ROOT / "configs" / "panda_joint_limits.yaml"))
+    robot = load_robot(load_problem(ROOT / "configs" / "panda_joint_limits.yaml").robot)
     t = np.arange(rows) / rate
     rng = np.random.default_rng(0)
     w = 2 * np.pi * np.array([0.1, 0.23, 0.37])

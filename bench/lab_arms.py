@@ -41,7 +41,7 @@ def played_checks(problem, result: Path) -> tuple[float, float, float]:
     """Lowest moving world capsule above the table [m], closest checked capsule pair [m] (coal) and
     largest |τ|/effort over every 1 kHz sample of the exported last iteration of ``result``."""
     played = export_trajectory(result, rate=1000.0)
-    robot = load_robot(problem, collision=True)
+    robot = load_robot(problem.robot, problem.folder, collision=True)
     env = problem.constraints.environment
     table = next(s for s in env.shapes if s.type == "half_space")
     point, normal = np.asarray(table.point), np.asarray(table.normal) / np.linalg.norm(table.normal)

@@ -48,7 +48,7 @@ def main(result: Path) -> int:
         return 0
     scene = run_view(result, output=result.with_name(result.stem + "_view.html"), rate=10.0, force=True)
     problem = problem_of_result(result)
-    robot = replace(load_robot(problem, collision=True), collision_model=pin.GeometryModel())
+    robot = replace(load_robot(problem.robot, problem.folder, collision=True), collision_model=pin.GeometryModel())
     shapes = world_shapes(problem.constraints.environment)  # drawn in both: only the robot's pixels differ
     played = export_trajectory(result, rate=10.0).q
     empty = write_scene(result.with_name(result.stem + "_view_empty.html"), robot, played, 10.0, shapes)

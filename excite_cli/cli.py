@@ -9,6 +9,7 @@ import typer
 from rich.console import Console
 from rich.markup import escape
 
+from excite_cli import workflows
 from excite_cli.config_file import load_problem, with_overrides
 from excite_cli.console import identification as identify_tables
 from excite_cli.console import tables
@@ -16,10 +17,8 @@ from excite_cli.console.errors import spellings, word
 from excite_cli.console.progress import Bars, wide_console
 from excite_cli.errors import ExciteError, Interrupted, Terminated, exit_status, sigterm_as_interrupt
 from excite_cli.identification.config import IdentifyProblem, SimulationConfig
-from excite_cli.identification.validate import validate_model
 from excite_cli.optimization.criterion import OBJECTIVES
-from excite_cli.storage.export import FORMATS, export_to_file
-from excite_cli.workflows import run_compare_random, run_identify, run_optimize, run_verify, run_view, simulate_runs
+from excite_cli.storage.export import FORMATS
 
 app = typer.Typer(add_completion=False, no_args_is_help=True)
 out, err = wide_console(), wide_console(stderr=True)
@@ -102,7 +101,7 @@ def optimize(
         },
     )
     with Bars(err) as bars:
-        run = run_optimize(problem, output or Path(problem.output), force, resume, *bars.iterations(problem))
+        run = workflows.run_optimize(problem, output or Path(problem.output), force, resume, *bars.iterations(problem))
     _say(
         tables.iterations(run.results, problem.optimizer),
         f"wrote {run.target} and {', '.join(str(p) for p in run.plots)}",
@@ -140,7 +139,7 @@ def compare_random(
     )
     with Bars(err) as bars:
         progress = bars.iterations(problem)[0] if optimized is None else None
-        comparison = run_compare_random(
+        comparison = workflows.run_compare_random(
             problem,
             optimized,
             output,
@@ -166,7 +165,7 @@ def verify_gradient(
     tolerance: float = typer.Option(1e-6, help="Largest relative error against central differences that passes."),
 ) -> None:
     """Analytic gradients (Eq. 49) and constraint Jacobians against finite differences; exit 1 above the tolerance."""
-    verification = run_verify(load_problem(config), result, objective or OBJECTIVES, step, seed, tolerance)
+    verification = workflows.run_verify(load_problem(config), result, objective or OBJECTIVES, step, seed, tolerance)
     _say(tables.verification(verification, tolerance))
     if verification.worst > tolerance:
         raise typer.Exit(1)
@@ -189,7 +188,7 @@ def identify(
     """Identify base parameters (Eq. 4), trace the residual to missing effects, report the error before/after."""
     problem = with_overrides(load_problem(config, IdentifyProblem), {"identification.fit": fit})
     with err.status("preprocessing, fitting and selecting effects ..."):
-        run = run_identify(problem, output or Path(problem.output), urdf_out, force)
+        run = workflows.run_identify(problem, output or Path(problem.output), urdf_out, force)
     _say(identify_tables.preprocessing_notes(run.report), console=err)
     _say(
         identify_tables.identification(run.report),
@@ -210,7 +209,7 @@ def export(
     output: Optional[Path] = typer.Option(None, "--output", "-o", help="File to write (default: beside the result)."),
 ) -> None:
     """Write a trajectory as a robot plays it: home → P periods → home, at the controller's rate, with torques."""
-    exported, target = export_to_file(result, iteration, rate, periods, fmt, output, force)
+    exported, target = workflows.run_export(result, iteration, rate, periods, fmt, output, force)
     _say(tables.export_lines(exported, rate), f"wrote {target}")
 
 
@@ -223,7 +222,7 @@ def view(
     output: Optional[Path] = typer.Option(None, "--output", "-o", help="HTML file (default: beside the result)."),
 ) -> None:
     """The motion as the robot would play it, in 3D, in one HTML file any browser opens (no server)."""
-    _say(f"wrote {run_view(result, iteration, output, rate, force)}")
+    _say(f"wrote {workflows.run_view(result, iteration, output, rate, force)}")
 
 
 @command()
@@ -232,9 +231,9 @@ def validate(
     config: Path = typer.Argument(..., help="Identification YAML whose data.runs are scored (roles ignored)."),
 ) -> None:
     """Score an identified model on other runs: torque error per run and joint, on data its fit never saw."""
-    problem = load_problem(config, IdentifyProblem)
     with err.status("preprocessing and predicting ..."):
-        _say(identify_tables.validation(report.name, problem.robot.active_joints, validate_model(report, problem)))
+        problem, errors = workflows.run_validate(report, config)
+    _say(identify_tables.validation(report.name, problem.robot.active_joints, errors))
 
 
 @command()
@@ -245,5 +244,5 @@ def simulate(
     force: bool = FORCE,
 ) -> None:
     """Measured-like CSV runs (one per iteration) of a result, with the effects and noise of an effects file."""
-    files = simulate_runs(result, load_problem(effects, SimulationConfig), output_dir, force=force)
+    files = workflows.simulate_runs(result, load_problem(effects, SimulationConfig), output_dir, force=force)
     _say("wrote " + ", ".join(str(f) for f in files))

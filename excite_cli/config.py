@@ -280,12 +280,16 @@ class Problem(Section):
             )
         return self
 
-    def resolve(self, path: str) -> Path:
-        """A path from the config, relative to the config file's folder (absolute paths kept)."""
-        p = Path(path).expanduser()
-        if p.is_absolute() or self.source_path is None:
-            return p
-        return self.source_path.parent / p
+    @property
+    def folder(self) -> Optional[Path]:
+        """The config file's folder, which relative paths in it are relative to (None without a file)."""
+        return None if self.source_path is None else self.source_path.parent
+
+
+def resolve_path(path: str, folder: Optional[Path]) -> Path:
+    """``path`` relative to ``folder`` (absolute paths, and any path without a folder, kept as given)."""
+    p = Path(path).expanduser()
+    return p if p.is_absolute() or folder is None else folder / p
 
 
 def effective_yaml(config: BaseModel) -> str:

@@ -13,6 +13,7 @@ from typer.testing import CliRunner
 from excite_cli.cli import app
 from excite_cli.config import Problem
 from excite_cli.config_file import load_problem
+from excite_cli.dynamics.robot import load_robot
 
 CONFIGS = Path(__file__).resolve().parent.parent / "configs"
 
@@ -38,6 +39,11 @@ UR5 = {
     },
     "limits": {"position_margin": 0.1, "acceleration": 4.0},
 }
+
+
+def robot_of(problem, collision: bool = False):
+    """The Robot of a validated problem (optimize or identify config)."""
+    return load_robot(problem.robot, problem.folder, collision)
 
 
 def small(problem: Problem, harmonics: int = 4, samples: int = 25) -> Problem:

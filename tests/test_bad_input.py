@@ -8,12 +8,11 @@ import h5py
 import numpy as np
 import pytest
 import yaml
-from conftest import UR5, assert_refused
+from conftest import UR5, assert_refused, robot_of
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
 from excite_cli.config_file import load_problem
-from excite_cli.dynamics.robot import load_robot
 
 runner = CliRunner()
 JOINTS = UR5["robot"]["active_joints"]
@@ -35,7 +34,7 @@ def _small(**edits):
 
 def _csv(path, rows=3000, rate=500.0, still=False, nan_at=None):
     """A run of the UR5 with RNEA torques, columns time, q_<joint>, tau_<joint>."""
-    robot = load_robot(load_problem(_yaml(path.parent / "robot.yaml", _small())))
+    robot = robot_of(load_problem(_yaml(path.parent / "robot.yaml", _small())))
     t = np.arange(rows) / rate
     q = 0.0 * np.outer(t, np.ones(6)) if still else 0.5 * np.sin(np.outer(t, np.arange(1, 7)))
     qd, qdd = np.gradient(q, t, axis=0), np.gradient(np.gradient(q, t, axis=0), t, axis=0)

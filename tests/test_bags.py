@@ -105,7 +105,7 @@ def test_a_bag_reads_to_the_samples_of_its_csv(simulated, kind, name):
     tmp, table = simulated
     write_bag(tmp / name, table, kind)
     problem = _config(tmp, name)
-    run = load_run(problem.data.runs[0], problem.data, problem, 7)
+    run = load_run(problem.data.runs[0], problem.data, problem.robot.active_joints, problem.folder)
     np.testing.assert_allclose(run.time - T0, table[:, 0], atol=2e-6)
     np.testing.assert_allclose(run.q, table[:, 1:8], rtol=0, atol=1e-12)
     np.testing.assert_allclose(run.tau, table[:, 8:15], rtol=0, atol=1e-12)
@@ -125,9 +125,9 @@ def test_a_bag_without_the_topic_or_a_file_without_columns_is_named(simulated):
     write_bag(tmp / "topic.bag", table[:50], "ros1")
     problem = _config(tmp, "topic.bag", {"topic": "/robot/joint_states"})
     with pytest.raises(ExciteError) as caught:
-        load_run(problem.data.runs[0], problem.data, problem, 7)
+        load_run(problem.data.runs[0], problem.data, problem.robot.active_joints, problem.folder)
     assert caught.value.field == "data.topic" and "/joint_states" in caught.value.problem
     problem = _config(tmp, "run_1.csv")
     with pytest.raises(ExciteError) as caught:
-        load_run(problem.data.runs[0], problem.data, problem, 7)
+        load_run(problem.data.runs[0], problem.data, problem.robot.active_joints, problem.folder)
     assert caught.value.field == "data.columns"

@@ -10,7 +10,7 @@ import pytest
 import yaml
 from conftest import CONFIGS, write_config
 
-from excite_cli.collision.capsules import capsule_placements, fit_capsule, segment_closest_points
+from excite_cli.collision.capsules import capsule_frames, fit_capsule, segment_closest_points
 from excite_cli.config_file import load_problem
 from excite_cli.errors import ExciteError
 from excite_cli.optimization.excitation import build_excitation
@@ -64,7 +64,7 @@ def test_closed_form_distances_and_witness_points_equal_coal(robot, request):
     constraint = excitation.constraints[-1]
     Q = excitation.grid_basis.q @ _lively(excitation, 3).T
     d, c1, normal, _, _ = constraint._closest(Q)
-    rotations, centres = capsule_placements(constraint.kinematics, constraint.capsules, Q)
+    rotations, centres = capsule_frames(*constraint.kinematics.placements(Q), constraint.capsules)
     radii = np.array([c.radius for c in constraint.capsules])
     for t in range(0, d.shape[0], 7):
         for p, (i, j) in enumerate(constraint.pairs):
@@ -157,7 +157,7 @@ def test_colliding_pair_at_home_is_named(tmp_path):
 def test_capsules_follow_the_links(panda):
     constraint = panda.constraints[1]
     q = panda.home[None]
-    rotations, centres = capsule_placements(constraint.kinematics, constraint.capsules, q)
+    rotations, centres = capsule_frames(*constraint.kinematics.placements(q), constraint.capsules)
     robot = panda.robot
     pin.forwardKinematics(robot.model, robot.data, robot.state(q[0], 0 * q[0], 0 * q[0])[0])
     pin.updateFramePlacements(robot.model, robot.data)

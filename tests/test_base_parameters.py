@@ -7,15 +7,14 @@ import sys
 
 import numpy as np
 import pytest
-from conftest import CONFIGS
+from conftest import CONFIGS, robot_of
 
 from excite_cli.dynamics.base_parameters import base_from_regressor, compute_base_parameters, pivoted_columns
-from excite_cli.dynamics.robot import load_robot
 
 
 @pytest.mark.parametrize("name", ["g1_problem", "panda_problem", "ur5_problem"])
 def test_base_regressor_reproduces_rnea(name, request):
-    robot = load_robot(request.getfixturevalue(name))
+    robot = robot_of(request.getfixturevalue(name))
     base = compute_base_parameters(robot)
     phi_b = base.from_standard(robot.urdf_parameters())
     Q, QD, QDD = robot.random_states(15, np.random.default_rng(123))
@@ -31,7 +30,7 @@ def test_base_regressor_reproduces_rnea(name, request):
 
 @pytest.mark.parametrize("name", ["panda_problem", "ur5_problem"])
 def test_number_of_base_parameters_is_the_regressor_rank(name, request):
-    robot = load_robot(request.getfixturevalue(name))
+    robot = robot_of(request.getfixturevalue(name))
     base = compute_base_parameters(robot)
     W = robot.regressor_stack(*robot.random_states(60, np.random.default_rng(7)))
     assert base.count == np.linalg.matrix_rank(W)
@@ -41,11 +40,11 @@ def test_number_of_base_parameters_is_the_regressor_rank(name, request):
 def test_panda_count_matches_the_literature(panda_problem):
     # A 7R arm with a vertical first axis and no parallel consecutive axes has 7n - 6 = 43 base
     # parameters (Gautier 1991); Gaz et al. (RA-L 2019) identify 43 for the Panda.
-    assert compute_base_parameters(load_robot(panda_problem)).count == 43
+    assert compute_base_parameters(robot_of(panda_problem)).count == 43
 
 
 def test_names_say_what_is_regrouped(panda_problem):
-    base = compute_base_parameters(load_robot(panda_problem))
+    base = compute_base_parameters(robot_of(panda_problem))
     assert len(base.names) == base.count
     assert any("+" in name or " - " in name for name in base.names)
 
@@ -58,7 +57,7 @@ def _random_regressor(robot, seed=0):
 def test_the_base_does_not_depend_on_the_order_of_rows_or_columns(name, request):
     # Ties (the G1's two arms, the regrouping rules) are broken by the parameters' order, not by
     # where a column sits or by rounding: permuted rows and columns give the same parameters.
-    robot = load_robot(request.getfixturevalue(name))
+    robot = robot_of(request.getfixturevalue(name))
     W, names = _random_regressor(robot), robot.parameter_names
     base = base_from_regressor(W, names)
     rng = np.random.default_rng(1)
@@ -85,7 +84,7 @@ _BASE_NAMES = (
     "import sys, hashlib; from excite_cli.config_file import load_problem; "
     "from excite_cli.dynamics.robot import load_robot; "
     "from excite_cli.dynamics.base_parameters import compute_base_parameters; "
-    "b = compute_base_parameters(load_robot(load_problem(sys.argv[1]))); "
+    "p = load_problem(sys.argv[1]); b = compute_base_parameters(load_robot(p.robot, p.folder)); "
     "print(hashlib.sha256(('|'.join(b.names)).encode() + b.regrouping.tobytes()).hexdigest())"
 )
 

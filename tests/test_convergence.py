@@ -14,6 +14,7 @@ from typer.testing import CliRunner
 
 from excite_cli.cli import app
 from excite_cli.config_file import load_problem
+from excite_cli.constraints import accepted
 from excite_cli.optimization.excitation import build_excitation
 from excite_cli.optimization.optimality import (
     ACTIVE_TOLERANCE,
@@ -25,7 +26,7 @@ from excite_cli.optimization.optimality import (
     kkt_optimality,
     stop_reason,
 )
-from excite_cli.optimization.optimizer import _accepted, _Evaluations, project, repair
+from excite_cli.optimization.optimizer import _Evaluations, project, repair
 
 runner = CliRunner()
 
@@ -119,12 +120,12 @@ def test_projection_ends_inside_and_nearer_than_bisection(ur5_problem):
     outside = start.copy()
     outside[:, 1:] *= 3.0  # well beyond the limits
     outside = excitation.boundary.project(outside)
-    assert not _accepted(excitation.constraints, outside)
+    assert not accepted(excitation.constraints, outside)
     criterion = excitation.criterion()
     problem = _Evaluations(criterion, excitation.constraints, excitation.boundary, criterion.value(start))
     z = excitation.boundary.to_variables(outside)
     projected = project(problem, z)
-    assert projected is not None and _accepted(excitation.constraints, projected)
+    assert projected is not None and accepted(excitation.constraints, projected)
     bisected = repair(excitation.constraints, outside, start, excitation.boundary)
     distance = [np.linalg.norm(excitation.boundary.to_variables(a) - z) for a in (projected, bisected)]
     assert distance[0] < distance[1]
@@ -140,7 +141,7 @@ def test_every_method_ends_feasible_and_below_its_start(ur5_problem, method):
     from excite_cli.optimization.sequence import RestartTask
 
     result = RestartTask(1, 0, 2, np.zeros((0, excitation.base.count)))(excitation)
-    assert _accepted(excitation.constraints, result.alpha)
+    assert accepted(excitation.constraints, result.alpha)
     assert result.objective < result.start_objective - 0.5 and result.iterations > 0
     assert result.history.shape == (result.iterations, 2) and result.stop
 
@@ -186,4 +187,4 @@ def test_screening_continues_the_best_starts_wherever_they_run(ur5_problem):
     assert all(r.history.shape == (r.iterations, 2) for r in runs)
     # the continued ones were the best two of the screening, and continuing never makes a point worse
     assert max(r.objective for r in kept) <= min(r.objective for r in out)
-    assert all(_accepted(excitation.constraints, r.alpha) for r in runs)
+    assert all(accepted(excitation.constraints, r.alpha) for r in runs)

@@ -32,7 +32,7 @@ def _load(tmp_path: Path, name: str, columns: dict, **data):
         }
     )
     problem.source_path = tmp_path / "identify.yaml"
-    return load_run(problem.data.runs[0], problem.data, problem, 7)
+    return load_run(problem.data.runs[0], problem.data, problem.robot.active_joints, problem.folder)
 
 
 def _check(run, dropped=0):

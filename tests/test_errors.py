@@ -5,11 +5,12 @@ import pytest
 import yaml
 from conftest import UR5, write_config
 
+from excite_cli.atomic import atomic_path
 from excite_cli.cli import export, validate
 from excite_cli.config_file import load_problem
 from excite_cli.console.errors import spellings, word
 from excite_cli.errors import CannotWrite, ExciteError, FileNotFound, OutputExists
-from excite_cli.h5 import atomic_path, open_h5
+from excite_cli.h5 import open_h5
 from excite_cli.storage.export import export_trajectory
 from excite_cli.storage.paths import check_target
 

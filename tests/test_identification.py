@@ -9,15 +9,14 @@ import numpy as np
 import pinocchio as pin
 import pytest
 import yaml
-from conftest import CONFIGS, write_config
+from conftest import CONFIGS, robot_of, write_config
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
 from excite_cli.config_file import load_problem
-from excite_cli.dynamics.robot import load_robot
 from excite_cli.h5 import read_strings, write_strings
 from excite_cli.identification.config import DEFAULT_CANDIDATES, IdentifyProblem, PreprocessingConfig, SimulationConfig
-from excite_cli.identification.effects import COEFFICIENTS, EFFECT_NAMES, POSITION, SHAPE_FIELDS, SHAPES, effect_columns
+from excite_cli.identification.effects import EFFECT_NAMES, EFFECTS, effect_columns
 from excite_cli.identification.fitting.dataset import run_offset_columns
 from excite_cli.identification.measured.measurements import Run, load_run
 from excite_cli.identification.measured.preprocessing import MIN_CUTOFF, Filter, choose_cutoff
@@ -58,8 +57,8 @@ def test_effect_columns_closed_forms():
         effect_columns("load_coulomb", q, qd, qdd, 0.01)
     with pytest.raises(ValueError):
         effect_columns("held", q, qd, qdd, 0.01)  # a shape effect needs its velocity
-    for effect, names in COEFFICIENTS.items():
-        assert col(effect, 0.1).shape == (4, len(names))
+    for effect in EFFECTS.values():  # one column per coefficient, units for each
+        assert col(effect.name, 0.1).shape == (4, len(effect.coefficients)) == (4, len(effect.units))
 
 
 def test_held_friction_holds_the_sign_of_the_last_motion():
@@ -151,7 +150,7 @@ def _simulate_and_identify(tmp: Path, optimized: Path, effects: dict, candidates
     problem = load_problem(write_config(tmp, config, "identify.yaml"), IdentifyProblem)
     report, robot, base, _ = run_identification(problem)
     # noise level after the same preprocessing: white noise through the same filter
-    runs = [load_run(r, problem.data, problem, 7) for r in problem.data.runs]
+    runs = [load_run(r, problem.data, problem.robot.active_joints, problem.folder) for r in problem.data.runs]
     rate = (runs[2].time.size - 1) / (runs[2].time[-1] - runs[2].time[0])
     from scipy import signal
 
@@ -206,21 +205,21 @@ NEW_EFFECTS = {
 @pytest.mark.parametrize("case", list(NEW_EFFECTS))
 def test_each_undeclared_effect_is_named_with_its_value_and_shape(tmp_path, optimized, case):
     effects, shapes = NEW_EFFECTS[case]
-    opt_in = list(DEFAULT_CANDIDATES) + [case] if case in POSITION else None
+    opt_in = list(DEFAULT_CANDIDATES) + [case] if EFFECTS[case].position else None
     report, *_ = _simulate_and_identify(tmp_path, optimized, effects, opt_in, **shapes)
     truth = {
         (e, c, j): v
         for e, per_joint in effects.items()
         for j, value in per_joint.items()
-        for c, v in zip(COEFFICIENTS[e], np.atleast_1d(value))
+        for c, v in zip(EFFECTS[e].coefficients, np.atleast_1d(value))
     }
     found = _found(report)
     assert {(e, j) for e, _, j in found} == {(e, j) for e, _, j in truth}, found
     for (effect, coefficient, joint), (value, std, shape) in found.items():
         expected = truth[(effect, coefficient.split("[")[0], joint)]  # an offset per run: tau0[run] each
         assert abs(value - expected) <= max(0.05 * abs(expected), 3 * std), (effect, joint, value, std)
-        if effect in SHAPES:  # the profile search picks the simulated velocity from the grid
-            assert shape == shapes[SHAPE_FIELDS[effect]]
+        if EFFECTS[effect].shape:  # the profile search picks the simulated velocity from the grid
+            assert shape == shapes[EFFECTS[effect].shape_field]
 
 
 def test_offsets_per_run_and_a_known_payload(tmp_path, optimized):
@@ -246,7 +245,7 @@ def test_offsets_per_run_and_a_known_payload(tmp_path, optimized):
             tmp_path,
             prefix,
         )
-    robot = load_robot(load_problem(CONFIGS / "panda_joint_limits.yaml"))
+    robot = robot_of(load_problem(CONFIGS / "panda_joint_limits.yaml"))
     loaded = robot.model.copy()
     frame = loaded.frames[loaded.getFrameId("panda_hand")]
     xx, xy, yy, xz, yz, zz = payload["inertia"]

@@ -5,12 +5,11 @@ import copy
 import h5py
 import numpy as np
 import pytest
-from conftest import UR5, write_config
+from conftest import UR5, robot_of, write_config
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
 from excite_cli.config_file import load_problem
-from excite_cli.dynamics.robot import load_robot
 from excite_cli.optimization.engine import Engine
 
 runner = CliRunner()
@@ -53,7 +52,7 @@ def test_schema(result):
 def test_table_is_consistent_and_limits_hold(result, tmp_path):
     out, output = result
     data = _data()
-    robot = load_robot(load_problem(write_config(tmp_path, data)))
+    robot = robot_of(load_problem(write_config(tmp_path, data)))
     margin, acceleration = data["limits"]["position_margin"], data["limits"]["acceleration"]
     with h5py.File(out) as f:
         blocks = [f[f"iterations/{k}/regressor"][()] for k in "123"]

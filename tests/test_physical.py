@@ -9,14 +9,13 @@ import numpy as np
 import pinocchio as pin
 import pytest
 import yaml
-from conftest import CONFIGS, write_config
+from conftest import CONFIGS, robot_of, write_config
 from test_identification import JOINTS, SHARED, optimized  # noqa: F401  (module fixture)
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
 from excite_cli.config_file import load_problem
 from excite_cli.dynamics.base_parameters import compute_base_parameters
-from excite_cli.dynamics.robot import load_robot
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.fitting.physical import pseudo_inertia
 from excite_cli.identification.pipeline import run_identification
@@ -90,7 +89,7 @@ def test_real_panda_consistent_fit_and_its_urdf(tmp_path):
     qdd = np.gradient(qd, t, axis=0)
     written = pin.buildModelFromUrdf(str(urdf))
     written_data = written.createData()
-    robot = load_robot(load_problem(path, IdentifyProblem))
+    robot = robot_of(load_problem(path, IdentifyProblem))
     X = compute_base_parameters(robot).composition_matrix
     for r in rows:
         tau = pin.rnea(written, written_data, np.r_[q[r], 0, 0], np.r_[qd[r], 0, 0], np.r_[qdd[r], 0, 0])[:7]
@@ -135,7 +134,7 @@ def test_negative_mass_data_stays_physical_with_the_consistent_fit(tmp_path, opt
     """Torques of a model whose hand body (link 7 with the hand merged) has all parameters negated:
     plain least squares says its mass is negative, the consistent fit keeps every body physical."""
     problem = problem_of_result(optimized)
-    robot = load_robot(problem)
+    robot = robot_of(problem)
     truth = robot.urdf_parameters()
     truth[60:70] *= -1.0
     trajectory = FourierTrajectory(problem.trajectory.harmonics, problem.trajectory.base_frequency)

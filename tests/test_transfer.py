@@ -8,13 +8,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import write_config
+from conftest import robot_of, write_config
 from test_identification import JOINTS, NOISE, app, optimized, runner  # noqa: F401  (module fixture)
 
 from excite_cli.config_file import load_problem
-from excite_cli.dynamics.robot import load_robot
 from excite_cli.identification.config import IdentifyProblem, SimulationConfig
-from excite_cli.identification.effects import POSITION
 from excite_cli.identification.fitting.least_squares import torque_errors
 from excite_cli.identification.pipeline import run_identification
 from excite_cli.identification.validate import validate_model
@@ -74,7 +72,7 @@ def test_poorly_exciting_fit_runs_get_the_fit_that_transfers(tmp_path, optimized
     0.85–1.15 (a CAD model near the truth), Coulomb friction 0.3 Nm, noise 0.05 Nm. The default is as
     good as the better fit, and keeps the true effects where the least-squares search adds spurious ones."""
     problem = problem_of_result(optimized)
-    robot = load_robot(problem)
+    robot = robot_of(problem)
     rng = np.random.default_rng(1)
     truth = robot.urdf_parameters() * np.repeat(rng.uniform(0.85, 1.15, robot.urdf_parameters().size // 10), 10)
     trajectory = FourierTrajectory(problem.trajectory.harmonics, problem.trajectory.base_frequency)
@@ -117,7 +115,7 @@ def test_a_position_effect_fitted_on_a_narrower_range_is_held_at_its_ends(tmp_pa
     validation a third at full amplitude. With the position effects as candidates, the guard (the
     default) holds the fitted term at the ends of the fit range instead of extrapolating it."""
     problem = problem_of_result(optimized)
-    robot = load_robot(problem)
+    robot = robot_of(problem)
     trajectory = FourierTrajectory(problem.trajectory.harmonics, problem.trajectory.base_frequency)
     time = np.arange(2 * int(trajectory.period * 500) + 1) / 500.0
     rng = np.random.default_rng(2)
@@ -147,7 +145,7 @@ def test_a_position_effect_fitted_on_a_narrower_range_is_held_at_its_ends(tmp_pa
     assert outside > 0.2
     # the same selection and fit (the fit data lie inside the range), a position effect on joint 6
     assert guarded.selection.terms == free.selection.terms
-    assert any(t.effect in POSITION and t.joint == 5 for t in guarded.selection.terms)
+    assert any(t.kind.position and t.joint == 5 for t in guarded.selection.terms)
     assert guarded.relative_after[5] < 0.6 * free.relative_after[5]
     assert guarded.relative_after.mean() < free.relative_after.mean() < plain.relative_after.mean()
     # validate holds the terms to the same range (the report stores it)

@@ -11,12 +11,11 @@ import pinocchio as pin
 import pytest
 import umsgpack
 import yaml
-from conftest import CONFIGS, assert_refused, exported_motion
+from conftest import CONFIGS, assert_refused, exported_motion, robot_of
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
 from excite_cli.config_file import load_problem
-from excite_cli.dynamics.robot import load_robot
 
 runner = CliRunner()
 JOINTS = [f"panda_joint{k}" for k in range(1, 8)]
@@ -46,7 +45,7 @@ def test_the_scene_plays_the_exported_motion_on_every_mesh_beside_the_table(pand
     assert result.exit_code == 0, result.output
     commands = _commands((panda_result / "run_iteration1.html").read_text())
     objects = {c["path"] for c in commands if c["type"] == "set_object"}
-    robot = load_robot(load_problem(panda_result / "run.yaml"), collision=True)
+    robot = robot_of(load_problem(panda_result / "run.yaml"), collision=True)
     meshes = [g.name for g in robot.collision_model.geometryObjects]
     assert {f"/meshcat/robot/visuals/{name}" for name in meshes} <= objects
     assert "/meshcat/world/table" in objects

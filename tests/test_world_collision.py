@@ -7,7 +7,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 import yaml
-from conftest import CONFIGS, assert_refused, constraint_jacobian_error, exported_motion, small
+from conftest import CONFIGS, assert_refused, constraint_jacobian_error, exported_motion, robot_of, small
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
@@ -16,7 +16,6 @@ from excite_cli.collision.geometry import link_points
 from excite_cli.config import EnvironmentConfig
 from excite_cli.config_file import load_problem
 from excite_cli.constraints.world_collision import WorldCollision, distance_bound, world_shapes
-from excite_cli.dynamics.robot import load_robot
 from excite_cli.optimization.excitation import build_excitation
 
 runner = CliRunner()
@@ -186,7 +185,7 @@ def test_a_lab_arm_plays_above_its_table_apart_from_itself_and_within_its_torque
     played = tmp_path / "lab.csv"
     assert runner.invoke(app, ["export", str(tmp_path / "lab.h5"), "-o", str(played), "--rate", "1000"]).exit_code == 0
     q, qd, qdd = exported_motion(played, problem.robot.active_joints)
-    robot = load_robot(problem, collision=True)
+    robot = robot_of(problem, collision=True)
     (table,) = problem.constraints.environment.shapes
     world = [c for c in capsules_from_config(problem.constraints.environment, robot) if _moves(robot, c)]
     capsules = capsules_from_config(problem.constraints.self_collision, robot)
@@ -213,7 +212,7 @@ def test_the_shipped_ur5_capsules_cover_every_vertex_of_its_collision_meshes():
     """configs/ur5.yaml gives its capsules (the fitted ones reach below the mounting plane): every
     vertex of every moving link's URDF collision mesh lies inside one of that link's capsules."""
     problem = load_problem(CONFIGS / "ur5.yaml")
-    robot = load_robot(problem, collision=True)
+    robot = robot_of(problem, collision=True)
     capsules = capsules_from_config(problem.constraints.self_collision, robot)
     for link in {c.link for c in capsules}:
         points, _ = link_points(robot, link)
@@ -223,7 +222,7 @@ def test_the_shipped_ur5_capsules_cover_every_vertex_of_its_collision_meshes():
 
 def test_ignored_links_leave_out_given_capsules_too():
     problem = load_problem(CONFIGS / "ur5.yaml")
-    robot = load_robot(problem, collision=True)
+    robot = robot_of(problem, collision=True)
     world = capsules_from_config(problem.constraints.environment, robot, "constraints.environment")
     assert {c.link for c in world} == {c.link for c in problem.constraints.environment.capsules} - {"shoulder_link"}
     assert "shoulder_link" in {c.link for c in capsules_from_config(problem.constraints.self_collision, robot)}

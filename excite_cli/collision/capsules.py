@@ -143,17 +143,10 @@ def capsule_frame(capsule: Capsule) -> pin.SE3:
     return pin.SE3(np.column_stack([x, np.cross(z, x), z]), (capsule.start + capsule.end) / 2.0)
 
 
-def capsule_placements(
-    kinematics: BatchKinematics, capsules: list[Capsule], Q: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
-    """World placements of every capsule's centred frame (z along the axis) at each configuration of
-    the active joints Q (T, n): rotations (T, C, 3, 3) and centres (T, C, 3) [m]."""
-    return capsule_frames(*kinematics.placements(Q), capsules)
-
-
 def capsule_frames(R: np.ndarray, p: np.ndarray, capsules: list[Capsule]) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`capsule_placements` from joint placements already computed (rotations (T, J, 3, 3),
-    origins (T, J, 3), :meth:`BatchKinematics.placements`)."""
+    """World placements of every capsule's centred frame (z along the axis) from joint placements
+    (rotations (T, J, 3, 3), origins (T, J, 3), :meth:`BatchKinematics.placements`): rotations
+    (T, C, 3, 3) and centres (T, C, 3) [m]."""
     joints = [c.joint for c in capsules]
     local = [capsule_frame(c) for c in capsules]
     local_R = np.stack([m.rotation for m in local])

@@ -10,8 +10,6 @@ from rich.table import Table
 from excite_cli.console.tables import titled_table
 from excite_cli.dynamics.robot import Robot
 from excite_cli.identification.choice.selection import MOVE_SIGNS
-from excite_cli.identification.effects import COEFFICIENTS, POSITION
-from excite_cli.identification.effects import UNITS as EFFECT_UNITS
 from excite_cli.identification.fitting.physical import body_properties, pseudo_inertia
 from excite_cli.identification.reporting.report import Report
 from excite_cli.identification.validate import RunError
@@ -166,7 +164,7 @@ def _selection_tables(report: Report) -> list[Table | str]:
                 t.effect,
                 report.joints[t.joint],
                 "" if t.shape is None else f"{t.shape:g}",
-                f"{name} [{EFFECT_UNITS[COEFFICIENTS[t.effect][0]]}]",
+                f"{name} [{t.kind.units[0]}]",
                 f"{value:.5g}",
                 f"{std:.2g}",
                 *((f"{consistent.effects[k]:.5g}",) if consistent else ()),
@@ -195,7 +193,7 @@ def _selection_tables(report: Report) -> list[Table | str]:
 
 def _guarded(report: Report) -> list[str]:
     """A line naming the q range [rad] each chosen position effect is held to, if any."""
-    joints = sorted({t.joint for t in report.selection.terms if t.effect in POSITION})
+    joints = sorted({t.joint for t in report.selection.terms if t.kind.position})
     if not joints:
         return []
     if report.q_range is None:

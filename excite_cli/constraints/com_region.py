@@ -61,6 +61,7 @@ class ComRegion(Constraint):
     """
 
     name = "com_region"
+    field = "constraints.com"
     grid_margin = ACCEPT_MARGIN
 
     def __init__(

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
+from typing import Sequence
 
 import numpy as np
 
@@ -31,6 +32,7 @@ class Constraint(ABC):
 
     Attributes:
         name: short identifier.
+        field: the config field a violation is reported under (e.g. ``constraints.com``).
         basis: Fourier basis on the constraint grid.
         grid_margin: normalized margin the exact grid samples must keep for α to be accepted; it
             covers the overshoot between grid instants.
@@ -40,6 +42,7 @@ class Constraint(ABC):
     """
 
     name: str
+    field: str
     basis: FourierBasis
     grid_margin: float = 0.0
     track_units: dict[str, str] = {}
@@ -86,3 +89,18 @@ class Constraint(ABC):
     def restore(self, alpha: np.ndarray) -> np.ndarray:
         """A nearby α that satisfies this constraint, where a cheap exact repair exists (default: α)."""
         return alpha
+
+
+def accepted(constraints: Sequence[Constraint], alpha: np.ndarray) -> bool:
+    """Whether every constraint accepts α (n, 2N+1) on its grid (:meth:`Constraint.accepts`)."""
+    return all(c.accepts(alpha) for c in constraints)
+
+
+def farthest_accepted(constraints: Sequence[Constraint], start: np.ndarray, end: np.ndarray, steps: int) -> float:
+    """The largest t ∈ [0, 1] that ``steps`` bisections find with start + t (end − start) accepted by
+    every constraint (``start`` (n, 2N+1) is assumed accepted, t = 0 when nothing beyond it is)."""
+    lo, hi = 0.0, 1.0
+    for _ in range(steps):
+        mid = (lo + hi) / 2.0
+        lo, hi = (mid, hi) if accepted(constraints, start + mid * (end - start)) else (lo, mid)
+    return lo

@@ -35,6 +35,7 @@ class JointLimits(Constraint):
     """
 
     name = "joint_limits"
+    field = "robot.home_posture"  # the limits come from the URDF; what violates them is the home posture
     grid_margin = ACCEPT_MARGIN
 
     def __init__(self, lower: np.ndarray, upper: np.ndarray, basis: FourierBasis):

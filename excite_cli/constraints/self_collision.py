@@ -74,6 +74,7 @@ class SelfCollision(Constraint):
     """
 
     name = "self_collision"
+    field = "constraints.self_collision"
     grid_margin = ACCEPT_MARGIN
 
     def __init__(

@@ -33,6 +33,7 @@ class TorqueLimits(Constraint):
     """
 
     name = "torque_limits"
+    field = "limits.torque"
     grid_margin = ACCEPT_MARGIN
     track_units = {"torque_use": "fraction of the limit"}
 
@@ -109,6 +110,7 @@ class TorqueUse(TorqueLimits):
     """
 
     name = "min_torque_use"
+    field = "limits.min_torque_use"
     needs_motion = True
 
     def __init__(self, robot: Robot, basis: FourierBasis, limit: np.ndarray, fraction: np.ndarray):

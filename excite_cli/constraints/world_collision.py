@@ -119,6 +119,7 @@ class WorldCollision(Constraint):
     """
 
     name = "world_collision"
+    field = "constraints.environment"
     grid_margin = ACCEPT_MARGIN
     track_units = {"min_world_distance": "m"}
 

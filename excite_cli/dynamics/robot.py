@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from excite_cli.config import Problem, RobotConfig
+from excite_cli.config import RobotConfig, resolve_path
 from excite_cli.dynamics.urdf_checks import check_urdf
 from excite_cli.errors import ExciteError
 
@@ -38,19 +38,22 @@ def example_robot_data_root() -> Path:
     return Path(dist.locate_file("cmeel.prefix/share")).resolve()
 
 
-def resolve_urdf(problem: Problem) -> tuple[Path, list[str]]:
+def resolve_urdf(cfg: RobotConfig, folder: Path | None = None) -> tuple[Path, list[str]]:
     """The URDF file named by ``robot.urdf`` and the package folders its meshes are found in.
+
+    Args:
+        cfg: the ``robot`` section.
+        folder: the config file's folder, which a relative ``urdf`` with ``source: file`` is in.
 
     Raises:
         ExciteError: the file does not exist.
     """
-    cfg = problem.robot
     if cfg.source == "example-robot-data":
         share = example_robot_data_root()
         path = share / "example-robot-data" / "robots" / cfg.urdf
         dirs = [str(share)]
     else:
-        path = problem.resolve(cfg.urdf)
+        path = resolve_path(cfg.urdf, folder)
         dirs = [str(path.parent), str(path.parent.parent)]
     if not path.is_file():
         raise ExciteError("robot.urdf", f"no URDF file at {path}")
@@ -224,19 +227,29 @@ def _check_joints(cfg: RobotConfig, full: pin.Model) -> list[str]:
     return movable
 
 
-def load_robot(problem: Problem, collision: bool = False) -> Robot:
-    """Build the :class:`Robot` of a problem: load the URDF, lock the non-active joints.
+def load_robot(
+    cfg: RobotConfig,
+    folder: Path | None = None,
+    collision: bool = False,
+    urdf: Path | None = None,
+    joint_rows_only: bool = False,
+) -> Robot:
+    """Build the :class:`Robot` of a ``robot`` section: load the URDF, lock the non-active joints.
 
     Args:
-        problem: the validated config.
+        cfg: the validated ``robot`` section.
+        folder: the config file's folder, which a relative ``robot.urdf`` is in.
         collision: also load the URDF's collision geometry (meshes), reduced with the model.
+        urdf: load this URDF file instead of ``robot.urdf`` (e.g. an identified one), with the
+            section's joints.
+        joint_rows_only: the regressor rows are the active joints' torques, whatever
+            ``robot.base_wrench_rows`` says (identification measures joint torques).
 
     Raises:
         ExciteError: missing URDF, unknown joint name, a joint that is not 1-DoF, a locked value
             outside the joint's limits, a body or active joint that cannot be (:func:`check_urdf`).
     """
-    cfg: RobotConfig = problem.robot
-    path, package_dirs = resolve_urdf(problem)
+    path, package_dirs = resolve_urdf(cfg, folder) if urdf is None else (urdf, [str(urdf.parent)])
     check_urdf(path, list(cfg.active_joints))  # before urdfdom, which prints what it cannot parse
     try:
         full = pin.buildModelFromUrdf(str(path), *([pin.JointModelFreeFlyer()] if cfg.floating_base else []))
@@ -261,7 +274,7 @@ def load_robot(problem: Problem, collision: bool = False) -> Robot:
     ids = [model.getJointId(n) for n in cfg.active_joints]
     q_idx = np.array([model.idx_qs[j] for j in ids])
     v_idx = np.array([model.idx_vs[j] for j in ids])
-    base_rows = np.arange(6) if (cfg.floating_base and cfg.base_wrench_rows) else np.arange(0)
+    base_rows = np.arange(6) if (cfg.floating_base and cfg.base_wrench_rows and not joint_rows_only) else np.arange(0)
     if cfg.base_wrench_rows and not cfg.floating_base:
         raise ExciteError("robot.base_wrench_rows", "needs robot.floating_base: true")
     lower, upper = model.lowerPositionLimit[q_idx].copy(), model.upperPositionLimit[q_idx].copy()

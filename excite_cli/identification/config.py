@@ -11,13 +11,13 @@ import numpy as np
 from pydantic import Field, NonNegativeFloat, NonNegativeInt, PositiveFloat, field_validator, model_validator
 
 from excite_cli.config import MAX_SEED, Problem, RobotConfig, Section
-from excite_cli.identification.effects import EFFECT_NAMES, POSITION, SHAPE_GRID
+from excite_cli.identification.effects import EFFECT_NAMES, EFFECTS, SHAPE_GRID
 
 Effect = Literal[EFFECT_NAMES]
 #: The default candidates: every effect but the position-dependent ones, which, even guarded to the fit
 #: data's q range, fitted the seen phases of the real Panda run and cost on unseen ones (README), so
 #: they are opt-in.
-DEFAULT_CANDIDATES = tuple(e for e in EFFECT_NAMES if e not in POSITION)
+DEFAULT_CANDIDATES = tuple(e for e in EFFECT_NAMES if not EFFECTS[e].position)
 #: Default regularization weights λ of the consistent fit, among which the cross-validation chooses.
 REGULARIZATION = (1e-5, 1e-4, 1e-3, 1e-2, 1e-1)
 
@@ -160,7 +160,7 @@ class IdentifyProblem(Section):
     source_path: Optional[Path] = Field(None, exclude=True)
     source_text: str = Field("", exclude=True)
 
-    resolve = Problem.resolve
+    folder = Problem.folder
 
 
 class SimulationConfig(Section):

@@ -1,22 +1,8 @@
 """Candidate effects the rigid-body model lacks: each a block of extra regressor columns for one joint,
 linear in its coefficients (τ_j += Σ c_k f_k(q_j, q̇_j, q̈_j)).
 
-| effect | columns f_k | coefficients |
-|---|---|---|
-| coulomb | tanh(q̇/v_c) | Fc [Nm] |
-| coulomb_asymmetric | abs(tanh(q̇/v_c)) | Fa [Nm]: levels Fc + Fa moving forward, Fc − Fa backward |
-| viscous | q̇ | Fv [Nm·s/rad] |
-| viscous_asymmetric | abs(q̇) | Fva [Nm·s/rad]: viscous Fv + Fva forward, Fv − Fva backward |
-| stribeck | tanh(q̇/v_c) exp(−(q̇/v_s)²) | Fs [Nm], v_s searched |
-| held | 1(abs(q̇) < v_h) · s_last | Fh [Nm]: held (static) friction, v_h searched |
-| load_coulomb | abs(τ_rigid) tanh(q̇/v_c) | Fl [Nm/Nm]: Coulomb friction growing with the transmitted load |
-| offset | 1 on the rows of run r, one column per fitted run | τ0 [Nm] per run |
-| armature | q̈ | Ia [kg·m²] |
-| spring | q | k [Nm/rad] |
-| gravity_compensator | sin q, cos q | gs, gc [Nm]: first harmonic of a position-dependent torque |
-| position_2 | sin 2q, cos 2q | gs2, gc2 [Nm]: second harmonic (cogging, cables) |
-
-v_c (a smooth sign, 0.01 rad/s) is fixed. The position-dependent effects (``POSITION``) are
+Each effect is one :class:`Effect` record in ``EFFECTS``: adding an effect is adding a record.
+v_c (a smooth sign, 0.01 rad/s) is fixed. The position-dependent effects (``position``) are
 guarded: outside the q range the fit data covered they hold their value at its nearer end instead
 of extrapolating a spring or a harmonic fitted to a narrower motion. Stribeck and held friction are nonlinear in a shape
 parameter, their velocity: each is a family of candidates, one per value of a log-spaced grid
@@ -24,7 +10,7 @@ parameter, their velocity: each is a family of candidates, one per value of a lo
 cross-validated error prefers (a profile search over the shape, scored on the fit data only).
 Direction-dependent Coulomb and Stribeck refine Coulomb friction, direction-dependent viscous
 refines viscous: they are candidates for a joint only once the effect they refine is in its model
-(``REQUIRES``). Held friction depends on the motion's history (the samples must be in time order):
+(``requires``). Held friction depends on the motion's history (the samples must be in time order):
 s_last is the sign of the last motion faster than v_h, so after a reversal the friction keeps its
 old sign until the joint really moves (presliding, stiction). Load-dependent Coulomb friction is
 two-stage: τ_rigid is the rigid-body prediction of a first fit (geared joints whose friction grows
@@ -36,73 +22,114 @@ friction: Hamon, Gautier, Garrec, IROS 2011.)
 
 from __future__ import annotations
 
-from typing import NamedTuple, Optional
+from dataclasses import dataclass
+from typing import Callable, NamedTuple, Optional
 
 import numpy as np
 
-COEFFICIENTS = {
-    "coulomb": ("Fc",),
-    "coulomb_asymmetric": ("Fa",),
-    "viscous": ("Fv",),
-    "viscous_asymmetric": ("Fva",),
-    "stribeck": ("Fs",),
-    "held": ("Fh",),
-    "load_coulomb": ("Fl",),
-    "offset": ("tau0",),
-    "armature": ("Ia",),
-    "spring": ("k",),
-    "gravity_compensator": ("gs", "gc"),
-    "position_2": ("gs2", "gc2"),
+
+class Signals(NamedTuple):
+    """One joint's samples an effect's columns are made of, in time order (T,) each: q [rad], q̇
+    [rad/s], q̈ [rad/s²], the smooth sign tanh(q̇/v_c), the shape velocity of a shaped effect [rad/s]
+    and the joint's rigid-body torque [Nm] of a two-stage effect (None where not needed)."""
+
+    q: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+    sign: np.ndarray
+    shape: Optional[float]
+    rigid: Optional[np.ndarray]
+
+
+@dataclass(frozen=True)
+class Effect:
+    """One candidate effect, everything about it in one record.
+
+    Attributes:
+        name: the name configs and reports use.
+        coefficients: its coefficients' names, one per column (an offset: one per fitted run).
+        units: their units.
+        columns: ``columns(signals)`` → the columns (a list of (T,) arrays) on the joint's own row.
+        requires: the effect it refines, which must be in the joint's model first (or None).
+        shape: the name of the velocity it is nonlinear in (``v_s``, ``v_h``), searched on a grid;
+            shape_field: the config field (identification and simulation) giving that grid [rad/s].
+        two_stage: its columns need the rigid-body torque of a first fit.
+        per_run: one column per fitted run.
+        position: its columns depend on the position, so they are guarded outside the fit data's
+            q range.
+    """
+
+    name: str
+    coefficients: tuple[str, ...]
+    units: tuple[str, ...]
+    columns: Callable[[Signals], list[np.ndarray]]
+    requires: Optional[str] = None
+    shape: Optional[str] = None
+    shape_field: Optional[str] = None
+    two_stage: bool = False
+    per_run: bool = False
+    position: bool = False
+
+    def unit(self, coefficient: str) -> str:
+        """The unit of one of its coefficients."""
+        return self.units[self.coefficients.index(coefficient)]
+
+
+#: Every candidate effect, by name (in the order configs and reports list them).
+EFFECTS = {
+    e.name: e
+    for e in (
+        Effect("coulomb", ("Fc",), ("Nm",), lambda s: [s.sign]),
+        Effect("coulomb_asymmetric", ("Fa",), ("Nm",), lambda s: [np.abs(s.sign)], requires="coulomb"),
+        Effect("viscous", ("Fv",), ("Nm·s/rad",), lambda s: [s.qd]),
+        Effect("viscous_asymmetric", ("Fva",), ("Nm·s/rad",), lambda s: [np.abs(s.qd)], requires="viscous"),
+        Effect(
+            "stribeck",
+            ("Fs",),
+            ("Nm",),
+            lambda s: [s.sign * np.exp(-((s.qd / s.shape) ** 2))],
+            requires="coulomb",
+            shape="v_s",
+            shape_field="stribeck_velocity",
+        ),
+        Effect(
+            "held", ("Fh",), ("Nm",), lambda s: [held_sign(s.qd, s.shape)], shape="v_h", shape_field="held_velocity"
+        ),
+        Effect("load_coulomb", ("Fl",), ("Nm/Nm",), lambda s: [np.abs(s.rigid) * s.sign], two_stage=True),
+        Effect("offset", ("tau0",), ("Nm",), lambda s: [np.ones_like(s.q)], per_run=True),
+        Effect("armature", ("Ia",), ("kg·m²",), lambda s: [s.qdd]),
+        Effect("spring", ("k",), ("Nm/rad",), lambda s: [s.q], position=True),
+        Effect("gravity_compensator", ("gs", "gc"), ("Nm", "Nm"), lambda s: [np.sin(s.q), np.cos(s.q)], position=True),
+        Effect("position_2", ("gs2", "gc2"), ("Nm", "Nm"), lambda s: [np.sin(2 * s.q), np.cos(2 * s.q)], position=True),
+    )
 }
-EFFECT_NAMES = tuple(COEFFICIENTS)
-REQUIRES = {"coulomb_asymmetric": "coulomb", "stribeck": "coulomb", "viscous_asymmetric": "viscous"}
-#: Effects whose columns need the rigid-body torque of a first fit.
-TWO_STAGE = ("load_coulomb",)
-#: Effects with one column per fitted run.
-PER_RUN = ("offset",)
-#: Effects nonlinear in a velocity [rad/s], and the name of that velocity.
-SHAPES = {"stribeck": "v_s", "held": "v_h"}
-#: The config field (identification and simulation) that gives each shape velocity [rad/s].
-SHAPE_FIELDS = {"stribeck": "stribeck_velocity", "held": "held_velocity"}
+EFFECT_NAMES = tuple(EFFECTS)
 #: Default grid of a shape velocity [rad/s]: factors of 2 to 2.5 from 0.02 to 0.5 rad/s.
 SHAPE_GRID = (0.02, 0.05, 0.1, 0.2, 0.5)
-#: Effects whose columns depend on the position (they extrapolate to positions the fit never saw).
-POSITION = ("spring", "gravity_compensator", "position_2")
-UNITS = {
-    "Fc": "Nm",
-    "Fa": "Nm",
-    "Fv": "Nm·s/rad",
-    "Fva": "Nm·s/rad",
-    "Fs": "Nm",
-    "Fh": "Nm",
-    "Fl": "Nm/Nm",
-    "tau0": "Nm",
-    "Ia": "kg·m²",
-    "k": "Nm/rad",
-    "gs": "Nm",
-    "gc": "Nm",
-    "gs2": "Nm",
-    "gc2": "Nm",
-}
 
 
 class Term(NamedTuple):
     """One effect on one joint: a block of columns of the model.
 
     Attributes:
-        effect: a key of ``COEFFICIENTS``.
+        effect: a key of ``EFFECTS``.
         joint: active joint index.
-        shape: the shape velocity [rad/s] of a ``SHAPES`` effect (Stribeck v_s, held v_h), else None.
+        shape: the shape velocity [rad/s] of a shaped effect (Stribeck v_s, held v_h), else None.
     """
 
     effect: str
     joint: int
     shape: Optional[float] = None
 
+    @property
+    def kind(self) -> Effect:
+        """Its :class:`Effect`."""
+        return EFFECTS[self.effect]
+
     def label(self, joints: list[str]) -> str:
         """e.g. ``held panda_joint7 (v_h 0.1 rad/s)``."""
         return f"{self.effect} {joints[self.joint]}" + (
-            f" ({SHAPES[self.effect]} {self.shape:g} rad/s)" if self.shape else ""
+            f" ({self.kind.shape} {self.shape:g} rad/s)" if self.shape else ""
         )
 
 
@@ -128,44 +155,30 @@ def effect_columns(
 
     Args:
         coulomb_velocity: v_c of the smooth sign [rad/s].
-        shape: the shape velocity [rad/s] of a ``SHAPES`` effect (Stribeck v_s, held v_h).
-        rigid: (T,) the joint's rigid-body torque [Nm], needed by ``load_coulomb`` only.
-        q_range: (lo, hi) [rad], the joint's q range over the fit data: a ``POSITION`` effect's
-            columns are evaluated at q clipped to it (held at their value at the nearer end, the
-            guard against extrapolating to positions the fit never saw); None: no guard.
+        shape: the shape velocity [rad/s] of a shaped effect (Stribeck v_s, held v_h).
+        rigid: (T,) the joint's rigid-body torque [Nm], needed by two-stage effects only.
+        q_range: (lo, hi) [rad], the joint's q range over the fit data: a position effect's columns
+            are evaluated at q clipped to it (held at their value at the nearer end, the guard
+            against extrapolating to positions the fit never saw); None: no guard.
 
     Raises:
         KeyError: unknown effect.
-        ValueError: ``load_coulomb`` without ``rigid``, a ``SHAPES`` effect without its shape.
+        ValueError: a two-stage effect without ``rigid``, a shaped effect without its shape.
     """
-    if effect in TWO_STAGE and rigid is None:
+    kind = EFFECTS[effect]
+    if kind.two_stage and rigid is None:
         raise ValueError(f"{effect} needs the rigid-body torque")
-    if effect in SHAPES and not shape:
-        raise ValueError(f"{effect} needs its shape velocity {SHAPES[effect]}")
-    if effect in POSITION and q_range is not None:
+    if kind.shape and not shape:
+        raise ValueError(f"{effect} needs its shape velocity {kind.shape}")
+    if kind.position and q_range is not None:
         q = np.clip(q, *q_range)
-    sign = np.tanh(qd / coulomb_velocity)
-    columns = {
-        "coulomb": lambda: [sign],
-        "coulomb_asymmetric": lambda: [np.abs(sign)],
-        "viscous": lambda: [qd],
-        "viscous_asymmetric": lambda: [np.abs(qd)],
-        "stribeck": lambda: [sign * np.exp(-((qd / shape) ** 2))],
-        "held": lambda: [held_sign(qd, shape)],
-        "load_coulomb": lambda: [np.abs(rigid) * sign],
-        "offset": lambda: [np.ones_like(q)],
-        "armature": lambda: [qdd],
-        "spring": lambda: [q],
-        "gravity_compensator": lambda: [np.sin(q), np.cos(q)],
-        "position_2": lambda: [np.sin(2.0 * q), np.cos(2.0 * q)],
-    }[effect]()
-    return np.column_stack(columns)
+    return np.column_stack(kind.columns(Signals(q, qd, qdd, np.tanh(qd / coulomb_velocity), shape, rigid)))
 
 
 def coefficient_names(term: Term, offset_runs: list[str]) -> list[str]:
-    """Names of a term's coefficients: those of ``COEFFICIENTS``, an offset per run as
-    ``tau0[run label]`` when the fit has several runs (``offset_runs``)."""
-    names = COEFFICIENTS[term.effect]
-    if term.effect in PER_RUN and len(offset_runs) > 1:
+    """Names of a term's coefficients: the effect's, an offset per run as ``tau0[run label]`` when
+    the fit has several runs (``offset_runs``)."""
+    names = term.kind.coefficients
+    if term.kind.per_run and len(offset_runs) > 1:
         return [f"{names[0]}[{label}]" for label in offset_runs]
     return list(names)

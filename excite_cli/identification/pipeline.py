@@ -9,14 +9,14 @@ from pathlib import Path
 
 import numpy as np
 
-from excite_cli.config_file import with_overrides
+from excite_cli.config import resolve_path
 from excite_cli.dynamics.base_parameters import BaseParameters, compute_base_parameters
 from excite_cli.dynamics.robot import Robot, load_robot, resolve_urdf
 from excite_cli.errors import ExciteError
 from excite_cli.identification.choice.fit_choice import choose_fit
 from excite_cli.identification.choice.selection import Selection, candidate_terms, select_effects
 from excite_cli.identification.config import IdentifyProblem
-from excite_cli.identification.effects import POSITION, SHAPE_FIELDS, TWO_STAGE, Term
+from excite_cli.identification.effects import EFFECTS, Term
 from excite_cli.identification.fitting.dataset import Dataset, build_datasets, fit_position_range
 from excite_cli.identification.fitting.least_squares import joint_weights, least_squares, predict, torque_errors
 from excite_cli.identification.fitting.normal import NormalEquations, excited_rank
@@ -42,7 +42,7 @@ def declared_terms(problem: IdentifyProblem, robot: Robot) -> list[Term]:
             raise ExciteError("identification.declared_effects", f"'{name}' is not an active joint")
         joints = range(robot.n_joints) if name == "*" else [robot.joint_names.index(name)]
         for e in effects:
-            grid = getattr(cfg, SHAPE_FIELDS[e]) if e in SHAPE_FIELDS else None
+            grid = getattr(cfg, EFFECTS[e].shape_field) if EFFECTS[e].shape_field else None
             for j in joints:
                 if all((u.effect, u.joint) != (e, j) for u in out):
                     out.append(Term(e, j, grid[len(grid) // 2] if grid else None))
@@ -76,7 +76,7 @@ def fold_groups(problem: IdentifyProblem, fitted: list[int]) -> np.ndarray | Non
         ExciteError: ``recording`` or ``run`` folds with fewer than two fit recordings or runs.
     """
     how = problem.identification.folds_by
-    files = np.unique([str(problem.resolve(r.file)) for r in problem.data.runs], return_inverse=True)[1]
+    files = np.unique([str(resolve_path(r.file, problem.folder)) for r in problem.data.runs], return_inverse=True)[1]
     groups = {"auto": files, "recording": files, "run": np.arange(files.size), "time_block": None}[how]
     count = 0 if groups is None else np.unique(groups[fitted]).size
     if how == "auto":
@@ -123,13 +123,13 @@ def prepare_data(problem: IdentifyProblem, robot: Robot, base: BaseParameters, t
         payload_parameters(robot, r.payload, f"data.runs[{k}].payload") if r.payload else None
         for k, r in enumerate(problem.data.runs)
     ]
-    runs = [load_run(r, problem.data, problem, robot.n_joints) for r in problem.data.runs]
+    runs = [load_run(r, problem.data, robot.joint_names, problem.folder) for r in problem.data.runs]
     cutoff, source = choose_cutoff(runs, problem.preprocessing)
     dropped = [(r.name, r.dropped) for r in runs if r.dropped]
     samples = [preprocess(runs.pop(0), problem.preprocessing, cutoff) for _ in range(len(runs))]
     rate = max(s.filter.rate / s.filter.step for s in samples)
     coulomb = [Term("coulomb", j) for j in range(robot.n_joints)]  # the load column's sign
-    guarded = cfg.position_guard and any(t.effect in POSITION for t in terms)  # the range costs a pass over q
+    guarded = cfg.position_guard and any(t.kind.position for t in terms)  # the range costs a pass over q
     q_range = fit_position_range(samples, problem.data.validation_blocks) if guarded else None
     fit, val, fitted = build_datasets(
         robot,
@@ -150,7 +150,7 @@ def prepare_data(problem: IdentifyProblem, robot: Robot, base: BaseParameters, t
             "through an exciting trajectory (see `excite optimize`), motionless or small motions cannot identify it",
         )
     first = least_squares(rigid_only, [], joint_weights(rigid_only, cfg.method == "wls"))
-    load = [t for t in terms if t.effect in TWO_STAGE]
+    load = [t for t in terms if t.kind.two_stage]
     return Prepared(
         fit.with_load_columns(first.x, load),
         val.with_load_columns(first.x, load),
@@ -182,8 +182,7 @@ def run_identification(
             solution.
     """
     return_freed_memory()  # memory follows the live (decimated) data
-    problem = with_overrides(problem, {"robot.base_wrench_rows": False})  # a copy: the caller's config is not changed
-    robot = load_robot(problem)
+    robot = load_robot(problem.robot, problem.folder, joint_rows_only=True)
     base = compute_base_parameters(robot)
     declared = declared_terms(problem, robot)  # before any data is read
     cfg = problem.identification
@@ -254,7 +253,7 @@ def write_identified_urdf(
     """
     if report.consistent is None:
         raise ExciteError("urdf_out", "needs the physically consistent fit (identification.fit)")
-    source, _ = resolve_urdf(problem)
+    source, _ = resolve_urdf(problem.robot, problem.folder)
     effects = [(t.effect, c, report.joints[t.joint], v) for t, c, v, _ in report.effect_values(consistent=True)]
     write_urdf(
         source,
@@ -265,4 +264,4 @@ def write_identified_urdf(
         f"physically consistent parameters identified from {problem.source_path or 'measured data'}",
     )
     X, phi_base = base.composition_matrix, report.consistent.base
-    return urdf_deviation(problem, robot, lambda q, qd, qdd: robot.regressor(q, qd, qdd) @ X @ phi_base, target)
+    return urdf_deviation(problem.robot, robot, lambda q, qd, qdd: robot.regressor(q, qd, qdd) @ X @ phi_base, target)

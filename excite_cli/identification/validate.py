@@ -17,13 +17,12 @@ from typing import Optional
 
 import numpy as np
 
-from excite_cli.config_file import with_overrides
 from excite_cli.dynamics.base_parameters import compute_base_parameters
 from excite_cli.dynamics.robot import load_robot
 from excite_cli.errors import ExciteError
 from excite_cli.h5 import open_h5, read_strings
 from excite_cli.identification.config import IdentifyProblem
-from excite_cli.identification.effects import TWO_STAGE, Term
+from excite_cli.identification.effects import Term
 from excite_cli.identification.fitting.dataset import build_datasets
 from excite_cli.identification.fitting.least_squares import predict, torque_errors
 from excite_cli.identification.measured.measurements import load_run
@@ -113,8 +112,7 @@ def validate_model(report: Path, problem: IdentifyProblem) -> list[RunError]:
             config (as ``identify``).
     """
     model = read_model(report)
-    problem = with_overrides(problem, {"robot.base_wrench_rows": False})  # a copy: the caller's config is not changed
-    robot = load_robot(problem)
+    robot = load_robot(problem.robot, problem.folder, joint_rows_only=True)
     base = compute_base_parameters(robot)
     if model.joints != robot.joint_names:
         raise ExciteError("report", f"{report} was identified for other joints than the config's robot")
@@ -127,7 +125,9 @@ def validate_model(report: Path, problem: IdentifyProblem) -> list[RunError]:
         payload = [payload_parameters(robot, run.payload, f"data.runs[{k}].payload") if run.payload else None]
         samples = [
             preprocess(
-                load_run(run.model_copy(update={"role": "validation"}), problem.data, problem, robot.n_joints),
+                load_run(
+                    run.model_copy(update={"role": "validation"}), problem.data, robot.joint_names, problem.folder
+                ),
                 problem.preprocessing,
                 model.cutoff,
             )
@@ -144,7 +144,7 @@ def validate_model(report: Path, problem: IdentifyProblem) -> list[RunError]:
             offset_runs=model.offset_runs,
             q_range=model.q_range,
         )
-        data = data.with_load_columns(model.rigid, [t for t in terms if t.effect in TWO_STAGE])
+        data = data.with_load_columns(model.rigid, [t for t in terms if t.kind.two_stage])
         predicted = predict(data, np.concatenate([model.base, model.coefficients]), terms)
         rms, _, relative = torque_errors(data.tau.reshape(-1, data.n), predicted)
         errors.append(RunError(run.label, rms, relative, data.time.size))

@@ -12,7 +12,7 @@ import numpy as np
 
 from excite_cli.collision.capsules import capsule_pairs, capsules_from_config
 from excite_cli.config import Problem
-from excite_cli.constraints import Constraint, JointLimits, SelfCollision
+from excite_cli.constraints import Constraint, JointLimits, SelfCollision, accepted
 from excite_cli.constraints.com_region import com_region_from_config
 from excite_cli.constraints.joint_limits import joint_limit_bounds
 from excite_cli.constraints.lse import GRID_MARGIN
@@ -116,7 +116,7 @@ class Excitation:
         waves = self.boundary.wave_space
         alpha[:, 1:] = np.einsum("jm,mr,kr->jk", np.round(alpha[:, 1:], START_DECIMALS), waves, waves, optimize=False)
         for _ in range(40):
-            if all(c.accepts(alpha) for c in self.constraints if not c.needs_motion):
+            if accepted([c for c in self.constraints if not c.needs_motion], alpha):
                 return alpha
             alpha[:, 1:] *= 0.7
         return self.static()
@@ -140,9 +140,8 @@ def build_excitation(problem: Problem, base: BaseParameters | None = None) -> Ex
         ExciteError: bad robot or limits input (see :func:`load_robot`, :func:`joint_limit_bounds`).
     """
     ccfg = problem.constraints
-    robot = load_robot(
-        problem, collision=bool(ccfg.self_collision or ccfg.environment or (ccfg.com and ccfg.com.support_links))
-    )
+    collision = bool(ccfg.self_collision or ccfg.environment or (ccfg.com and ccfg.com.support_links))
+    robot = load_robot(problem.robot, problem.folder, collision)
     base = base or compute_base_parameters(robot)
     tcfg = problem.trajectory
     if tcfg.cost_samples * robot.n_rows < base.count:
@@ -222,18 +221,11 @@ def _check_home_posture(excitation: Excitation) -> None:
         ExciteError: naming the constraint and where it fails (the capsule pair, the CoM distance).
     """
     static = excitation.static()
-    fields = {
-        "joint_limits": "robot.home_posture",
-        "torque_limits": "limits.torque",
-        "com_region": "constraints.com",
-        "self_collision": "constraints.self_collision",
-        "world_collision": "constraints.environment",
-    }
     for c in (c for c in excitation.constraints if not c.needs_motion):
         check = c.check(static, excitation.grid_basis)
         if check.max_violation > -c.grid_margin:
             raise ExciteError(
-                fields[c.name],
+                c.field,
                 f"violated before optimization, at the home posture with the locked "
                 f"joints: {check.where or 'joint limits'}",
             )

@@ -19,7 +19,7 @@ import numpy as np
 from scipy.optimize import minimize
 
 from excite_cli.config import OptimizerConfig
-from excite_cli.constraints import Constraint
+from excite_cli.constraints import Constraint, accepted, farthest_accepted
 from excite_cli.optimization.criterion import Criterion
 from excite_cli.optimization.optimality import Optimality, kkt_optimality, stop_reason
 from excite_cli.optimization.solvers import solve
@@ -72,10 +72,6 @@ def best_restart(results: Sequence[RestartResult]) -> RestartResult:
     return min(results, key=lambda r: (r.objective, r.index))
 
 
-def _accepted(constraints: Sequence[Constraint], alpha: np.ndarray) -> bool:
-    return all(c.accepts(alpha) for c in constraints)
-
-
 def repair(
     constraints: Sequence[Constraint],
     alpha: np.ndarray,
@@ -98,13 +94,9 @@ def repair(
         alpha = c.restore(alpha)
     if boundary is not None:
         alpha = boundary.project(alpha)
-    if _accepted(constraints, alpha):
+    if accepted(constraints, alpha):
         return alpha
-    lo, hi = 0.0, 1.0
-    for _ in range(steps):
-        mid = (lo + hi) / 2.0
-        lo, hi = (mid, hi) if _accepted(constraints, feasible + mid * (alpha - feasible)) else (lo, mid)
-    return feasible + lo * (alpha - feasible)
+    return feasible + farthest_accepted(constraints, feasible, alpha, steps) * (alpha - feasible)
 
 
 class _Evaluations:
@@ -201,7 +193,7 @@ def project(problem: _Evaluations, z: np.ndarray, iterations: int = PROJECTION_I
     for c in problem.all:
         alpha = c.restore(alpha)
     alpha = problem.boundary.project(alpha)
-    return alpha if _accepted(problem.all, alpha) else None
+    return alpha if accepted(problem.all, alpha) else None
 
 
 def optimize_restart(
@@ -264,7 +256,7 @@ def optimize_restart(
     scored = [
         (criterion.value(alpha), k, name, alpha)
         for k, (name, alpha) in enumerate(ends)
-        if name == "projected" or _accepted(constraints, alpha)
+        if name == "projected" or accepted(constraints, alpha)
     ]  # the projection is already accepted
     # only a constraint that needs motion rejects the start: when no end point meets it, none is kept
     value, _, end, alpha = min(scored, key=lambda item: item[:2]) if scored else (np.inf, 0, "none", start)

@@ -16,6 +16,7 @@ from typing import Callable, Optional, Sequence
 
 import numpy as np
 
+from excite_cli.constraints import accepted, farthest_accepted
 from excite_cli.constraints.lse import GRID_MARGIN
 from excite_cli.optimization.engine import Engine
 from excite_cli.optimization.excitation import Excitation
@@ -46,22 +47,15 @@ class Pool:
 def random_candidate(excitation: Excitation, rng: np.random.Generator) -> Optional[np.ndarray]:
     """One feasible random α (n, 2N+1) that uses as much of the limits as the constraints allow, or
     None when even a small motion violates a constraint."""
-
-    def accepted(alpha: np.ndarray) -> bool:
-        return all(c.accepts(alpha) for c in excitation.constraints)
-
     alpha = excitation.random_motion(rng, 1.0 - GRID_MARGIN)
-    if accepted(alpha):
+    if accepted(excitation.constraints, alpha):
         return alpha
-    lo, hi = 0.0, 1.0
-    for _ in range(SCALE_STEPS):
-        mid = (lo + hi) / 2.0
-        trial = alpha.copy()
-        trial[:, 1:] *= mid
-        lo, hi = (mid, hi) if accepted(trial) else (lo, mid)
-    if lo == 0.0:
+    still = alpha.copy()
+    still[:, 1:] = 0.0  # the offsets alone: oscillations scaled by t are still + t (α − still)
+    scale = farthest_accepted(excitation.constraints, still, alpha, SCALE_STEPS)
+    if scale == 0.0:
         return None
-    alpha[:, 1:] *= lo
+    alpha[:, 1:] *= scale
     return alpha
 
 

@@ -117,6 +117,15 @@ class RestartTask:
         )
 
 
+def stacked_regressors(
+    excitation: Excitation, prior: Optional[np.ndarray], results: Sequence[IterationResult]
+) -> np.ndarray:
+    """C₀ of the next iteration (Eq. 41): the prior rows (m, b), or none, then every earlier
+    iteration's regressor, in order: (m + Σ T·n_rows, b)."""
+    first = np.zeros((0, excitation.base.count)) if prior is None else prior
+    return np.vstack([first, *[r.regressor for r in results]])
+
+
 def describe(
     excitation: Excitation,
     index: int,
@@ -266,12 +275,9 @@ def run_sequence(
     if engine is None:
         with Engine(excitation) as serial:
             return run_sequence(excitation, iterations, seed, prior, progress, on_iteration, serial, finished)
-    stacked = np.vstack(
-        [np.zeros((0, excitation.base.count)) if prior is None else prior, *[r.regressor for r in finished]]
-    )
     results: list[IterationResult] = list(finished)
     for k in range(len(finished) + 1, iterations + 1):
-        start = time.perf_counter()
+        start, stacked = time.perf_counter(), stacked_regressors(excitation, prior, results)
         runs = run_restarts(
             excitation,
             engine,
@@ -282,7 +288,6 @@ def run_sequence(
             progress(k) if progress else None,
         )
         result = describe(excitation, k, best_restart(runs).alpha, stacked, time.perf_counter() - start, runs)
-        stacked = np.vstack([stacked, result.regressor])
         results.append(result)
         if on_iteration:
             on_iteration(result)

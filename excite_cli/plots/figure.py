@@ -10,7 +10,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from excite_cli.h5 import atomic_bytes  # noqa: E402
+from excite_cli.atomic import atomic_bytes  # noqa: E402
 
 
 def save_figure(fig: plt.Figure, path: Path, dpi: int) -> Path:

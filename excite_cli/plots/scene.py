@@ -12,9 +12,9 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
+from excite_cli.atomic import atomic_bytes
 from excite_cli.constraints.world_collision import WorldShape
 from excite_cli.dynamics.robot import Robot
-from excite_cli.h5 import atomic_bytes
 
 #: Side [m] and thickness of the slab that draws a half-space.
 SLAB = (3.0, 0.01)

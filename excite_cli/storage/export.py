@@ -14,11 +14,11 @@ from pathlib import Path
 
 import numpy as np
 
+from excite_cli.atomic import atomic_path
+from excite_cli.config_file import with_overrides
 from excite_cli.errors import ExciteError
-from excite_cli.h5 import atomic_path
 from excite_cli.optimization.excitation import build_excitation
 from excite_cli.optimization.playback import check_motion, plan_playback
-from excite_cli.storage.paths import check_target
 from excite_cli.storage.results import problem_of_result, read_alphas
 
 #: Highest export rate accepted [Hz] (memory grows with rate × duration).
@@ -71,8 +71,8 @@ def export_trajectory(result: Path, iteration: int | None = None, rate: float = 
         raise ExciteError("rate", f"{rate:g} Hz is out of range", rate, f"(0, {MAX_RATE:g}] Hz")
     if not 1 <= periods <= MAX_PERIODS:
         raise ExciteError("periods", f"{periods} is out of range", periods, f"1 to {MAX_PERIODS}")
-    problem = problem_of_result(result)
-    problem.robot.base_wrench_rows = False
+    # a copy whose regressor rows are the joints' torques, the feed-forward a robot plays
+    problem = with_overrides(problem_of_result(result), {"robot.base_wrench_rows": False})
     alphas = dict(read_alphas(result))
     k = max(alphas) if iteration is None else iteration
     if k not in alphas:
@@ -196,28 +196,3 @@ def ros2_goal(export: Export) -> str:
             f"time_from_start: {{sec: {ns // 10**9}, nanosec: {ns % 10**9}}}}}"
         )
     return "\n".join(lines) + "\n"
-
-
-def export_to_file(
-    result: Path,
-    iteration: int | None = None,
-    rate: float = 1000.0,
-    periods: int = 1,
-    fmt: str = "csv",
-    output: Path | None = None,
-    force: bool = False,
-) -> tuple[Export, Path]:
-    """:func:`export_trajectory` written by :func:`write_export` to ``output`` (default
-    ``<result>_iteration<K>_<rate>Hz.<ending>``, the ending of :data:`FORMATS`, beside the result); a
-    given ``output`` is checked first.
-
-    Raises:
-        ExciteError: see both, and a bad or existing (without ``force``) output path.
-    """
-    if fmt not in FORMATS:
-        raise ExciteError("format", f"must be one of {', '.join(FORMATS)} (got {fmt!r})")
-    if output is not None:
-        check_target(output, "output", force)
-    export = export_trajectory(result, iteration, rate, periods)
-    target = output or result.with_name(f"{result.stem}_iteration{export.iteration}_{rate:g}Hz.{FORMATS[fmt]}")
-    return export, write_export(check_target(target, "output", force), export, fmt)

@@ -10,8 +10,8 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Iterator
 
+from excite_cli.atomic import new_folders
 from excite_cli.errors import CannotWrite, ExciteError, OutputExists
-from excite_cli.h5 import new_folders
 
 
 def check_target(path: Path, field: str, force: bool = False, exists_ok: bool = False) -> Path:

@@ -22,7 +22,7 @@ from excite_cli.h5 import atomic_h5, open_h5, read_strings, write_strings
 from excite_cli.optimization.excitation import Excitation
 from excite_cli.optimization.optimality import Optimality
 from excite_cli.optimization.optimizer import RestartResult
-from excite_cli.optimization.sequence import IterationResult, describe
+from excite_cli.optimization.sequence import IterationResult, describe, stacked_regressors
 
 UNITS = {
     "alpha": "rad",
@@ -238,8 +238,7 @@ def read_iterations(
     Raises:
         ExciteError: missing or unreadable file, or a result of another problem.
     """
-    stacked = np.zeros((0, excitation.base.count)) if prior is None else prior
-    results = []
+    results: list[IterationResult] = []
     with open_h5(path, field) as f:
         if "iterations" not in f:
             raise ExciteError(field, f"{path} is not an excite optimize result (no /iterations)")
@@ -254,8 +253,8 @@ def read_iterations(
                 if "restarts" in g
                 else []
             )
+            stacked = stacked_regressors(excitation, prior, results)
             results.append(describe(excitation, int(key), alpha, stacked, float(g.attrs["wall_time_s"]), restarts))
-            stacked = np.vstack([stacked, results[-1].regressor])
     return results
 
 

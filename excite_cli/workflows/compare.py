@@ -15,7 +15,7 @@ from excite_cli.h5 import open_h5, read_strings
 from excite_cli.optimization.excitation import Excitation, build_excitation
 from excite_cli.optimization.optimizer import ProgressHook
 from excite_cli.optimization.random_baseline import draw_pool, greedy_selection, pool_convergence
-from excite_cli.optimization.sequence import describe
+from excite_cli.optimization.sequence import describe, stacked_regressors
 from excite_cli.plots.optimize import plot_comparison
 from excite_cli.storage.paths import check_target, output_lock
 from excite_cli.storage.results import check_base, read_table, results_table, write_result
@@ -98,11 +98,9 @@ def run_compare_random(
     begin = time.perf_counter()
     chosen, _ = greedy_selection(drawn.regressors, count)
     selection_s = time.perf_counter() - begin
-    stacked = np.zeros((0, excitation.base.count))
     results = []
     for k, index in enumerate(chosen, start=1):
-        results.append(describe(excitation, k, drawn.alphas[index], stacked))
-        stacked = np.vstack([stacked, results[-1].regressor])
+        results.append(describe(excitation, k, drawn.alphas[index], stacked_regressors(excitation, None, results)))
     write_result(
         target,
         excitation,

@@ -9,7 +9,7 @@ from typing import Callable, Optional
 import numpy as np
 import yaml
 
-from excite_cli.config import Problem, effective_yaml
+from excite_cli.config import Problem, effective_yaml, resolve_path
 from excite_cli.config_file import parse_yaml
 from excite_cli.errors import ExciteError, FileNotFound, Interrupted, exit_status
 from excite_cli.h5 import open_h5
@@ -91,7 +91,11 @@ def run_optimize(
     if resume and not target.is_file():
         raise FileNotFound("resume", target, "result to continue")
     excitation = build_excitation(problem)
-    prior = read_prior(problem.resolve(problem.sequence.prior), excitation.base) if problem.sequence.prior else None
+    prior = (
+        read_prior(resolve_path(problem.sequence.prior, problem.folder), excitation.base)
+        if problem.sequence.prior
+        else None
+    )
     finished = _resumable(target, excitation, prior) if resume else []
     written = list(finished)
 

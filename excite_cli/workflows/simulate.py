@@ -11,11 +11,11 @@ from pathlib import Path
 
 import numpy as np
 
+from excite_cli.atomic import atomic_paths
 from excite_cli.dynamics.robot import Robot, load_robot
 from excite_cli.errors import ExciteError
-from excite_cli.h5 import atomic_paths
 from excite_cli.identification.config import SimulationConfig
-from excite_cli.identification.effects import COEFFICIENTS, SHAPE_FIELDS, effect_columns
+from excite_cli.identification.effects import EFFECTS, effect_columns
 from excite_cli.storage.paths import check_folder
 from excite_cli.storage.results import problem_of_result, read_alphas
 from excite_cli.trajectory.fourier import FourierTrajectory
@@ -39,12 +39,13 @@ def effect_torques(
             if name != "*" and name not in robot.joint_names:
                 raise ExciteError(f"effects.{effect}", f"'{name}' is not an active joint")
             coefficients = np.atleast_1d(np.asarray(value, dtype=float))
-            if coefficients.size != len(COEFFICIENTS[effect]):
+            if coefficients.size != len(EFFECTS[effect].coefficients):
                 raise ExciteError(
-                    f"effects.{effect}.{name}", f"needs {len(COEFFICIENTS[effect])} value(s) {COEFFICIENTS[effect]}"
+                    f"effects.{effect}.{name}",
+                    f"needs {len(EFFECTS[effect].coefficients)} value(s) {EFFECTS[effect].coefficients}",
                 )
             for j in range(robot.n_joints) if name == "*" else [robot.joint_names.index(name)]:
-                shape = getattr(sim, SHAPE_FIELDS[effect]) if effect in SHAPE_FIELDS else None
+                shape = getattr(sim, EFFECTS[effect].shape_field) if EFFECTS[effect].shape_field else None
                 cols = effect_columns(effect, q[:, j], qd[:, j], qdd[:, j], sim.coulomb_velocity, shape, rigid[:, j])
                 tau[:, j] += cols @ coefficients
     return tau
@@ -70,8 +71,7 @@ def simulate_runs(
             non-finite effect values, more than MAX_SAMPLES samples per run, files in the way.
     """
     problem = problem_of_result(result)
-    problem.robot.base_wrench_rows = False
-    robot = load_robot(problem)
+    robot = load_robot(problem.robot, problem.folder, joint_rows_only=True)
     trajectory = FourierTrajectory(problem.trajectory.harmonics, problem.trajectory.base_frequency)
     rng = np.random.default_rng(sim.seed)
     alphas = read_alphas(result)

@@ -41,5 +41,5 @@ def run_view(
         output or result.with_name(f"{result.stem}_iteration{played.iteration}.html"), "output", force
     )
     problem = problem_of_result(result)
-    robot = load_robot(problem, collision=True)
+    robot = load_robot(problem.robot, problem.folder, collision=True)
     return write_scene(target, robot, played.q, rate, world_shapes(problem.constraints.environment))

@@ -32,7 +32,7 @@ from typing import Callable
 
 import numpy as np
 
-from excite_cli.identification.effects import PER_RUN, Term
+from excite_cli.identification.effects import Term
 from excite_cli.identification.fitting.dataset import Dataset
 from excite_cli.identification.fitting.normal import NormalEquations, solve
 
@@ -136,7 +136,7 @@ class CrossValidation:
         out, start = [], self.b
         for t in terms:
             size = self.place[t].size
-            if t.effect in PER_RUN and self.run_fold is not None and size == self.run_fold.size:
+            if t.kind.per_run and self.run_fold is not None and size == self.run_fold.size:
                 out.append((t.joint, np.arange(start, start + size)))
             start += size
         return out

@@ -209,7 +209,8 @@ def choose_fit(
     Args:
         selection: the searches, the least-squares fit, weights, normal equations and folds.
         robot, base, offset_runs: for the consistent fits (:class:`ConsistentModel`).
-        cfg: ``fit``, ``regularization`` (λ, one or several) and ``min_improvement`` (the price p pays).
+        cfg: ``fit`` and ``regularization`` (λ, one or several); the price p pays is the selection's
+            ``min_improvement``, the same the search used.
         oversampling: samples per independent sample of the fit data, for the least-squares std.
         consistent_beside: fit the consistent model (at the first λ) even when least squares is the
             only fit (the identified URDF needs one).
@@ -228,7 +229,7 @@ def choose_fit(
     cv = np.full((len(models), len(lams)), np.nan)
     if not single:
         cv = np.array([_scores(selection, m, lams, p) for m, p in zip(models, programs)])
-    J = objective(cv, [[m.effects] for m in models], cfg.min_improvement)
+    J = objective(cv, [[m.effects] for m in models], selection.min_improvement)
     win, chosen = (0, 0) if single else np.unravel_index(int(np.nanargmin(J)), J.shape)
     consistent = [k for k, lam in enumerate(lams) if lam is not None]
     best = min(consistent, key=lambda k: np.nan_to_num(cv[win, k], nan=np.inf)) if consistent else None

@@ -31,7 +31,7 @@ import numpy as np
 
 from excite_cli.identification.choice.crossval import CrossValidation
 from excite_cli.identification.config import IdentificationConfig
-from excite_cli.identification.effects import REQUIRES, SHAPE_FIELDS, Term
+from excite_cli.identification.effects import EFFECTS, Term
 from excite_cli.identification.fitting.dataset import Dataset
 from excite_cli.identification.fitting.least_squares import Fit, joint_weights, least_squares
 from excite_cli.identification.fitting.normal import ABSORBED, NormalEquations, outside_fraction
@@ -154,12 +154,12 @@ def objective(cv_error, effects, min_improvement: float):
 
 
 def candidate_terms(cfg: IdentificationConfig, n: int) -> list[Term]:
-    """Every candidate term: each candidate effect on each joint, one per shape of ``SHAPES`` effects."""
+    """Every candidate term: each candidate effect on each joint, one per shape of shaped effects."""
     return [
         Term(e, j, s)
         for e in cfg.candidates
         for j in range(n)
-        for s in (getattr(cfg, SHAPE_FIELDS[e]) if e in SHAPE_FIELDS else [None])
+        for s in (getattr(cfg, EFFECTS[e].shape_field) if EFFECTS[e].shape_field else [None])
     ]
 
 
@@ -194,10 +194,10 @@ class _Search:
                 ("add", c, terms + [c])
                 for c in self.candidates
                 if (c.effect, c.joint) not in family
-                and (c.effect not in REQUIRES or (REQUIRES[c.effect], c.joint) in family)
+                and (c.kind.requires is None or (c.kind.requires, c.joint) in family)
             ]
         for t in terms:
-            needed = any(REQUIRES.get(u.effect) == t.effect and u.joint == t.joint for u in terms)
+            needed = any(u.kind.requires == t.effect and u.joint == t.joint for u in terms)
             if (t.effect, t.joint) not in self.fixed and not needed:
                 out.append(("remove", t, [u for u in terms if u != t]))
             if t.shape is not None:

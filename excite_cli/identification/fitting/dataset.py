@@ -10,7 +10,7 @@ import numpy as np
 from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.dynamics.robot import Robot
 from excite_cli.errors import ExciteError
-from excite_cli.identification.effects import COEFFICIENTS, PER_RUN, TWO_STAGE, Term, effect_columns
+from excite_cli.identification.effects import Term, effect_columns
 from excite_cli.identification.measured.preprocessing import Samples
 
 
@@ -115,7 +115,7 @@ def _run_columns(
                 t,
                 (
                     run_offset_columns(index, fitted, kept, offsets)
-                    if t.effect in PER_RUN
+                    if t.kind.per_run
                     else s.filter.decimate(
                         effect_columns(
                             t.effect,
@@ -185,8 +185,8 @@ def build_datasets(
         raise ExciteError("data.runs", "need data for fitting and for validation (roles fit/validation, or blocks)")
     fitted = [k for k, m in enumerate(masks) if m.any()] if split else []
     offsets = len(fitted) if split else max(offset_runs or 1, 1)
-    terms = list(dict.fromkeys(t for t in terms if t.effect not in TWO_STAGE))
-    width = {t: offsets if t.effect in PER_RUN else len(COEFFICIENTS[t.effect]) for t in terms}
+    terms = list(dict.fromkeys(t for t in terms if not t.kind.two_stage))
+    width = {t: offsets if t.kind.per_run else len(t.kind.coefficients) for t in terms}
     out = {
         side: {
             "Y": np.empty((size, n * b)),

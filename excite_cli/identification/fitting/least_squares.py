@@ -64,11 +64,6 @@ def joint_weights(normal: NormalEquations, weighted: bool) -> np.ndarray | None:
     return 1.0 / np.maximum(least_squares(normal, []).sigma, 1e-12)
 
 
-def design(data: Dataset, effects: list[Term]) -> np.ndarray:
-    """[Y_B, effect blocks] (M, b + Σk)."""
-    return np.hstack([data.regressor] + [data.block(t) for t in effects])
-
-
 def torque_errors(measured: np.ndarray, predicted: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Per joint, of measured and predicted torques (N, n) [Nm]: the RMS error (n,) [Nm], the RMS of
     the measured torque (n,) [Nm] and their ratio (n,) [%] (relative to 1 Nm where a joint's torque

@@ -10,8 +10,9 @@ from typing import Optional
 
 import numpy as np
 
+from excite_cli.config import resolve_path
 from excite_cli.errors import ExciteError, FileNotFound
-from excite_cli.identification.config import ColumnsConfig, DataConfig, IdentifyProblem, RunConfig
+from excite_cli.identification.config import ColumnsConfig, DataConfig, RunConfig
 from excite_cli.identification.measured.bags import bag_columns, is_bag, read_bag
 from excite_cli.identification.measured.files import Table, read_table
 
@@ -75,26 +76,26 @@ def _usable(time: np.ndarray, signals: dict[str, np.ndarray]) -> tuple[np.ndarra
     return ok, problem
 
 
-def load_run(run: RunConfig, data: DataConfig, problem: IdentifyProblem, n: int) -> Run:
+def load_run(run: RunConfig, data: DataConfig, joints: list[str], folder: Path | None = None) -> Run:
     """Read, convert and validate one run (CSV with or without header, NPZ, MAT or HDF5, see
     :mod:`excite_cli.identification.measured.files`; a ROS bag, see :mod:`excite_cli.identification.measured.bags`).
 
     Args:
         run: the run's entry of ``data.runs``.
         data: the data section (columns, units, gains, signs, bad rows).
-        problem: for resolving the file path.
-        n: number of active joints.
+        joints: the active joints' names (a ROS bag's messages are matched by them).
+        folder: the config file's folder, which a relative ``file`` is in.
 
     Raises:
         ExciteError: missing or unreadable file, wrong column count or name, NaN, missing or
             implausible values (> 1e6) or time not strictly increasing (unless ``bad_rows: drop``),
             a crop that leaves nothing.
     """
-    path = problem.resolve(run.file)
+    path = resolve_path(run.file, folder)
+    n = len(joints)
     if not path.exists():
         raise FileNotFound("data.runs", path)
     drop = data.bad_rows == "drop"
-    joints = problem.robot.active_joints
     if is_bag(path):
         table = read_bag(path, data.topic, joints)
         cols = data.columns or ColumnsConfig(**bag_columns(joints, table))

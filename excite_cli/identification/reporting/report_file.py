@@ -15,7 +15,6 @@ from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.dynamics.robot import Robot
 from excite_cli.h5 import atomic_h5, write_strings, write_table
 from excite_cli.identification.config import IdentifyProblem
-from excite_cli.identification.effects import COEFFICIENTS, UNITS
 from excite_cli.identification.fitting.physical import body_properties
 from excite_cli.identification.reporting.report import Report
 
@@ -125,7 +124,7 @@ def _write_effects(g: h5py.Group, report: Report) -> None:
     for row, (term, coefficient, value, std) in zip(effects, rows):
         row["order"], row["coefficient"], row["value"], row["std"] = order[term], coefficient, value, std
         row["effect"], row["joint"], row["shape"] = _term_fields(term, report.joints)
-        row["unit"], row["declared"] = UNITS[COEFFICIENTS[term.effect][0]], order[term] <= sel.declared
+        row["unit"], row["declared"] = term.kind.units[0], order[term] <= sel.declared
     data = g.create_dataset("effects", data=effects)
     data.attrs["shape_unit"] = "rad/s (Stribeck v_s, held v_h; NaN for other effects)"
     write_strings(g, "offset_runs", report.offset_runs)

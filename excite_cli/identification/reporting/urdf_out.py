@@ -19,9 +19,10 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
+from excite_cli.atomic import atomic_path
+from excite_cli.config import RobotConfig
 from excite_cli.dynamics.robot import Robot, load_robot
 from excite_cli.errors import ExciteError
-from excite_cli.h5 import atomic_path
 
 #: Friction coefficients that URDF's <dynamics> carries: coefficient → attribute.
 DYNAMICS = {"Fc": "friction", "Fv": "damping"}
@@ -124,16 +125,14 @@ def write_urdf(
     return target
 
 
-def urdf_deviation(problem, robot: Robot, torques, target: Path, samples: int = 200) -> float:
+def urdf_deviation(cfg: RobotConfig, robot: Robot, torques, target: Path, samples: int = 200) -> float:
     """Largest |τ_URDF − τ_identified| [Nm] over ``samples`` random states: the written URDF (loaded
     by pinocchio with the same active and locked joints) against the identified model's rigid-body
-    torques ``torques(q, q̇, q̈)`` → (n,).
+    torques ``torques(q, q̇, q̈)`` → (n,). ``cfg`` is the ``robot`` section (joints).
 
     Raises:
         ExciteError: pinocchio cannot load the written file.
     """
-    copy = problem.model_copy(deep=True)
-    copy.robot.urdf, copy.robot.source = str(Path(target).resolve()), "file"
-    written = load_robot(copy)
+    written = load_robot(cfg, urdf=Path(target).resolve(), joint_rows_only=True)
     states = robot.random_states(samples, np.random.default_rng(0))
     return float(max(np.abs(written.torques(*x) - torques(*x)).max() for x in zip(*states)))

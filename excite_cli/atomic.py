@@ -1,0 +1,90 @@
+"""Files written whole or not at all: every file excite writes (HDF5, PNG, HTML, CSV, URDF) goes
+through a temporary ``<path>.partial`` moved onto its path only when it is complete, and the folders
+made for it are removed again when nothing was written."""
+
+from __future__ import annotations
+
+import os
+from contextlib import contextmanager, suppress
+from pathlib import Path
+from typing import Iterator, Sequence
+
+from excite_cli.errors import CannotWrite
+
+
+@contextmanager
+def new_folders(paths: Sequence[Path], field: str = "output") -> Iterator[None]:
+    """The folders of ``paths``, created as needed for the block; those it created that are empty
+    when the block ends (an error, or nothing written into them) are removed again.
+
+    Raises:
+        CannotWrite: a folder cannot be created.
+    """
+    parents = [Path(p).parent for p in paths]
+    created = sorted({d for f in parents for d in (f, *f.parents) if not d.exists()}, key=lambda d: -len(d.parts))
+    try:
+        for path, folder in zip(paths, parents):
+            try:
+                folder.mkdir(parents=True, exist_ok=True)
+            except OSError as exc:
+                raise CannotWrite(field, Path(path), exc.strerror or exc) from None
+        yield
+    finally:
+        for folder in created:
+            with suppress(OSError):
+                folder.rmdir()
+
+
+@contextmanager
+def atomic_paths(paths: Sequence[Path], field: str = "output") -> Iterator[list[Path]]:
+    """Temporary paths ``<path>.partial`` to write to, moved onto ``paths`` (``os.replace``) when the
+    block ends without error and removed otherwise, with any folder made for them
+    (:func:`new_folders`), so a crash, Ctrl-C or full disk never leaves a half-written file nor a
+    part of the set.
+
+    Args:
+        field: the config field or argument that named ``paths``, for the message.
+
+    Raises:
+        CannotWrite: a file cannot be written (``OSError`` in the block or in a move).
+    """
+    paths = [Path(p) for p in paths]
+    tmps = [p.with_name(p.name + ".partial") for p in paths]
+    try:
+        with new_folders(paths, field):
+            try:
+                yield tmps
+                for tmp, path in zip(tmps, paths):
+                    os.replace(tmp, path)
+            finally:
+                for tmp in tmps:
+                    tmp.unlink(missing_ok=True)
+    except OSError as exc:
+        at = next((p for p, t in zip(paths, tmps) if str(t) == str(exc.filename)), paths[0])
+        raise CannotWrite(field, at, exc.strerror or exc) from None
+
+
+@contextmanager
+def atomic_path(path: Path, field: str = "output") -> Iterator[Path]:
+    """One file written through :func:`atomic_paths`: ``<path>.partial`` to write to.
+
+    Raises:
+        CannotWrite: the file cannot be written.
+    """
+    with atomic_paths([path], field) as (tmp,):
+        yield tmp
+
+
+def atomic_bytes(path: Path, data: bytes, field: str = "output") -> Path:
+    """``data`` written to ``path`` through :func:`atomic_path` and flushed to the disk (``fsync``),
+    so a full disk or a file-size limit is a :class:`CannotWrite` and never a half-written file.
+
+    Raises:
+        CannotWrite: the file cannot be written.
+    """
+    with atomic_path(path, field) as tmp:
+        with open(tmp, "wb") as f:
+            f.write(data)
+            f.flush()
+            os.fsync(f.fileno())
+    return Path(path)

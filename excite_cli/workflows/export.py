@@ -1,0 +1,34 @@
+"""``excite export``: an optimize result's trajectory as the robot plays it, written to a file."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from excite_cli.errors import ExciteError
+from excite_cli.storage.export import FORMATS, Export, export_trajectory, write_export
+from excite_cli.storage.paths import check_target
+
+
+def run_export(
+    result: Path,
+    iteration: int | None = None,
+    rate: float = 1000.0,
+    periods: int = 1,
+    fmt: str = "csv",
+    output: Path | None = None,
+    force: bool = False,
+) -> tuple[Export, Path]:
+    """:func:`export_trajectory` written by :func:`write_export` to ``output`` (default
+    ``<result>_iteration<K>_<rate>Hz.<ending>``, the ending of :data:`FORMATS`, beside the result); a
+    given ``output`` is checked first.
+
+    Raises:
+        ExciteError: see both, and a bad or existing (without ``force``) output path.
+    """
+    if fmt not in FORMATS:
+        raise ExciteError("format", f"must be one of {', '.join(FORMATS)} (got {fmt!r})")
+    if output is not None:
+        check_target(output, "output", force)
+    export = export_trajectory(result, iteration, rate, periods)
+    target = output or result.with_name(f"{result.stem}_iteration{export.iteration}_{rate:g}Hz.{FORMATS[fmt]}")
+    return export, write_export(check_target(target, "output", force), export, fmt)
