@@ -48,30 +48,38 @@ def run_all(package: Path, work: Path, folder: Path, names: list[str]) -> None:
         os.replace(work / name, folder / name)
 
 
-def differences(a: h5py.Group, b: h5py.Group, where: str = "") -> list[str]:
-    """Every dataset or attribute of ``a`` and ``b`` that is not the same bit for bit."""
+def _attributes(a, b, where: str) -> list[str]:
+    """The attributes of ``a`` and ``b`` (groups or datasets) that differ, but those of ``RECORDS``."""
     out = []
     for key in sorted(set(a.attrs) | set(b.attrs)):
         if key in RECORDS or key.startswith("version_"):
             continue
         x, y = a.attrs.get(key), b.attrs.get(key)
-        if (
-            x is None
-            or y is None
-            or not np.array_equal(np.asarray(x), np.asarray(y), equal_nan=np.asarray(x).dtype.kind == "f")
-        ):
+        if x is None or y is None or not _same(x, y):
             out.append(f"{where}@{key}")
+    return out
+
+
+def _same(x, y) -> bool:
+    """Bit for bit; arrays holding strings (object references) by their values."""
+    x, y = np.asarray(x), np.asarray(y)
+    if x.dtype != y.dtype or x.shape != y.shape:
+        return False
+    return repr(x.tolist()) == repr(y.tolist()) if x.dtype.hasobject else x.tobytes() == y.tobytes()
+
+
+def differences(a: h5py.Group, b: h5py.Group, where: str = "") -> list[str]:
+    """Every dataset or attribute of ``a`` and ``b`` that is not the same bit for bit."""
+    out = _attributes(a, b, where)
     for key in sorted(set(a) | set(b)):
         if key not in a or key not in b:
             out.append(f"{where}/{key} (only in one)")
         elif isinstance(a[key], h5py.Group):
             out += differences(a[key], b[key], f"{where}/{key}")
         else:
-            x, y = a[key][()], b[key][()]
-            same = x.dtype == y.dtype and x.shape == y.shape and x.tobytes() == y.tobytes()
-            if not same:
+            if not _same(a[key][()], b[key][()]):
                 out.append(f"{where}/{key}")
-            out += differences(a[key], b[key], f"{where}/{key}") if a[key].attrs else []
+            out += _attributes(a[key], b[key], f"{where}/{key}")
     return out
 
 

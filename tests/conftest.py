@@ -15,7 +15,13 @@ from excite_cli.config import Problem
 from excite_cli.config_file import load_problem
 from excite_cli.dynamics.robot import load_robot
 
-CONFIGS = Path(__file__).resolve().parent.parent / "configs"
+TESTS = Path(__file__).resolve().parent
+CONFIGS = TESTS.parent / "configs"
+#: The real Panda run of ../shared (not in the repository).
+SHARED = TESTS.parent.parent / "shared" / "data" / "panda-gaz2019"
+JOINTS = [f"panda_joint{k}" for k in range(1, 8)]
+#: Torque noise of the simulated identification runs [Nm].
+NOISE = 0.05
 
 UR5 = {
     "robot": {
@@ -155,3 +161,25 @@ def constraint_jacobian_error(constraint, alpha: np.ndarray, step: float = 1e-6)
         plus, minus = (constraint.evaluate((flat + s * e).reshape(alpha.shape))[0] for s in (1, -1))
         differences[:, k] = (plus - minus) / (2 * step)
     return float(np.abs(jacobian - differences).max() / np.abs(differences).max())
+
+
+@pytest.fixture(scope="module")
+def optimized(tmp_path_factory):
+    """A small optimized Panda result with 3 trajectories."""
+    tmp = tmp_path_factory.mktemp("opt")
+    data = yaml.safe_load((CONFIGS / "smoke.yaml").read_text())
+    data.update(sequence={"iterations": 3}, output=str(tmp / "panda.h5"))
+    result = CliRunner().invoke(app, ["optimize", str(write_config(tmp, data))])
+    assert result.exit_code == 0, result.output
+    return tmp / "panda.h5"
+
+
+@pytest.fixture(scope="session")
+def simulated_identification():
+    """``identify`` of the shipped simulated Panda runs (Coulomb and viscous friction undeclared):
+    (problem, report, robot, base, regressor parts), as the pipeline returns them."""
+    from excite_cli.identification.config import IdentifyProblem
+    from excite_cli.identification.pipeline import run_identification
+
+    problem = load_problem(CONFIGS / "panda_identify_simulated.yaml", IdentifyProblem)
+    return (problem, *run_identification(problem))

@@ -1,12 +1,15 @@
 """Bad input gets one line naming the field, a non-zero exit and no traceback or output file."""
 
 import copy
+from pathlib import Path
 
 import pytest
+import yaml
 from conftest import UR5, write_config
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
+from excite_cli.config import Problem, effective_yaml, resolve_path
 from excite_cli.config_file import load_problem
 from excite_cli.errors import ExciteError
 from excite_cli.optimization.excitation import build_excitation
@@ -84,3 +87,14 @@ def test_library_raises_the_same_error(tmp_path):
     data["robot"]["active_joints"] = ["nope"]
     with pytest.raises(ExciteError, match="robot.active_joints"):
         build_excitation(load_problem(write_config(tmp_path, data)))
+
+
+def test_paths_are_relative_to_the_config_file_and_the_effective_config_is_complete(tmp_path):
+    problem = load_problem(write_config(tmp_path, UR5))
+    assert problem.folder == tmp_path
+    assert resolve_path("prior.h5", problem.folder) == tmp_path / "prior.h5"
+    assert resolve_path("/data/prior.h5", problem.folder) == Path("/data/prior.h5")
+    assert resolve_path("prior.h5", None) == Path("prior.h5")
+    stored = yaml.safe_load(effective_yaml(problem))
+    assert stored["optimizer"]["objective"] == "log_det" and stored["optimizer"]["scaling"] == "none"
+    assert Problem.model_validate(stored).model_dump() == problem.model_dump()  # what ran can be run again

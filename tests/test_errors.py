@@ -6,9 +6,7 @@ import yaml
 from conftest import UR5, write_config
 
 from excite_cli.atomic import atomic_path
-from excite_cli.cli import export, validate
 from excite_cli.config_file import load_problem
-from excite_cli.console.errors import spellings, word
 from excite_cli.errors import CannotWrite, ExciteError, FileNotFound, OutputExists
 from excite_cli.h5 import open_h5
 from excite_cli.storage.export import export_trajectory
@@ -35,17 +33,6 @@ def test_library_errors_name_arguments_not_flags(tmp_path):
     with pytest.raises(OutputExists) as exists:
         check_target(tmp_path / "there.h5", "output")
     assert exists.value.field == "output" and "--" not in str(exists.value)
-
-
-def test_the_command_line_words_fields_as_its_options():
-    spelled = spellings(export)
-    assert spelled["fmt"] == spelled["format"] == "--format" and spelled["result"] == "RESULT"
-    assert spellings(validate)["report"] == "REPORT"
-    assert (
-        word(ExciteError("format", "unknown", "xml", "csv or npz"), spelled) == "--format: unknown; expected csv or npz"
-    )
-    assert word(ExciteError("limits.velocity", "must be > 0", -1.0), spelled) == "limits.velocity: must be > 0"
-    assert word(OutputExists("output", "r.h5"), spelled) == "--output: r.h5 exists; use --force to replace it"
 
 
 def test_an_atomic_write_that_fails_leaves_nothing_and_names_its_field(tmp_path):

@@ -1,13 +1,15 @@
 """The house rules of the package, checked on its source: a thin command line, small modules and
 functions, imports that only run down the stack (the import graph has no cycle), and the command
 line's libraries (typer, rich) only in the modules that print, modules in role folders, identification
-independent of the optimizer, and no command-line flag in a library message."""
+independent of the optimizer, no command-line flag in a library message, tests that mirror the
+package's folders with every module tested in its own, and lower floors handed values, not problems."""
 
 import ast
 import re
 from pathlib import Path
 
-PACKAGE = Path(__file__).resolve().parent.parent / "excite_cli"
+TESTS = Path(__file__).resolve().parent
+PACKAGE = TESTS.parent / "excite_cli"
 PRINTING = {"excite_cli.cli"} | {f"excite_cli.console.{m}" for m in ("tables", "identification", "progress", "errors")}
 
 
@@ -150,3 +152,53 @@ def test_no_library_message_names_a_command_line_flag():
     }
     assert {name: found for name, found in flagged.items() if found} == {}
     assert any(re.search(r"--[a-z]", s) for s in _messages(_modules()["excite_cli.cli"]))  # the check sees flags
+
+
+def _tested_modules() -> dict[str, set[str]]:
+    """For each package module, the test modules that import it (or a name from it)."""
+    modules, tested = _modules(), {}
+    for test in TESTS.rglob("test_*.py"):
+        imports = _imports(ast.parse(test.read_text()))
+        for name in modules:
+            if name in imports:
+                tested.setdefault(name, set()).add(str(test.relative_to(TESTS)))
+    return tested
+
+
+def test_tests_mirror_the_package_and_every_module_is_tested_in_its_own_folder():
+    """tests/ has the package's folders; every module (but the entry point and the packages' own
+    __init__) is imported by a test module in the folder that mirrors its own."""
+    folders = {p.relative_to(PACKAGE) for p in PACKAGE.rglob("*") if p.is_dir() and p.name != "__pycache__"}
+    assert folders <= {p.relative_to(TESTS) for p in TESTS.rglob("*") if p.is_dir() and p.name != "__pycache__"}
+    tested = _tested_modules()
+    untested = []
+    for path in PACKAGE.rglob("*.py"):
+        if path.name in ("__main__.py", "__init__.py") and path.parent != PACKAGE / "workflows":
+            continue
+        name = ".".join(path.relative_to(PACKAGE.parent).with_suffix("").parts).removesuffix(".__init__")
+        folder = path.parent.relative_to(PACKAGE)
+        if not any(Path(t).parent == folder for t in tested.get(name, ())):
+            untested.append(name)
+    assert untested == []
+
+
+def test_lower_floors_take_sections_and_values_not_whole_problems():
+    """Robots, data, constraints, trajectories and the identification's measured, fitting and choice
+    rooms are handed the config section or the value they use, never a whole problem (the report
+    file stores the whole config, so reporting may take it)."""
+    lower = (
+        "dynamics",
+        "collision",
+        "constraints",
+        "trajectory",
+        "identification.measured",
+        "identification.fitting",
+        "identification.choice",
+    )
+    offenders = [
+        name
+        for name, tree in _modules().items()
+        if name.removeprefix("excite_cli.").startswith(lower)
+        and {"excite_cli.config.Problem", "excite_cli.identification.config.IdentifyProblem"} & _imports(tree)
+    ]
+    assert offenders == []

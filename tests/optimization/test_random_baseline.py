@@ -2,21 +2,21 @@
 every selected candidate on the fine grid."""
 
 import itertools
-from pathlib import Path
 
 import h5py
 import numpy as np
 import pytest
 import yaml
-from conftest import write_config
+from conftest import CONFIGS, TESTS, write_config
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
 from excite_cli.config_file import load_problem
+from excite_cli.optimization.engine import Engine
 from excite_cli.optimization.excitation import build_excitation
-from excite_cli.optimization.random_baseline import greedy_selection, random_candidate
+from excite_cli.optimization.random_baseline import DrawTask, draw_pool, greedy_selection, random_candidate
 
-HERE = Path(__file__).resolve().parent
+HERE = TESTS
 
 
 def _cond(C):
@@ -75,3 +75,12 @@ def test_compare_random_command(tmp_path):
         assert f["table"]["cond_stacked"][1] == pytest.approx(_cond(stacked), rel=1e-9)
     assert (tmp_path / "panda_random_comparison.png").stat().st_size > 5000
     assert (tmp_path / "panda_optimized.h5").exists()
+
+
+def test_random_pool_counts():
+    excitation = build_excitation(load_problem(CONFIGS / "smoke.yaml"))
+    with Engine(excitation) as engine:
+        pool = draw_pool(engine, 45, seed=3)
+    assert len(pool.alphas) == 45 and pool.drawn >= 45 and pool.regressors.shape[0] == 45  # 3 tasks: 20 + 20 + 5
+    alphas, regressors, drawn = DrawTask(0, 3, 10**9, budget_s=0.0)(excitation)
+    assert alphas.shape[0] == regressors.shape[0] == drawn == 0  # no time, no draw

@@ -1,7 +1,6 @@
 """Closing the loop: effect columns against closed forms, detection of undeclared effects on
 simulated data with known parameters, no false effect, bad data, and the real Panda run."""
 
-from dataclasses import replace
 from pathlib import Path
 
 import h5py
@@ -9,29 +8,26 @@ import numpy as np
 import pinocchio as pin
 import pytest
 import yaml
-from conftest import CONFIGS, robot_of, write_config
+from conftest import CONFIGS, JOINTS, NOISE, SHARED, TESTS, robot_of, write_config
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
 from excite_cli.config_file import load_problem
 from excite_cli.h5 import read_strings, write_strings
-from excite_cli.identification.config import DEFAULT_CANDIDATES, IdentifyProblem, PreprocessingConfig, SimulationConfig
+from excite_cli.identification.config import DEFAULT_CANDIDATES, IdentifyProblem, SimulationConfig
 from excite_cli.identification.effects import EFFECT_NAMES, EFFECTS, effect_columns
 from excite_cli.identification.fitting.dataset import run_offset_columns
-from excite_cli.identification.measured.measurements import Run, load_run
-from excite_cli.identification.measured.preprocessing import MIN_CUTOFF, Filter, choose_cutoff
+from excite_cli.identification.measured.measurements import load_run
+from excite_cli.identification.measured.preprocessing import Filter
 from excite_cli.identification.pipeline import run_identification
 from excite_cli.identification.validate import validate_model
 from excite_cli.trajectory.fourier import FourierTrajectory
 from excite_cli.workflows.simulate import simulate_runs
 
 runner = CliRunner()
-HERE = Path(__file__).resolve().parent
-SHARED = HERE.parent.parent / "shared" / "data" / "panda-gaz2019"
-JOINTS = [f"panda_joint{k}" for k in range(1, 8)]
+HERE = TESTS
 TRUE = {"coulomb": 0.6, "viscous": 0.4}
 ARMATURE = {"panda_joint4": 0.1, "panda_joint6": 0.05}
-NOISE = 0.05
 
 
 def test_effect_columns_closed_forms():
@@ -85,40 +81,6 @@ def test_asymmetric_coulomb_gives_direction_dependent_levels():
 def test_run_offsets_are_indicators_or_the_mean_for_an_unfitted_run():
     np.testing.assert_array_equal(run_offset_columns(2, [0, 2], 3, 2), [[0, 1]] * 3)
     np.testing.assert_array_equal(run_offset_columns(1, [0, 2], 2, 2), [[0.5, 0.5]] * 2)
-
-
-def test_default_cutoff_from_the_fitted_runs_hann_spectrum():
-    rate, t = 1000.0, np.arange(0, 12.0, 0.001)
-
-    def moving(f, crop):
-        n = int(crop * rate)
-        return Run(
-            "m", "fit", t[:n], np.column_stack([np.sin(2 * np.pi * f * t[:n])] * 2), None, None, np.zeros((n, 2))
-        )
-
-    static = Run(
-        "s", "validation", t, np.random.default_rng(0).normal(0, 1e-3, (t.size, 2)), None, None, np.zeros((t.size, 2))
-    )
-    cfg = PreprocessingConfig()
-    # a 0.8 Hz motion cropped mid-period: 10 x its bandwidth, within the spectrum's resolution (2 bins
-    # of 1/7.3 s); the static, noisy validation run has no bandwidth and is not looked at (with it:
-    # the cap, 40 % of the 200 Hz rate)
-    cutoff, source = choose_cutoff([moving(0.8, 7.3), static], cfg)
-    assert 8.0 <= cutoff <= 8.0 + 10 * 2 / 7.3 and "fitted runs" in source
-    assert choose_cutoff([replace(static, role="fit")], cfg)[0] == 80.0
-    assert choose_cutoff([moving(0.1, 12.0)], cfg)[0] == MIN_CUTOFF  # a slow run: the floor
-    assert choose_cutoff([moving(0.8, 7.3)], PreprocessingConfig(cutoff=3.0)) == (3.0, "preprocessing.cutoff")
-
-
-@pytest.fixture(scope="module")
-def optimized(tmp_path_factory):
-    """A small optimized Panda result with 3 trajectories."""
-    tmp = tmp_path_factory.mktemp("opt")
-    data = yaml.safe_load((HERE.parent / "configs" / "smoke.yaml").read_text())
-    data.update(sequence={"iterations": 3}, output=str(tmp / "panda.h5"))
-    result = runner.invoke(app, ["optimize", str(write_config(tmp, data))])
-    assert result.exit_code == 0, result.output
-    return tmp / "panda.h5"
 
 
 def _simulate_and_identify(tmp: Path, optimized: Path, effects: dict, candidates: list | None = None, **sim_extra):

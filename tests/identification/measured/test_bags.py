@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from conftest import write_config
+from conftest import CONFIGS, write_config
 from rosbags.rosbag1 import Writer as Ros1Writer
 from rosbags.rosbag2 import StoragePlugin
 from rosbags.rosbag2 import Writer as Ros2Writer
@@ -18,6 +18,7 @@ from excite_cli.cli import app
 from excite_cli.config_file import load_problem
 from excite_cli.errors import ExciteError
 from excite_cli.identification.config import IdentifyProblem, SimulationConfig
+from excite_cli.identification.measured.bags import is_bag, read_bag
 from excite_cli.identification.measured.measurements import load_run
 from excite_cli.identification.pipeline import run_identification
 from excite_cli.workflows.simulate import simulate_runs
@@ -81,7 +82,7 @@ def write_bag(path: Path, table: np.ndarray, kind: str) -> Path:
 def simulated(tmp_path_factory):
     """One simulated Panda run with Coulomb friction 0.4 Nm on every joint (CSV), from the smoke problem."""
     tmp = tmp_path_factory.mktemp("bags")
-    data = yaml.safe_load((Path(__file__).resolve().parent.parent / "configs" / "smoke.yaml").read_text())
+    data = yaml.safe_load((CONFIGS / "smoke.yaml").read_text())
     data.update(sequence={"iterations": 1}, output=str(tmp / "panda.h5"))
     result = CliRunner().invoke(app, ["optimize", str(write_config(tmp, data))])
     assert result.exit_code == 0, result.output
@@ -106,6 +107,9 @@ def test_a_bag_reads_to_the_samples_of_its_csv(simulated, kind, name):
     write_bag(tmp / name, table, kind)
     problem = _config(tmp, name)
     run = load_run(problem.data.runs[0], problem.data, problem.robot.active_joints, problem.folder)
+    assert is_bag(tmp / name) and not is_bag(tmp / "run_1.csv")
+    raw = read_bag(tmp / name, "/joint_states", JOINTS[::-1])  # matched by name, in any order
+    np.testing.assert_allclose(raw.column(f"position/{JOINTS[-1]}", "q", tmp / name), table[:, 7], rtol=0, atol=1e-12)
     np.testing.assert_allclose(run.time - T0, table[:, 0], atol=2e-6)
     np.testing.assert_allclose(run.q, table[:, 1:8], rtol=0, atol=1e-12)
     np.testing.assert_allclose(run.tau, table[:, 8:15], rtol=0, atol=1e-12)

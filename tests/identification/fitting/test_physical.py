@@ -9,8 +9,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 import yaml
-from conftest import CONFIGS, robot_of, write_config
-from test_identification import JOINTS, SHARED, optimized  # noqa: F401  (module fixture)
+from conftest import CONFIGS, JOINTS, SHARED, robot_of, write_config
 from typer.testing import CliRunner
 
 from excite_cli.cli import app

@@ -6,7 +6,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 import yaml
-from conftest import CONFIGS, robot_of
+from conftest import CONFIGS
 from rosbags.typesys import Stores, get_typestore
 from typer.testing import CliRunner
 
@@ -15,7 +15,6 @@ from excite_cli.constraints import JointLimits
 from excite_cli.constraints.lse import GRID_MARGIN
 from excite_cli.dynamics.robot import example_robot_data_root
 from excite_cli.optimization.playback import RESOLUTION, Transition, plan_transition
-from excite_cli.plots.skeleton import skeleton
 
 runner = CliRunner()
 PANDA_URDF = "example-robot-data/robots/panda_description/urdf/panda.urdf"
@@ -218,22 +217,3 @@ def test_rest_to_rest_transition_is_as_short_as_the_velocity_limit_allows():
     _, qd, _ = transition.evaluate(np.linspace(0.0, transition.duration, 2001))
     assert np.abs(qd).max() <= 1.0 - GRID_MARGIN + 1e-12
     assert plan_transition(start, start, limits, "none") is None
-
-
-def test_skeleton_of_the_panda_at_zero_reaches_the_flange():
-    from excite_cli.config_file import load_problem
-
-    robot = robot_of(load_problem(CONFIGS / "panda_joint_limits.yaml"))
-    points = skeleton(robot, np.zeros(7)).reshape(-1, 3)
-    # Panda kinematics at q = 0 (Franka's DH table): flange at x = 0.088 m, z = 0.333 + 0.316 + 0.384 − 0.107 m
-    assert np.min(np.linalg.norm(points - [0.088, 0.0, 0.926], axis=1)) < 1e-6
-    assert np.min(np.linalg.norm(points - [0.0825, 0.0, 0.649], axis=1)) < 1e-6
-
-
-def test_skeleton_of_the_g1_has_its_locked_legs(g1_problem):
-
-    robot = robot_of(g1_problem)
-    points = skeleton(robot, robot.home).reshape(-1, 3)
-    lengths = np.linalg.norm(np.diff(skeleton(robot, robot.home), axis=1)[:, 0], axis=1)
-    # the soles are ~0.79 m below the pelvis (the floating base at the origin); legs are locked joints
-    assert points[:, 2].min() < -0.7 and np.count_nonzero(lengths > 0.1) >= 8

@@ -10,6 +10,7 @@ import scipy.io
 
 from excite_cli.errors import ExciteError
 from excite_cli.identification.config import IdentifyProblem
+from excite_cli.identification.measured.files import read_table
 from excite_cli.identification.measured.measurements import load_run
 
 JOINTS = [f"panda_joint{k}" for k in range(1, 8)]
@@ -73,6 +74,22 @@ def test_npz_and_mat_runs(tmp_path):
             {"time": "t", "q": [f"Q[{k}]" for k in range(7)], "tau": [f"tau[{k}]" for k in range(7)]},
         )
     )
+
+
+def test_a_table_gives_its_columns_by_name_or_position(tmp_path):
+    np.savetxt(
+        tmp_path / "run.csv",
+        np.column_stack([TIME, Q]),
+        delimiter=",",
+        fmt="%.17g",
+        header=",".join(["t"] + [f"q{k}" for k in range(1, 8)]),
+        comments="",
+    )
+    table = read_table(tmp_path / "run.csv")
+    np.testing.assert_array_equal(table.column("q3", "q", tmp_path / "run.csv"), Q[:, 2])
+    np.testing.assert_array_equal(table.column(0, "time", tmp_path / "run.csv"), TIME)
+    with pytest.raises(ExciteError, match="q9"):
+        table.column("q9", "q", tmp_path / "run.csv")
 
 
 def test_semicolon_csv_with_header(tmp_path):

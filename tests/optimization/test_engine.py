@@ -1,10 +1,9 @@
 """Restarts and random draws in parallel: a process pool and a Dask cluster give the serial run's
 trajectories and candidates, bit for bit, for the same seed; each restart draws its own start."""
 
-from pathlib import Path
-
 import numpy as np
 import pytest
+from conftest import TESTS
 
 import excite_cli.optimization.engine as engine_module
 from excite_cli.config_file import load_problem
@@ -15,7 +14,7 @@ from excite_cli.optimization.optimizer import RestartResult, best_restart
 from excite_cli.optimization.random_baseline import draw_pool
 from excite_cli.optimization.sequence import RestartTask, run_sequence
 
-HERE = Path(__file__).resolve().parent
+HERE = TESTS
 
 
 @pytest.fixture(scope="module")

@@ -8,9 +8,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import robot_of, write_config
-from test_identification import JOINTS, NOISE, app, optimized, runner  # noqa: F401  (module fixture)
+from conftest import JOINTS, NOISE, robot_of, write_config
+from typer.testing import CliRunner
 
+from excite_cli.cli import app
 from excite_cli.config_file import load_problem
 from excite_cli.identification.config import IdentifyProblem, SimulationConfig
 from excite_cli.identification.fitting.least_squares import torque_errors
@@ -22,6 +23,9 @@ from excite_cli.workflows.simulate import simulate_runs
 
 COLUMNS = {"q": [f"q_{j}" for j in JOINTS], "tau": [f"tau_{j}" for j in JOINTS]}
 ROBOT = {"urdf": "panda_description/urdf/panda.urdf", "source": "example-robot-data", "active_joints": JOINTS}
+
+
+runner = CliRunner()
 
 
 def _identify(tmp: Path, runs: list[dict], name: str, **identification):

@@ -1,22 +1,21 @@
 """CoM region (Eq. 52) and capsule self-collision (Eq. 53): Jacobians against finite differences,
 exact distances against coal, capsule fitting, and problems infeasible before optimization."""
 
-from pathlib import Path
-
 import coal
 import numpy as np
 import pinocchio as pin
 import pytest
 import yaml
-from conftest import CONFIGS, write_config
+from conftest import CONFIGS, TESTS, write_config
 
-from excite_cli.collision.capsules import capsule_frames, fit_capsule, segment_closest_points
+from excite_cli.collision.capsules import capsule_frames
 from excite_cli.config_file import load_problem
+from excite_cli.constraints.self_collision import SelfCollision
 from excite_cli.errors import ExciteError
 from excite_cli.optimization.excitation import build_excitation
 from excite_cli.optimization.verify import constraint_jacobian_error
 
-HERE = Path(__file__).resolve().parent
+HERE = TESTS
 
 
 def _g1(tmp_path, **edits):
@@ -62,6 +61,7 @@ def test_panda_capsule_jacobian_matches_finite_differences(panda):
 def test_closed_form_distances_and_witness_points_equal_coal(robot, request):
     excitation = request.getfixturevalue(robot)
     constraint = excitation.constraints[-1]
+    assert isinstance(constraint, SelfCollision)
     Q = excitation.grid_basis.q @ _lively(excitation, 3).T
     d, c1, normal, _, _ = constraint._closest(Q)
     rotations, centres = capsule_frames(*constraint.kinematics.placements(Q), constraint.capsules)
@@ -74,65 +74,6 @@ def test_closed_form_distances_and_witness_points_equal_coal(robot, request):
             np.testing.assert_allclose(
                 c1[:, t, p] + (d[t, p] + radii[i]) * normal[:, t, p], exact.getNearestPoint2(), atol=1e-6
             )
-
-
-@pytest.mark.parametrize("robot", ["panda", "g1"])
-def test_batched_kinematics_equal_pinocchio(robot, request):
-    excitation = request.getfixturevalue(robot)
-    model, kinematics = excitation.robot.model, excitation.constraints[-1].kinematics
-    data = model.createData()
-    Q = excitation.grid_basis.q @ _lively(excitation, 4).T
-    R, p = kinematics.placements(Q)
-    for t in range(0, Q.shape[0], 5):
-        state = excitation.robot.state(Q[t], 0 * Q[t], 0 * Q[t])[0]
-        pin.computeJointJacobians(model, data, state)
-        for j in range(1, model.njoints):
-            np.testing.assert_allclose(R[t, j], data.oMi[j].rotation, atol=1e-12)
-            np.testing.assert_allclose(p[t, j], data.oMi[j].translation, atol=1e-12)
-        point, normal = p[t, -1] + [0.1, -0.05, 0.2], np.array([0.6, 0.0, 0.8])
-        J = pin.getJointJacobian(model, data, model.njoints - 1, pin.LOCAL_WORLD_ALIGNED)[:, excitation.robot.v_idx]
-        expected = normal @ (J[:3] - pin.skew(point - p[t, -1]) @ J[3:])
-        got = kinematics.distance_rates(R[t : t + 1], p[t : t + 1], point[:, None, None], normal[:, None, None])
-        np.testing.assert_allclose(got[0, 0] * kinematics.ancestors[-1], expected, atol=1e-12)
-
-
-def segment_distances(p1, q1, p2, q2):
-    c1, c2 = segment_closest_points(p1, q1, p2, q2)
-    return np.linalg.norm(c2 - c1, axis=0)
-
-
-def test_segment_distance_closed_forms():
-    z = np.zeros(3)
-    assert segment_distances(z, np.array([1.0, 0, 0]), np.array([0.5, 1, 0]), np.array([0.5, 2, 0])) == pytest.approx(
-        1.0
-    )
-    assert segment_distances(z, np.array([1.0, 0, 0]), np.array([2.0, 0, 0]), np.array([3.0, 0, 0])) == pytest.approx(
-        1.0
-    )
-    assert segment_distances(z, z, np.array([0, 3.0, 4.0]), np.array([0, 3.0, 4.0])) == pytest.approx(5.0)
-    point = np.array([0.5, 2.0, 0.0])
-    assert segment_distances(z, np.array([1.0, 0, 0]), point, point) == pytest.approx(2.0)
-    assert segment_distances(point, point, z, np.array([1.0, 0, 0])) == pytest.approx(2.0)
-    skew = segment_distances(
-        np.array([-1.0, 0, 0]), np.array([1.0, 0, 0]), np.array([0, -1.0, 2]), np.array([0, 1.0, 2])
-    )
-    assert skew == pytest.approx(2.0)
-
-
-def test_fitted_capsule_covers_its_points():
-    rng = np.random.default_rng(0)
-    points = rng.normal(size=(500, 3)) * [0.2, 0.03, 0.02] + [0.1, -0.2, 0.3]
-    radius, start, end = fit_capsule(points)
-    assert (
-        segment_distances(
-            np.broadcast_to(start[:, None], points.T.shape),
-            np.broadcast_to(end[:, None], points.T.shape),
-            points.T,
-            points.T,
-        ).max()
-        <= radius + 1e-12
-    )
-    assert np.linalg.norm(end - start) > 0.5  # along the long axis
 
 
 def test_com_region_holds_at_home_and_fails_when_too_small(g1, tmp_path):

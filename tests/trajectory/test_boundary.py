@@ -7,6 +7,8 @@ from conftest import CONFIGS, small
 from excite_cli.config_file import load_problem
 from excite_cli.errors import ExciteError
 from excite_cli.optimization.excitation import build_excitation
+from excite_cli.trajectory.boundary import BoundaryConditions, boundary_rows
+from excite_cli.trajectory.fourier import FourierTrajectory
 
 
 def _excitation(boundary="rest", ends_at_home=False, duration=None, harmonics=4):
@@ -91,3 +93,16 @@ def test_random_starts_are_at_rest_and_feasible():
 def test_too_few_harmonics_for_rest_is_a_config_error():
     with pytest.raises(ExciteError, match="trajectory.harmonics"):
         _excitation(harmonics=1)
+
+
+def test_rows_are_the_fourier_basis_of_velocity_acceleration_and_position_at_both_ends():
+    trajectory = FourierTrajectory(3, 0.7)
+    rows = boundary_rows(trajectory, 5.0, rest=True, at_home=True)
+    ends = trajectory.basis(np.array([0.0, 5.0]))
+    expected = np.vstack([ends.qd, ends.qdd, ends.q])  # q̇, q̈ at 0 and T, then q at 0 and T
+    assert rows.shape == expected.shape
+    for row in expected:
+        assert np.min(np.abs(rows - row).max(axis=1)) < 1e-12
+    conditions = BoundaryConditions(rows, np.zeros((2, rows.shape[0])), np.ones((2, 7)))
+    alpha = conditions.to_alpha(np.random.default_rng(0).standard_normal(conditions.size))
+    np.testing.assert_allclose(alpha @ rows.T, 0.0, atol=1e-12)  # every point of the coordinates meets them

@@ -1,11 +1,10 @@
 """The base parameters travel with the data: every file stores them, every reader checks them by name,
 takes columns in another order, and refuses other base parameters in one line."""
 
-from pathlib import Path
-
 import h5py
 import numpy as np
 import pytest
+from conftest import CONFIGS
 
 from excite_cli.config_file import load_problem
 from excite_cli.errors import ExciteError
@@ -13,8 +12,6 @@ from excite_cli.h5 import read_strings, write_strings
 from excite_cli.optimization.excitation import build_excitation
 from excite_cli.optimization.sequence import describe
 from excite_cli.storage.results import read_iterations, read_prior, write_result
-
-CONFIGS = Path(__file__).resolve().parent.parent / "configs"
 
 
 @pytest.fixture(scope="module")

@@ -1,0 +1,95 @@
+"""What the commands print, from the library's records: Table I and the restarts, the validation
+table, the progress lines of a log, and errors worded as the command's options."""
+
+import io
+
+import numpy as np
+from conftest import CONFIGS
+from rich.console import Console
+
+from excite_cli.cli import export, validate
+from excite_cli.config import OptimizerConfig
+from excite_cli.config_file import load_problem
+from excite_cli.console import tables
+from excite_cli.console.errors import spellings, word
+from excite_cli.console.identification import validation
+from excite_cli.console.progress import Bars
+from excite_cli.errors import ExciteError, OutputExists
+from excite_cli.identification.validate import RunError
+from excite_cli.optimization.optimality import Optimality
+from excite_cli.optimization.optimizer import RestartResult
+from excite_cli.optimization.sequence import IterationResult
+
+
+def _text(renderables) -> str:
+    console = Console(record=True, width=300, file=io.StringIO())
+    for r in renderables:
+        console.print(r)
+    return console.export_text()
+
+
+def _iteration() -> IterationResult:
+    restart = RestartResult(
+        0,
+        np.zeros((1, 3)),
+        np.log(12.34),
+        200,
+        "limit",
+        1.0,
+        np.log(99.0),
+        np.zeros((200, 2)),
+        Optimality(0.25, 3, 1.0, -0.01),
+        "stalled",
+        "projected",
+    )
+    return IterationResult(
+        1,
+        np.zeros((1, 3)),
+        np.zeros(2),
+        np.zeros((2, 1)),
+        np.zeros((2, 1)),
+        np.zeros((2, 1)),
+        np.ones((4, 2)),
+        12.34,
+        12.34,
+        -0.011,
+        2077.9,
+        2077.9,
+        0.5,
+        0.5,
+        restarts=(restart,),
+    )
+
+
+def test_table_one_prints_both_condition_numbers_and_the_restarts_name_the_criterion():
+    text = _text(tables.iterations([_iteration()], OptimizerConfig(objective="log_cond", scaling="urdf")))
+    row = next(line for line in text.splitlines() if line.strip().startswith("│    1 │"))
+    assert "12.3" in row and "2078" in row and "0.5" in row and "stalled" in row
+    assert "end cond(CL)" in text and "12.34" in text and "2.5e-01" in text  # exp of the kept log cond
+    assert "end log_det(C)" in _text(tables.iterations([_iteration()], OptimizerConfig(objective="log_det")))
+
+
+def test_validation_table_gives_each_run_its_joints_and_mean():
+    errors = [RunError("run.csv", np.array([0.1, 0.2]), np.array([1.0, 2.0]), 150)]
+    row = next(line for line in _text([validation("r.h5", ["j1", "j2"], errors)]).splitlines() if "run.csv" in line)
+    assert [cell.strip() for cell in row.split("│")[2:6]] == ["150", "1.0", "2.0", "1.5"]
+
+
+def test_a_log_gets_one_line_per_finished_iteration():
+    out = io.StringIO()
+    with Bars(Console(file=out, width=200, force_terminal=False)) as bars:
+        progress, done = bars.iterations(load_problem(CONFIGS / "smoke.yaml"))
+        progress(1)(0, 5, -3.0)
+        done(_iteration())
+    assert "iteration 1: cond(C(i)) 12.3, cond(C) 12.3, 0 s, 200 solver iterations, stop: stalled" in out.getvalue()
+
+
+def test_the_command_line_words_fields_as_its_options():
+    spelled = spellings(export)
+    assert spelled["fmt"] == spelled["format"] == "--format" and spelled["result"] == "RESULT"
+    assert spellings(validate)["report"] == "REPORT"
+    assert (
+        word(ExciteError("format", "unknown", "xml", "csv or npz"), spelled) == "--format: unknown; expected csv or npz"
+    )
+    assert word(ExciteError("limits.velocity", "must be > 0", -1.0), spelled) == "limits.velocity: must be > 0"
+    assert word(OutputExists("output", "r.h5"), spelled) == "--output: r.h5 exists; use --force to replace it"

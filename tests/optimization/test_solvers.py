@@ -1,0 +1,50 @@
+"""Every method of optimizer.method on a problem whose optimum is known: the nearest point of a disc
+to an outside point, min |z − a|² s.t. |z|² ≤ 1, optimum a/|a|, multiplier |a| − 1."""
+
+import numpy as np
+import pytest
+
+from excite_cli.errors import ExciteError
+from excite_cli.optimization.solvers import METHODS, solve
+
+
+class Disc:
+    """The NLP protocol of the solvers, with evaluation counts."""
+
+    def __init__(self, target):
+        self.target, self.calls = np.asarray(target, dtype=float), {"value": 0, "gradient": 0}
+
+    def value(self, z):
+        self.calls["value"] += 1
+        return float((z - self.target) @ (z - self.target))
+
+    def gradient(self, z):
+        self.calls["gradient"] += 1
+        return 2.0 * (z - self.target)
+
+    def constraint_values(self, z):
+        return np.array([z @ z - 1.0])
+
+    def constraint_jacobian(self, z):
+        return 2.0 * z[None, :]
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_each_method_finds_the_nearest_point_of_the_disc(method):
+    if method == "ipopt":
+        pytest.importorskip("cyipopt")
+    nlp, seen = Disc([3.0, 4.0]), []
+    run = solve(method, nlp, np.zeros(2), 200, 1e-10, seen.append)
+    np.testing.assert_allclose(run.z, [0.6, 0.8], atol=1e-5)
+    assert not run.failed and 0 < run.iterations <= 200 and len(seen) >= 1
+    assert nlp.calls["gradient"] <= nlp.calls["value"] + 1  # gradients only where the solver needs them
+
+
+def test_an_iteration_limit_is_reported_as_such():
+    run = solve("SLSQP", Disc([3.0, 4.0]), np.array([-0.9, 0.1]), 1, 1e-12, lambda z: None)
+    assert run.limit and not run.failed and run.iterations == 1
+
+
+def test_an_unknown_method_is_named():
+    with pytest.raises(ExciteError, match="optimizer.method"):
+        solve("newton", Disc([1.0, 1.0]), np.zeros(2), 10, 1e-6, lambda z: None)

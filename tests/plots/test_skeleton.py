@@ -1,0 +1,23 @@
+"""The skeleton drawn in the posture strip: joint origins against the robots' own geometry."""
+
+import numpy as np
+from conftest import CONFIGS, robot_of
+
+from excite_cli.config_file import load_problem
+from excite_cli.plots.skeleton import skeleton
+
+
+def test_skeleton_of_the_panda_at_zero_reaches_the_flange():
+    robot = robot_of(load_problem(CONFIGS / "panda_joint_limits.yaml"))
+    points = skeleton(robot, np.zeros(7)).reshape(-1, 3)
+    # Panda kinematics at q = 0 (Franka's DH table): flange at x = 0.088 m, z = 0.333 + 0.316 + 0.384 − 0.107 m
+    assert np.min(np.linalg.norm(points - [0.088, 0.0, 0.926], axis=1)) < 1e-6
+    assert np.min(np.linalg.norm(points - [0.0825, 0.0, 0.649], axis=1)) < 1e-6
+
+
+def test_skeleton_of_the_g1_has_its_locked_legs(g1_problem):
+    robot = robot_of(g1_problem)
+    points = skeleton(robot, robot.home).reshape(-1, 3)
+    lengths = np.linalg.norm(np.diff(skeleton(robot, robot.home), axis=1)[:, 0], axis=1)
+    # the soles are ~0.79 m below the pelvis (the floating base at the origin); legs are locked joints
+    assert points[:, 2].min() < -0.7 and np.count_nonzero(lengths > 0.1) >= 8
