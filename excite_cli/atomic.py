@@ -75,7 +75,7 @@ def atomic_path(path: Path, field: str = "output") -> Iterator[Path]:
         yield tmp
 
 
-def atomic_bytes(path: Path, data: bytes, field: str = "output") -> Path:
+def atomic_bytes(path: Path, data: bytes | memoryview, field: str = "output") -> Path:
     """``data`` written to ``path`` through :func:`atomic_path` and flushed to the disk (``fsync``),
     so a full disk or a file-size limit is a :class:`CannotWrite` and never a half-written file.
 

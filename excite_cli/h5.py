@@ -18,6 +18,8 @@ import numpy as np
 from excite_cli.atomic import atomic_bytes
 from excite_cli.errors import ExciteError, FileNotFound
 
+#: Rows written at once by :func:`write_parts` (16 chunks of 4096; a few MB).
+WRITE_ROWS = 65536
 VERSIONED_PACKAGES = ("excite", "pin", "coal", "numpy", "scipy", "h5py", "example-robot-data")
 
 
@@ -37,7 +39,8 @@ def atomic_h5(path: Path, field: str = "output") -> Iterator[h5py.File]:
         for name, version in package_versions().items():
             f.attrs[f"version_{name}"] = version
         yield f
-    atomic_bytes(path, buffer.getvalue(), field)
+    with buffer.getbuffer() as view:  # the file's bytes without a copy of them (it can be most of the memory)
+        atomic_bytes(path, view, field)
 
 
 @contextmanager
@@ -97,3 +100,21 @@ def write_table(group: h5py.Group, name: str, rows: Sequence[tuple], fields: str
 def read_strings(group: h5py.Group, name: str) -> list[str]:
     """The strings of a dataset written by :func:`write_strings` (bytes decoded)."""
     return [v.decode() if isinstance(v, bytes) else str(v) for v in group[name][()]]
+
+
+def write_parts(group: h5py.Group, name: str, parts: list[np.ndarray], columns: int) -> h5py.Dataset:
+    """One dataset (M, columns) of the rows of ``parts`` ((M_k, columns) each, in order), compressed
+    (gzip with byte shuffling, 4096-row chunks) and written ``WRITE_ROWS`` rows at a time: no stacked
+    copy, and ``parts`` is emptied as they are written, so that a part's memory is freed while the
+    file (built in memory by :func:`atomic_h5`) grows by as much."""
+    total = sum(part.shape[0] for part in parts)
+    options = {"compression": "gzip", "shuffle": True, "chunks": (min(total, 4096), columns)} if total else {}
+    data = group.create_dataset(name, shape=(total, columns), dtype="f8", **options)
+    at = 0
+    while parts:
+        part = parts.pop(0)
+        for lo in range(0, part.shape[0], WRITE_ROWS):  # h5py copies what it writes: a slice at a time
+            rows = part[lo : lo + WRITE_ROWS]
+            data[at : at + rows.shape[0]] = rows
+            at += rows.shape[0]
+    return data

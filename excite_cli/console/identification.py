@@ -9,7 +9,7 @@ from rich.table import Table
 
 from excite_cli.console.tables import titled_table
 from excite_cli.dynamics.robot import Robot
-from excite_cli.identification.choice.selection import MOVE_SIGNS
+from excite_cli.identification.choice.search import MOVE_SIGNS
 from excite_cli.identification.fitting.physical import body_properties, pseudo_inertia
 from excite_cli.identification.reporting.report import Report
 from excite_cli.identification.validate import RunError
@@ -25,10 +25,15 @@ def validation(name: str, joints: Sequence[str], errors: Sequence[RunError]) -> 
 
 
 def preprocessing_notes(report: Report) -> list[str]:
-    """The cut-off used (and where it came from) and the rows dropped per run."""
-    return [f"low-pass cut-off {report.cutoff:.3g} Hz ({report.cutoff_source}); stored as cutoff_Hz"] + [
-        f"data.bad_rows: dropped {rows} unusable row(s) of {name}" for name, rows in report.dropped
-    ]
+    """The cut-off used (and where it came from), the rows dropped per run, the warnings and the
+    joints the model predicts worse than the rigid body."""
+    worse = [report.joints[j] for j in np.flatnonzero(report.worse_than_rigid_body)]
+    return (
+        [f"low-pass cut-off {report.cutoff:.3g} Hz ({report.cutoff_source}); stored as cutoff_Hz"]
+        + [f"data.bad_rows: dropped {rows} unusable row(s) of {name}" for name, rows in report.dropped]
+        + [f"warning: {w}" for w in report.warnings]
+        + ([f"warning: worse than the rigid body on the validation data: {', '.join(worse)}"] if worse else [])
+    )
 
 
 def identification(report: Report) -> list[Table | str]:
@@ -162,7 +167,7 @@ def _selection_tables(report: Report) -> list[Table | str]:
             (
                 str(order[t]),
                 t.effect,
-                report.joints[t.joint],
+                t.where(report.joints) if t.coupling is None else f"motor of {t.where(report.joints)}",
                 "" if t.shape is None else f"{t.shape:g}",
                 f"{name} [{t.kind.units[0]}]",
                 f"{value:.5g}",

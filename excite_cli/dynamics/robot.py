@@ -11,53 +11,18 @@ from __future__ import annotations
 
 import difflib
 from dataclasses import dataclass, field
-from importlib import metadata
 from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 
-from excite_cli.config import RobotConfig, resolve_path
+from excite_cli.config import RobotConfig
 from excite_cli.dynamics.urdf_checks import check_urdf
+from excite_cli.dynamics.urdf_source import resolve_urdf
 from excite_cli.errors import ExciteError
 
 #: Order of pinocchio's 10 dynamic parameters of one body (``Inertia.toDynamicParameters``).
 PARAMETER_SYMBOLS = ("m", "mx", "my", "mz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz")
-
-
-def example_robot_data_root() -> Path:
-    """Folder ``share`` of the installed example-robot-data package (holds ``example-robot-data/robots``).
-
-    Raises:
-        ExciteError: the package is not installed.
-    """
-    try:
-        dist = metadata.distribution("example-robot-data")
-    except metadata.PackageNotFoundError:
-        raise ExciteError("robot.source", "example-robot-data is not installed (run `make install`)") from None
-    return Path(dist.locate_file("cmeel.prefix/share")).resolve()
-
-
-def resolve_urdf(cfg: RobotConfig, folder: Path | None = None) -> tuple[Path, list[str]]:
-    """The URDF file named by ``robot.urdf`` and the package folders its meshes are found in.
-
-    Args:
-        cfg: the ``robot`` section.
-        folder: the config file's folder, which a relative ``urdf`` with ``source: file`` is in.
-
-    Raises:
-        ExciteError: the file does not exist.
-    """
-    if cfg.source == "example-robot-data":
-        share = example_robot_data_root()
-        path = share / "example-robot-data" / "robots" / cfg.urdf
-        dirs = [str(share)]
-    else:
-        path = resolve_path(cfg.urdf, folder)
-        dirs = [str(path.parent), str(path.parent.parent)]
-    if not path.is_file():
-        raise ExciteError("robot.urdf", f"no URDF file at {path}")
-    return path, dirs
 
 
 def _unknown_joint(field_name: str, name: str, known: list[str]) -> ExciteError:
@@ -101,6 +66,7 @@ class Robot:
     home: np.ndarray
     collision_model: pin.GeometryModel | None = None
     links: list[tuple[str, str]] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
     data: pin.Data = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
@@ -233,6 +199,7 @@ def load_robot(
     collision: bool = False,
     urdf: Path | None = None,
     joint_rows_only: bool = False,
+    physical: bool = True,
 ) -> Robot:
     """Build the :class:`Robot` of a ``robot`` section: load the URDF, lock the non-active joints.
 
@@ -244,13 +211,15 @@ def load_robot(
             section's joints.
         joint_rows_only: the regressor rows are the active joints' torques, whatever
             ``robot.base_wrench_rows`` says (identification measures joint torques).
+        physical: refuse a moved link whose URDF inertia no body can have; False (identification,
+            which takes the URDF's inertias as a reference only): keep it in ``Robot.warnings``.
 
     Raises:
         ExciteError: missing URDF, unknown joint name, a joint that is not 1-DoF, a locked value
             outside the joint's limits, a body or active joint that cannot be (:func:`check_urdf`).
     """
     path, package_dirs = resolve_urdf(cfg, folder) if urdf is None else (urdf, [str(urdf.parent)])
-    check_urdf(path, list(cfg.active_joints))  # before urdfdom, which prints what it cannot parse
+    problems = check_urdf(path, list(cfg.active_joints), physical)  # before urdfdom, which prints what it cannot parse
     try:
         full = pin.buildModelFromUrdf(str(path), *([pin.JointModelFreeFlyer()] if cfg.floating_base else []))
     except (RuntimeError, ValueError) as exc:
@@ -296,4 +265,5 @@ def load_robot(
         home=np.clip(home, lower, upper),
         collision_model=geometry,
         links=joint_frame_links(full),
+        warnings=[f"{p} in {path.name}: kept as the identification's reference only" for p in problems],
     )

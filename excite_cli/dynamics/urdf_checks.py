@@ -48,16 +48,20 @@ def _number(element: ElementTree.Element, attribute: str, what: str) -> float:
     return value
 
 
-def check_inertial(link: ElementTree.Element, moved: bool = True) -> None:
+def check_inertial(link: ElementTree.Element, moved: bool = True) -> str:
     """The inertial parameters of one URDF ``<link>`` (module docstring); ``moved``: an active joint
     moves it (its principal moments are checked).
 
+    Returns:
+        The principal moments' problem in words (the link's inertia no body can have), or "".
+
     Raises:
-        ExciteError: naming the link and what is wrong.
+        ExciteError: naming the link and what is wrong (a mass or inertia that is not a number, a
+            negative mass).
     """
     inertial = link.find("inertial")
     if inertial is None:
-        return
+        return ""
     name = f"link '{link.get('name')}'"
     mass = inertial.find("mass")
     m = 0.0 if mass is None else _number(mass, "value", f"{name}: mass")
@@ -65,20 +69,17 @@ def check_inertial(link: ElementTree.Element, moved: bool = True) -> None:
         raise ExciteError("robot.urdf", f"{name} has a negative mass ({m:g} kg)", m, "a mass ≥ 0 kg")
     element = inertial.find("inertia")
     if element is None:
-        return
+        return ""
     ixx, ixy, ixz, iyy, iyz, izz = (_number(element, k, f"{name}: inertia") for k in INERTIA)
     if not moved:
-        return
+        return ""
     moments = np.linalg.eigvalsh(np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]]))
     slack = TOLERANCE * max(abs(moments[2]), 1e-12)
     if moments[0] < -slack or moments[0] + moments[1] < moments[2] - slack:
-        raise ExciteError(
-            "robot.urdf",
-            f"{name} has an inertia no body can have (principal moments {', '.join(f'{x:.4g}' for x in moments)} "
-            "kg·m²)",
-            None,
-            "moments ≥ 0 with the two smaller summing to at least the largest",
+        return (
+            f"{name} has an inertia no body can have (principal moments {', '.join(f'{x:.4g}' for x in moments)} kg·m²)"
         )
+    return ""
 
 
 def check_joints(root: ElementTree.Element, active: list[str]) -> None:
@@ -108,11 +109,20 @@ def check_joints(root: ElementTree.Element, active: list[str]) -> None:
             )
 
 
-def check_urdf(path: Path, active: list[str]) -> None:
+def check_urdf(path: Path, active: list[str], physical: bool = True) -> list[str]:
     """Every check of the module docstring on the URDF at ``path``.
 
+    Args:
+        physical: refuse a moved link whose inertia no body can have; False (identification, which
+            uses the URDF's inertias as a reference only, and vendors' URDFs often break the triangle
+            inequality): return such links' problems in words instead.
+
+    Returns:
+        The moved links' inertias no body can have, in words (empty with ``physical``).
+
     Raises:
-        ExciteError: the file is not XML, or a link or active joint that cannot be.
+        ExciteError: the file is not XML, a mass or inertia that is not a number, a negative mass, an
+            active joint that cannot be, or (with ``physical``) an inertia no body can have.
     """
     try:
         root = ElementTree.parse(path).getroot()
@@ -130,6 +140,10 @@ def check_urdf(path: Path, active: list[str]) -> None:
         link = moved.pop()
         below.add(link)
         moved += [c for c in children.get(link, []) if c not in below]
-    for link in root.findall("link"):
-        check_inertial(link, link.get("name") in below)
+    problems = [p for link in root.findall("link") if (p := check_inertial(link, link.get("name") in below))]
+    if problems and physical:
+        raise ExciteError(
+            "robot.urdf", problems[0], None, "moments ≥ 0 with the two smaller summing to at least the largest"
+        )
     check_joints(root, active)
+    return problems

@@ -20,6 +20,9 @@ Effect = Literal[EFFECT_NAMES]
 DEFAULT_CANDIDATES = tuple(e for e in EFFECT_NAMES if not EFFECTS[e].position)
 #: Default regularization weights λ of the consistent fit, among which the cross-validation chooses.
 REGULARIZATION = (1e-5, 1e-4, 1e-3, 1e-2, 1e-1)
+#: Default ratios r of the couplings q_i + r q_(i+1) the search proposes between neighbouring joints
+#: when no transmission is declared (a motor turning with two joints: a coupled wrist).
+COUPLING_RATIOS = (1.0, -1.0)
 
 
 Column = Union[NonNegativeInt, str]
@@ -28,20 +31,31 @@ MAX_RATE = 100_000.0
 
 
 class ColumnsConfig(Section):
-    """Columns of measured data, in active-joint order, by name or by 0-based position (README:
-    identification config)."""
+    """Columns of measured data, in active-joint order, by name or by 0-based position, and the factor
+    of any column recorded in other units (SI value = recorded value × factor: encoder counts → rad,
+    mA → A, ms → s) (README: identification config)."""
 
-    time: Column = "time"
+    time: Optional[Column] = "time"
     q: list[Column] = Field(min_length=1)
     qd: Optional[list[Column]] = None
     qdd: Optional[list[Column]] = None
     tau: Optional[list[Column]] = None
     current: Optional[list[Column]] = None
+    factors: dict[str, float] = Field(default_factory=dict)
 
     @model_validator(mode="after")
     def _torque_source(self) -> "ColumnsConfig":
         if (self.tau is None) == (self.current is None):
             raise ValueError("give exactly one of tau or current columns")
+        named = {str(k) for keys in (self.q, self.qd, self.qdd, self.tau, self.current) for k in keys or []}
+        named.add(str(self.time))
+        for key, factor in self.factors.items():
+            if key not in named:
+                raise ValueError(f"factors names '{key}', which is not one of the columns given")
+            if factor == 0.0 or not np.isfinite(factor):
+                raise ValueError(
+                    f"the factor of '{key}' must be a finite number other than 0 (SI value per recorded unit)"
+                )
         return self
 
 
@@ -71,7 +85,7 @@ class PayloadConfig(Section):
 class RunConfig(Section):
     """One measured run: file, optional crop [s], role (fit, validation or time blocks), a known payload."""
 
-    file: str
+    file: Union[str, list[str]]
     crop: Optional[tuple[float, float]] = None
     role: Literal["fit", "validation", "blocks"] = "blocks"
     payload: Optional[PayloadConfig] = None
@@ -79,7 +93,43 @@ class RunConfig(Section):
     @property
     def label(self) -> str:
         """The file name with the crop, for tables and reports, e.g. ``run.csv [7.8, 13.2] s``."""
-        return Path(self.file).name + (f" [{self.crop[0]:g}, {self.crop[1]:g}] s" if self.crop else "")
+        files = [self.file] if isinstance(self.file, str) else self.file
+        return " + ".join(Path(f).name for f in files) + (
+            f" [{self.crop[0]:g}, {self.crop[1]:g}] s" if self.crop else ""
+        )
+
+
+class TransmissionConfig(Section):
+    """The transmissions from the datasheet: gear ratios N (n,) and a coupling matrix C (n, n) (default
+    the identity), so that motor angles are m = R q with R = diag(N) C and joint torques τ = Rᵀ τ_m. A
+    coupled wrist whose motor 6 turns with q5 + q6 has C row 6 = [0, 0, 0, 0, 1, 1]."""
+
+    gear_ratios: list[float] = Field(min_length=1)
+    coupling: Optional[list[list[float]]] = None
+
+    @field_validator("gear_ratios")
+    @classmethod
+    def _nonzero_ratios(cls, values):
+        if any(v == 0.0 or not np.isfinite(v) for v in values):
+            raise ValueError("every gear ratio must be a finite number other than 0")
+        return values
+
+    @model_validator(mode="after")
+    def _invertible(self) -> "TransmissionConfig":
+        n = len(self.gear_ratios)
+        if self.coupling is not None:
+            C = np.asarray(self.coupling, dtype=float)
+            if C.shape != (n, n) or not np.all(np.isfinite(C)):
+                raise ValueError(f"coupling must be {n} rows of {n} numbers, one per motor and joint")
+            if abs(np.linalg.det(C)) < 1e-9:
+                raise ValueError("coupling must be invertible: every joint angle follows from the motor angles")
+        return self
+
+    def reduction(self) -> np.ndarray:
+        """R (n, n) = diag(N) C: motor angles m = R q."""
+        n = len(self.gear_ratios)
+        C = np.eye(n) if self.coupling is None else np.asarray(self.coupling, dtype=float)
+        return np.asarray(self.gear_ratios, dtype=float)[:, None] * C
 
 
 class DataConfig(Section):
@@ -95,6 +145,17 @@ class DataConfig(Section):
     signs: Optional[list[float]] = None
     validation_blocks: int = Field(4, ge=2, le=100)
     bad_rows: Literal["error", "drop"] = "error"
+    transmission: Optional[TransmissionConfig] = None
+    motor_side: bool = False
+    sample_rate: Optional[PositiveFloat] = None
+
+    @model_validator(mode="after")
+    def _consistent(self) -> "DataConfig":
+        if self.motor_side and self.transmission is None:
+            raise ValueError("motor_side needs data.transmission (gear ratios and coupling) to reach the joints")
+        if self.columns is not None and self.columns.time is None and self.sample_rate is None:
+            raise ValueError("files without a time column (columns.time: null) need data.sample_rate [Hz]")
+        return self
 
     @field_validator("torque_constants")
     @classmethod
@@ -141,6 +202,8 @@ class IdentificationConfig(Section):
     max_effects: int = Field(60, ge=0)
     fit: Literal["auto", "least_squares", "consistent"] = "auto"
     regularization: list[NonNegativeFloat] = Field(default_factory=lambda: list(REGULARIZATION), min_length=1)
+    coupling_ratios: list[float] = Field(default_factory=lambda: list(COUPLING_RATIOS))
+    coupling_improvement: float = Field(0.2, ge=0.0, lt=10.0)
 
     @field_validator("stribeck_velocity", "held_velocity", "regularization", mode="before")
     @classmethod
@@ -176,3 +239,12 @@ class SimulationConfig(Section):
     stribeck_velocity: float = Field(0.1, gt=0.0)
     coulomb_velocity: float = Field(0.01, gt=0.0)
     held_velocity: float = Field(0.02, gt=0.0)
+    transmission: Optional[TransmissionConfig] = None
+    motor_effects: dict[Literal["armature", "coulomb", "viscous"], dict[str, float]] = Field(default_factory=dict)
+    motor_side: bool = False
+
+    @model_validator(mode="after")
+    def _motors_need_the_transmission(self) -> "SimulationConfig":
+        if (self.motor_effects or self.motor_side) and self.transmission is None:
+            raise ValueError("motor_effects and motor_side need a transmission (gear ratios and coupling)")
+        return self

@@ -57,6 +57,8 @@ class Effect:
         per_run: one column per fitted run.
         position: its columns depend on the position, so they are guarded outside the fit data's
             q range.
+        motor: a motor's inertia or friction, which acts through a transmission: a candidate on
+            coupled motors too (:class:`Term` ``coupling``).
     """
 
     name: str
@@ -69,6 +71,7 @@ class Effect:
     two_stage: bool = False
     per_run: bool = False
     position: bool = False
+    motor: bool = False
 
     def unit(self, coefficient: str) -> str:
         """The unit of one of its coefficients."""
@@ -79,9 +82,9 @@ class Effect:
 EFFECTS = {
     e.name: e
     for e in (
-        Effect("coulomb", ("Fc",), ("Nm",), lambda s: [s.sign]),
+        Effect("coulomb", ("Fc",), ("Nm",), lambda s: [s.sign], motor=True),
         Effect("coulomb_asymmetric", ("Fa",), ("Nm",), lambda s: [np.abs(s.sign)], requires="coulomb"),
-        Effect("viscous", ("Fv",), ("Nm·s/rad",), lambda s: [s.qd]),
+        Effect("viscous", ("Fv",), ("Nm·s/rad",), lambda s: [s.qd], motor=True),
         Effect("viscous_asymmetric", ("Fva",), ("Nm·s/rad",), lambda s: [np.abs(s.qd)], requires="viscous"),
         Effect(
             "stribeck",
@@ -97,7 +100,7 @@ EFFECTS = {
         ),
         Effect("load_coulomb", ("Fl",), ("Nm/Nm",), lambda s: [np.abs(s.rigid) * s.sign], two_stage=True),
         Effect("offset", ("tau0",), ("Nm",), lambda s: [np.ones_like(s.q)], per_run=True),
-        Effect("armature", ("Ia",), ("kg·m²",), lambda s: [s.qdd]),
+        Effect("armature", ("Ia",), ("kg·m²",), lambda s: [s.qdd], motor=True),
         Effect("spring", ("k",), ("Nm/rad",), lambda s: [s.q], position=True),
         Effect("gravity_compensator", ("gs", "gc"), ("Nm", "Nm"), lambda s: [np.sin(s.q), np.cos(s.q)], position=True),
         Effect("position_2", ("gs2", "gc2"), ("Nm", "Nm"), lambda s: [np.sin(2 * s.q), np.cos(2 * s.q)], position=True),
@@ -109,28 +112,66 @@ SHAPE_GRID = (0.02, 0.05, 0.1, 0.2, 0.5)
 
 
 class Term(NamedTuple):
-    """One effect on one joint: a block of columns of the model.
+    """One effect on one joint, or on a motor that turns with several joints: a block of columns of
+    the model.
+
+    A coupled term acts through a transmission (a coupled wrist: one motor turns with q5 + q6): its
+    columns are the effect's in the motor coordinate s = Σ_i c_i q_i (``coupling`` c, (n,)), and it
+    adds c_i × its torque to joint i's row, τ = cᵀ τ_motor (DESIGN: transmissions and coupled joints).
+    With c a row of the reduction matrix R (m = R q) its coefficients are the motor's own.
 
     Attributes:
         effect: a key of ``EFFECTS``.
-        joint: active joint index.
+        joint: active joint index (a coupled term: its first joint).
         shape: the shape velocity [rad/s] of a shaped effect (Stribeck v_s, held v_h), else None.
+        coupling: (n,) the motor coordinate's weights over the joints, or None (the joint's own row).
     """
 
     effect: str
     joint: int
     shape: Optional[float] = None
+    coupling: Optional[tuple[float, ...]] = None
 
     @property
     def kind(self) -> Effect:
         """Its :class:`Effect`."""
         return EFFECTS[self.effect]
 
+    @property
+    def joints(self) -> tuple[int, ...]:
+        """The joints whose rows it touches."""
+        return (self.joint,) if self.coupling is None else tuple(int(j) for j in np.flatnonzero(self.coupling))
+
+    @property
+    def family(self) -> tuple:
+        """What a model holds at most one of: the effect on these joints (any shape or coupling ratio)."""
+        return (self.effect, self.joint, self.joints)
+
+    def rows(self, n: int) -> np.ndarray:
+        """(n,) the weight of its torque on each joint's row."""
+        if self.coupling is not None:
+            return np.asarray(self.coupling, dtype=float)
+        out = np.zeros(n)
+        out[self.joint] = 1.0
+        return out
+
+    def where(self, joints: list[str]) -> str:
+        """The joint, or the motor coordinate, e.g. ``panda_joint5`` or ``q5 + q6`` by name."""
+        if self.coupling is None:
+            return joints[self.joint]
+        text = ""
+        for k, j in enumerate(self.joints):
+            c = self.coupling[j]
+            size = "" if abs(abs(c) - 1.0) < 1e-12 else f"{abs(c):g}·"
+            sign = ("−" if c < 0 else "") if k == 0 else (" − " if c < 0 else " + ")
+            text += f"{sign}{size}{joints[j]}"
+        return text
+
     def label(self, joints: list[str]) -> str:
-        """e.g. ``held panda_joint7 (v_h 0.1 rad/s)``."""
-        return f"{self.effect} {joints[self.joint]}" + (
-            f" ({self.kind.shape} {self.shape:g} rad/s)" if self.shape else ""
-        )
+        """e.g. ``held panda_joint7 (v_h 0.1 rad/s)``, ``armature motor of j5 + j6``."""
+        shape = f" ({self.kind.shape} {self.shape:g} rad/s)" if self.shape else ""
+        where = self.where(joints) if self.coupling is None else f"motor of {self.where(joints)}"
+        return f"{self.effect} {where}{shape}"
 
 
 def held_sign(qd: np.ndarray, held_velocity: float) -> np.ndarray:

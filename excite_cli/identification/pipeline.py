@@ -11,16 +11,17 @@ import numpy as np
 
 from excite_cli.config import resolve_path
 from excite_cli.dynamics.base_parameters import BaseParameters, compute_base_parameters
-from excite_cli.dynamics.robot import Robot, load_robot, resolve_urdf
+from excite_cli.dynamics.robot import Robot, load_robot
+from excite_cli.dynamics.urdf_source import resolve_urdf
 from excite_cli.errors import ExciteError
 from excite_cli.identification.choice.fit_choice import choose_fit
-from excite_cli.identification.choice.selection import Selection, candidate_terms, select_effects
+from excite_cli.identification.choice.selection import Selection, candidate_terms, motor_couplings, select_effects
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.effects import EFFECTS, Term
 from excite_cli.identification.fitting.dataset import Dataset, build_datasets, fit_position_range
 from excite_cli.identification.fitting.least_squares import joint_weights, least_squares, predict, torque_errors
 from excite_cli.identification.fitting.normal import NormalEquations, excited_rank
-from excite_cli.identification.measured.measurements import load_run
+from excite_cli.identification.measured.measurements import check_against_limits, load_run, silent_channels
 from excite_cli.identification.measured.payload import payload_parameters
 from excite_cli.identification.measured.preprocessing import choose_cutoff, preprocess
 from excite_cli.identification.reporting.report import Report
@@ -76,7 +77,9 @@ def fold_groups(problem: IdentifyProblem, fitted: list[int]) -> np.ndarray | Non
         ExciteError: ``recording`` or ``run`` folds with fewer than two fit recordings or runs.
     """
     how = problem.identification.folds_by
-    files = np.unique([str(resolve_path(r.file, problem.folder)) for r in problem.data.runs], return_inverse=True)[1]
+    files = np.unique([str(resolve_path(str(r.file), problem.folder)) for r in problem.data.runs], return_inverse=True)[
+        1
+    ]
     groups = {"auto": files, "recording": files, "run": np.arange(files.size), "time_block": None}[how]
     count = 0 if groups is None else np.unique(groups[fitted]).size
     if how == "auto":
@@ -96,7 +99,8 @@ class Prepared:
     """The data ``identify`` works on: fit and validation datasets (two-stage columns included), the
     runs with fit instants, the cut-off [Hz] and its source, rows dropped per run, decimated rate [Hz],
     the fit data's q range per joint (n, 2) [rad] that guards the position-dependent effects (None
-    with ``identification.position_guard`` off or no position effect among the terms)."""
+    with ``identification.position_guard`` off or no position effect among the terms), the joints
+    whose torque channel carries no signal (n,)."""
 
     fit: Dataset
     validation: Dataset
@@ -106,6 +110,7 @@ class Prepared:
     dropped: list[tuple[str, int]]
     rate: float
     q_range: np.ndarray | None
+    silent: np.ndarray
 
 
 def prepare_data(problem: IdentifyProblem, robot: Robot, base: BaseParameters, terms: list[Term]) -> Prepared:
@@ -123,7 +128,17 @@ def prepare_data(problem: IdentifyProblem, robot: Robot, base: BaseParameters, t
         payload_parameters(robot, r.payload, f"data.runs[{k}].payload") if r.payload else None
         for k, r in enumerate(problem.data.runs)
     ]
-    runs = [load_run(r, problem.data, robot.joint_names, problem.folder) for r in problem.data.runs]
+    runs = [
+        check_against_limits(
+            load_run(r, problem.data, robot.joint_names, problem.folder),
+            robot.joint_names,
+            robot.lower,
+            robot.upper,
+            robot.velocity_limit,
+        )
+        for r in problem.data.runs
+    ]  # a list only: the runs are released one by one as they are preprocessed
+    silent = silent_channels(runs)
     cutoff, source = choose_cutoff(runs, problem.preprocessing)
     dropped = [(r.name, r.dropped) for r in runs if r.dropped]
     samples = [preprocess(runs.pop(0), problem.preprocessing, cutoff) for _ in range(len(runs))]
@@ -160,6 +175,7 @@ def prepare_data(problem: IdentifyProblem, robot: Robot, base: BaseParameters, t
         dropped,
         rate,
         q_range,
+        silent,
     )
 
 
@@ -182,13 +198,13 @@ def run_identification(
             solution.
     """
     return_freed_memory()  # memory follows the live (decimated) data
-    robot = load_robot(problem.robot, problem.folder, joint_rows_only=True)
+    robot = load_robot(problem.robot, problem.folder, joint_rows_only=True, physical=False)
     base = compute_base_parameters(robot)
     declared = declared_terms(problem, robot)  # before any data is read
     cfg = problem.identification
-    data = prepare_data(
-        problem, robot, base, declared + [t for t in candidate_terms(cfg, robot.n_joints) if t not in declared]
-    )
+    couplings = motor_couplings(problem.data.transmission, cfg.coupling_ratios, robot.n_joints)
+    candidates = candidate_terms(cfg, robot.n_joints, couplings)
+    data = prepare_data(problem, robot, base, declared + [t for t in candidates if t not in declared])
     fit_data, val_data = data.fit, data.validation
     oversampling = max(1.0, data.rate / (2.0 * data.cutoff))
     selection = select_effects(
@@ -199,6 +215,8 @@ def run_identification(
         oversampling=oversampling,
         recordings=fold_groups(problem, data.fitted),
         fitted_offsets=set(np.unique(val_data.run).tolist()) <= set(data.fitted),
+        couplings=couplings,
+        scored=~data.silent,
     )
     labels = [r.label for r in problem.data.runs]
     offset_runs = [labels[k] for k in data.fitted]
@@ -238,6 +256,12 @@ def run_identification(
         offset_runs=offset_runs,
         ladder=ladder,
         q_range=data.q_range,
+        warnings=robot.warnings
+        + [
+            f"{robot.joint_names[j]}: the torque channel carries no signal (mostly exact zeros); left out of the "
+            "selection score"
+            for j in np.flatnonzero(data.silent)
+        ],
     )
     return report, robot, base, [fit_data.regressor, val_data.regressor]
 
@@ -254,7 +278,7 @@ def write_identified_urdf(
     if report.consistent is None:
         raise ExciteError("urdf_out", "needs the physically consistent fit (identification.fit)")
     source, _ = resolve_urdf(problem.robot, problem.folder)
-    effects = [(t.effect, c, report.joints[t.joint], v) for t, c, v, _ in report.effect_values(consistent=True)]
+    effects = [(t.effect, c, t.where(report.joints), v) for t, c, v, _ in report.effect_values(consistent=True)]
     write_urdf(
         source,
         target,

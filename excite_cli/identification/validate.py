@@ -47,7 +47,7 @@ class IdentifiedModel:
     Attributes:
         joints: (n,) active joint names; base_names: (b,) base-parameter names.
         base: (b,) base parameters [SI]; rigid: (b,) the rigid-body-only fit's (for load-dependent terms).
-        terms: (effect, joint name, shape or None) of every effect column, in order.
+        terms: (effect, joint name, shape or None, coupling or None) of every effect column, in order.
         coefficients: effect coefficients, in the order of ``terms``' columns [SI].
         offset_runs: offset columns (one per fitted run, at least 1).
         cutoff: low-pass cut-off [Hz]; coulomb_velocity: smoothing velocity of sign(q̇) [rad/s].
@@ -59,7 +59,7 @@ class IdentifiedModel:
     base_names: list[str]
     base: np.ndarray
     rigid: np.ndarray
-    terms: list[tuple[str, str, Optional[float]]]
+    terms: list[tuple[str, str, Optional[float], Optional[tuple[float, ...]]]]
     coefficients: np.ndarray
     offset_runs: int
     cutoff: float
@@ -81,12 +81,14 @@ def read_model(path: Path) -> IdentifiedModel:
         consistent = bool(g["physically_consistent"][()]) if "physically_consistent" in g else False
         values = rows["value_consistent"] if consistent else rows["value"]
         shapes = rows["shape"] if "shape" in rows.dtype.names else np.full(len(rows), np.nan)
-        terms: list[tuple[str, str, float | None]] = []
+        coupling = g["effect_coupling"][()] if "effect_coupling" in g else np.zeros((len(rows), 1))
+        terms: list[tuple[str, str, float | None, tuple[float, ...] | None]] = []
         effects, joints = (
             [v.decode() if isinstance(v, bytes) else str(v) for v in rows[c]] for c in ("effect", "joint")
         )
-        for effect, joint, shape in zip(effects, joints, shapes):
-            term = (effect, joint, None if np.isnan(shape) else float(shape))
+        for effect, joint, shape, weights in zip(effects, joints, shapes, coupling):
+            coupled = tuple(float(w) for w in weights) if np.any(weights) else None
+            term = (effect, joint, None if np.isnan(shape) else float(shape), coupled)
             if term not in terms:
                 terms.append(term)
         return IdentifiedModel(
@@ -112,13 +114,16 @@ def validate_model(report: Path, problem: IdentifyProblem) -> list[RunError]:
             config (as ``identify``).
     """
     model = read_model(report)
-    robot = load_robot(problem.robot, problem.folder, joint_rows_only=True)
+    robot = load_robot(problem.robot, problem.folder, joint_rows_only=True, physical=False)
     base = compute_base_parameters(robot)
     if model.joints != robot.joint_names:
         raise ExciteError("report", f"{report} was identified for other joints than the config's robot")
     order = base.column_order(model.base_names, "report", report)  # the same base, maybe in another order
     model = replace(model, base_names=base.names, base=model.base[order], rigid=model.rigid[order])
-    terms = [Term(e, robot.joint_names.index(j), s) for e, j, s in model.terms]
+    terms = [
+        Term(e, int(np.flatnonzero(c)[0]), s, c) if c else Term(e, robot.joint_names.index(j), s)
+        for e, j, s, c in model.terms
+    ]
     needed = terms + [Term("coulomb", j) for j in range(robot.n_joints)]
     errors = []
     for k, run in enumerate(problem.data.runs):

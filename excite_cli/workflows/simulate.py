@@ -1,8 +1,13 @@
 """``excite simulate``: measured-like runs from a trajectory result and the URDF model, with effects and
 noise from a separate effects file, written as CSV in the format ``identify`` reads.
 
-τ = RNEA(q, q̇, q̈; URDF inertias) + Σ effects + N(0, σ_τ²); q is written with N(0, σ_q²) added and
-timestamps with uniform jitter. Columns: ``time, q_<joint>..., tau_<joint>...``.
+τ = RNEA(q, q̇, q̈; URDF inertias) + Σ effects + Σ motor effects + N(0, σ_τ²); q is written with
+N(0, σ_q²) added and timestamps with uniform jitter. Columns: ``time, q_<joint>..., tau_<joint>...``.
+
+With a ``transmission`` (m = R q, τ = Rᵀ τ_m), each motor k's effects (``motor_effects``: its rotor
+inertia and friction, the motor's own values) act in its coordinate m_k = R_k q: τ += R_kᵀ (I_k m̈_k +
+Fc_k tanh(ṁ_k / v_c) + Fv_k ṁ_k), on every joint motor k turns with. ``motor_side`` writes what a
+controller records instead: motor angles m and motor torques τ_m = R⁻ᵀ τ, in the same columns.
 """
 
 from __future__ import annotations
@@ -51,6 +56,29 @@ def effect_torques(
     return tau
 
 
+def motor_torques(sim: SimulationConfig, robot: Robot, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
+    """(T, n) joint torques [Nm] of the motors' effects of ``sim.motor_effects`` ({effect: {joint or
+    "*": value}}, a joint naming the motor of its row of R) at the samples q, q̇, q̈ (T, n).
+
+    Raises:
+        ExciteError: an unknown joint, gear ratios for another number of joints.
+    """
+    tau = np.zeros_like(q)
+    if sim.transmission is None:
+        return tau
+    R = sim.transmission.reduction()
+    if R.shape != (robot.n_joints,) * 2:
+        raise ExciteError("transmission.gear_ratios", f"{R.shape[0]} gear ratios for {robot.n_joints} active joints")
+    for effect, per_motor in sim.motor_effects.items():
+        for name, value in per_motor.items():
+            if name != "*" and name not in robot.joint_names:
+                raise ExciteError(f"motor_effects.{effect}", f"'{name}' is not an active joint")
+            for k in range(robot.n_joints) if name == "*" else [robot.joint_names.index(name)]:
+                m = [x @ R[k] for x in (q, qd, qdd)]
+                tau += np.outer(value * effect_columns(effect, *m, sim.coulomb_velocity)[:, 0], R[k])
+    return tau
+
+
 def simulate_runs(
     result: Path, sim: SimulationConfig, out_dir: Path, prefix: str = "run", force: bool = False
 ) -> list[Path]:
@@ -90,7 +118,10 @@ def simulate_runs(
         time[1:-1] += rng.uniform(-sim.timestamp_jitter, sim.timestamp_jitter, count - 2) / sim.sample_rate
         q, qd, qdd = trajectory.basis(time).evaluate(alpha)
         rigid = np.array([robot.torques(*x) for x in zip(q, qd, qdd)])
-        tau = rigid + effect_torques(sim, robot, q, qd, qdd, rigid)
+        tau = rigid + effect_torques(sim, robot, q, qd, qdd, rigid) + motor_torques(sim, robot, q, qd, qdd)
+        if sim.motor_side:  # what the controller records: motor angles m = R q, motor torques τ_m = R⁻ᵀ τ
+            R = sim.transmission.reduction()
+            q, tau = q @ R.T, np.linalg.solve(R.T, tau.T).T
         tau += rng.normal(0.0, sim.torque_noise, tau.shape)
         tables[k] = np.column_stack([time, q + rng.normal(0.0, sim.position_noise, q.shape), tau])
         if not np.all(np.isfinite(tables[k])):

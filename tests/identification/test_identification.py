@@ -283,10 +283,13 @@ def test_identify_command_writes_report_and_prior(tmp_path, optimized):
         assert ladder["validation_error"][-1] == pytest.approx(g["relative_after"][()].mean(), rel=1e-9)
         assert ladder["cv_error"][-1] == pytest.approx(g.attrs["cv_error"], rel=1e-12)
         assert len(steps) >= 1 and set(tried["step"]) == set(steps["step"]) and len(tried) > 10 * len(steps)
-        # an addition or a shape move buys min_improvement (2 %); a removal saves its price and may cost up to it
+        # an addition or a shape move buys its price (min_improvement, 2 %; a coupled effect's
+        # coupling_improvement, 20 %); a removal saves its price and may cost up to it
         grows = np.array([m.decode() != "remove" for m in steps["move"]])
-        assert np.all(steps["gain"][grows] > 100 * (1 - 1 / 1.02) - 1e-9)
-        assert np.all(steps["gain"][~grows] > -100 * 0.02 - 1e-9)
+        coupled = np.array([" + " in j.decode() or " − " in j.decode() for j in steps["joint"]])
+        price = np.where(coupled, 0.2, 0.02)
+        assert np.all(steps["gain"][grows] > 100 * (1 - 1 / (1 + price[grows])) - 1e-9)
+        assert np.all(steps["gain"][~grows] > -100 * price[~grows] - 1e-9)
         assert "min_improvement" in g.attrs["stop_reason"]
         v = g["validation"]
         assert v["measured"].shape == v["predicted_after"].shape == (g.attrs["validation_samples"], 7)

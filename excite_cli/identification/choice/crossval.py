@@ -87,6 +87,8 @@ class CrossValidation:
             are two or more; None: time blocks.
         fitted_offsets: in recording folds, fit a held-out run's offsets to it instead of giving it
             the mean of the training runs' (module docstring).
+        scored: (n,) the joints CV(M) is the mean over (default all; a torque channel without signal
+            is not scored).
 
     Attributes:
         by_recording: whether the folds are whole recordings; folds: their number.
@@ -101,6 +103,7 @@ class CrossValidation:
         margin: float,
         recordings: np.ndarray | None = None,
         fitted_offsets: bool = False,
+        scored: np.ndarray | None = None,
     ):
         runs = np.unique(data.run)
         recording = None if recordings is None else np.asarray(recordings)[data.run]
@@ -109,6 +112,7 @@ class CrossValidation:
         self.folds, self.fitted_offsets = len(margins), fitted_offsets
         self.run_fold = fold[np.searchsorted(data.run, runs)] if self.by_recording else None  # (runs,)
         self.b, self.n, self.instants = data.regressor.shape[1], data.n, data.time.size
+        self.scored = np.ones(self.n, dtype=bool) if scored is None or not np.any(scored) else np.asarray(scored)
         sizes = [data.blocks[key].shape[1] for key in keys]
         starts = self.b + np.concatenate([[0], np.cumsum(sizes)]).astype(int)
         self.place = {key: np.arange(starts[k], starts[k + 1]) for k, key in enumerate(keys)}
@@ -173,4 +177,4 @@ class CrossValidation:
         [Y_B, ``terms``], fitted by least squares or ``refit`` (:meth:`fold_sse`)."""
         sse = self.fold_sse(terms, refit).sum(axis=0)
         per_joint = 100.0 * np.sqrt(sse / max(self.instants, 1)) / np.where(self.rms > 0, self.rms, 1.0)
-        return float(per_joint.mean()), per_joint
+        return float(per_joint[self.scored].mean()), per_joint

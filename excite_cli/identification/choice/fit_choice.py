@@ -30,7 +30,8 @@ import numpy as np
 
 from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.dynamics.robot import Robot
-from excite_cli.identification.choice.selection import Selection, objective
+from excite_cli.identification.choice.search import effect_count, objective
+from excite_cli.identification.choice.selection import Selection
 from excite_cli.identification.config import IdentificationConfig
 from excite_cli.identification.effects import Term, coefficient_names
 from excite_cli.identification.fitting.least_squares import least_squares
@@ -43,13 +44,14 @@ LEAST_SQUARES = "least squares"
 @dataclass(frozen=True)
 class Model:
     """A model scored with the fits: the search it comes from, whether it is that search's start or
-    end, its terms and the number of effects it adds beyond the declared ones (p)."""
+    end, its terms and the number of effects it adds beyond the declared ones (p, a coupled one
+    counting as several: :func:`~excite_cli.identification.choice.selection.effect_count`)."""
 
     search: int
     start: str
     at_start: bool
     terms: list[Term]
-    effects: int
+    effects: float
 
     @property
     def label(self) -> str:
@@ -125,7 +127,7 @@ class ConsistentModel:
     def __init__(
         self, terms: list[Term], selection: Selection, robot: Robot, base: BaseParameters, offset_runs: list[str]
     ):
-        names = [f"{name} {robot.joint_names[t.joint]}" for t in terms for name in coefficient_names(t, offset_runs)]
+        names = [f"{name} {t.where(robot.joint_names)}" for t in terms for name in coefficient_names(t, offset_runs)]
         reference = selection.normal.system(selection.weights, terms)[0]
         self.program = ConsistentProgram(reference, base.regrouping, robot.urdf_parameters(), names, robot.body_names)
 
@@ -157,7 +159,8 @@ def compared_models(selection: Selection) -> list[Model]:
         search = selection.searches[k]
         for at_start, terms in ((False, search.terms), (True, search.initial)):
             if all(set(terms) != set(m.terms) for m in out):
-                out.append(Model(k, search.start, at_start, list(terms), len(terms) - selection.declared))
+                p = effect_count(list(terms), selection.declared, selection.coupling_weight)
+                out.append(Model(k, search.start, at_start, list(terms), p))
     return out
 
 

@@ -25,73 +25,24 @@ the one the search scored.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from excite_cli.identification.choice.crossval import CrossValidation
-from excite_cli.identification.config import IdentificationConfig
+from excite_cli.identification.choice.search import Search, Step, StepwiseSearch, coupling_weight
+from excite_cli.identification.config import IdentificationConfig, TransmissionConfig
 from excite_cli.identification.effects import EFFECTS, Term
 from excite_cli.identification.fitting.dataset import Dataset
 from excite_cli.identification.fitting.least_squares import Fit, joint_weights, least_squares
 from excite_cli.identification.fitting.normal import ABSORBED, NormalEquations, outside_fraction
 
-#: How a move is written: added, removed, shape changed.
-MOVE_SIGNS = {"add": "+", "remove": "−", "shape": "~"}
 #: Starts of the search beyond the declared effects: friction a real joint is most likely to have.
 STARTS = {
     "declared effects": (),
     "Coulomb on every joint": ("coulomb",),
     "Coulomb and viscous on every joint": ("coulomb", "viscous"),
 }
-
-
-@dataclass(frozen=True)
-class Step:
-    """One move of the search.
-
-    Attributes:
-        move: ``add``, ``remove`` or ``shape`` (a Stribeck or held term's velocity changed).
-        term: the term added, removed, or the new shape's term.
-        terms: the model after the move.
-        cv_error: CV(M) [%] after the move; before: CV(M) [%] before it.
-        tried: every move considered at this step: (move, term, CV after [%]).
-    """
-
-    move: str
-    term: Term
-    terms: list[Term]
-    cv_error: float
-    before: float
-    tried: list[tuple[str, Term, float]]
-
-    def gain_of(self, cv_error: float) -> float:
-        """The cut [%] of the CV error before this step that a move to ``cv_error`` [%] makes."""
-        return 100.0 * (1.0 - cv_error / self.before)
-
-    @property
-    def gain(self) -> float:
-        """The cut [%] of the CV error this step made."""
-        return self.gain_of(self.cv_error)
-
-    def label(self, joints: list[str]) -> str:
-        """e.g. ``+ held panda_joint7 (v_h 0.1 rad/s)``."""
-        return f"{MOVE_SIGNS[self.move]} {self.term.label(joints)}"
-
-
-@dataclass
-class Search:
-    """The search from one start: its name, start model and its CV error [%], end model and its CV
-    error [%] and objective J, the steps and why it stopped."""
-
-    start: str
-    initial: list[Term]
-    initial_error: float
-    terms: list[Term]
-    cv_error: float
-    objective: float
-    steps: list[Step] = field(default_factory=list)
-    stop: str = ""
 
 
 @dataclass
@@ -111,7 +62,8 @@ class Selection:
             :mod:`~excite_cli.identification.choice.fit_choice`).
         absorbed: candidates skipped as not separately identifiable.
         cross_validation: the folds every model was scored on, for scoring other fits of the model.
-        min_improvement: the price of an effect (a fraction).
+        min_improvement: the price of an effect (a fraction); coupling_weight: the effects a coupled
+            one counts as (:func:`effect_count`).
         normal: the fit data's normal equations (every candidate), for refitting other models.
     """
 
@@ -129,6 +81,7 @@ class Selection:
     cross_validation: CrossValidation
     min_improvement: float
     normal: NormalEquations
+    coupling_weight: float = 1.0
     at_start: bool = False
 
     @property
@@ -147,90 +100,39 @@ class Selection:
         return [] if self.at_start else self.searches[self.chosen].steps
 
 
-def objective(cv_error, effects, min_improvement: float):
-    """J = log CV + p · log(1 + min_improvement) (module docstring) of CV errors [%] with p added
-    effects; scalars or arrays that broadcast."""
-    return np.log(np.maximum(cv_error, 1e-12)) + np.asarray(effects) * np.log1p(min_improvement)
-
-
-def candidate_terms(cfg: IdentificationConfig, n: int) -> list[Term]:
-    """Every candidate term: each candidate effect on each joint, one per shape of shaped effects."""
-    return [
+def candidate_terms(cfg: IdentificationConfig, n: int, couplings: list[tuple[float, ...]] = ()) -> list[Term]:
+    """Every candidate term: each candidate effect on each joint, one per shape of shaped effects,
+    and each candidate motor effect (inertia, Coulomb and viscous friction) on each motor coordinate
+    of ``couplings`` ((n,) weights each, :func:`motor_couplings`)."""
+    single = [
         Term(e, j, s)
         for e in cfg.candidates
         for j in range(n)
         for s in (getattr(cfg, EFFECTS[e].shape_field) if EFFECTS[e].shape_field else [None])
     ]
+    coupled = [
+        Term(e, int(np.flatnonzero(c)[0]), None, tuple(float(x) for x in c))
+        for c in couplings
+        for e in cfg.candidates
+        if EFFECTS[e].motor and not EFFECTS[e].shape_field
+    ]
+    return single + coupled
 
 
-class _Search:
-    """The moves and the objective J of one selection problem."""
-
-    def __init__(self, cv: CrossValidation, candidates: list[Term], declared: list[Term], cfg: IdentificationConfig):
-        self.cv, self.candidates, self.declared, self.cfg = cv, candidates, declared, cfg
-        self.fixed = {(t.effect, t.joint) for t in declared}  # declared: never removed (their shape may move)
-        self.penalty = np.log1p(cfg.min_improvement)
-        self.cache: dict[frozenset, float] = {}
-
-    def error(self, terms: list[Term]) -> float:
-        key = frozenset(terms)
-        if key not in self.cache:
-            self.cache[key] = self.cv.error(terms)[0]
-        return self.cache[key]
-
-    def objective(self, terms: list[Term], error: float) -> float:
-        return float(objective(error, len(terms) - len(self.declared), self.cfg.min_improvement))
-
-    def cost(self, move: str, terms: list[Term], error: float) -> float:
-        """J of the model a move leads to; a shape change pays the price of an effect as well."""
-        return self.objective(terms, error) + (self.penalty if move == "shape" else 0.0)
-
-    def moves(self, terms: list[Term]) -> list[tuple[str, Term, list[Term]]]:
-        """(move, term, model after) of every allowed move from ``terms``."""
-        family = {(t.effect, t.joint): t for t in terms}
-        out = []
-        if len(terms) - len(self.declared) < self.cfg.max_effects:
-            out += [
-                ("add", c, terms + [c])
-                for c in self.candidates
-                if (c.effect, c.joint) not in family
-                and (c.kind.requires is None or (c.kind.requires, c.joint) in family)
-            ]
-        for t in terms:
-            needed = any(u.kind.requires == t.effect and u.joint == t.joint for u in terms)
-            if (t.effect, t.joint) not in self.fixed and not needed:
-                out.append(("remove", t, [u for u in terms if u != t]))
-            if t.shape is not None:
-                out += [
-                    ("shape", c, [c if u == t else u for u in terms])
-                    for c in self.candidates
-                    if c.effect == t.effect and c.joint == t.joint and c.shape != t.shape
-                ]
-        return out
-
-    def run(self, name: str, start: list[Term]) -> Search:
-        terms = list(start)
-        error = self.error(terms)
-        search = Search(name, list(terms), error, terms, error, self.objective(terms, error))
-        while True:
-            tried = [(move, term, after, self.error(after)) for move, term, after in self.moves(terms)]
-            if not tried:
-                search.stop = "no move left (every candidate is in the model)"
-                break
-            move, term, after, value = min(tried, key=lambda m: self.cost(m[0], m[2], m[3]))
-            if self.cost(move, after, value) >= search.objective - 1e-12:
-                search.stop = (
-                    f"no addition, removal or shape change lowers the cross-validated error by "
-                    f"min_improvement ({100 * self.cfg.min_improvement:g} %)"
-                )
-                if len(terms) - len(self.declared) >= self.cfg.max_effects:
-                    search.stop = f"max_effects ({self.cfg.max_effects}) reached; no removal or shape change helps"
-                break
-            search.steps.append(Step(move, term, after, value, error, [(m, t, v) for m, t, _, v in tried]))
-            terms, error = after, value
-            search.objective = self.objective(terms, error)
-        search.terms, search.cv_error = terms, error
-        return search
+def motor_couplings(transmission: TransmissionConfig | None, ratios: list[float], n: int) -> list[tuple[float, ...]]:
+    """The motor coordinates coupled effects are proposed on: with a declared transmission, the rows
+    of R = diag(N) C that turn with two joints or more (the coefficients are then the motor's own);
+    without one, q_i + r q_(i+1) for every pair of neighbouring joints and ratio r of ``ratios`` (a
+    coupled motor the data hold but nobody declared)."""
+    if transmission is not None:
+        return [tuple(float(x) for x in row) for row in transmission.reduction() if np.count_nonzero(row) > 1]
+    out = []
+    for i in range(n - 1):
+        for r in ratios:
+            c = np.zeros(n)
+            c[i], c[i + 1] = 1.0, r
+            out.append(tuple(c))
+    return out
 
 
 def select_effects(
@@ -241,6 +143,8 @@ def select_effects(
     oversampling: float = 1.0,
     recordings: np.ndarray | None = None,
     fitted_offsets: bool = False,
+    couplings: list[tuple[float, ...]] = (),
+    scored: np.ndarray | None = None,
 ) -> Selection:
     """The stepwise search of the module docstring on the fit data.
 
@@ -255,19 +159,23 @@ def select_effects(
             folds whole recordings; None: time blocks (:class:`CrossValidation`).
         fitted_offsets: every validation run is fitted too, so its offsets are known (recording folds
             fit the held-out runs' offsets).
+        couplings: the motor coordinates of coupled candidates (:func:`motor_couplings`).
+        scored: (n,) the joints the CV error is the mean over (a channel without signal is not).
     """
     n = fit_data.n
-    candidates = [t for t in candidate_terms(cfg, n) if t not in declared and t in fit_data.blocks]
+    candidates = [t for t in candidate_terms(cfg, n, couplings) if t not in declared and t in fit_data.blocks]
     total = NormalEquations(fit_data, declared + candidates)
     weights = joint_weights(total, cfg.method == "wls")
     model = total.system(weights, declared)[0].shape[0]
     absorbed = [t for t in candidates if outside_fraction(total.system(weights, declared + [t])[0], model) < ABSORBED]
     candidates = [t for t in candidates if t not in absorbed]
-    cv = CrossValidation(fit_data, declared + candidates, weights, cfg.folds, margin, recordings, fitted_offsets)
-    search = _Search(cv, candidates, declared, cfg)
+    cv = CrossValidation(
+        fit_data, declared + candidates, weights, cfg.folds, margin, recordings, fitted_offsets, scored
+    )
+    search = StepwiseSearch(cv, candidates, declared, cfg)
     searches, seen = [], []
     for name, effects in STARTS.items():
-        start = declared + [t for t in candidates if t.effect in effects and t.shape is None]
+        start = declared + [t for t in candidates if t.effect in effects and t.shape is None and t.coupling is None]
         if any(set(start) == set(s) for s in seen):
             continue
         seen.append(start)
@@ -289,4 +197,5 @@ def select_effects(
         cross_validation=cv,
         min_improvement=cfg.min_improvement,
         normal=total,
+        coupling_weight=coupling_weight(cfg),
     )

@@ -22,7 +22,8 @@ class Dataset:
         regressor: (N·n, b) base regressor Y_B (Eq. 3).
         tau: (N·n,) measured torques [Nm].
         time: (N,) [s]; run: (N,) index of the run of each instant.
-        blocks: effect columns by :class:`Term`, (N, k) each, on that term's joint's rows.
+        blocks: effect columns by :class:`Term`, (N, k) each, on that term's joint's rows (a coupled
+            term's on each of its joints' rows, times the joint's weight in its coupling).
     """
 
     regressor: np.ndarray
@@ -42,10 +43,11 @@ class Dataset:
         return np.tile(np.arange(self.n), self.time.size)
 
     def block(self, term: Term) -> np.ndarray:
-        """(N·n, k) columns of ``term``: nonzero only on its joint's rows."""
-        cols = self.blocks[term]
+        """(N·n, k) columns of ``term``: nonzero only on its joints' rows."""
+        cols, weights = self.blocks[term], term.rows(self.n)
         out = np.zeros((self.tau.size, cols.shape[1]))
-        out[term.joint :: self.n] = cols
+        for j in term.joints:
+            out[j :: self.n] = weights[j] * cols
         return out
 
     def with_load_columns(self, base_parameters: np.ndarray, terms: list[Term]) -> "Dataset":
@@ -105,12 +107,16 @@ def _run_columns(
     q_range: np.ndarray | None,
 ):
     """Each term's columns of one run, filtered and decimated (offsets: indicator or mean columns;
-    position effects guarded by ``q_range`` (n, 2) [rad]), one term at a time, joint by joint:
+    position effects guarded by ``q_range`` (n, 2) [rad]; coupled terms in their motor coordinate,
+    first), one term at a time, joint by joint:
     yields (term, columns). A joint's full-rate signals are released once its terms are done (the
     samples are used up)."""
     kept = s.filter.kept(s.time.size)
+    for t in (t for t in terms if t.coupling is not None):  # motor coordinates: before any joint is released
+        coordinate = [sum(t.coupling[j] * x[j] for j in t.joints) for x in (s.q, s.qd, s.qdd)]
+        yield t, s.filter.decimate(effect_columns(t.effect, *coordinate, coulomb_velocity, t.shape))
     for j in range(len(s.q)):
-        for t in (t for t in terms if t.joint == j):
+        for t in (t for t in terms if t.coupling is None and t.joint == j):
             yield (
                 t,
                 (

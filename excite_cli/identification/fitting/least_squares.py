@@ -81,6 +81,6 @@ def predict(data: Dataset, x: np.ndarray, effects: list[Term]) -> np.ndarray:
     k = b
     for t in effects:
         cols = data.blocks[t]
-        out[:, t.joint] += cols @ x[k : k + cols.shape[1]]
+        out += np.outer(cols @ x[k : k + cols.shape[1]], t.rows(data.n))
         k += cols.shape[1]
     return out

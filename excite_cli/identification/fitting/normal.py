@@ -1,8 +1,10 @@
 """Least squares of the identification model through normal equations kept per joint.
 
 Every row of the design [Y_B, effect blocks] belongs to one joint, and an effect block of joint j is
-zero outside joint j's rows. So the weighted normal equations of any model (a subset of effect
-blocks) and any per-joint weights w_j are sums over joints of per-joint pieces
+zero outside joint j's rows (a coupled term's block is nonzero on each of its joints' rows, times the
+joint's weight in its coupling: it is placed in each of those joints' pieces, with the same
+unknowns). So the weighted normal equations of any model (a subset of effect blocks) and any
+per-joint weights w_j are sums over joints of per-joint pieces
 
     G = Σ_j w_j² L_jᵀL_j,  c = Σ_j w_j² L_jᵀτ_j,  s = Σ_j w_j² τ_jᵀτ_j,
 
@@ -43,15 +45,16 @@ class NormalEquations:
         self.n, self.b, self.rows = n, b, rows.size * n
         self.local: list[dict[Term, np.ndarray]] = []
         self.G, self.c, self.s = [], [], []
+        self.size = {key: data.blocks[key].shape[1] for key in keys}
         for j in range(n):
-            own = [key for key in keys if key.joint == j]
-            sizes = [data.blocks[key].shape[1] for key in own]
+            own = [key for key in keys if j in key.joints]
+            sizes = [self.size[key] for key in own]
             starts = b + np.concatenate([[0], np.cumsum(sizes)]).astype(int)
             self.local.append({key: np.arange(starts[k], starts[k + 1]) for k, key in enumerate(own)})
             G, c, s = np.zeros((starts[-1], starts[-1])), np.zeros(starts[-1]), 0.0
             for lo in range(0, rows.size, CHUNK):  # the stacked columns of a chunk only: bounded memory
                 part = rows[lo : lo + CHUNK]
-                L = np.hstack([data.regressor[part * n + j]] + [data.blocks[key][part] for key in own])
+                L = np.hstack([data.regressor[part * n + j]] + [key.rows(n)[j] * data.blocks[key][part] for key in own])
                 tau = data.tau[part * n + j]
                 G += L.T @ L
                 c += L.T @ tau
@@ -62,19 +65,19 @@ class NormalEquations:
 
     def columns(self, effects: list[Term]) -> int:
         """Number of unknowns of the model [Y_B, ``effects``]."""
-        return self.b + sum(self.local[t.joint][t].size for t in effects)
+        return self.b + sum(self.size[t] for t in effects)
 
     def _placement(self, effects: list[Term]) -> list[tuple[np.ndarray, np.ndarray]]:
         """Per joint j, (indices in j's local pieces, indices among the model's unknowns) of the base
-        parameters and of j's effects in the model [Y_B, ``effects``]."""
+        parameters and of the effects in the model [Y_B, ``effects``] that touch j's rows."""
         base = np.arange(self.b)
         local, glob = [[base] for _ in range(self.n)], [[base] for _ in range(self.n)]
         start = self.b
         for t in effects:
-            columns = self.local[t.joint][t]
-            local[t.joint].append(columns)
-            glob[t.joint].append(np.arange(start, start + columns.size))
-            start += columns.size
+            for j in t.joints:
+                local[j].append(self.local[j][t])
+                glob[j].append(np.arange(start, start + self.size[t]))
+            start += self.size[t]
         return [(np.concatenate(l), np.concatenate(g)) for l, g in zip(local, glob)]
 
     def system(self, weights: np.ndarray | None, effects: list[Term]) -> tuple[np.ndarray, np.ndarray, float]:

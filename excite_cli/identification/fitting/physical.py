@@ -96,6 +96,37 @@ class ConsistentFit:
     unconstrained: np.ndarray
 
 
+def nearest_physical(phi: np.ndarray) -> np.ndarray:
+    """(p,) standard parameters with every body some mass distribution can have: a body whose
+    pseudo-inertia is not positive definite (a vendor URDF whose principal moments break the triangle
+    inequality) keeps its mass and centre of mass, and its second moment about the centre of mass,
+    Σ_c = Σ − h hᵀ/m, gets its negative eigenvalues raised to a small positive floor (the nearest
+    positive semidefinite matrix in the Frobenius norm, Higham 1988). Physical bodies are returned
+    unchanged.
+
+    Args:
+        phi: (p,) pinocchio's standard parameters, 10 per body (module docstring).
+
+    Returns:
+        (p,) the projected parameters; a massless or negative-mass body gets 10 g at its frame origin.
+    """
+    out = np.array(phi, dtype=float)
+    for body in out.reshape(-1, 10):
+        if np.linalg.eigvalsh(pseudo_inertia(body))[0] > 0.0:
+            continue
+        m = max(body[0], 0.01)
+        h = body[1:4] if body[0] > 0.0 else np.zeros(3)
+        c = h / m
+        J = pseudo_inertia(body)
+        sigma_c = J[:3, :3] - np.outer(h, h) / m
+        floor = 2.0 * MARGIN * m * LENGTH**2 * (1.0 + c @ c / LENGTH**2)  # above the SDP's ε_i (module docstring)
+        w, V = np.linalg.eigh(0.5 * (sigma_c + sigma_c.T))
+        sigma = (V * np.maximum(w, floor)) @ V.T + np.outer(h, h) / m
+        inertia = np.trace(sigma) * np.eye(3) - sigma
+        body[:] = [m, *h, inertia[0, 0], inertia[0, 1], inertia[1, 1], inertia[0, 2], inertia[1, 2], inertia[2, 2]]
+    return out
+
+
 def body_scales(phi_urdf: np.ndarray) -> np.ndarray:
     """(p,) scale D of each standard parameter: m₀, m₀ℓ (×3), m₀ℓ² (×6) per body, m₀ the URDF mass
     (at least 10 g)."""
@@ -130,7 +161,8 @@ class ConsistentProgram:
         reference: (b + k, b + k) weighted normal equations AᵀW²A of A = [Y_B, E], the base regressor
             and the effect columns, on all fit data: they fix the unknowns' scaling and which
             standard parameters the torques never see (null space of K).
-        regrouping: K (b, p), φ_B = K φ; phi_urdf: (p,) the URDF's standard parameters.
+        regrouping: K (b, p), φ_B = K φ; phi_urdf: (p,) the URDF's standard parameters (a body no
+            mass distribution can have is replaced by :func:`nearest_physical`'s).
         effect_names: (k,) ``"<coefficient> <joint>"`` of each effect column (e.g. ``"Fc panda_joint1"``);
             coefficients named in ``NONNEGATIVE`` are kept ≥ 0.
         bodies: (p/10,) body names, for the ``active`` list.
@@ -144,6 +176,7 @@ class ConsistentProgram:
         effect_names: list[str],
         bodies: list[str],
     ):
+        phi_urdf = nearest_physical(phi_urdf)  # unseen parameters stay at φ_URDF: it must be feasible
         self.regrouping, self.phi_urdf, self.names, self.bodies = regrouping, phi_urdf, effect_names, bodies
         self.scale = scale = body_scales(phi_urdf)
         b, k, p = regrouping.shape[0], len(effect_names), scale.size

@@ -14,7 +14,7 @@ from excite_cli.config import resolve_path
 from excite_cli.errors import ExciteError, FileNotFound
 from excite_cli.identification.config import ColumnsConfig, DataConfig, RunConfig
 from excite_cli.identification.measured.bags import bag_columns, is_bag, read_bag
-from excite_cli.identification.measured.files import Table, read_table
+from excite_cli.identification.measured.files import Table, join_tables, read_table
 
 
 @dataclass(frozen=True)
@@ -45,10 +45,18 @@ class Run:
 IMPLAUSIBLE = 1e6
 
 
-def _matrix(table: Table, keys: list, field: str, path: Path, n: int) -> np.ndarray:
+def _column(table: Table, cols: ColumnsConfig, key: int | str, field: str, path: Path) -> np.ndarray:
+    """(T,) one column in SI units: times its ``data.columns.factors`` entry, if any."""
+    values = table.column(key, field, path)
+    factor = cols.factors.get(str(key))
+    return values if factor is None else values * factor
+
+
+def _matrix(table: Table, cols: ColumnsConfig, field: str, path: Path, n: int) -> np.ndarray:
+    keys = getattr(cols, field)
     if len(keys) != n:
         raise ExciteError(f"data.columns.{field}", f"{len(keys)} columns for the robot's {n} active joints")
-    return np.column_stack([table.column(key, field, path) for key in keys])
+    return np.column_stack([_column(table, cols, key, field, path) for key in keys])
 
 
 def _usable(time: np.ndarray, signals: dict[str, np.ndarray]) -> tuple[np.ndarray, str]:
@@ -76,6 +84,78 @@ def _usable(time: np.ndarray, signals: dict[str, np.ndarray]) -> tuple[np.ndarra
     return ok, problem
 
 
+#: A position further than this many joint ranges (or 2π for a joint without limits) outside the
+#: limits is not a joint angle: motor angles (× the gear ratio) or another unit.
+RANGE_SLACK = 1.0
+#: A given velocity above this many times the joint's velocity limit is not a joint velocity.
+VELOCITY_SLACK = 3.0
+#: A torque channel whose samples are exact zeros this often carries no signal.
+SILENT = 0.5
+
+
+def check_against_limits(
+    run: Run, joints: list[str], lower: np.ndarray, upper: np.ndarray, velocity: np.ndarray
+) -> Run:
+    """Refuse joint positions far outside the robot's limits (``RANGE_SLACK`` ranges beyond them) and
+    given velocities far beyond them (``VELOCITY_SLACK`` times the limit): motor-side signals or
+    another unit.
+
+    Args:
+        run: a loaded run (joint side); joints: (n,) names; lower, upper: (n,) position limits [rad];
+        velocity: (n,) velocity limits [rad/s] (0 or inf: none).
+
+    Returns:
+        ``run``, unchanged.
+
+    Raises:
+        ExciteError: naming the column's field, the joint, the value and the limits, with the hint
+            that the column may hold motor angles.
+    """
+    hint = "motor angles? (give data.transmission and data.motor_side: true, or data.angle_unit)"
+    span = np.where(np.isfinite(upper - lower), upper - lower, 2 * np.pi)
+    lo, hi = run.q.min(axis=0), run.q.max(axis=0)
+    far = (lo < lower - RANGE_SLACK * span) | (hi > upper + RANGE_SLACK * span)
+    if far.any():
+        j = int(np.flatnonzero(far)[0])
+        value = lo[j] if lo[j] < lower[j] - RANGE_SLACK * span[j] else hi[j]
+        raise ExciteError(
+            "data.columns.q",
+            f"{run.name}: {joints[j]} reaches {value:.4g} rad, far outside its limits [{lower[j]:.3g}, "
+            f"{upper[j]:.3g}] rad; {hint}",
+        )
+    if run.qd is not None:
+        limit = np.where((velocity > 0) & np.isfinite(velocity), velocity, np.inf)
+        fastest = np.abs(run.qd).max(axis=0)
+        far = fastest > VELOCITY_SLACK * limit
+        if far.any():
+            j = int(np.flatnonzero(far)[0])
+            raise ExciteError(
+                "data.columns.qd",
+                f"{run.name}: {joints[j]} reaches {fastest[j]:.4g} rad/s, {fastest[j] / limit[j]:.3g} times its "
+                f"velocity limit {limit[j]:.3g} rad/s; {hint}",
+            )
+    return run
+
+
+def silent_channels(runs: list[Run]) -> np.ndarray:
+    """(n,) the joints whose torque samples are exact zeros at least ``SILENT`` of the time over
+    ``runs``: a channel with no signal (a joint not recorded, a sensor off)."""
+    zeros = sum(np.count_nonzero(r.tau == 0.0, axis=0) for r in runs)
+    return zeros >= SILENT * sum(r.time.size for r in runs)
+
+
+def _reduction(data: DataConfig, n: int) -> np.ndarray:
+    """R (n, n) of ``data.transmission``.
+
+    Raises:
+        ExciteError: gear ratios for another number of joints.
+    """
+    R = data.transmission.reduction()
+    if R.shape != (n, n):
+        raise ExciteError("data.transmission.gear_ratios", f"{R.shape[0]} gear ratios for {n} active joints")
+    return R
+
+
 def load_run(run: RunConfig, data: DataConfig, joints: list[str], folder: Path | None = None) -> Run:
     """Read, convert and validate one run (CSV with or without header, NPZ, MAT or HDF5, see
     :mod:`excite_cli.identification.measured.files`; a ROS bag, see :mod:`excite_cli.identification.measured.bags`).
@@ -91,12 +171,18 @@ def load_run(run: RunConfig, data: DataConfig, joints: list[str], folder: Path |
             implausible values (> 1e6) or time not strictly increasing (unless ``bad_rows: drop``),
             a crop that leaves nothing.
     """
-    path = resolve_path(run.file, folder)
-    n = len(joints)
-    if not path.exists():
-        raise FileNotFound("data.runs", path)
+    paths = [resolve_path(f, folder) for f in ([run.file] if isinstance(run.file, str) else run.file)]
+    path, n = paths[0], len(joints)
+    for p in paths:
+        if not p.exists():
+            raise FileNotFound("data.runs", p)
     drop = data.bad_rows == "drop"
-    if is_bag(path):
+    if len(paths) > 1:
+        if data.columns is None:
+            raise ExciteError("data.columns", "is required for a run of several files")
+        table, cols = join_tables([(p, read_table(p, drop)) for p in paths], data.columns.time), data.columns
+        cols = cols if cols.time is None else cols.model_copy(update={"time": "time"})
+    elif is_bag(path):
         table = read_bag(path, data.topic, joints)
         cols = data.columns or ColumnsConfig(**bag_columns(joints, table))
     elif path.is_dir():
@@ -107,18 +193,22 @@ def load_run(run: RunConfig, data: DataConfig, joints: list[str], folder: Path |
         )
     else:
         table, cols = read_table(path, drop), data.columns
-    time = table.column(cols.time, "time", path)
-    q = _matrix(table, cols.q, "q", path, n)
-    qd = _matrix(table, cols.qd, "qd", path, n) if cols.qd else None
-    qdd = _matrix(table, cols.qdd, "qdd", path, n) if cols.qdd else None
+    time = (
+        _column(table, cols, cols.time, "time", path)
+        if cols.time is not None
+        else np.arange(len(table.lines)) / data.sample_rate
+    )
+    q = _matrix(table, cols, "q", path, n)
+    qd = _matrix(table, cols, "qd", path, n) if cols.qd else None
+    qdd = _matrix(table, cols, "qdd", path, n) if cols.qdd else None
     if cols.tau:
-        tau = _matrix(table, cols.tau, "tau", path, n)
+        tau = _matrix(table, cols, "tau", path, n)
     else:
         if data.torque_constants is None or len(data.torque_constants) != n:
             raise ExciteError("data.torque_constants", f"give one torque constant [Nm/A] per active joint ({n})")
         if not np.all(np.isfinite(data.torque_constants)):
             raise ExciteError("data.torque_constants", "every torque constant must be a finite number [Nm/A]")
-        tau = _matrix(table, cols.current, "current", path, n) * np.asarray(data.torque_constants)
+        tau = _matrix(table, cols, "current", path, n) * np.asarray(data.torque_constants)
     signals = {
         name: x
         for name, x in (("time", time[:, None]), ("q", q), ("qd", qd), ("qdd", qdd), ("tau", tau))
@@ -134,6 +224,11 @@ def load_run(run: RunConfig, data: DataConfig, joints: list[str], folder: Path |
             raise ExciteError("data.signs", f"{len(data.signs)} signs for {n} active joints")
         s = np.asarray(data.signs, dtype=float)
         q, qd, qdd, tau = (None if x is None else x * s for x in (q, qd, qdd, tau))
+    if data.motor_side:  # motor angles m = R q and motor torques: to the joints, q = R⁻¹ m and τ = Rᵀ τ_m
+        R = _reduction(data, n)
+        inverse = np.linalg.inv(R)
+        q, qd, qdd = (None if x is None else x @ inverse.T for x in (q, qd, qdd))
+        tau = tau @ R
     keep = ok if run.crop is None else ok & (time >= run.crop[0]) & (time <= run.crop[1])
     if keep.sum() < 2 and run.crop is None:
         raise ExciteError("data", f"{path.name} has fewer than 2 usable rows")

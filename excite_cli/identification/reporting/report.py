@@ -41,6 +41,8 @@ class Report:
         q_range: (n, 2) [rad] each joint's q range over the fit data; the position-dependent
             effects hold their value at its ends outside it (None: no position effect among the
             candidates, or ``position_guard`` off).
+        warnings: what the user should know, in words (a URDF inertia kept as a reference only, a
+            torque channel without signal).
     """
 
     joints: list[str]
@@ -64,6 +66,12 @@ class Report:
     offset_runs: list[str] = field(default_factory=list)
     ladder: list[tuple[str, float, float]] = field(default_factory=list)
     q_range: np.ndarray | None = None
+    warnings: list[str] = field(default_factory=list)
+
+    @property
+    def worse_than_rigid_body(self) -> np.ndarray:
+        """(n,) the joints whose validation error ends above the rigid body's."""
+        return self.rms_after > self.rms_before
 
     @property
     def consistent(self) -> ConsistentFit | None:

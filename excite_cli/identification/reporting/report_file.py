@@ -13,7 +13,7 @@ import numpy as np
 from excite_cli.config import effective_yaml
 from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.dynamics.robot import Robot
-from excite_cli.h5 import atomic_h5, write_strings, write_table
+from excite_cli.h5 import atomic_h5, write_parts, write_strings, write_table
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.fitting.physical import body_properties
 from excite_cli.identification.reporting.report import Report
@@ -35,7 +35,8 @@ def write_identification(
         report: the :class:`~excite_cli.identification.pipeline.Report`.
         problem: the identify config that ran (stored as the effective config, every default filled
             in, beside the file's original text).
-        regressor: base regressor rows of all samples, in parts ((M_k, b) each, e.g. fit and validation).
+        regressor: base regressor rows of all samples, in parts ((M_k, b) each, e.g. fit and validation);
+            emptied as the parts are written.
 
     Raises:
         ExciteError: the file cannot be written.
@@ -50,7 +51,9 @@ def write_identification(
         group.create_dataset("regrouping_matrix", data=base.regrouping).attrs["description"] = (
             "K (b x p): phi_B = K phi"
         )
-        _write_regressor(f, regressor, b)
+        write_parts(f, "regressor", regressor, b).attrs["description"] = (
+            "base regressor of all preprocessed (decimated) samples, fit then validation (prior data C0, Eq. 41)"
+        )
         g = f.create_group("identification")
         g.attrs["method"], g.attrs["cutoff_Hz"], g.attrs["cutoff_source"] = (
             problem.identification.method,
@@ -64,6 +67,10 @@ def write_identification(
         g.attrs["coulomb_velocity_rad_s"] = problem.identification.coulomb_velocity
         g.attrs["cv_error_rigid"], g.attrs["cv_error"] = sel.cv_rigid, report.cv_error
         g.attrs["stop_reason"] = sel.searches[sel.chosen].stop
+        g.attrs["warnings"] = "; ".join(report.warnings) or "none"
+        write_strings(
+            g, "joints_worse_than_rigid_body", [report.joints[j] for j in np.flatnonzero(report.worse_than_rigid_body)]
+        )
         write_strings(g, "joint_names", report.joints)
         write_strings(g, "base_parameter_names", report.base_names)
         consistent, chosen = report.consistent, report.fit_choice.is_consistent
@@ -80,24 +87,9 @@ def write_identification(
         _write_validation(g, report)
 
 
-def _write_regressor(f: h5py.File, regressor: list[np.ndarray], b: int) -> None:
-    """``/regressor``: the decimated base regressor rows of every sample, fit then validation, stored
-    once and compressed (gzip with byte shuffling), written part by part (no stacked copy)."""
-    total = sum(part.shape[0] for part in regressor)
-    options = {"compression": "gzip", "shuffle": True, "chunks": (min(total, 4096), b)} if total else {}
-    data = f.create_dataset("regressor", shape=(total, b), dtype="f8", **options)
-    at = 0
-    for part in regressor:
-        data[at : at + part.shape[0]] = part
-        at += part.shape[0]
-    data.attrs["description"] = (
-        "base regressor of all preprocessed (decimated) samples, fit then validation (prior data C0, Eq. 41)"
-    )
-
-
 def _term_fields(term, joints: list[str]) -> tuple[str, str, float]:
-    """(effect, joint, shape velocity [rad/s] or NaN) of a term."""
-    return term.effect, joints[term.joint], np.nan if term.shape is None else term.shape
+    """(effect, joint (a coupled term: its motor coordinate), shape velocity [rad/s] or NaN) of a term."""
+    return term.effect, term.where(joints), np.nan if term.shape is None else term.shape
 
 
 def _write_effects(g: h5py.Group, report: Report) -> None:
@@ -127,6 +119,10 @@ def _write_effects(g: h5py.Group, report: Report) -> None:
         row["unit"], row["declared"] = term.kind.units[0], order[term] <= sel.declared
     data = g.create_dataset("effects", data=effects)
     data.attrs["shape_unit"] = "rad/s (Stribeck v_s, held v_h; NaN for other effects)"
+    coupling = np.array([t.rows(len(report.joints)) if t.coupling else np.zeros(len(report.joints)) for t, *_ in rows])
+    g.create_dataset("effect_coupling", data=coupling.reshape(len(rows), len(report.joints))).attrs["description"] = (
+        "per effects row: the motor coordinate's weights over the joints of a coupled term (0 for a joint's own)"
+    )
     write_strings(g, "offset_runs", report.offset_runs)
     if report.q_range is not None:
         g.create_dataset("fit_q_range", data=report.q_range).attrs["unit"] = (

@@ -79,7 +79,8 @@ def write_urdf(
         source: the URDF the identification used.
         robot: the identification model (bodies, merged links).
         standard: (p,) identified standard parameters φ, 10 per body [kg, kg·m, kg·m²].
-        effects: (effect, coefficient, joint, value) of the identified effects.
+        effects: (effect, coefficient, joint, value) of the identified effects (a coupled motor's
+            ``joint`` is its motor coordinate, written as a comment).
         note: a line for the header comment (where the parameters come from).
 
     Raises:
@@ -106,7 +107,9 @@ def write_urdf(
         for attribute in DYNAMICS.values():
             dynamics.set(attribute, "0.0")
     for effect, coefficient, joint, value in effects:
-        if coefficient in DYNAMICS:
+        if joint not in joints:  # a motor turning with several joints: a URDF has no place for it
+            root.append(ET.Comment(f" excite: {effect} {coefficient} of the motor of {joint} = {value:.6g} "))
+        elif coefficient in DYNAMICS:
             joints[joint].find("dynamics").set(DYNAMICS[coefficient], _number(value))
         else:
             joints[joint].append(ET.Comment(f" excite: {effect} {coefficient} = {value:.6g} "))

@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 from excite_cli.identification.choice.crossval import CrossValidation, fold_assignment
-from excite_cli.identification.choice.selection import _Search, candidate_terms, select_effects
+from excite_cli.identification.choice.search import StepwiseSearch
+from excite_cli.identification.choice.selection import candidate_terms, select_effects
 from excite_cli.identification.config import IdentificationConfig
 from excite_cli.identification.effects import Term, effect_columns
 from excite_cli.identification.fitting.dataset import Dataset, run_offset_columns
@@ -123,7 +124,7 @@ def test_a_declared_shape_effect_moves_along_its_grid_and_stays():
     assert selection.terms == [Term("held", 1, 0.2)] and selection.declared == 1
     assert [step.move for step in selection.steps] == ["shape"]
     # once moved along its grid, the declared effect is still never a removal candidate
-    search = _Search(None, [Term("held", 1, v) for v in cfg.held_velocity], [Term("held", 1, 0.05)], cfg)
+    search = StepwiseSearch(None, [Term("held", 1, v) for v in cfg.held_velocity], [Term("held", 1, 0.05)], cfg)
     moves = search.moves([Term("held", 1, 0.2)])
     assert {m for m, _, _ in moves} == {"shape"}
 

@@ -16,7 +16,7 @@ from excite_cli.cli import app
 from excite_cli.config_file import load_problem
 from excite_cli.dynamics.base_parameters import compute_base_parameters
 from excite_cli.identification.config import IdentifyProblem
-from excite_cli.identification.fitting.physical import pseudo_inertia
+from excite_cli.identification.fitting.physical import MARGIN, nearest_physical, pseudo_inertia
 from excite_cli.identification.pipeline import run_identification
 from excite_cli.storage.results import problem_of_result, read_alphas
 from excite_cli.trajectory.fourier import FourierTrajectory
@@ -48,6 +48,22 @@ def test_pseudo_inertia_matches_pinocchio_and_tells_physical_bodies():
     assert np.linalg.eigvalsh(pseudo_inertia(rod.toDynamicParameters()))[0] < 0
     negative = -pin.Inertia.FromBox(1.0, 0.1, 0.2, 0.3).toDynamicParameters()
     assert np.linalg.eigvalsh(pseudo_inertia(negative))[0] < 0
+
+
+def test_nearest_physical_keeps_physical_bodies_and_mends_the_others_keeping_mass_and_centre():
+    box = pin.SE3.Random().act(pin.Inertia.FromBox(2.0, 0.1, 0.2, 0.3)).toDynamicParameters()
+    rod = pin.Inertia(1.5, np.array([0.1, -0.2, 0.05]), np.diag([0.01, 0.01, 0.05]))  # I_zz > I_xx + I_yy
+    bad = rod.toDynamicParameters()
+    out = nearest_physical(np.concatenate([box, bad]))
+    assert np.array_equal(out[:10], box)
+    assert np.allclose(out[10:14], bad[:4])  # mass and first moment kept
+    J = pseudo_inertia(out[10:])
+    assert np.linalg.eigvalsh(J)[0] >= MARGIN * 1.5 * 0.1**2  # above the SDP's floor ε_i
+    mended = pin.Inertia.FromDynamicParameters(out[10:])
+    moments = np.linalg.eigvalsh(mended.inertia)
+    assert moments[2] <= moments[0] + moments[1]  # the triangle inequality holds again
+    # the nearest: the change is no larger than the violation it removes (I_zz − I_xx − I_yy = 0.03)
+    assert np.abs(mended.inertia - rod.inertia).max() <= 0.03 + 1e-9
 
 
 @pytest.mark.skipif(not (SHARED / "exciting_traj_1.csv").exists(), reason="shared Panda data not present")

@@ -1,0 +1,44 @@
+"""Where a robot's URDF is: inside the installed example-robot-data package, or a file beside the config."""
+
+from __future__ import annotations
+
+from importlib import metadata
+from pathlib import Path
+
+from excite_cli.config import RobotConfig, resolve_path
+from excite_cli.errors import ExciteError
+
+
+def example_robot_data_root() -> Path:
+    """Folder ``share`` of the installed example-robot-data package (holds ``example-robot-data/robots``).
+
+    Raises:
+        ExciteError: the package is not installed.
+    """
+    try:
+        dist = metadata.distribution("example-robot-data")
+    except metadata.PackageNotFoundError:
+        raise ExciteError("robot.source", "example-robot-data is not installed (run `make install`)") from None
+    return Path(dist.locate_file("cmeel.prefix/share")).resolve()
+
+
+def resolve_urdf(cfg: RobotConfig, folder: Path | None = None) -> tuple[Path, list[str]]:
+    """The URDF file named by ``robot.urdf`` and the package folders its meshes are found in.
+
+    Args:
+        cfg: the ``robot`` section.
+        folder: the config file's folder, which a relative ``urdf`` with ``source: file`` is in.
+
+    Raises:
+        ExciteError: the file does not exist.
+    """
+    if cfg.source == "example-robot-data":
+        share = example_robot_data_root()
+        path = share / "example-robot-data" / "robots" / cfg.urdf
+        dirs = [str(share)]
+    else:
+        path = resolve_path(cfg.urdf, folder)
+        dirs = [str(path.parent), str(path.parent.parent)]
+    if not path.is_file():
+        raise ExciteError("robot.urdf", f"no URDF file at {path}")
+    return path, dirs
