@@ -1,5 +1,5 @@
 """Files written whole or not at all: every file excite writes (HDF5, PNG, HTML, CSV, URDF) goes
-through a temporary ``<path>.partial`` moved onto its path only when it is complete, and the folders
+through a temporary ``.<name>.partial`` beside ``<path>`` moved onto its path only when it is complete, and the folders
 made for it are removed again when nothing was written."""
 
 from __future__ import annotations
@@ -37,7 +37,7 @@ def new_folders(paths: Sequence[Path], field: str = "output") -> Iterator[None]:
 
 @contextmanager
 def atomic_paths(paths: Sequence[Path], field: str = "output") -> Iterator[list[Path]]:
-    """Temporary paths ``<path>.partial`` to write to, moved onto ``paths`` (``os.replace``) when the
+    """Temporary paths ``.<name>.partial`` beside ``<path>`` to write to, moved onto ``paths`` (``os.replace``) when the
     block ends without error and removed otherwise, with any folder made for them
     (:func:`new_folders`), so a crash, Ctrl-C or full disk never leaves a half-written file nor a
     part of the set.
@@ -49,7 +49,7 @@ def atomic_paths(paths: Sequence[Path], field: str = "output") -> Iterator[list[
         CannotWrite: a file cannot be written (``OSError`` in the block or in a move).
     """
     paths = [Path(p) for p in paths]
-    tmps = [p.with_name(p.name + ".partial") for p in paths]
+    tmps = [p.with_name(f".{p.name}.partial") for p in paths]  # hidden: a killed run's is not in the way
     try:
         with new_folders(paths, field):
             try:
@@ -66,7 +66,7 @@ def atomic_paths(paths: Sequence[Path], field: str = "output") -> Iterator[list[
 
 @contextmanager
 def atomic_path(path: Path, field: str = "output") -> Iterator[Path]:
-    """One file written through :func:`atomic_paths`: ``<path>.partial`` to write to.
+    """One file written through :func:`atomic_paths`: ``.<name>.partial`` beside ``<path>`` to write to.
 
     Raises:
         CannotWrite: the file cannot be written.

@@ -81,23 +81,34 @@ def parse_yaml(text: str, where: str, field: str = "config") -> object:
     """The value of the YAML document ``text`` (``where``: its file, for the message).
 
     Raises:
-        ExciteError: malformed YAML (with its line and column), nesting deeper than
+        ExciteError: malformed YAML or a character YAML does not allow (with its line and column), nesting deeper than
             :data:`MAX_DEPTH`, aliases expanding beyond :data:`MAX_VALUES` values.
     """
-    loader = _Loader(text)
+    loader = None
     try:
+        loader = _Loader(text)  # its reader refuses characters YAML does not allow (a NUL byte) here
         node = loader.get_single_node()
         if node is not None and _expanded_size(node, {}) > MAX_VALUES:
             raise ExciteError(
                 field, f"{where}: its aliases expand to more than {MAX_VALUES:,} values", where, "a config file"
             )
         return None if node is None else loader.construct_document(node)
+    except yaml.reader.ReaderError as exc:
+        line = text.count("\n", 0, exc.position) + 1
+        column = exc.position - (text.rfind("\n", 0, exc.position) + 1) + 1
+        code = exc.character if isinstance(exc.character, int) else ord(exc.character)
+        raise ExciteError(
+            field,
+            f"{where}: malformed YAML at line {line}, column {column}: character #x{code:04x} is not allowed",
+            where,
+        ) from None
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         at = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
         raise ExciteError(field, f"{where}: malformed YAML{at}: {getattr(exc, 'problem', exc)}", where) from None
     finally:
-        loader.dispose()
+        if loader is not None:
+            loader.dispose()
 
 
 def read_yaml(path: Path, field: str = "config") -> tuple[object, str]:

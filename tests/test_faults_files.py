@@ -104,7 +104,7 @@ def test_a_disk_that_fills_up_at_the_plots_keeps_the_result(pendulum_run, tmp_pa
     _one_error_line(process, "cannot write again_trajectories.png: File too large")
     with h5py.File(folder / "again.h5") as f:
         assert len(f["iterations"]) == 2
-    assert not [p.name for p in folder.iterdir() if p.name.startswith("again_") or p.suffix == ".partial"]
+    assert not [p.name for p in folder.iterdir() if p.name.startswith("again_") or p.name.endswith(".partial")]
 
 
 # --- problems with no motion in them ---------------------------------------------------------------
@@ -179,8 +179,14 @@ def test_a_command_line_number_beyond_its_bound_is_refused_by_name(tmp_path, com
     assert_refused(tmp_path, [command, str(pendulum_config(tmp_path)), *option], option[0].lstrip("-"))
 
 
+def test_an_export_rate_below_the_motion_is_refused_by_name(pendulum_run, tmp_path):
+    folder = _copy(pendulum_run, tmp_path / "run")
+    assert_refused(folder, ["export", str(folder / "out.h5"), "--rate", "1e-9"], "cannot represent the trajectory")
+
+
 SIMULATION_BOUNDS = [
     ("rate", {"sample_rate": 1e12}, "sample_rate"),
+    ("rate-below-the-motion", {"sample_rate": 1e-9}, "sample_rate: 1e-09 Hz cannot represent the trajectory"),
     ("periods", {"periods": 10**9}, "periods"),
     ("samples", {"periods": 1000, "sample_rate": 90000.0}, "samples per run"),
     ("seed", {"seed": 2**70}, "seed"),
@@ -196,6 +202,8 @@ def test_a_simulation_beyond_its_bounds_is_refused_by_name(pendulum_run, tmp_pat
 
 IDENTIFY_FIELDS = [
     ("zero-torque-constant", {"data": {"torque_constants": [0.0]}}, "data.torque_constants"),
+    ("negative-torque-constant", {"data": {"torque_constants": [-1.0]}}, "data.signs: -1"),
+    ("time-true", {"data": {"columns": {"time": True, "q": ["q_hinge"], "tau": ["tau_hinge"]}}}, "data.columns.time"),
     ("zero-sign", {"data": {"signs": [0.0]}}, "every sign must be 1 or -1"),
     ("blocks", {"data": {"validation_blocks": 10**9}}, "data.validation_blocks"),
     ("rate", {"preprocessing": {"sample_rate": 1e12}}, "preprocessing.sample_rate"),
@@ -238,8 +246,9 @@ BOMB = "a: &a [x, x, x, x, x, x, x, x, x, x]\n" + "".join(
         ("a:\n" + "".join("  " * k + "b:\n" for k in range(1, 200)), "nested more than 64 levels deep"),
         ("robot: 1\nrobot: 2\n", "duplicate key 'robot'"),
         ("robot: !!python/object/apply:os.system ['true']\n", "malformed YAML"),
+        ("robot:\n  urdf: a\x00b\n", "malformed YAML at line 2, column 10: character #x0000 is not allowed"),
     ],
-    ids=["alias-bomb", "recursive-alias", "deep-flow", "deep-block", "duplicate-key", "python-tag"],
+    ids=["alias-bomb", "recursive-alias", "deep-flow", "deep-block", "duplicate-key", "python-tag", "nul-byte"],
 )
 @pytest.mark.parametrize("command", ["optimize", "identify", "simulate"])
 def test_a_hostile_yaml_file_is_one_short_line(pendulum_run, tmp_path, command, text, expected):
@@ -313,6 +322,17 @@ def test_links_in_an_hdf5_data_file_that_lead_nowhere_are_left_out(pendulum_run,
     assert sorted(read_table(tmp_path / "data.h5").names) == ["q_hinge", "tau_hinge", "time"]
 
 
+def test_a_column_that_is_an_external_link_is_named_as_one(pendulum_run, tmp_path):
+    folder = _copy(pendulum_run, tmp_path / "run")
+    columns = _columns(pendulum_run)
+    _write_h5(folder / "times.h5", {"t": columns["time"]}, {})
+    del columns["time"]
+    _write_h5(folder / "data.h5", columns, {"time": h5py.ExternalLink("times.h5", "/t")})
+    assert_refused(
+        folder, _identify_on(folder, "data.h5"), "'time' is a link to times.h5:/t, which excite does not follow"
+    )
+
+
 @pytest.mark.parametrize("suffix", [".h5", ".npz"])
 def test_a_data_file_of_empty_arrays_is_refused(pendulum_run, tmp_path, suffix):
     folder = _copy(pendulum_run, tmp_path / "run")
@@ -342,6 +362,13 @@ def test_a_csv_of_nul_bytes_is_refused(pendulum_run, tmp_path):
     with open(folder / "zeros.csv", "wb") as f:
         f.truncate(50_000_000)
     assert_refused(folder, _identify_on(folder, "zeros.csv"), "holds NUL bytes")
+
+
+def test_a_fifo_given_as_a_data_file_is_refused_at_once(pendulum_run, tmp_path):
+    folder = _copy(pendulum_run, tmp_path / "run")
+    os.mkfifo(folder / "pipe.csv")  # nobody writes: opening it to read would wait for ever
+    process = _run(_identify_on(folder, "pipe.csv"), folder, timeout=60)  # a hang fails by the timeout
+    _one_error_line(process, "pipe.csv is not a regular file")
 
 
 # --- damaged results and reports ---------------------------------------------------------------------
@@ -410,6 +437,15 @@ def test_a_damaged_report_is_one_line(pendulum_run, tmp_path):
     assert_refused(tmp_path, argv, "is damaged or not an excite file")
 
 
+def test_a_report_whose_cutoff_is_not_a_number_is_one_line(pendulum_run, tmp_path):
+    folder = _copy(pendulum_run, tmp_path / "run")
+    assert runner.invoke(app, ["identify", str(folder / "id.yaml"), "-o", str(folder / "report.h5")]).exit_code == 0
+    with h5py.File(folder / "report.h5", "a") as f:
+        f["identification"].attrs["cutoff_Hz"] = np.nan
+    argv = ["validate", str(folder / "report.h5"), str(folder / "id.yaml")]
+    assert_refused(folder, argv, "cutoff_Hz is nan")
+
+
 # --- two runs, one output ----------------------------------------------------------------------------
 
 
@@ -420,13 +456,13 @@ def test_an_output_another_run_is_writing_is_refused(pendulum_run, tmp_path, com
     with output_lock(folder / "busy.h5", "output"):
         argv = [command, str(folder / config), "-o", str(folder / "busy.h5"), "--force"]
         assert_refused(folder, argv, f"is being written by another excite run (process {os.getpid()})")
-    assert not (folder / "busy.h5.lock").exists()
+    assert not (folder / ".busy.h5.lock").exists()
 
 
 def test_a_lock_left_by_a_killed_run_is_taken_over(pendulum_run, tmp_path):
     folder = _copy(pendulum_run, tmp_path / "run")
-    (folder / "again.h5.lock").write_text("99999999\n")  # no process holds it
+    (folder / ".again.h5.lock").write_text("99999999\n")  # no process holds it
     assert (
         runner.invoke(app, ["optimize", str(folder / "pendulum.yaml"), "-o", str(folder / "again.h5")]).exit_code == 0
     )
-    assert (folder / "again.h5").is_file() and not (folder / "again.h5.lock").exists()
+    assert (folder / "again.h5").is_file() and not (folder / ".again.h5.lock").exists()

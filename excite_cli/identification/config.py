@@ -5,10 +5,10 @@ in README.md ("Identification config", "Effects file") with its unit and default
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Literal, Optional, Union
+from typing import Annotated, Literal, Optional, Union
 
 import numpy as np
-from pydantic import Field, NonNegativeFloat, NonNegativeInt, PositiveFloat, field_validator, model_validator
+from pydantic import Field, NonNegativeFloat, PositiveFloat, field_validator, model_validator
 
 from excite_cli.config import MAX_SEED, Problem, RobotConfig, Section
 from excite_cli.identification.effects import EFFECT_NAMES, EFFECTS, SHAPE_GRID
@@ -25,7 +25,7 @@ REGULARIZATION = (1e-5, 1e-4, 1e-3, 1e-2, 1e-1)
 COUPLING_RATIOS = (1.0, -1.0)
 
 
-Column = Union[NonNegativeInt, str]
+Column = Union[Annotated[int, Field(ge=0, strict=True)], str]  # strict: `time: true` is not column 1
 #: Highest sample rate [Hz] (of the decimated data, of a simulated run).
 MAX_RATE = 100_000.0
 
@@ -160,8 +160,11 @@ class DataConfig(Section):
     @field_validator("torque_constants")
     @classmethod
     def _nonzero(cls, values):
-        if values is not None and 0.0 in values:
-            raise ValueError("a torque constant of 0 Nm/A makes every torque of its joint 0; expected the motor's")
+        if values is not None and any(v <= 0.0 for v in values):
+            raise ValueError(
+                "every torque constant must be > 0 Nm/A (the motor's, from its datasheet); "
+                "a motor mounted the other way round is data.signs: -1"
+            )
         return values
 
     @field_validator("signs")

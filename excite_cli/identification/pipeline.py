@@ -21,7 +21,12 @@ from excite_cli.identification.effects import EFFECTS, Term
 from excite_cli.identification.fitting.dataset import Dataset, build_datasets, fit_position_range
 from excite_cli.identification.fitting.least_squares import joint_weights, least_squares, predict, torque_errors
 from excite_cli.identification.fitting.normal import NormalEquations, excited_rank
-from excite_cli.identification.measured.measurements import check_against_limits, load_run, silent_channels
+from excite_cli.identification.measured.measurements import (
+    check_against_limits,
+    in_sample_validation,
+    load_run,
+    silent_channels,
+)
 from excite_cli.identification.measured.payload import payload_parameters
 from excite_cli.identification.measured.preprocessing import choose_cutoff, preprocess
 from excite_cli.identification.reporting.report import Report
@@ -257,6 +262,7 @@ def run_identification(
         ladder=ladder,
         q_range=data.q_range,
         warnings=robot.warnings
+        + in_sample_validation(problem.data.runs, problem.folder)
         + [
             f"{robot.joint_names[j]}: the torque channel carries no signal (mostly exact zeros); left out of the "
             "selection score"

@@ -71,12 +71,17 @@ def read_model(path: Path) -> IdentifiedModel:
     """The model of the ``identify`` report at ``path``.
 
     Raises:
-        ExciteError: missing or unreadable file, or not an identify report.
+        ExciteError: missing or unreadable file, not an identify report, or a cut-off or Coulomb
+            velocity that is not a positive number.
     """
     with open_h5(path, "report") as f:
         if "identification" not in f or "effects" not in f["identification"]:
             raise ExciteError("report", f"{path} is not an excite identify report (no /identification/effects)")
         g = f["identification"]
+        for name, unit in (("cutoff_Hz", "Hz"), ("coulomb_velocity_rad_s", "rad/s")):
+            value = float(g.attrs.get(name, 0.01))
+            if not (np.isfinite(value) and value > 0.0):  # checked like the config field it came from
+                raise ExciteError("report", f"{path}: /identification {name} is {value:g}", value, f"> 0 {unit}")
         rows = g["effects"][()]
         consistent = bool(g["physically_consistent"][()]) if "physically_consistent" in g else False
         values = rows["value_consistent"] if consistent else rows["value"]

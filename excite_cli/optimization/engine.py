@@ -144,6 +144,8 @@ class Engine:
         if self._client is not None:
             from dask.distributed import as_completed as dask_completed
 
+            # a worker that dies mid-task: the scheduler runs the task again on another (a restart is a
+            # pure function of problem, base and seed, so the result is the same bit for bit)
             futures = {self._client.submit(run_on_worker, problem, base, task, pure=False): task for task in tasks}
             for future in dask_completed(list(futures)):
                 yield futures[future], future.result()

@@ -87,6 +87,14 @@ def export_trajectory(result: Path, iteration: int | None = None, rate: float = 
             f"{result}: iteration {k} has α of shape {alpha.shape}, its config needs "
             f"{(excitation.robot.n_joints, excitation.trajectory.n_coefficients)}",
         )
+    if rate <= excitation.trajectory.nyquist_rate:
+        raise ExciteError(
+            "rate",
+            f"{rate:g} Hz cannot represent the trajectory (its highest harmonic needs more than "
+            f"{excitation.trajectory.nyquist_rate:.3g} Hz)",
+            rate,
+            f"more than {excitation.trajectory.nyquist_rate:.3g} Hz",
+        )
     playback = plan_playback(excitation, alpha, periods)
     if playback.duration * rate > MAX_SAMPLES:
         raise ExciteError(

@@ -64,7 +64,7 @@ def check_folder(folder: Path, names: list[str], field: str, force: bool = False
 
 @contextmanager
 def output_lock(path: Path, field: str) -> Iterator[None]:
-    """Hold ``<path>.lock`` (an exclusive ``flock``, with this process's id inside) while the block
+    """Hold ``.<name>.lock`` beside ``path`` (an exclusive ``flock``, with this process's id inside) while the block
     runs, so a second run writing ``path`` stops at once instead of replacing the first one's result.
     The lock file is removed when the block ends; one left by a killed run is taken over (the system
     releases its lock). Folders made for it and left empty are removed (:func:`new_folders`).
@@ -74,7 +74,7 @@ def output_lock(path: Path, field: str) -> Iterator[None]:
         CannotWrite: the lock file cannot be created.
     """
     path = Path(path)
-    lock = path.with_name(path.name + ".lock")
+    lock = path.with_name(f".{path.name}.lock")  # hidden, like the .partial files
     with new_folders([lock], field):
         try:
             fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)

@@ -52,6 +52,12 @@ class FourierTrajectory:
         """Period 2π/ω [s]."""
         return 2.0 * np.pi / self.base_frequency
 
+    @property
+    def nyquist_rate(self) -> float:
+        """Twice the highest harmonic's frequency, N ω / π [Hz]: a sample rate at or below it cannot
+        represent the motion (Shannon)."""
+        return self.harmonics * self.base_frequency / np.pi
+
     def basis(self, time: np.ndarray) -> FourierBasis:
         """The basis at the instants ``time`` (T,) [s]."""
         time = np.asarray(time, dtype=float)

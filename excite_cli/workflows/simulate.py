@@ -106,6 +106,14 @@ def simulate_runs(
     check_folder(out_dir, [f"{prefix}_{k}.csv" for k, _ in alphas], "output_dir", force)
     header = ["time"] + [f"q_{j}" for j in robot.joint_names] + [f"tau_{j}" for j in robot.joint_names]
     count = int(round(sim.periods * trajectory.period * sim.sample_rate)) + 1
+    if sim.sample_rate <= trajectory.nyquist_rate:
+        raise ExciteError(
+            "sample_rate",
+            f"{sim.sample_rate:g} Hz cannot represent the trajectory (its highest harmonic needs more than "
+            f"{trajectory.nyquist_rate:.3g} Hz)",
+            sim.sample_rate,
+            f"more than {trajectory.nyquist_rate:.3g} Hz",
+        )
     if count > MAX_SAMPLES:
         raise ExciteError(
             "periods",

@@ -1,9 +1,17 @@
 """Restarts and random draws in parallel: a process pool and a Dask cluster give the serial run's
 trajectories and candidates, bit for bit, for the same seed; each restart draws its own start."""
 
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import h5py
 import numpy as np
 import pytest
-from conftest import TESTS
+import yaml
+from conftest import TESTS, write_config
 
 import excite_cli.optimization.engine as engine_module
 from excite_cli.config_file import load_problem
@@ -103,3 +111,51 @@ def test_workers_optimize_in_the_main_process_base(excitation):
     for run in runs:
         assert run.objective == pytest.approx(other.criterion(prior).value(run.alpha), rel=1e-12)
         assert run.objective != pytest.approx(excitation.criterion(prior).value(run.alpha), rel=1e-6)
+
+
+def test_a_dask_worker_killed_mid_run_gives_the_uninterrupted_result(tmp_path):
+    """Real `dask scheduler` and `dask worker` processes; one worker process is killed (SIGKILL) while
+    it runs a restart: the scheduler gives the task to a worker again (restarts are pure functions
+    of the problem, the base and their seed) and the result is the serial one, bit for bit."""
+    psutil = pytest.importorskip("psutil")
+    distributed = pytest.importorskip("dask.distributed")
+    config = yaml.safe_load((HERE / "panda_capsules.yaml").read_text())
+    config["optimizer"] = {"restarts": 4, "max_iterations": 25}
+    config["sequence"] = {"iterations": 1}
+    path = write_config(tmp_path, config)
+    excite, dask = (str(Path(sys.executable).with_name(name)) for name in ("excite", "dask"))
+    serial = subprocess.run([excite, "optimize", str(path), "-o", str(tmp_path / "serial.h5"), "--workers", "1"])
+    assert serial.returncode == 0
+    port = 8500 + os.getpid() % 300
+    quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL}
+    scheduler = subprocess.Popen([dask, "scheduler", "--port", str(port), "--no-dashboard"], **quiet)
+    worker = subprocess.Popen(
+        [dask, "worker", f"tcp://127.0.0.1:{port}", "--nworkers", "2", "--nthreads", "1", "--no-dashboard"], **quiet
+    )
+    run = None
+    try:
+        with distributed.Client(f"tcp://127.0.0.1:{port}", timeout=60) as client:
+            client.wait_for_workers(2, timeout=120)  # started: a kill now is a death mid-run, not a failed start
+            workers = [psutil.Process(pid) for pid in client.run(os.getpid).values()]
+        run = subprocess.Popen(
+            [excite, "optimize", str(path), "-o", str(tmp_path / "dask.h5"), "--scheduler", f"tcp://127.0.0.1:{port}"],
+            **quiet,
+        )
+        killed = None
+        deadline = time.monotonic() + 120
+        while killed is None and run.poll() is None and time.monotonic() < deadline:
+            for process in workers:
+                if process.cpu_percent(interval=0.2) > 20:  # busy with a restart (an idle worker: ~1 %)
+                    process.kill()
+                    killed = process.pid
+                    break
+        assert killed is not None, "no worker was seen running a restart"
+        assert run.wait(300) == 0
+    finally:
+        for process in (run, worker, scheduler):
+            if process is not None and process.poll() is None:
+                process.terminate()
+                process.wait(20)
+    with h5py.File(tmp_path / "serial.h5") as a, h5py.File(tmp_path / "dask.h5") as b:
+        np.testing.assert_array_equal(a["iterations/1/alpha"][()], b["iterations/1/alpha"][()])
+        assert a["iterations/1"].attrs["cond_stacked"] == b["iterations/1"].attrs["cond_stacked"]

@@ -176,7 +176,7 @@ def test_export_rejects_bad_options_without_writing(panda_runs, tmp_path, args, 
     target = tmp_path / "x.csv"
     run = runner.invoke(app, ["export", str(panda_runs["rest"]), *args, "-o", str(target)])
     assert run.exit_code == 2 and message in run.output and "Traceback" not in run.output
-    assert not target.exists() and not target.with_name("x.csv.partial").exists()
+    assert not target.exists() and not target.with_name(".x.csv.partial").exists()
 
 
 def test_export_of_a_file_that_is_not_a_result(tmp_path):

@@ -38,7 +38,7 @@ def test_a_figure_is_written_as_a_whole_png_and_closed(tmp_path):
     ax.plot([0, 1], [1, 0])
     path = save_figure(fig, tmp_path / "f.png", 50)
     assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and not plt.fignum_exists(fig.number)
-    assert not (tmp_path / "f.png.partial").exists()
+    assert not (tmp_path / ".f.png.partial").exists()
 
 
 def test_table_one_chart_draws_each_iteration_s_condition_numbers(kept, results, tmp_path):

@@ -42,4 +42,4 @@ def test_a_second_run_on_one_output_stops_at_once(tmp_path):
                 pass
     with output_lock(tmp_path / "r.h5", "output"):  # released: taken again
         pass
-    assert not (tmp_path / "r.h5.lock").exists()
+    assert not (tmp_path / ".r.h5.lock").exists()

@@ -1,6 +1,7 @@
 """Fourier series (Eq. 50): derivatives and the chain rule (Eq. 49) against finite differences."""
 
 import numpy as np
+import pytest
 
 from excite_cli.trajectory.fourier import FourierTrajectory, sample_times
 
@@ -50,3 +51,11 @@ def test_sample_times_match_the_paper_grids():
     assert sample_times(8.0, 0.2).size == 40
     assert sample_times(8.0, 0.02, include_end=True).size == 401
     np.testing.assert_allclose(sample_times(8.0, 0.2)[-1], 7.8)
+
+
+def test_nyquist_rate_is_twice_the_highest_harmonic_and_below_it_samples_alias():
+    trajectory = FourierTrajectory(harmonics=3, base_frequency=2 * np.pi * 0.5)  # harmonics at 0.5, 1, 1.5 Hz
+    assert trajectory.nyquist_rate == pytest.approx(3.0)
+    # at 2.5 Hz the 1.5 Hz harmonic's samples are those of a 1.0 Hz sine (aliasing): the motion is lost
+    t = np.arange(10) / 2.5
+    assert np.allclose(np.sin(2 * np.pi * 1.5 * t), -np.sin(2 * np.pi * 1.0 * t))

@@ -122,4 +122,4 @@ def test_interrupted_run_keeps_finished_iterations(tmp_path, monkeypatch):
     assert "kept 1 finished iteration" in run.output
     with h5py.File(out) as f:
         assert list(f["iterations"].keys()) == ["1"] and len(f["table"]) == 1
-    assert not out.with_name("cut.h5.partial").exists()
+    assert not out.with_name(".cut.h5.partial").exists()

@@ -13,7 +13,7 @@ the file and the line, or, with ``bad_rows: drop``, left out and counted.
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import h5py
@@ -38,12 +38,14 @@ class Table:
         values: (T, m) values, NaN where a value is missing.
         dropped: rows left out because they could not be read (with ``bad_rows: drop``).
         lines: (T,) line (CSV, 1-based) or row (others, 1-based) of each kept row, for messages.
+        unread: names in the file that were not read, with why (an HDF5 link not followed).
     """
 
     names: list[str]
     values: np.ndarray
     dropped: int
     lines: np.ndarray
+    unread: dict[str, str] = field(default_factory=dict)
 
     def column(self, key: int | str, field: str, path: Path) -> np.ndarray:
         """(T,) the column named ``key`` or at position ``key`` (0-based).
@@ -59,6 +61,8 @@ class Table:
             )
         if key in self.names:
             return self.values[:, self.names.index(key)]
+        if key in self.unread:
+            raise ExciteError(f"data.columns.{field}", f"{path.name}: '{key}' is {self.unread[key]}")
         raise ExciteError(
             f"data.columns.{field}",
             f"{path.name} has no column '{key}' (it has: {', '.join(self.names[:12])}"
@@ -165,8 +169,9 @@ def _read_text(path: Path, drop: bool) -> Table:
     return Table(names, np.array(rows, dtype=float), dropped, np.array(kept))
 
 
-def _columns(arrays: dict[str, np.ndarray], path: Path) -> Table:
-    """1-D arrays by name, 2-D arrays as ``name[k]``, rows along the longer axis."""
+def _columns(arrays: dict[str, np.ndarray], path: Path, unread: dict[str, str] | None = None) -> Table:
+    """1-D arrays by name, 2-D arrays as ``name[k]``, rows along the longer axis (``unread``: see
+    :class:`Table`)."""
     names, columns = [], []
     for name, array in arrays.items():
         array = np.asarray(array)
@@ -190,23 +195,26 @@ def _columns(arrays: dict[str, np.ndarray], path: Path) -> Table:
         keep = [k for k, c in enumerate(columns) if c.size == longest]
         names, columns = [names[k] for k in keep], [columns[k] for k in keep]
     values = np.column_stack(columns)
-    return Table(names, values, 0, np.arange(1, values.shape[0] + 1))
+    return Table(names, values, 0, np.arange(1, values.shape[0] + 1), unread or {})
 
 
-def _h5_datasets(f: h5py.File) -> dict[str, np.ndarray]:
-    """The datasets at the root of ``f`` by name; links to other files are not followed, links that
-    lead nowhere (a missing target, a loop) are left out."""
-    arrays = {}
+def _h5_datasets(f: h5py.File) -> tuple[dict[str, np.ndarray], dict[str, str]]:
+    """The datasets at the root of ``f`` by name, and the names not read with why: links to other
+    files are not followed, links that lead nowhere (a missing target, a loop) are left out."""
+    arrays, unread = {}, {}
     for name in f:
-        if isinstance(f.get(name, getlink=True), h5py.ExternalLink):
+        link = f.get(name, getlink=True)
+        if isinstance(link, h5py.ExternalLink):
+            unread[name] = f"a link to {link.filename}:{link.path}, which excite does not follow (copy the data in)"
             continue
         try:
             item = f[name]
         except (KeyError, RuntimeError):
+            unread[name] = "a link that leads nowhere (a missing target or a loop)"
             continue
         if isinstance(item, h5py.Dataset):
             arrays[name] = item[()]
-    return arrays
+    return arrays, unread
 
 
 def _check_text_size(path: Path) -> None:
@@ -238,8 +246,10 @@ def read_table(path: Path, drop: bool = False) -> Table:
         drop: leave out rows that cannot be read instead of stopping.
 
     Raises:
-        ExciteError: an unreadable file or row, naming the file (and the line).
+        ExciteError: not a regular file, an unreadable file or row, naming the file (and the line).
     """
+    if not path.is_file():  # before anything opens it: reading a FIFO waits for a writer
+        raise ExciteError("data", f"{path.name} is not a regular file (a FIFO, a device or a socket?)", path)
     suffix = path.suffix.lower()
     try:
         if suffix == ".npz":
@@ -249,7 +259,8 @@ def read_table(path: Path, drop: bool = False) -> Table:
             return _columns({k: v for k, v in scipy.io.loadmat(path).items() if not k.startswith("__")}, path)
         if suffix in (".h5", ".hdf5"):
             with h5py.File(path, "r") as f:
-                return _columns(_h5_datasets(f), path)
+                arrays, unread = _h5_datasets(f)
+                return _columns(arrays, path, unread)
     except (OSError, ValueError, NotImplementedError) as exc:
         raise ExciteError(
             "data", f"cannot read {path.name} as {suffix[1:].upper()}: {' '.join(str(exc).split())[:160]}"

@@ -137,6 +137,27 @@ def check_against_limits(
     return run
 
 
+def in_sample_validation(runs: list[RunConfig], folder: Path | None) -> list[str]:
+    """Warnings, one per validation run that is a fit run's recording over overlapping times (the
+    same files, crops that overlap): its "validation" error is in-sample."""
+
+    def span(run: RunConfig) -> tuple[float, float]:
+        return run.crop if run.crop is not None else (-np.inf, np.inf)
+
+    def files(run: RunConfig) -> list[Path]:
+        return [resolve_path(f, folder) for f in ([run.file] if isinstance(run.file, str) else run.file)]
+
+    out = []
+    for v in (r for r in runs if r.role == "validation"):
+        for f in (r for r in runs if r.role == "fit" and files(r) == files(v)):
+            if span(f)[0] <= span(v)[1] and span(v)[0] <= span(f)[1]:
+                out.append(
+                    f"{v.label}: the validation run is the fit run {f.label} over the same times, so its error "
+                    "is in-sample (crop them apart, or validate on another recording)"
+                )
+    return out
+
+
 def silent_channels(runs: list[Run]) -> np.ndarray:
     """(n,) the joints whose torque samples are exact zeros at least ``SILENT`` of the time over
     ``runs``: a channel with no signal (a joint not recorded, a sensor off)."""

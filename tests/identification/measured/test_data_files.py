@@ -9,9 +9,9 @@ import pytest
 import scipy.io
 
 from excite_cli.errors import ExciteError
-from excite_cli.identification.config import IdentifyProblem
+from excite_cli.identification.config import IdentifyProblem, RunConfig
 from excite_cli.identification.measured.files import read_table
-from excite_cli.identification.measured.measurements import load_run
+from excite_cli.identification.measured.measurements import in_sample_validation, load_run
 
 JOINTS = [f"panda_joint{k}" for k in range(1, 8)]
 T = 400
@@ -150,3 +150,15 @@ def test_an_excite_result_given_as_data_names_the_missing_column(tmp_path):
         f["iterations/1/alpha"] = np.zeros((7, 3))
     with pytest.raises(ExciteError, match="data"):
         _load(tmp_path, "result.h5", {"q": ["q0"] * 7, "tau": ["t0"] * 7})
+
+
+def test_a_validation_run_that_is_a_fit_run_over_the_same_times_is_warned_about(tmp_path):
+    def runs(*specs):
+        return [RunConfig(file=f, role=role, crop=crop) for f, role, crop in specs]
+
+    same = in_sample_validation(runs(("a.csv", "fit", None), ("./a.csv", "validation", None)), tmp_path)
+    assert len(same) == 1 and "in-sample" in same[0]
+    apart = runs(("a.csv", "fit", (0.0, 10.0)), ("a.csv", "validation", (10.5, 20.0)), ("b.csv", "validation", None))
+    assert in_sample_validation(apart, tmp_path) == []  # crops apart, or another recording
+    overlap = runs(("a.csv", "fit", (0.0, 10.0)), ("a.csv", "validation", (5.0, 20.0)))
+    assert len(in_sample_validation(overlap, tmp_path)) == 1
