@@ -91,10 +91,14 @@ class RunConfig(Section):
     payload: Optional[PayloadConfig] = None
 
     @property
+    def files(self) -> list[str]:
+        """The run's file or files, as written."""
+        return [self.file] if isinstance(self.file, str) else list(self.file)
+
+    @property
     def label(self) -> str:
         """The file name with the crop, for tables and reports, e.g. ``run.csv [7.8, 13.2] s``."""
-        files = [self.file] if isinstance(self.file, str) else self.file
-        return " + ".join(Path(f).name for f in files) + (
+        return " + ".join(Path(f).name for f in self.files) + (
             f" [{self.crop[0]:g}, {self.crop[1]:g}] s" if self.crop else ""
         )
 

@@ -82,9 +82,8 @@ def fold_groups(problem: IdentifyProblem, fitted: list[int]) -> np.ndarray | Non
         ExciteError: ``recording`` or ``run`` folds with fewer than two fit recordings or runs.
     """
     how = problem.identification.folds_by
-    files = np.unique([str(resolve_path(str(r.file), problem.folder)) for r in problem.data.runs], return_inverse=True)[
-        1
-    ]
+    recordings = [" + ".join(str(resolve_path(f, problem.folder)) for f in r.files) for r in problem.data.runs]
+    files = np.unique(recordings, return_inverse=True)[1]
     groups = {"auto": files, "recording": files, "run": np.arange(files.size), "time_block": None}[how]
     count = 0 if groups is None else np.unique(groups[fitted]).size
     if how == "auto":

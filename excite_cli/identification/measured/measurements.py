@@ -145,7 +145,7 @@ def in_sample_validation(runs: list[RunConfig], folder: Path | None) -> list[str
         return run.crop if run.crop is not None else (-np.inf, np.inf)
 
     def files(run: RunConfig) -> list[Path]:
-        return [resolve_path(f, folder) for f in ([run.file] if isinstance(run.file, str) else run.file)]
+        return [resolve_path(f, folder) for f in run.files]
 
     out = []
     for v in (r for r in runs if r.role == "validation"):
@@ -192,7 +192,7 @@ def load_run(run: RunConfig, data: DataConfig, joints: list[str], folder: Path |
             implausible values (> 1e6) or time not strictly increasing (unless ``bad_rows: drop``),
             a crop that leaves nothing.
     """
-    paths = [resolve_path(f, folder) for f in ([run.file] if isinstance(run.file, str) else run.file)]
+    paths = [resolve_path(f, folder) for f in run.files]
     path, n = paths[0], len(joints)
     for p in paths:
         if not p.exists():
