@@ -5,11 +5,25 @@ made for it are removed again when nothing was written."""
 from __future__ import annotations
 
 import os
+import warnings
 from contextlib import contextmanager, suppress
 from pathlib import Path
 from typing import Iterator, Sequence
 
-from excite_cli.errors import CannotWrite
+from excite_cli.errors import CannotWrite, ExciteWarning
+
+
+def partial_path(path: Path) -> Path:
+    """The hidden temporary ``.<name>.partial`` beside ``path`` that :func:`atomic_paths` writes first."""
+    return path.with_name(f".{path.name}.partial")
+
+
+def remove_stale(path: Path, why: str = "left by an interrupted run") -> None:
+    """Remove ``path`` if it exists, with an :class:`~excite_cli.errors.ExciteWarning` saying so
+    (a temporary file of a run that was killed: nothing else writes it now)."""
+    with suppress(FileNotFoundError):
+        path.unlink()
+        warnings.warn(f"removed {path}, {why}", ExciteWarning, stacklevel=2)
 
 
 @contextmanager
@@ -40,7 +54,7 @@ def atomic_paths(paths: Sequence[Path], field: str = "output") -> Iterator[list[
     """Temporary paths ``.<name>.partial`` beside ``<path>`` to write to, moved onto ``paths`` (``os.replace``) when the
     block ends without error and removed otherwise, with any folder made for them
     (:func:`new_folders`), so a crash, Ctrl-C or full disk never leaves a half-written file nor a
-    part of the set.
+    part of the set; one a killed run left is removed first, with a warning (:func:`remove_stale`).
 
     Args:
         field: the config field or argument that named ``paths``, for the message.
@@ -49,7 +63,9 @@ def atomic_paths(paths: Sequence[Path], field: str = "output") -> Iterator[list[
         CannotWrite: a file cannot be written (``OSError`` in the block or in a move).
     """
     paths = [Path(p) for p in paths]
-    tmps = [p.with_name(f".{p.name}.partial") for p in paths]  # hidden: a killed run's is not in the way
+    tmps = [partial_path(p) for p in paths]  # hidden: a killed run's is not in the way
+    for tmp in tmps:
+        remove_stale(tmp)
     try:
         with new_folders(paths, field):
             try:

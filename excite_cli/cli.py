@@ -13,7 +13,7 @@ from excite_cli import workflows
 from excite_cli.config_file import load_problem, with_overrides
 from excite_cli.console import identification as identify_tables
 from excite_cli.console import tables
-from excite_cli.console.errors import spellings, word
+from excite_cli.console.errors import printed_warnings, spellings, word
 from excite_cli.console.progress import Bars, wide_console
 from excite_cli.errors import ExciteError, Interrupted, Terminated, exit_status, sigterm_as_interrupt
 from excite_cli.identification.config import IdentifyProblem, SimulationConfig
@@ -37,10 +37,11 @@ def command(name: Optional[str] = None) -> Callable:
         @functools.wraps(function)
         def guarded(*args, **kwargs):
             try:
-                with sigterm_as_interrupt():
+                with sigterm_as_interrupt(), printed_warnings(err):
                     return function(*args, **kwargs)
             except ExciteError as exc:
-                err.print(f"[bold red]error:[/] {escape(word(exc, spelled))}", highlight=False, soft_wrap=True)
+                line = word(exc, spelled, kwargs.get("config") or kwargs.get("effects"))
+                err.print(f"[bold red]error:[/] {escape(line)}", highlight=False, soft_wrap=True)
                 raise typer.Exit(2) from None
             except Interrupted as exc:
                 err.print(str(exc), highlight=False, soft_wrap=True)
@@ -178,7 +179,7 @@ def identify(
     fit: Optional[str] = typer.Option(
         None,
         "--fit",
-        help="auto (the one the cross-validation prefers), least_squares or consistent (overrides config).",
+        help="auto (the one the cross-validation prefers), least_squares or consistent (identification.fit).",
     ),
     urdf_out: Optional[Path] = typer.Option(
         None, "--urdf-out", help="Write the identified URDF (of the physically consistent fit)."
@@ -244,5 +245,5 @@ def simulate(
     force: bool = FORCE,
 ) -> None:
     """Measured-like CSV runs (one per iteration) of a result, with the effects and noise of an effects file."""
-    files = workflows.simulate_runs(result, load_problem(effects, SimulationConfig), output_dir, force=force)
+    files = workflows.simulate_runs(result, load_problem(effects, SimulationConfig, "effects"), output_dir, force=force)
     _say("wrote " + ", ".join(str(f) for f in files))

@@ -182,7 +182,7 @@ class OptimizerConfig(Section):
     (:mod:`excite_cli.optimization.optimality`), seed, restarts, the random starts screened for
     ``screen_iterations`` before the best ``restarts`` continue (``starts``, default: no
     screening), and where restarts run (``workers`` local processes, default the machine's cores;
-    or a Dask ``scheduler`` address)."""
+    or a Dask ``scheduler`` address: a run stops after ``worker_wait`` seconds without any worker)."""
 
     @property
     def screened(self) -> int:
@@ -211,6 +211,7 @@ class OptimizerConfig(Section):
     screen_iterations: int = Field(30, ge=1, le=100_000)
     workers: Optional[int] = Field(None, ge=1, le=MAX_WORKERS)
     scheduler: Optional[str] = None
+    worker_wait: float = Field(120.0, gt=0.0, le=86_400.0)
 
     @field_validator("scheduler")
     @classmethod

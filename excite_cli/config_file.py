@@ -16,7 +16,8 @@ import yaml
 from pydantic import BaseModel, ValidationError
 
 from excite_cli.config import FieldProblem, Problem
-from excite_cli.errors import NO_VALUE, ExciteError, FileNotFound
+from excite_cli.errors import NO_VALUE, ExciteError
+from excite_cli.inputs import input_file
 
 #: Largest YAML file read [bytes]; a config or an effects file is a few kB.
 MAX_BYTES = 10_000_000
@@ -116,12 +117,10 @@ def read_yaml(path: Path, field: str = "config") -> tuple[object, str]:
 
     Raises:
         FileNotFound: no file at ``path``.
-        ExciteError: not a UTF-8 text file, bigger than :data:`MAX_BYTES`, unreadable, or refused
-            by :func:`parse_yaml`.
+        ExciteError: a folder, FIFO or device (:func:`~excite_cli.inputs.input_file`), not a UTF-8
+            text file, bigger than :data:`MAX_BYTES`, unreadable, or refused by :func:`parse_yaml`.
     """
-    path = Path(path)
-    if not path.is_file():
-        raise FileNotFound(field, path, f"{field} file")
+    path = input_file(path, field, f"{field} file")
     try:
         if path.stat().st_size > MAX_BYTES:
             raise ExciteError(field, f"{path} is larger than {MAX_BYTES // 1_000_000} MB", path, "a YAML config")
@@ -133,7 +132,7 @@ def read_yaml(path: Path, field: str = "config") -> tuple[object, str]:
     return parse_yaml(text, str(path), field), text
 
 
-def _validation_error(path: Path, error: ValidationError) -> ExciteError:
+def _validation_error(path: Path | None, error: ValidationError) -> ExciteError:
     first = error.errors()[0]
     field = ".".join(str(part) for part in first["loc"]) or "(top level)"
     message = first["msg"].removeprefix("Value error, ")
@@ -151,12 +150,13 @@ def _validation_error(path: Path, error: ValidationError) -> ExciteError:
     return ExciteError(field, f"{message}{suffix}", value, source=path)
 
 
-def load_problem(path: str | Path, kind: type[BaseModel] = Problem):
+def load_problem(path: str | Path, kind: type[BaseModel] = Problem, field: str = "config"):
     """Read and validate a YAML file as a :class:`Problem` (or another config ``kind``).
 
     Args:
         path: the YAML file.
         kind: :class:`Problem`, :class:`IdentifyProblem` or :class:`SimulationConfig`.
+        field: the argument that named the file (``config``, ``effects``), for the messages.
 
     Returns:
         The validated config, with ``source_path`` and ``source_text`` set where it has them.
@@ -165,10 +165,10 @@ def load_problem(path: str | Path, kind: type[BaseModel] = Problem):
         ExciteError: missing file, malformed YAML or an invalid field; the message names the field.
     """
     path = Path(path)
-    raw, text = read_yaml(path)
+    raw, text = read_yaml(path, field)
     if not isinstance(raw, dict):
         raise ExciteError(
-            "config",
+            field,
             f"{path}: {'empty file' if raw is None else 'not a mapping'}",
             path,
             "a mapping of sections (see README 'Config reference')",
@@ -189,7 +189,8 @@ def with_overrides(config: BaseModel, overrides: dict[str, object]) -> BaseModel
     not changed, so what ran is the copy (stored as the effective config).
 
     Raises:
-        ExciteError: an override is not valid for its field (the message names the field).
+        ExciteError: an override is not valid for its field (the error's field is the dotted field,
+            which the command line words as the option that set it).
     """
     data = config.model_dump()
     for dotted, value in overrides.items():
@@ -200,7 +201,7 @@ def with_overrides(config: BaseModel, overrides: dict[str, object]) -> BaseModel
     try:
         copy = type(config).model_validate(data)
     except ValidationError as error:
-        raise _validation_error(Path("command line"), error) from None
+        raise _validation_error(None, error) from None
     for name in ("source_path", "source_text"):
         if name in type(config).model_fields:
             setattr(copy, name, getattr(config, name))

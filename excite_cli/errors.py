@@ -32,14 +32,21 @@ class ExciteError(Exception):
         self.field, self.problem, self.value, self.expected, self.source = field, problem, value, expected, source
         super().__init__(field, problem, value, expected)
 
-    def describe(self, field: str | None = None) -> str:
-        """One line: ``field: problem[; expected …]``, with ``field`` worded by the caller if given."""
+    def describe(self, field: str | None = None, source: Path | None = None) -> str:
+        """One line: ``[source: ]field: problem[; expected …]``, with ``field`` worded by the caller and
+        ``source`` (the file a config field is in) given by it if the error has none."""
         tail = f"; expected {self.expected}" if self.expected else ""
-        head = f"{self.source}: " if self.source else ""
+        source = self.source or source
+        head = f"{source}: " if source else ""
         return f"{head}{field or self.field}: {self.problem}{tail}"
 
     def __str__(self) -> str:
         return self.describe()
+
+
+class ExciteWarning(UserWarning):
+    """What a user should know that does not stop the run (a stale temporary file removed), raised
+    with :func:`warnings.warn`; the command line prints it as one line ``warning: ...``."""
 
 
 class FileNotFound(ExciteError):

@@ -16,7 +16,8 @@ import h5py
 import numpy as np
 
 from excite_cli.atomic import atomic_bytes
-from excite_cli.errors import ExciteError, FileNotFound
+from excite_cli.errors import ExciteError
+from excite_cli.inputs import input_file
 
 #: Rows written at once by :func:`write_parts` (16 chunks of 4096; a few MB).
 WRITE_ROWS = 65536
@@ -52,12 +53,11 @@ def open_h5(path: Path, field: str = "result") -> Iterator[h5py.File]:
 
     Raises:
         FileNotFound: no file at ``path``.
-        ExciteError: the file is not HDF5, or reading it in the block failed (a missing or empty
-            dataset, a link that leads nowhere, a value of the wrong type: a damaged file).
+        ExciteError: a folder, FIFO or device (:func:`~excite_cli.inputs.input_file`), the file is
+            not HDF5, or reading it in the block failed (a missing or empty dataset, a link that
+            leads nowhere, a value of the wrong type: a damaged file).
     """
-    path = Path(path)
-    if not path.is_file():
-        raise FileNotFound(field, path)
+    path = input_file(path, field, "HDF5 file")
     try:
         with h5py.File(path, "r") as f:
             yield f

@@ -198,8 +198,8 @@ CASES = [
     ),
     ("objective-unknown", lambda t, s: _optimize_config(t, **{"optimizer.objective": "fast"}), "optimizer.objective"),
     ("config-missing", lambda t, s: ["optimize", str(t / "missing.yaml")], "not found"),
-    ("seed-negative", lambda t, s: _optimize_config(t) + ["--seed", "-1"], "optimizer.seed"),
-    ("iterations-zero", lambda t, s: _optimize_config(t) + ["--iterations", "0"], "sequence.iterations"),
+    ("seed-negative", lambda t, s: _optimize_config(t) + ["--seed", "-1"], "error: --seed: "),
+    ("iterations-zero", lambda t, s: _optimize_config(t) + ["--iterations", "0"], "error: --iterations: "),
     ("workers-zero", lambda t, s: _optimize_config(t) + ["--workers", "0"], "workers"),
     ("output-is-folder", lambda t, s: _optimize_config(t)[:2] + ["-o", str(t)], "is a folder"),
     (
@@ -243,7 +243,7 @@ CASES = [
             "-o",
             str(t / "r.h5"),
         ],
-        "random_baseline.pool_size",
+        "error: --pool: ",
     ),
     (
         "compare-optimized-missing",

@@ -34,6 +34,18 @@ URDF_CASES = [
     ("moved-held-link-triangle", {"tip_ixx": "1e-2"}, "link 'tip' has an inertia no body can have"),
     ("limits-crossed", {"lower": "3.0"}, "joint 'hinge' has lower limit 3 above upper 2"),
     ("nan-velocity-limit", {"velocity": "nan"}, "joint 'hinge': limit velocity is 'nan'"),
+    # a link with two parent joints (pinocchio said "'j1' is not a joint of the robot" or "no body named tip")
+    (
+        "kinematic-loop",
+        {"mimic": '</joint><joint name="loop" type="revolute"><parent link="tip"/><child link="arm"/>'},
+        "robot.urdf: link 'arm' is the child of 2 joints ('hinge', 'loop'): a closed kinematic chain",
+    ),
+    # the follower of an active joint, held still while its leader moves (it was, silently)
+    (
+        "mimic-follower-held",
+        {"mimic": '<mimic joint="hinge" multiplier="2"/>'},
+        "robot.locked_joints: joint 'tip_joint' mimics active joint 'hinge' (multiplier 2, offset 0)",
+    ),
 ]
 
 

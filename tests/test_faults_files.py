@@ -368,7 +368,7 @@ def test_a_fifo_given_as_a_data_file_is_refused_at_once(pendulum_run, tmp_path):
     folder = _copy(pendulum_run, tmp_path / "run")
     os.mkfifo(folder / "pipe.csv")  # nobody writes: opening it to read would wait for ever
     process = _run(_identify_on(folder, "pipe.csv"), folder, timeout=60)  # a hang fails by the timeout
-    _one_error_line(process, "pipe.csv is not a regular file")
+    _one_error_line(process, "pipe.csv is a FIFO, not a regular file")
 
 
 # --- damaged results and reports ---------------------------------------------------------------------
@@ -466,3 +466,83 @@ def test_a_lock_left_by_a_killed_run_is_taken_over(pendulum_run, tmp_path):
         runner.invoke(app, ["optimize", str(folder / "pendulum.yaml"), "-o", str(folder / "again.h5")]).exit_code == 0
     )
     assert (folder / "again.h5").is_file() and not (folder / ".again.h5.lock").exists()
+
+
+# --- every input file through one opener, every message in one style ---------------------------------
+
+#: Each file a command reads, as (argv with {} for the file, where the line names it).
+INPUTS = {
+    "optimize-CONFIG": (["optimize", "{}"], "CONFIG"),
+    "identify-CONFIG": (["identify", "{}"], "CONFIG"),
+    "export-RESULT": (["export", "{}"], "RESULT"),
+    "view-RESULT": (["view", "{}"], "RESULT"),
+    "validate-REPORT": (["validate", "{}", "id.yaml"], "REPORT"),
+    "validate-CONFIG": (["validate", "out.h5", "{}"], "CONFIG"),
+    "simulate-RESULT": (["simulate", "{}", "effects.yaml"], "RESULT"),
+    "simulate-EFFECTS": (["simulate", "out.h5", "{}"], "EFFECTS"),
+    "compare-random--optimized": (["compare-random", "pendulum.yaml", "--optimized", "{}"], "--optimized"),
+    "verify-gradient--result": (["verify-gradient", "pendulum.yaml", "--result", "{}"], "--result"),
+    "robot.urdf": (["optimize", "urdf.yaml"], "urdf.yaml: robot.urdf"),
+    "sequence.prior": (["optimize", "prior.yaml"], "prior.yaml: sequence.prior"),
+}
+
+
+@pytest.mark.parametrize("kind", ["folder", "fifo"])
+@pytest.mark.parametrize("given", list(INPUTS))
+def test_an_input_that_is_not_a_regular_file_is_named_at_once(pendulum_run, tmp_path, given, kind):
+    """A folder or a FIFO (which nobody writes: reading it would wait for ever) given as any input
+    file: one line naming the argument or config field as the command spells it, at once."""
+    folder = _copy(pendulum_run, tmp_path / "run")
+    odd = folder / "odd.h5"
+    odd.mkdir() if kind == "folder" else os.mkfifo(odd)
+    config = {**yaml.safe_load((folder / "pendulum.yaml").read_text()), "output": "new.h5"}
+    (folder / "urdf.yaml").write_text(yaml.safe_dump({**config, "robot": {**config["robot"], "urdf": "odd.h5"}}))
+    (folder / "prior.yaml").write_text(yaml.safe_dump({**config, "sequence": {"iterations": 1, "prior": "odd.h5"}}))
+    argv, where = INPUTS[given]
+    process = _run([a.format("odd.h5") for a in argv], folder, timeout=60)  # a hang fails by the timeout
+    what = "is a folder" if kind == "folder" else "is a FIFO, not a regular file"
+    _one_error_line(process, f"odd.h5 {what}")
+    (line,) = [line for line in process.stderr.splitlines() if line.startswith("error:")]
+    assert line.startswith(f"error: {where}: ") or f"/{where}: " in line, line
+
+
+@pytest.mark.parametrize(
+    "argv, head",
+    [
+        (["optimize", "pendulum.yaml", "--iterations", "0"], "error: --iterations: "),
+        (["optimize", "pendulum.yaml", "--workers", "0"], "error: --workers: "),
+        (["compare-random", "pendulum.yaml", "--seed", "-1"], "error: --seed: "),
+        (["identify", "id.yaml", "--fit", "bogus"], "error: --fit: "),
+        (["simulate", "out.h5", "missing.yaml"], "error: EFFECTS: effects file not found: missing.yaml"),
+        (["identify", "missing_run.yaml"], "error: missing_run.yaml: data.runs: file not found: "),
+    ],
+    ids=["override-iterations", "override-workers", "override-seed", "override-fit", "effects-file", "runtime-field"],
+)
+def test_every_message_names_what_the_user_typed(pendulum_run, tmp_path, argv, head):
+    """One style: an argument as the command spells it, an option that overrode a config field by its
+    flag (it said 'command line: sequence.iterations'), a config field after its file, including
+    those found while the run reads its data (they named no file); the effects file is EFFECTS."""
+    folder = _copy(pendulum_run, tmp_path / "run")
+    config = yaml.safe_load((folder / "id.yaml").read_text())
+    config["data"]["runs"][0]["file"] = "sim/run_9.csv"
+    (folder / "missing_run.yaml").write_text(yaml.safe_dump(config))
+    process = _run(argv, folder, timeout=120)
+    _one_error_line(process, "")
+    (line,) = [line for line in process.stderr.splitlines() if line.startswith("error:")]
+    assert line.startswith(head), line
+
+
+def test_a_killed_runs_lock_and_partial_file_are_removed_with_a_line_each(pendulum_run, tmp_path):
+    """SIGKILL leaves the hidden .again.h5.lock and .again.h5.partial: the next run takes them over
+    and says so (it used to take them over silently), and leaves neither behind."""
+    folder = _copy(pendulum_run, tmp_path / "run")
+    (folder / ".again.h5.lock").write_text("99999999\n")  # no process holds it
+    (folder / ".again.h5.partial").write_bytes(b"half a file")
+    process = _run(["optimize", "pendulum.yaml", "-o", "again.h5"], folder)
+    assert process.returncode == 0, process.stderr
+    warnings = [line for line in process.stderr.splitlines() if line.startswith("warning:")]
+    assert warnings == [
+        "warning: took over .again.h5.lock, left by process 99999999, which was killed",
+        "warning: removed .again.h5.partial, left by an interrupted run",
+    ], process.stderr
+    assert not [p.name for p in folder.iterdir() if p.name.startswith(".again")]

@@ -219,7 +219,8 @@ def load_robot(
             outside the joint's limits, a body or active joint that cannot be (:func:`check_urdf`).
     """
     path, package_dirs = resolve_urdf(cfg, folder) if urdf is None else (urdf, [str(urdf.parent)])
-    problems = check_urdf(path, list(cfg.active_joints), physical)  # before urdfdom, which prints what it cannot parse
+    # before urdfdom, which prints what it cannot parse
+    problems = check_urdf(path, list(cfg.active_joints), physical, list(cfg.locked_joints))
     try:
         full = pin.buildModelFromUrdf(str(path), *([pin.JointModelFreeFlyer()] if cfg.floating_base else []))
     except (RuntimeError, ValueError) as exc:

@@ -12,8 +12,9 @@ not held to it: 46 of the 2149 links of example-robot-data's URDFs break it (sen
 PR2, fingers of the Allegro hand, Romeo's torso), and refusing a robot for a link the problem does
 not move would refuse valid work. Per active joint: the limits are numbers and lower ≤ upper. A
 ``<mimic>`` joint follows another in a way the model does not represent, so it may not be active;
-the joint it follows may (the follower is then held, as the Panda's second finger is when the first
-is active).
+the joint it follows may, but the follower is then held still while its leader moves, so it must be
+listed in ``robot.locked_joints`` (held on purpose, as the Panda's second finger when the first is
+active): otherwise the model would silently differ from the robot.
 """
 
 from __future__ import annotations
@@ -82,8 +83,9 @@ def check_inertial(link: ElementTree.Element, moved: bool = True) -> str:
     return ""
 
 
-def check_joints(root: ElementTree.Element, active: list[str]) -> None:
-    """Limits and ``<mimic>`` of the active joints (module docstring).
+def check_joints(root: ElementTree.Element, active: list[str], locked: list[str] = ()) -> None:
+    """Limits and ``<mimic>`` of the active joints (module docstring); ``locked``: the joints held on
+    purpose (``robot.locked_joints``).
 
     Raises:
         ExciteError: naming the joint.
@@ -107,12 +109,49 @@ def check_joints(root: ElementTree.Element, active: list[str]) -> None:
                 name,
                 "active joints without <mimic>",
             )
+        if mimic is not None and followed in active and name not in locked:
+            raise ExciteError(
+                "robot.locked_joints",
+                f"joint '{name}' mimics active joint '{followed}' (multiplier {mimic.get('multiplier', '1')}, "
+                f"offset {mimic.get('offset', '0')}), a coupling the model does not represent: it would be held "
+                f"still while '{followed}' moves",
+                name,
+                f"'{name}' listed in robot.locked_joints (held on purpose) or '{followed}' not active",
+            )
 
 
-def check_urdf(path: Path, active: list[str], physical: bool = True) -> list[str]:
+def check_tree(links: list[str], parents: dict[str, list[str]]) -> None:
+    """The links and joints of a URDF form one tree: no link is the child of two joints (a closed
+    kinematic chain, which a URDF cannot describe and pinocchio misreads) and one link is the root.
+
+    Args:
+        links: every ``<link>``'s name.
+        parents: the joints that have each link as their child.
+
+    Raises:
+        ExciteError: (``robot.urdf``) a link with two parent joints, or no root link (a loop).
+    """
+    for link, joints in parents.items():
+        if len(joints) > 1:
+            raise ExciteError(
+                "robot.urdf",
+                f"link '{link}' is the child of {len(joints)} joints ({', '.join(repr(j) for j in joints)}): "
+                "a closed kinematic chain, which a URDF cannot describe",
+                link,
+                "a tree of links (one parent joint per link)",
+            )
+    if links and all(link in parents for link in links):
+        raise ExciteError(
+            "robot.urdf", "every link is the child of a joint: the joints form a loop", None, "one root link"
+        )
+
+
+def check_urdf(path: Path, active: list[str], physical: bool = True, locked: list[str] = ()) -> list[str]:
     """Every check of the module docstring on the URDF at ``path``.
 
     Args:
+        active: the active joints' names.
+        locked: the joints held on purpose (``robot.locked_joints``).
         physical: refuse a moved link whose inertia no body can have; False (identification, which
             uses the URDF's inertias as a reference only, and vendors' URDFs often break the triangle
             inequality): return such links' problems in words instead.
@@ -121,21 +160,25 @@ def check_urdf(path: Path, active: list[str], physical: bool = True) -> list[str
         The moved links' inertias no body can have, in words (empty with ``physical``).
 
     Raises:
-        ExciteError: the file is not XML, a mass or inertia that is not a number, a negative mass, an
-            active joint that cannot be, or (with ``physical``) an inertia no body can have.
+        ExciteError: the file is not XML, links that are no tree (:func:`check_tree`), a mass or
+            inertia that is not a number, a negative mass, an active joint that cannot be, or (with
+            ``physical``) an inertia no body can have.
     """
     try:
         root = ElementTree.parse(path).getroot()
     except (ElementTree.ParseError, OSError) as exc:
         raise ExciteError("robot.urdf", f"cannot read {path}: {exc}") from None
     children: dict[str, list[str]] = {}
+    parents: dict[str, list[str]] = {}
     moved: list[str] = []
     below: set[str] = set()
     for joint in root.findall("joint"):
         parent, child = joint.find("parent"), joint.find("child")
         if parent is not None and child is not None:
             children.setdefault(parent.get("link"), []).append(child.get("link"))
+            parents.setdefault(child.get("link"), []).append(joint.get("name"))
             moved += [child.get("link")] if joint.get("name") in active else []
+    check_tree([link.get("name") for link in root.findall("link")], parents)
     while moved:  # every link below an active joint
         link = moved.pop()
         below.add(link)
@@ -145,5 +188,5 @@ def check_urdf(path: Path, active: list[str], physical: bool = True) -> list[str
         raise ExciteError(
             "robot.urdf", problems[0], None, "moments ≥ 0 with the two smaller summing to at least the largest"
         )
-    check_joints(root, active)
+    check_joints(root, active, locked)
     return problems

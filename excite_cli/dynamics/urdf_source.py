@@ -7,6 +7,7 @@ from pathlib import Path
 
 from excite_cli.config import RobotConfig, resolve_path
 from excite_cli.errors import ExciteError
+from excite_cli.inputs import input_file
 
 
 def example_robot_data_root() -> Path:
@@ -30,7 +31,7 @@ def resolve_urdf(cfg: RobotConfig, folder: Path | None = None) -> tuple[Path, li
         folder: the config file's folder, which a relative ``urdf`` with ``source: file`` is in.
 
     Raises:
-        ExciteError: the file does not exist.
+        ExciteError: the file does not exist, is a folder, a FIFO or a device (:func:`~excite_cli.inputs.input_file`).
     """
     if cfg.source == "example-robot-data":
         share = example_robot_data_root()
@@ -39,6 +40,4 @@ def resolve_urdf(cfg: RobotConfig, folder: Path | None = None) -> tuple[Path, li
     else:
         path = resolve_path(cfg.urdf, folder)
         dirs = [str(path.parent), str(path.parent.parent)]
-    if not path.is_file():
-        raise ExciteError("robot.urdf", f"no URDF file at {path}")
-    return path, dirs
+    return input_file(path, "robot.urdf", "URDF"), dirs

@@ -21,6 +21,7 @@ from excite_cli.identification.effects import EFFECTS, Term
 from excite_cli.identification.fitting.dataset import Dataset, build_datasets, fit_position_range
 from excite_cli.identification.fitting.least_squares import joint_weights, least_squares, predict, torque_errors
 from excite_cli.identification.fitting.normal import NormalEquations, excited_rank
+from excite_cli.identification.fitting.plausibility import implausible
 from excite_cli.identification.measured.measurements import (
     check_against_limits,
     in_sample_validation,
@@ -262,6 +263,7 @@ def run_identification(
         q_range=data.q_range,
         warnings=robot.warnings
         + in_sample_validation(problem.data.runs, problem.folder)
+        + implausible(fit_data, base.from_standard(robot.urdf_parameters()), robot, choice.consistent)
         + [
             f"{robot.joint_names[j]}: the torque channel carries no signal (mostly exact zeros); left out of the "
             "selection score"

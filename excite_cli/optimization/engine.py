@@ -16,14 +16,16 @@ from __future__ import annotations
 import os
 import signal
 import threading
+import time
 from concurrent.futures import Executor, ProcessPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
 from typing import Any, Callable, Iterator, Optional, Protocol, Sequence
 
 from threadpoolctl import threadpool_limits
 
 from excite_cli.config import Problem
 from excite_cli.dynamics.base_parameters import BaseParameters
-from excite_cli.errors import ExciteError
+from excite_cli.errors import NO_VALUE, ExciteError
 from excite_cli.memory import keep_freed_memory
 from excite_cli.optimization.excitation import Excitation, build_excitation
 
@@ -31,6 +33,8 @@ from excite_cli.optimization.excitation import Excitation, build_excitation
 CONNECT_TIMEOUT = "10s"
 #: Seconds a stopped worker process is given to end.
 WORKER_STOP = 5.0
+#: Seconds between looks at a Dask cluster's workers while its tasks run.
+WORKER_LOOK = 1.0
 
 
 class Task(Protocol):
@@ -74,14 +78,19 @@ class Engine:
     as many as the first parallel run has tasks), or on the Dask scheduler at ``scheduler``.
 
     Use as a context manager: this process runs with one BLAS thread inside it (and keeps freed
-    memory), and the pool or client is closed on exit.
+    memory), and the pool or client is closed on exit. A Dask worker that dies mid-task is replaced
+    by another (the scheduler runs the task again, and a task is a pure function of problem, base and
+    seed, so the result is the same bit for bit); a cluster left without any worker for
+    ``worker_wait`` seconds stops the run, as does a task that killed the workers it ran on.
 
     Raises:
         ExciteError: the scheduler cannot be reached.
     """
 
-    def __init__(self, excitation: Excitation, workers: int = 1, scheduler: Optional[str] = None):
-        self.excitation, self.workers, self.scheduler = excitation, workers, scheduler
+    def __init__(
+        self, excitation: Excitation, workers: int = 1, scheduler: Optional[str] = None, worker_wait: float = 120.0
+    ):
+        self.excitation, self.workers, self.scheduler, self.worker_wait = excitation, workers, scheduler, worker_wait
         self._pool: Optional[Executor] = None
         self._client = None
         self._limits: Optional[threadpool_limits] = None
@@ -127,6 +136,11 @@ class Engine:
             tasks: the tasks (distinct indices).
             progress: passed to each task when it runs in this process.
             on_result: called with each result as it arrives.
+
+        Raises:
+            ExciteError: a local worker process died (``optimizer.workers``: killed by the system, out
+                of memory?); the Dask cluster had no worker for ``worker_wait`` seconds, or a task
+                killed every worker it was given (``optimizer.scheduler``).
         """
         results = {}
         for task, result in self._completed(tasks, progress):
@@ -142,19 +156,52 @@ class Engine:
             return
         problem, base = self.excitation.problem, self.excitation.base
         if self._client is not None:
-            from dask.distributed import as_completed as dask_completed
-
-            # a worker that dies mid-task: the scheduler runs the task again on another (a restart is a
-            # pure function of problem, base and seed, so the result is the same bit for bit)
             futures = {self._client.submit(run_on_worker, problem, base, task, pure=False): task for task in tasks}
-            for future in dask_completed(list(futures)):
-                yield futures[future], future.result()
+            yield from self._dask_completed(futures)
             return
         if self._pool is None:  # sized by the work: more processes than tasks would only start and wait
             self._pool = ProcessPoolExecutor(max_workers=min(self.workers, len(tasks)), initializer=_worker_signals)
-        pool_futures = {self._pool.submit(run_on_worker, problem, base, task): task for task in tasks}
-        for future in as_completed(pool_futures):
-            yield pool_futures[future], future.result()
+        try:  # a process killed while idle breaks the pool too: submit raises then
+            pool_futures = {self._pool.submit(run_on_worker, problem, base, task): task for task in tasks}
+            for future in as_completed(pool_futures):
+                yield pool_futures[future], future.result()
+        except BrokenProcessPool:
+            raise ExciteError(
+                "optimizer.workers",
+                "a worker process died during the run (killed by the system: out of memory?)",
+                NO_VALUE,
+                "fewer workers, or a machine with more memory",
+            ) from None
+
+    def _dask_completed(self, futures: dict) -> Iterator[tuple[Task, Any]]:
+        """``futures``' tasks and results as they finish, the cluster's workers looked at meanwhile."""
+        from dask.distributed import KilledWorker, wait
+
+        pending, alone_since = set(futures), None
+        while pending:
+            try:
+                done, pending = wait(pending, timeout=WORKER_LOOK, return_when="FIRST_COMPLETED")
+            except TimeoutError:
+                done = set()
+            for future in done:
+                try:
+                    yield futures[future], future.result()
+                except KilledWorker:
+                    raise ExciteError(
+                        "optimizer.scheduler",
+                        f"task {futures[future].index} ended every worker that ran it (killed: out of memory?)",
+                    ) from None
+            if self._client.nthreads():
+                alone_since = None
+            elif alone_since is None:
+                alone_since = time.monotonic()
+            elif time.monotonic() - alone_since > self.worker_wait:
+                raise ExciteError(
+                    "optimizer.scheduler",
+                    f"the Dask cluster at {self.scheduler} had no worker for {self.worker_wait:g} s",
+                    self.scheduler,
+                    "a running worker (or a longer optimizer.worker_wait)",
+                )
 
 
 def default_workers() -> int:

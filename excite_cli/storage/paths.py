@@ -6,12 +6,13 @@ from __future__ import annotations
 
 import fcntl
 import os
+import warnings
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Iterator
 
-from excite_cli.atomic import new_folders
-from excite_cli.errors import CannotWrite, ExciteError, OutputExists
+from excite_cli.atomic import new_folders, partial_path, remove_stale
+from excite_cli.errors import CannotWrite, ExciteError, ExciteWarning, OutputExists
 
 
 def check_target(path: Path, field: str, force: bool = False, exists_ok: bool = False) -> Path:
@@ -67,7 +68,9 @@ def output_lock(path: Path, field: str) -> Iterator[None]:
     """Hold ``.<name>.lock`` beside ``path`` (an exclusive ``flock``, with this process's id inside) while the block
     runs, so a second run writing ``path`` stops at once instead of replacing the first one's result.
     The lock file is removed when the block ends; one left by a killed run is taken over (the system
-    releases its lock). Folders made for it and left empty are removed (:func:`new_folders`).
+    releases its lock), and so is its ``.<name>.partial``, each with a warning
+    (:class:`~excite_cli.errors.ExciteWarning`). Folders made for it and left empty are removed
+    (:func:`new_folders`).
 
     Raises:
         ExciteError: another process holds the lock (its id in the message).
@@ -95,6 +98,10 @@ def output_lock(path: Path, field: str) -> Iterator[None]:
                     path,
                     "another output path, or that run to end",
                 )
+            stale = os.pread(fd, 32, 0).decode(errors="replace").strip()
+            if stale:
+                warnings.warn(f"took over {lock}, left by process {stale}, which was killed", ExciteWarning)
+                remove_stale(partial_path(path))
             os.ftruncate(fd, 0)
             os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
             yield

@@ -24,13 +24,14 @@ from excite_cli.storage.results import read_iterations, read_prior, write_result
 #: The largest cond(C) of a result that identifies something: above it, noise in the torques is
 #: amplified a million times into the base parameters (Eq. 5 bounds the relative error by cond(C)).
 MAX_USEFUL_COND = 1e6
-RESUMABLE_CHANGES = ("sequence.iterations", "optimizer.workers", "optimizer.scheduler")
+RESUMABLE_CHANGES = ("sequence.iterations", "optimizer.workers", "optimizer.scheduler", "optimizer.worker_wait")
 
 
 def engine_for(problem: Problem, excitation: Excitation) -> Engine:
     """Where restarts and draws run: ``optimizer.scheduler``, else ``optimizer.workers`` local
     processes (default: the machine's cores)."""
-    return Engine(excitation, problem.optimizer.workers or default_workers(), problem.optimizer.scheduler)
+    cfg = problem.optimizer
+    return Engine(excitation, cfg.workers or default_workers(), cfg.scheduler, cfg.worker_wait)
 
 
 @dataclass
@@ -84,7 +85,8 @@ def run_optimize(
 
     Raises:
         ExciteError: bad target, prior data or problem; a result to resume made with another config;
-            another run writing ``target`` (:func:`output_lock`).
+            another run writing ``target`` (:func:`output_lock`); workers lost during the run
+            (:class:`~excite_cli.optimization.engine.Engine`), with the finished iterations kept in ``target``.
         Interrupted: Ctrl-C or SIGTERM; the finished iterations are in ``target``, the workers stopped.
     """
     check_target(target, "output", force, exists_ok=resume)
@@ -120,6 +122,11 @@ def run_optimize(
                 )
         except KeyboardInterrupt as exc:
             raise Interrupted(target, len(written), exit_status(exc)) from None
+        except ExciteError as exc:  # the cluster lost its workers: what is finished stays, and says so
+            if not written:
+                raise
+            kept = f"; kept {len(written)} finished iteration(s) in {target}, which a resumed run continues"
+            raise ExciteError(exc.field, exc.problem + kept, exc.value, exc.expected, exc.source) from None
         return OptimizeRun(excitation, results, target, plot_result(target, excitation, results))
 
 

@@ -30,3 +30,35 @@ def test_the_pendulum_is_a_robot_that_can_be(tmp_path):
 def test_a_body_or_joint_that_cannot_be_is_named(tmp_path, fields, active, expected):
     with pytest.raises(ExciteError, match=expected):
         check_urdf(_urdf(tmp_path, **fields), active)
+
+
+LOOP = '<joint name="loop" type="revolute"><parent link="tip"/><child link="arm"/><axis xyz="0 1 0"/></joint>'
+
+
+def test_a_closed_kinematic_chain_is_named_not_misread(tmp_path):
+    """pinocchio reads a link with two parent joints as 'no body named tip', far from the cause."""
+    path = _urdf(tmp_path)
+    path.write_text(path.read_text().replace("</robot>", LOOP + "</robot>"))
+    with pytest.raises(ExciteError, match=r"link 'arm' is the child of 2 joints \('hinge', 'loop'\)"):
+        check_urdf(path, ["hinge"])
+
+
+def test_joints_that_form_a_ring_have_no_root(tmp_path):
+    path = _urdf(tmp_path)
+    ring = '<joint name="ring" type="fixed"><parent link="tip"/><child link="base"/></joint>'
+    path.write_text(path.read_text().replace("</robot>", ring + "</robot>"))
+    with pytest.raises(ExciteError, match="the joints form a loop"):
+        check_urdf(path, ["hinge"])
+
+
+MIMIC = '<mimic joint="hinge" multiplier="2"/>'
+
+
+def test_a_mimic_joint_held_while_its_leader_moves_is_refused_unless_locked_on_purpose(tmp_path):
+    path = _urdf(tmp_path, mimic=MIMIC)
+    with pytest.raises(ExciteError, match="'tip_joint' mimics active joint 'hinge' \\(multiplier 2") as caught:
+        check_urdf(path, ["hinge"])
+    assert caught.value.field == "robot.locked_joints"
+    check_urdf(path, ["hinge"], locked=["tip_joint"])  # held on purpose
+    with pytest.raises(ExciteError, match="a coupling the model does not represent"):
+        check_urdf(path, ["hinge", "tip_joint"])  # the follower itself may not be active

@@ -39,6 +39,7 @@ def test_passes_per_row_equal_passes_per_parameter(name, base_rows, prismatic, r
     if prismatic:
         problem.robot.active_joints = [*problem.robot.active_joints[:3], "panda_finger_joint1"]
         problem.robot.locked_joints.pop("panda_finger_joint1", None)
+        problem.robot.locked_joints["panda_finger_joint2"] = 0.0  # it mimics finger 1: held on purpose
         problem.limits.position_margin = 0.002
     robot = build_excitation(problem).robot
     dynamics = VirtualDynamics(robot)

@@ -2,10 +2,13 @@
 trajectories and candidates, bit for bit, for the same seed; each restart draws its own start."""
 
 import os
+import re
 import subprocess
 import sys
 import time
+from contextlib import contextmanager
 from pathlib import Path
+from typing import Iterator
 
 import h5py
 import numpy as np
@@ -113,6 +116,26 @@ def test_workers_optimize_in_the_main_process_base(excitation):
         assert run.objective != pytest.approx(excitation.criterion(prior).value(run.alpha), rel=1e-6)
 
 
+@contextmanager
+def _dask_cluster(port: int) -> Iterator[tuple[str, subprocess.Popen]]:
+    """A real `dask scheduler` on ``port`` and a `dask worker` of two one-thread processes: (address, the
+    worker's process), both stopped when the block ends."""
+    dask = str(Path(sys.executable).with_name("dask"))
+    quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL}
+    address = f"tcp://127.0.0.1:{port}"
+    scheduler = subprocess.Popen([dask, "scheduler", "--port", str(port), "--no-dashboard"], **quiet)
+    worker = subprocess.Popen(
+        [dask, "worker", address, "--nworkers", "2", "--nthreads", "1", "--no-dashboard"], **quiet
+    )
+    try:
+        yield address, worker
+    finally:
+        for process in (worker, scheduler):
+            if process.poll() is None:
+                process.terminate()
+                process.wait(20)
+
+
 def test_a_dask_worker_killed_mid_run_gives_the_uninterrupted_result(tmp_path):
     """Real `dask scheduler` and `dask worker` processes; one worker process is killed (SIGKILL) while
     it runs a restart: the scheduler gives the task to a worker again (restarts are pure functions
@@ -123,39 +146,111 @@ def test_a_dask_worker_killed_mid_run_gives_the_uninterrupted_result(tmp_path):
     config["optimizer"] = {"restarts": 4, "max_iterations": 25}
     config["sequence"] = {"iterations": 1}
     path = write_config(tmp_path, config)
-    excite, dask = (str(Path(sys.executable).with_name(name)) for name in ("excite", "dask"))
+    excite = str(Path(sys.executable).with_name("excite"))
     serial = subprocess.run([excite, "optimize", str(path), "-o", str(tmp_path / "serial.h5"), "--workers", "1"])
     assert serial.returncode == 0
-    port = 8500 + os.getpid() % 300
-    quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL}
-    scheduler = subprocess.Popen([dask, "scheduler", "--port", str(port), "--no-dashboard"], **quiet)
-    worker = subprocess.Popen(
-        [dask, "worker", f"tcp://127.0.0.1:{port}", "--nworkers", "2", "--nthreads", "1", "--no-dashboard"], **quiet
-    )
     run = None
-    try:
-        with distributed.Client(f"tcp://127.0.0.1:{port}", timeout=60) as client:
-            client.wait_for_workers(2, timeout=120)  # started: a kill now is a death mid-run, not a failed start
-            workers = [psutil.Process(pid) for pid in client.run(os.getpid).values()]
-        run = subprocess.Popen(
-            [excite, "optimize", str(path), "-o", str(tmp_path / "dask.h5"), "--scheduler", f"tcp://127.0.0.1:{port}"],
-            **quiet,
-        )
-        killed = None
-        deadline = time.monotonic() + 120
-        while killed is None and run.poll() is None and time.monotonic() < deadline:
-            for process in workers:
-                if process.cpu_percent(interval=0.2) > 20:  # busy with a restart (an idle worker: ~1 %)
-                    process.kill()
-                    killed = process.pid
-                    break
-        assert killed is not None, "no worker was seen running a restart"
-        assert run.wait(300) == 0
-    finally:
-        for process in (run, worker, scheduler):
-            if process is not None and process.poll() is None:
-                process.terminate()
-                process.wait(20)
+    with _dask_cluster(8500 + os.getpid() % 300) as (address, _):
+        try:
+            with distributed.Client(address, timeout=60) as client:
+                client.wait_for_workers(2, timeout=120)  # started: a kill now is a death mid-run, not a failed start
+                workers = [psutil.Process(pid) for pid in client.run(os.getpid).values()]
+            argv = [excite, "optimize", str(path), "-o", str(tmp_path / "dask.h5"), "--scheduler", address]
+            run = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            killed = None
+            deadline = time.monotonic() + 120
+            while killed is None and run.poll() is None and time.monotonic() < deadline:
+                for process in workers:
+                    if process.cpu_percent(interval=0.2) > 20:  # busy with a restart (an idle worker: ~1 %)
+                        process.kill()
+                        killed = process.pid
+                        break
+            assert killed is not None, "no worker was seen running a restart"
+            assert run.wait(300) == 0
+        finally:
+            if run is not None and run.poll() is None:
+                run.kill()
     with h5py.File(tmp_path / "serial.h5") as a, h5py.File(tmp_path / "dask.h5") as b:
         np.testing.assert_array_equal(a["iterations/1/alpha"][()], b["iterations/1/alpha"][()])
         assert a["iterations/1"].attrs["cond_stacked"] == b["iterations/1"].attrs["cond_stacked"]
+
+
+def _busy_optimize(tmp_path: Path, iterations: int, **optimizer) -> Path:
+    """The Panda with capsules, restarts long enough to be caught running."""
+    config = yaml.safe_load((HERE / "panda_capsules.yaml").read_text())
+    config["optimizer"] = {"restarts": 4, "max_iterations": 60, **optimizer}
+    config["sequence"] = {"iterations": iterations}
+    return write_config(tmp_path, config)
+
+
+def _kill_when(process: subprocess.Popen, ready, kill, deadline_s: float = 180) -> bool:
+    """Call ``kill()`` once ``ready()`` holds while ``process`` runs; whether it was called."""
+    deadline = time.monotonic() + deadline_s
+    while process.poll() is None and time.monotonic() < deadline:
+        if ready():
+            kill()
+            return True
+        time.sleep(0.1)
+    return False
+
+
+def test_a_cluster_that_loses_every_worker_stops_with_one_line_and_keeps_the_finished_iterations(tmp_path):
+    """Real `dask scheduler` and `dask worker` processes; once iteration 1 is written the whole worker
+    (its nanny and processes) is killed: the run stops after optimizer.worker_wait seconds without a
+    worker (it would wait for one for ever), says so in one line and keeps the finished iterations."""
+    psutil = pytest.importorskip("psutil")
+    pytest.importorskip("dask.distributed")
+    path = _busy_optimize(tmp_path, iterations=4, worker_wait=3.0)
+    out = tmp_path / "dask.h5"
+    run = None
+    with _dask_cluster(8200 + os.getpid() % 300) as (address, worker):
+        try:
+            argv = [str(Path(sys.executable).with_name("excite")), "optimize", str(path), "-o", str(out)]
+            run = subprocess.Popen(
+                [*argv, "--scheduler", address], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True
+            )
+
+            def kill_every_worker() -> None:
+                tree = psutil.Process(worker.pid)
+                for process in [*tree.children(recursive=True), tree]:
+                    process.kill()
+
+            assert _kill_when(run, out.exists, kill_every_worker), "iteration 1 was not written"
+            _, stderr = run.communicate(timeout=120)
+        finally:
+            if run is not None and run.poll() is None:
+                run.kill()
+    _assert_stopped_keeping_iterations(run, stderr, "had no worker for 3 s", out)
+
+
+def _assert_stopped_keeping_iterations(run: subprocess.Popen, stderr: str, expected: str, out: Path) -> None:
+    """Exit 2, one error line containing ``expected`` and "kept k finished iteration(s)" with k ≥ 1,
+    and iterations 1 … k in ``out``."""
+    assert run.returncode == 2 and "Traceback" not in stderr, stderr
+    (line,) = [line for line in stderr.splitlines() if line.startswith("error:")]
+    assert expected in line, line
+    kept = int(re.search(r"kept (\d+) finished iteration", line).group(1))
+    with h5py.File(out) as f:
+        assert kept >= 1 and sorted(f["iterations"], key=int) == [str(k) for k in range(1, kept + 1)]
+
+
+def test_a_local_worker_process_killed_mid_run_is_one_line(tmp_path):
+    """The pool's worker processes killed (as the system's out-of-memory killer would) once iteration
+    1 is written: one line naming --workers (optimizer.workers), exit 2, the finished iterations kept."""
+    psutil = pytest.importorskip("psutil")
+    path = _busy_optimize(tmp_path, iterations=4)
+    out = tmp_path / "pool.h5"
+    argv = [str(Path(sys.executable).with_name("excite")), "optimize", str(path), "-o", str(out), "--workers", "2"]
+    run = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    try:
+
+        def kill_workers() -> None:
+            for process in psutil.Process(run.pid).children():
+                process.kill()
+
+        assert _kill_when(run, out.exists, kill_workers), "iteration 1 was not written"
+        _, stderr = run.communicate(timeout=120)
+    finally:
+        if run.poll() is None:
+            run.kill()
+    _assert_stopped_keeping_iterations(run, stderr, "--workers: a worker process died during the run", out)

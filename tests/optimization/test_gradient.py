@@ -144,6 +144,7 @@ def test_gradient_with_a_prismatic_joint(panda_problem):
     problem = small(panda_problem, harmonics=3, samples=15)
     problem.robot.active_joints = [*problem.robot.active_joints[:3], "panda_finger_joint1"]
     problem.robot.locked_joints.pop("panda_finger_joint1", None)
+    problem.robot.locked_joints["panda_finger_joint2"] = 0.0  # it mimics finger 1: held on purpose
     problem.limits.position_margin = 0.002
     excitation = build_excitation(problem)
     criterion = excitation.criterion(objective="log_cond")  # two passes per parameter vector and the shift's

@@ -19,6 +19,7 @@ from rosbags.typesys import Stores, get_typestore
 
 from excite_cli.errors import ExciteError
 from excite_cli.identification.measured.files import Table
+from excite_cli.inputs import input_file
 
 BAG_SUFFIXES = (".bag", ".db3", ".mcap")
 FIELDS = ("position", "velocity", "effort")
@@ -64,8 +65,11 @@ def read_bag(path: Path, topic: str, joints: Sequence[str]) -> Table:
         joints: (n,) the active joints' names, as in the URDF.
 
     Raises:
-        ExciteError: not a readable bag, no such topic or not JointState, no message with every joint.
+        ExciteError: not a readable bag (a FIFO or device: :func:`~excite_cli.inputs.input_file`), no such topic or not
+            JointState, no message with every joint.
     """
+    if not path.is_dir():  # a ROS 1 file or a ROS 2 bag's .db3 / .mcap
+        input_file(path, "data.runs", "ROS bag")
     try:
         with AnyReader(_bag_paths(path), default_typestore=get_typestore(Stores.LATEST)) as reader:
             connections = [c for c in reader.connections if c.topic == topic]

@@ -21,6 +21,7 @@ import numpy as np
 import scipy.io
 
 from excite_cli.errors import ExciteError
+from excite_cli.inputs import input_file
 
 DELIMITERS = (",", ";", "\t")
 #: Largest CSV or text file read [bytes] (binary formats are read without this bound).
@@ -248,8 +249,7 @@ def read_table(path: Path, drop: bool = False) -> Table:
     Raises:
         ExciteError: not a regular file, an unreadable file or row, naming the file (and the line).
     """
-    if not path.is_file():  # before anything opens it: reading a FIFO waits for a writer
-        raise ExciteError("data", f"{path.name} is not a regular file (a FIFO, a device or a socket?)", path)
+    input_file(path, "data.runs", "data file")  # before anything opens it: reading a FIFO waits for a writer
     suffix = path.suffix.lower()
     try:
         if suffix == ".npz":
