@@ -499,9 +499,12 @@ def test_an_input_that_is_not_a_regular_file_is_named_at_once(pendulum_run, tmp_
     (folder / "urdf.yaml").write_text(yaml.safe_dump({**config, "robot": {**config["robot"], "urdf": "odd.h5"}}))
     (folder / "prior.yaml").write_text(yaml.safe_dump({**config, "sequence": {"iterations": 1, "prior": "odd.h5"}}))
     argv, where = INPUTS[given]
-    process = _run([a.format("odd.h5") for a in argv], folder, timeout=60)  # a hang fails by the timeout
-    what = "is a folder" if kind == "folder" else "is a FIFO, not a regular file"
-    _one_error_line(process, f"odd.h5 {what}")
+    argv = [a.format("odd.h5") for a in argv]
+    if kind == "folder":  # in this process (quicker); paths from the folder
+        assert_refused(folder, [str(folder / a) if (folder / a).exists() else a for a in argv], "odd.h5 is a folder")
+        return
+    process = _run(argv, folder, timeout=60)  # a hang fails by the timeout
+    _one_error_line(process, "odd.h5 is a FIFO, not a regular file")
     (line,) = [line for line in process.stderr.splitlines() if line.startswith("error:")]
     assert line.startswith(f"error: {where}: ") or f"/{where}: " in line, line
 
@@ -546,3 +549,13 @@ def test_a_killed_runs_lock_and_partial_file_are_removed_with_a_line_each(pendul
         "warning: removed .again.h5.partial, left by an interrupted run",
     ], process.stderr
     assert not [p.name for p in folder.iterdir() if p.name.startswith(".again")]
+
+
+def test_a_prior_regressor_of_three_dimensions_is_named_by_its_shape(pendulum_run, tmp_path):
+    """A (2, 3, b) prior said 'has b regressor columns, the robot has b base parameters'."""
+    folder = _copy(pendulum_run, tmp_path / "run")
+    with h5py.File(folder / "prior3.h5", "w") as f:
+        f["regressor"] = np.ones((2, 3, 3))
+    config = {**yaml.safe_load((folder / "pendulum.yaml").read_text()), "output": "new.h5"}
+    (folder / "prior3.yaml").write_text(yaml.safe_dump({**config, "sequence": {"iterations": 1, "prior": "prior3.h5"}}))
+    assert_refused(folder, ["optimize", str(folder / "prior3.yaml")], "has regressor rows of shape 2x3x3")
