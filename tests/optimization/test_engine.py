@@ -194,35 +194,6 @@ def _kill_when(process: subprocess.Popen, ready, kill, deadline_s: float = 180) 
     return False
 
 
-def test_a_cluster_that_loses_every_worker_stops_with_one_line_and_keeps_the_finished_iterations(tmp_path):
-    """Real `dask scheduler` and `dask worker` processes; once iteration 1 is written the whole worker
-    (its nanny and processes) is killed: the run stops after optimizer.worker_wait seconds without a
-    worker (it would wait for one for ever), says so in one line and keeps the finished iterations."""
-    psutil = pytest.importorskip("psutil")
-    pytest.importorskip("dask.distributed")
-    path = _busy_optimize(tmp_path, iterations=4, worker_wait=3.0)
-    out = tmp_path / "dask.h5"
-    run = None
-    with _dask_cluster(8200 + os.getpid() % 300) as (address, worker):
-        try:
-            argv = [str(Path(sys.executable).with_name("excite")), "optimize", str(path), "-o", str(out)]
-            run = subprocess.Popen(
-                [*argv, "--scheduler", address], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True
-            )
-
-            def kill_every_worker() -> None:
-                tree = psutil.Process(worker.pid)
-                for process in [*tree.children(recursive=True), tree]:
-                    process.kill()
-
-            assert _kill_when(run, out.exists, kill_every_worker), "iteration 1 was not written"
-            _, stderr = run.communicate(timeout=120)
-        finally:
-            if run is not None and run.poll() is None:
-                run.kill()
-    _assert_stopped_keeping_iterations(run, stderr, "had no worker for 3 s", out)
-
-
 def _assert_stopped_keeping_iterations(run: subprocess.Popen, stderr: str, expected: str, out: Path) -> None:
     """Exit 2, one error line containing ``expected`` and "kept k finished iteration(s)" with k ≥ 1,
     and iterations 1 … k in ``out``."""
