@@ -184,13 +184,17 @@ class Engine:
             except TimeoutError:
                 done = set()
             for future in done:
-                try:
-                    yield futures[future], future.result()
+                try:  # bounded: a result held by a worker that died is 'lost' until another computes it
+                    result = future.result(timeout=WORKER_LOOK)
+                except TimeoutError:
+                    pending.add(future)
+                    continue
                 except KilledWorker:
                     raise ExciteError(
                         "optimizer.scheduler",
                         f"task {futures[future].index} ended every worker that ran it (killed: out of memory?)",
                     ) from None
+                yield futures[future], result
             if self._client.nthreads():
                 alone_since = None
             elif alone_since is None:
