@@ -18,12 +18,12 @@ def partial_path(path: Path) -> Path:
     return path.with_name(f".{path.name}.partial")
 
 
-def remove_stale(path: Path, why: str = "left by an interrupted run") -> None:
+def remove_stale(path: Path) -> None:
     """Remove ``path`` if it exists, with an :class:`~excite_cli.errors.ExciteWarning` saying so
     (a temporary file of a run that was killed: nothing else writes it now)."""
     with suppress(FileNotFoundError):
         path.unlink()
-        warnings.warn(f"removed {path}, {why}", ExciteWarning, stacklevel=2)
+        warnings.warn(f"removed {path}, left by an interrupted run", ExciteWarning, stacklevel=2)
 
 
 @contextmanager
