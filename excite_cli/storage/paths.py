@@ -90,17 +90,16 @@ def output_lock(path: Path, field: str) -> Iterator[None]:
                 held = os.fstat(fd).st_ino == os.stat(lock).st_ino  # not a lock file its holder just removed
             except OSError:
                 pass
+            holder = os.pread(fd, 32, 0).decode(errors="replace").strip()  # the running or the killed run's id
             if not held:
-                holder = os.pread(fd, 32, 0).decode(errors="replace").strip() or "?"
                 raise ExciteError(
                     field,
-                    f"{path} is being written by another excite run (process {holder})",
+                    f"{path} is being written by another excite run (process {holder or '?'})",
                     path,
                     "another output path, or that run to end",
                 )
-            stale = os.pread(fd, 32, 0).decode(errors="replace").strip()
-            if stale:
-                warnings.warn(f"took over {lock}, left by process {stale}, which was killed", ExciteWarning)
+            if holder:
+                warnings.warn(f"took over {lock}, left by process {holder}, which was killed", ExciteWarning)
                 remove_stale(partial_path(path))
             os.ftruncate(fd, 0)
             os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
