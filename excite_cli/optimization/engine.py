@@ -183,6 +183,7 @@ class Engine:
                 done, pending = wait(pending, timeout=WORKER_LOOK, return_when="FIRST_COMPLETED")
             except TimeoutError:
                 done = set()
+            arrived = False
             for future in done:
                 try:  # bounded: a result held by a worker that died is 'lost' until another computes it
                     result = future.result(timeout=WORKER_LOOK)
@@ -194,8 +195,9 @@ class Engine:
                         "optimizer.scheduler",
                         f"task {futures[future].index} ended every worker that ran it (killed: out of memory?)",
                     ) from None
+                arrived = True
                 yield futures[future], result
-            if self._client.nthreads():
+            if arrived or self._client.nthreads():  # the scheduler is asked only when nothing arrived
                 alone_since = None
             elif alone_since is None:
                 alone_since = time.monotonic()
