@@ -66,6 +66,16 @@ def run_on_worker(problem: Problem, base: BaseParameters, task: Task) -> Any:
     return task(_worker_excitation(problem, base))
 
 
+def _quiet_abandoned_gathers(loop, context: dict) -> None:
+    """The Dask client's event loop reports what its tasks raise as asyncio does, except the
+    ``AllExit`` of a result fetch given up on (:meth:`Engine._dask_completed` waits with a bound):
+    it ends when the client closes, and would print a traceback after the run's own one line."""
+    from distributed.client import AllExit
+
+    if not isinstance(context.get("exception"), AllExit):
+        loop.default_exception_handler(context)
+
+
 def _worker_signals() -> None:
     """A pool worker leaves stopping to the main process: Ctrl-C (sent to the whole terminal group) is
     ignored, SIGTERM (sent by the main process when it stops) ends it at once, without a traceback."""
@@ -107,6 +117,7 @@ class Engine:
                 raise ExciteError(
                     "optimizer.scheduler", f"cannot reach the Dask scheduler at {self.scheduler}: {exc}"
                 ) from None
+            self._client.loop.asyncio_loop.set_exception_handler(_quiet_abandoned_gathers)
         return self
 
     def __exit__(self, kind, *exc) -> None:
