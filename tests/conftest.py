@@ -84,9 +84,9 @@ def write_config(tmp_path: Path, data: dict, name: str = "problem.yaml") -> Path
     return path
 
 
-def assert_refused(folder: Path, argv: list[str], expected: str) -> None:
+def assert_refused(folder: Path, argv: list[str], expected: str) -> str:
     """``excite argv`` exits with status 2 and one line starting ``error:`` that contains
-    ``expected``, prints no traceback, and writes or changes no file under ``folder``."""
+    ``expected``, prints no traceback, and writes or changes no file under ``folder``; that line."""
     before = {p: p.stat().st_mtime_ns for p in folder.rglob("*")}
     result = CliRunner().invoke(app, argv, env={"COLUMNS": "400"})
     assert isinstance(result.exception, SystemExit), repr(result.exception)
@@ -97,6 +97,7 @@ def assert_refused(folder: Path, argv: list[str], expected: str) -> None:
     assert "Traceback" not in result.output
     after = {p: p.stat().st_mtime_ns for p in folder.rglob("*")}
     assert after == before, f"files written or changed: {sorted(set(after) ^ set(before))}"
+    return lines[0]
 
 
 PENDULUM = """<?xml version="1.0"?>
