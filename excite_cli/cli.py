@@ -12,7 +12,7 @@ from rich.markup import escape
 from excite_cli import workflows
 from excite_cli.config_file import load_problem, with_overrides
 from excite_cli.console import identification as identify_tables
-from excite_cli.console import tables
+from excite_cli.console import model_files, tables
 from excite_cli.console.errors import printed_warnings, spellings, word
 from excite_cli.console.progress import Bars, wide_console
 from excite_cli.errors import ExciteError, Interrupted, Terminated, exit_status, sigterm_as_interrupt
@@ -181,20 +181,20 @@ def identify(
         "--fit",
         help="auto (the one the cross-validation prefers), least_squares or consistent (identification.fit).",
     ),
-    urdf_out: Optional[Path] = typer.Option(
-        None, "--urdf-out", help="Write the identified URDF (of the physically consistent fit)."
-    ),
+    urdf_out: Optional[Path] = typer.Option(None, "--urdf-out", help="Write the identified URDF (consistent fit)."),
+    mjcf_out: Optional[Path] = typer.Option(None, "--mjcf-out", help="Write the identified MJCF, checked by MuJoCo."),
     force: bool = FORCE,
 ) -> None:
     """Identify base parameters (Eq. 4), trace the residual to missing effects, report the error before/after."""
     problem = with_overrides(load_problem(config, IdentifyProblem), {"identification.fit": fit})
     with err.status("preprocessing, fitting and selecting effects ..."):
-        run = workflows.run_identify(problem, output or Path(problem.output), urdf_out, force)
+        run = workflows.run_identify(problem, output or Path(problem.output), urdf_out, force, mjcf_out)
     _say(identify_tables.preprocessing_notes(run.report), console=err)
     _say(
         identify_tables.identification(run.report),
         [identify_tables.bodies(run.report, run.robot)] if run.report.consistent else [],
-        [identify_tables.urdf_written(run.report, urdf_out, run.urdf_deviation)] if urdf_out else [],
+        [model_files.urdf_written(run)] if urdf_out else [],
+        model_files.mjcf_written(run) if mjcf_out else [],
         f"wrote {run.target} and {', '.join(str(p) for p in run.plots)}",
     )
 

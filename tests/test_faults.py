@@ -186,11 +186,27 @@ def _identify_config(folder: Path) -> Path:
     return folder / "id.yaml"
 
 
-@pytest.mark.parametrize("urdf_out", ["report.h5", "report_residuals.png", "report_ladder.png"])
-def test_the_identified_urdf_may_not_overwrite_the_report_or_its_plots(tmp_path, urdf_out):
+@pytest.mark.parametrize("option", ["--urdf-out", "--mjcf-out"])
+@pytest.mark.parametrize("model", ["report.h5", "report_residuals.png", "report_ladder.png"])
+def test_the_identified_model_may_not_overwrite_the_report_or_its_plots(tmp_path, option, model):
     config = _identify_config(tmp_path)
-    argv = ["identify", str(config), "-o", str(tmp_path / "report.h5"), "--urdf-out", str(tmp_path / urdf_out)]
-    assert_refused(tmp_path, argv, "is also the report or one of its plots")
+    argv = ["identify", str(config), "-o", str(tmp_path / "report.h5"), option, str(tmp_path / model)]
+    line = assert_refused(tmp_path, argv, "is also the report or one of its plots")
+    assert line.startswith(f"error: {option}: ")
+
+
+@pytest.mark.parametrize("case", ["same", "folder", "unwritable", "fifo"])
+def test_a_bad_mjcf_path_is_one_line_before_anything_runs(tmp_path, case):
+    config = _identify_config(tmp_path)
+    target = {"same": tmp_path / "m.xml", "folder": tmp_path, "unwritable": config / "m.xml"}.get(case)
+    if case == "fifo":
+        target = tmp_path / "m.xml"
+        os.mkfifo(target)
+    argv = ["identify", str(config), "-o", str(tmp_path / "r.h5"), "--mjcf-out", str(target), "--force"]
+    if case == "same":
+        argv += ["--urdf-out", str(target)]
+    expected = {"same": "is also the other model file", "folder": "folder", "unwritable": "is a file"}
+    assert_refused(tmp_path, argv, expected.get(case, "is not a regular file"))
 
 
 @pytest.mark.parametrize("command", ["optimize", "identify"])

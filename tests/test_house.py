@@ -10,7 +10,9 @@ from pathlib import Path
 
 TESTS = Path(__file__).resolve().parent
 PACKAGE = TESTS.parent / "excite_cli"
-PRINTING = {"excite_cli.cli"} | {f"excite_cli.console.{m}" for m in ("tables", "identification", "progress", "errors")}
+PRINTING = {"excite_cli.cli"} | {
+    f"excite_cli.console.{m}" for m in ("tables", "identification", "model_files", "progress", "errors")
+}
 
 
 def _modules() -> dict[str, ast.Module]:

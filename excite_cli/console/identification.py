@@ -69,22 +69,6 @@ def identification(report: Report) -> list[Table | str]:
     return [errors, *fits(report), *_selection_tables(report)]
 
 
-def urdf_written(report: Report, path, deviation: float) -> str:
-    """What ``--urdf-out`` wrote: its fit (always the physically consistent one) and how well its RNEA
-    reproduces the identified torques."""
-    choice, consistent = report.fit_choice, report.relative_consistent
-    note = (
-        ""
-        if choice.is_consistent
-        else f" (a URDF needs physical bodies: the reported model is {choice.name}, the URDF's validation error "
-        f"{consistent.mean():.1f} % against {report.relative_after.mean():.1f} %)"
-    )
-    return (
-        f"wrote {path} from the physically consistent fit{note}: its RNEA matches that fit's rigid-body "
-        f"torques to {deviation:.1e} Nm"
-    )
-
-
 def fits(report: Report) -> list[Table]:
     """The candidate fits and their cross-validated errors, when there were several."""
     choice = report.fit_choice

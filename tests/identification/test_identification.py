@@ -4,6 +4,7 @@ simulated data with known parameters, no false effect, bad data, and the real Pa
 from pathlib import Path
 
 import h5py
+import mujoco
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -22,6 +23,7 @@ from excite_cli.identification.measured.preprocessing import Filter
 from excite_cli.identification.pipeline import run_identification
 from excite_cli.identification.validate import validate_model
 from excite_cli.trajectory.fourier import FourierTrajectory
+from excite_cli.workflows.identify import write_identified_mjcf
 from excite_cli.workflows.simulate import simulate_runs
 
 runner = CliRunner()
@@ -83,7 +85,9 @@ def test_run_offsets_are_indicators_or_the_mean_for_an_unfitted_run():
     np.testing.assert_array_equal(run_offset_columns(1, [0, 2], 2, 2), [[0.5, 0.5]] * 2)
 
 
-def _simulate_and_identify(tmp: Path, optimized: Path, effects: dict, candidates: list | None = None, **sim_extra):
+def _simulate(tmp: Path, optimized: Path, effects: dict, candidates: list | None = None, **extra) -> IdentifyProblem:
+    """Three simulated runs of ``optimized`` with ``effects`` in ``tmp`` and their identify config
+    (``identify.yaml``), loaded."""
     # 8 periods per run and time blocks in every run: ~720 independent held-out samples per joint
     # at the 5 Hz cut-off, so each joint's RMS is known to ~2.6 % (1 sigma)
     sim = {
@@ -93,7 +97,7 @@ def _simulate_and_identify(tmp: Path, optimized: Path, effects: dict, candidates
         "torque_noise": NOISE,
         "seed": 4,
         "effects": effects,
-        **sim_extra,
+        **extra,
     }
     result = runner.invoke(
         app, ["simulate", str(optimized), str(write_config(tmp, sim, "effects.yaml")), "-o", str(tmp), "--force"]
@@ -109,8 +113,16 @@ def _simulate_and_identify(tmp: Path, optimized: Path, effects: dict, candidates
     }
     if candidates is not None:
         config["identification"] = {"candidates": candidates}
-    problem = load_problem(write_config(tmp, config, "identify.yaml"), IdentifyProblem)
-    report, robot, base, _ = run_identification(problem)
+    return load_problem(write_config(tmp, config, "identify.yaml"), IdentifyProblem)
+
+
+def _simulate_and_identify(
+    tmp: Path, optimized: Path, effects: dict, candidates: list | None = None, consistent: bool = False, **sim_extra
+):
+    """:func:`_simulate` and identify (the consistent fit beside with ``consistent``): report, robot,
+    base, the torque noise level after preprocessing [Nm] and the problem."""
+    problem = _simulate(tmp, optimized, effects, candidates, **sim_extra)
+    report, robot, base, _ = run_identification(problem, consistent_beside=consistent)
     # noise level after the same preprocessing: white noise through the same filter
     runs = [load_run(r, problem.data, problem.robot.active_joints, problem.folder) for r in problem.data.runs]
     rate = (runs[2].time.size - 1) / (runs[2].time[-1] - runs[2].time[0])
@@ -118,7 +130,7 @@ def _simulate_and_identify(tmp: Path, optimized: Path, effects: dict, candidates
 
     sos = signal.butter(4, report.cutoff, fs=rate, output="sos")
     noise = Filter(sos, rate, report.cutoff, 0, 1).low_pass(np.random.default_rng(0).normal(0, NOISE, (20000, 7)))
-    return report, robot, base, float(noise.std())
+    return report, robot, base, float(noise.std()), problem
 
 
 def _found(report) -> dict:
@@ -126,9 +138,9 @@ def _found(report) -> dict:
     return {(t.effect, c, report.joints[t.joint]): (v, s, t.shape) for t, c, v, s in report.effect_values()}
 
 
-def test_undeclared_friction_and_armature_are_found(tmp_path, optimized):
+def test_undeclared_friction_and_armature_are_found_and_written_to_mjcf(tmp_path, optimized):
     effects = {"coulomb": {"*": TRUE["coulomb"]}, "viscous": {"*": TRUE["viscous"]}, "armature": ARMATURE}
-    report, robot, base, noise_level = _simulate_and_identify(tmp_path, optimized, effects)
+    report, robot, base, noise_level, problem = _simulate_and_identify(tmp_path, optimized, effects, consistent=True)
     expected = {(e, j) for e in TRUE for j in JOINTS} | {("armature", j) for j in ARMATURE}
     assert {(e, j) for e, _, j in _found(report)} == expected
     for (effect, _, joint), (value, std, _) in _found(report).items():
@@ -140,6 +152,19 @@ def test_undeclared_friction_and_armature_are_found(tmp_path, optimized):
     assert np.linalg.norm(estimate - truth) < 0.01 * np.linalg.norm(truth)
     assert np.mean(np.abs(estimate - truth) <= 3 * std) > 0.95  # deviations account for the filtering
     assert np.all(np.abs(report.rms_after - noise_level) <= 0.1 * noise_level)
+    # the MJCF for MuJoCo: MuJoCo reads the simulated armature and friction back from its own joint
+    # fields, its inverse dynamics is excite's, its validation error within 1 point of excite's
+    model, check = write_identified_mjcf(problem, report, robot, base, tmp_path / "panda.xml")
+    mj = mujoco.MjModel.from_xml_path(str(tmp_path / "panda.xml"))
+    for joint in JOINTS:
+        dof = mj.joint(joint).dofadr[0]
+        assert mj.dof_frictionloss[dof] == pytest.approx(TRUE["coulomb"], rel=0.05)
+        assert mj.dof_damping[dof] == pytest.approx(TRUE["viscous"], rel=0.05)
+        assert mj.dof_armature[dof] == pytest.approx(ARMATURE.get(joint, 0.0), rel=0.05)
+    assert model.unwritten == [] and check.unwritten == []
+    assert check.rigid <= 1e-5 and check.friction <= 1e-5
+    assert abs(check.relative_mujoco.mean() - check.relative_excite.mean()) <= 1.0
+    np.testing.assert_allclose(check.relative_written, check.relative_excite, rtol=1e-12)
     assert np.all(report.rms_before >= 3 * report.rms_after)
 
 
@@ -256,8 +281,7 @@ def test_offsets_per_run_and_a_known_payload(tmp_path, optimized):
 
 
 def test_identify_command_writes_report_and_prior(tmp_path, optimized):
-    effects = {"coulomb": {"*": 0.5}}
-    _simulate_and_identify(tmp_path, optimized, effects)
+    _simulate(tmp_path, optimized, {"coulomb": {"*": 0.5}})
     config = yaml.safe_load((tmp_path / "identify.yaml").read_text())
     config["identification"] = {"declared_effects": {"panda_joint1": ["viscous"]}}  # not in the data
     result = runner.invoke(

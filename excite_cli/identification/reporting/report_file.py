@@ -16,6 +16,8 @@ from excite_cli.dynamics.robot import Robot
 from excite_cli.h5 import atomic_h5, write_parts, write_strings, write_table
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.fitting.physical import body_properties
+from excite_cli.identification.reporting.mjcf_check import MujocoCheck, write_mujoco_group
+from excite_cli.identification.reporting.mjcf_out import MjcfModel
 from excite_cli.identification.reporting.report import Report
 
 STR = h5py.string_dtype()
@@ -28,6 +30,8 @@ def write_identification(
     base: BaseParameters,
     problem: IdentifyProblem,
     regressor: list[np.ndarray],
+    mjcf: MjcfModel | None = None,
+    mujoco: MujocoCheck | None = None,
 ) -> None:
     """Write (atomically) an ``identify`` report.
 
@@ -37,6 +41,7 @@ def write_identification(
             in, beside the file's original text).
         regressor: base regressor rows of all samples, in parts ((M_k, b) each, e.g. fit and validation);
             emptied as the parts are written.
+        mjcf, mujoco: the MJCF written and MuJoCo's check of it (``/mujoco``), or None.
 
     Raises:
         ExciteError: the file cannot be written.
@@ -85,6 +90,8 @@ def write_identification(
         _write_effects(g, report)
         _write_search(g, report)
         _write_validation(g, report)
+        if mjcf is not None:
+            write_mujoco_group(f, mjcf, mujoco, report.joints)
 
 
 def _term_fields(term, joints: list[str]) -> tuple[str, str, float]:
