@@ -10,7 +10,8 @@ armature → ``armature`` (reflected rotor inertia, on the mass matrix diagonal)
 ``damping`` and Coulomb friction → ``frictionloss`` with ``solreffriction`` at its stiffest
 (MuJoCo documentation, XML reference: joint; Computation: friction loss).
 Every other effect (offsets, asymmetric, Stribeck, held, load-dependent and position-dependent terms,
-a motor turning with several joints) is listed, not written: MuJoCo has no joint field for it.
+a motor turning with several joints) is listed, not written: MuJoCo has no joint field for it. Each
+active joint gets a torque motor (``<motor>``, ``ctrl`` in Nm, limited to the URDF's effort).
 """
 
 from __future__ import annotations
@@ -183,6 +184,17 @@ def _joint_fields(spec, robot: Robot, effects: list[tuple[Term, str, float]], mo
             model.written.append((term, coefficient))
 
 
+def _motors(mujoco, spec, robot: Robot) -> None:
+    """A torque motor (gear 1, ``ctrl`` in Nm) on each active joint, named after it, its control range
+    the URDF's effort limit where the URDF gives one (MuJoCo reads it as the joint's
+    ``actuatorfrcrange``), so that the model plays measured or planned torques as they are."""
+    for name in robot.joint_names:
+        motor = spec.add_actuator(name=name, target=name, trntype=mujoco.mjtTrn.mjTRN_JOINT)
+        limit = np.asarray(spec.joint(name).actfrcrange, float)
+        if limit[1] > limit[0]:
+            motor.ctrlrange, motor.ctrllimited = limit, mujoco.mjtLimited.mjLIMITED_TRUE
+
+
 def write_mjcf(
     urdf: Path,
     package_dirs: list[str],
@@ -216,6 +228,7 @@ def write_mjcf(
     _weld(mujoco, spec, robot, locked, model.notes)
     _inertias(spec, robot, standard, model.notes)
     _joint_fields(spec, robot, effects, model)
+    _motors(mujoco, spec, robot)
     try:
         spec.compile()
     except ValueError as exc:

@@ -96,6 +96,9 @@ def test_effects_go_to_mujocos_joint_fields_or_are_listed_with_the_reason(tmp_pa
     assert model.dof_frictionloss[dof["panda_joint3"]] == 0.0  # negative: not written
     assert model.dof_damping[dof["panda_joint2"]] == 0.0  # no URDF <dynamics damping> left anywhere
     assert set(JOINT_FIELDS.values()) >= {a for _, a in written.fields}
+    # one torque motor per joint, limited to the URDF's effort (87 Nm, 12 Nm from joint 5 on)
+    assert [model.actuator(k).name for k in range(model.nu)] == JOINTS
+    np.testing.assert_array_equal(model.actuator_ctrlrange[:, 1], [87.0] * 4 + [12.0] * 3)
     reasons = {t.effect + ("*" if t.coupling else ""): why for t, _, _, why in written.unwritten}
     assert reasons == {
         "coulomb": "negative, MuJoCo's frictionloss cannot be",
@@ -109,6 +112,13 @@ def test_effects_go_to_mujocos_joint_fields_or_are_listed_with_the_reason(tmp_pa
     q, qd, qdd = states
     np.testing.assert_allclose(tau[:, 3] - rigid[:, 3], 0.2 * qdd[:, 3], atol=1e-5 * np.abs(rigid).max())
     np.testing.assert_allclose(tau[:, 0] - rigid[:, 0], 0.3 * qd[:, 0], atol=1e-5 * np.abs(rigid).max())
+    # the motors play those torques: forward dynamics gives back q̈ (friction loss and limits off)
+    model.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_FRICTIONLOSS) | int(mujoco.mjtDisableBit.mjDSBL_LIMIT)
+    model.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONTACT) | int(mujoco.mjtDisableBit.mjDSBL_CLAMPCTRL)
+    data = mujoco.MjData(model)
+    data.qpos[:], data.qvel[:], data.ctrl[:] = q[0], qd[0], tau[0]
+    mujoco.mj_forward(model, data)
+    np.testing.assert_allclose(data.qacc, qdd[0], rtol=1e-6, atol=1e-6)
 
 
 def test_a_body_below_mujocos_smallest_mass_is_bounded_and_missing_meshes_are_left_out(tmp_path):
