@@ -1,66 +1,21 @@
 """Command line: parses options, calls one library function per command, prints what it returns."""
 
-import functools
 from importlib import metadata
 from pathlib import Path
-from typing import Callable, Optional
+from typing import Optional
 
 import typer
-from rich.console import Console
 from rich.markup import escape
 
 from excite_cli import workflows
 from excite_cli.config_file import load_problem, with_overrides
 from excite_cli.console import identification as identify_tables
 from excite_cli.console import model_files, tables
-from excite_cli.console.errors import printed_warnings, spellings, word
-from excite_cli.console.progress import Bars, wide_console
-from excite_cli.errors import ExciteError, Interrupted, Terminated, exit_status, sigterm_as_interrupt
+from excite_cli.console.app import FORCE, SCHEDULER, WORKERS, app, command, err, out, say
+from excite_cli.console.progress import Bars
 from excite_cli.identification.config import IdentifyProblem, SimulationConfig
 from excite_cli.optimization.criterion import OBJECTIVES
 from excite_cli.storage.export import FORMATS
-
-app = typer.Typer(add_completion=False, no_args_is_help=True)
-out, err = wide_console(), wide_console(stderr=True)
-FORCE = typer.Option(False, "--force", help="Replace existing output files.")
-WORKERS = typer.Option(
-    None, "--workers", help="Local processes for restarts and draws (optimizer.workers; default: the cores)."
-)
-SCHEDULER = typer.Option(None, "--scheduler", help="Dask scheduler, e.g. tcp://host:8786 (optimizer.scheduler).")
-
-
-def command(name: Optional[str] = None) -> Callable:
-    """A command of ``app``: ExciteError → one line, exit 2 (no traceback); Ctrl-C or SIGTERM → what
-    was kept, exit 130 or 143."""
-
-    def register(function: Callable) -> Callable:
-        @functools.wraps(function)
-        def guarded(*args, **kwargs):
-            try:
-                with sigterm_as_interrupt(), printed_warnings(err):
-                    return function(*args, **kwargs)
-            except ExciteError as exc:
-                line = word(exc, spelled, kwargs.get("config") or kwargs.get("effects"))
-                err.print(f"[bold red]error:[/] {escape(line)}", highlight=False, soft_wrap=True)
-                raise typer.Exit(2) from None
-            except Interrupted as exc:
-                err.print(str(exc), highlight=False, soft_wrap=True)
-                raise typer.Exit(exc.status) from None
-            except KeyboardInterrupt as exc:
-                err.print("terminated" if isinstance(exc, Terminated) else "interrupted", highlight=False)
-                raise typer.Exit(exit_status(exc)) from None
-
-        spelled = spellings(function)
-        return app.command(name)(guarded)
-
-    return register
-
-
-def _say(*items, console: Console = out) -> None:
-    """Print tables and lines (as written, not rich markup), flattening lists."""
-    for item in items:
-        for part in item if isinstance(item, list) else [item]:
-            console.print(escape(part) if isinstance(part, str) else part, highlight=False)
 
 
 def _version(show: bool) -> None:
@@ -90,6 +45,7 @@ def optimize(
     scheduler: Optional[str] = SCHEDULER,
     force: bool = FORCE,
     resume: bool = typer.Option(False, "--resume", help="Continue the iterations already in the output file."),
+    dry_run: bool = typer.Option(False, "--dry-run", help="Build the problem and say what would run (as `check`)."),
 ) -> None:
     """Optimize Fourier trajectories minimizing cond(C), sequentially; the result is rewritten after every iteration."""
     problem = with_overrides(
@@ -101,15 +57,30 @@ def optimize(
             "optimizer.scheduler": scheduler,
         },
     )
+    if dry_run:
+        return say(tables.plan(workflows.plan_optimize(problem)))
     with Bars(err) as bars:
         run = workflows.run_optimize(problem, output or Path(problem.output), force, resume, *bars.iterations(problem))
-    _say(
+    say(
         tables.iterations(run.results, problem.optimizer),
         f"wrote {run.target} and {', '.join(str(p) for p in run.plots)}",
     )
     if run.warning:
         err.print(f"[bold yellow]warning:[/] {escape(run.warning)}", highlight=False, soft_wrap=True)
         raise typer.Exit(1)
+
+
+@command()
+def check(
+    config: Path = typer.Argument(..., help="Problem YAML file."),
+    iterations: Optional[int] = typer.Option(None, "--iterations", "-k", help="Sequential iterations."),
+    workers: Optional[int] = WORKERS,
+) -> None:
+    """What `optimize` would run, not running it: joints, base parameters, constraints, time; exit 2 if refused."""
+    overrides = {"sequence.iterations": iterations, "optimizer.workers": workers}
+    with err.status("building the problem ..."):
+        plan = workflows.plan_optimize(with_overrides(load_problem(config), overrides))
+    say(tables.plan(plan))
 
 
 @command("compare-random")
@@ -149,7 +120,7 @@ def compare_random(
             progress,
             bars.draws(None if equal_effort else problem.random_baseline.pool_size),
         )
-    _say(tables.comparison(comparison), f"wrote {comparison.target} and {comparison.plot}")
+    say(tables.comparison(comparison), f"wrote {comparison.target} and {comparison.plot}")
 
 
 @command("verify-gradient")
@@ -167,7 +138,7 @@ def verify_gradient(
 ) -> None:
     """Analytic gradients (Eq. 49) and constraint Jacobians against finite differences; exit 1 above the tolerance."""
     verification = workflows.run_verify(load_problem(config), result, objective or OBJECTIVES, step, seed, tolerance)
-    _say(tables.verification(verification, tolerance))
+    say(tables.verification(verification, tolerance))
     if verification.worst > tolerance:
         raise typer.Exit(1)
 
@@ -189,8 +160,8 @@ def identify(
     problem = with_overrides(load_problem(config, IdentifyProblem), {"identification.fit": fit})
     with err.status("preprocessing, fitting and selecting effects ..."):
         run = workflows.run_identify(problem, output or Path(problem.output), urdf_out, force, mjcf_out)
-    _say(identify_tables.preprocessing_notes(run.report), console=err)
-    _say(
+    say(identify_tables.preprocessing_notes(run.report), console=err)
+    say(
         identify_tables.identification(run.report),
         [identify_tables.bodies(run.report, run.robot)] if run.report.consistent else [],
         [model_files.urdf_written(run)] if urdf_out else [],
@@ -211,7 +182,7 @@ def export(
 ) -> None:
     """Write a trajectory as a robot plays it: home → P periods → home, at the controller's rate, with torques."""
     exported, target = workflows.run_export(result, iteration, rate, periods, fmt, output, force)
-    _say(tables.export_lines(exported, rate), f"wrote {target}")
+    say(tables.export_lines(exported, rate), f"wrote {target}")
 
 
 @command()
@@ -223,7 +194,7 @@ def view(
     output: Optional[Path] = typer.Option(None, "--output", "-o", help="HTML file (default: beside the result)."),
 ) -> None:
     """The motion as the robot would play it, in 3D, in one HTML file any browser opens (no server)."""
-    _say(f"wrote {workflows.run_view(result, iteration, output, rate, force)}")
+    say(f"wrote {workflows.run_view(result, iteration, output, rate, force)}")
 
 
 @command()
@@ -234,7 +205,7 @@ def validate(
     """Score an identified model on other runs: torque error per run and joint, on data its fit never saw."""
     with err.status("preprocessing and predicting ..."):
         problem, errors = workflows.run_validate(report, config)
-    _say(identify_tables.validation(report.name, problem.robot.active_joints, errors))
+    say(identify_tables.validation(report.name, problem.robot.active_joints, errors))
 
 
 @command()
@@ -246,4 +217,4 @@ def simulate(
 ) -> None:
     """Measured-like CSV runs (one per iteration) of a result, with the effects and noise of an effects file."""
     files = workflows.simulate_runs(result, load_problem(effects, SimulationConfig, "effects"), output_dir, force=force)
-    _say("wrote " + ", ".join(str(f) for f in files))
+    say("wrote " + ", ".join(str(f) for f in files))

@@ -1,4 +1,4 @@
-"""What ``optimize``, ``compare-random``, ``verify-gradient`` and ``export`` print: rich tables built
+"""What ``optimize``, ``check``, ``compare-random``, ``verify-gradient`` and ``export`` print: rich tables built
 from what the library returns."""
 
 from __future__ import annotations
@@ -12,6 +12,7 @@ from rich.table import Table
 from excite_cli.config import OptimizerConfig
 from excite_cli.optimization.sequence import IterationResult
 from excite_cli.storage.export import Export
+from excite_cli.workflows.check import Plan
 from excite_cli.workflows.compare import Comparison
 from excite_cli.workflows.verify_gradient import Verification
 
@@ -201,3 +202,36 @@ def export_lines(e: Export, rate: float) -> list[str]:
         f"{e.time.size} samples at {rate:g} Hz; every constraint holds: largest normalized violation "
         f"{e.max_violation:+.2e} (≤ 0 satisfied), closest: {e.worst}"
     ]
+
+
+def plan(p: Plan) -> list[Table | str]:
+    """What ``check`` found: the problem ``optimize`` would run, its constraints and an estimated time."""
+    e, cfg = p.excitation, p.excitation.problem
+    t = cfg.trajectory
+    grid, fine = e.grid_basis.q.shape[0], e.fine_basis.q.shape[0]
+    rows = [(c.name, str(c.rows), c.what) for c in p.constraints]
+    caption = (
+        f"each row aggregated over the {grid}-instant constraint grid ({t.constraint_period:g} s); "
+        f"the fine check: {fine} instants"
+    )
+    lines = [
+        f"robot: {e.robot.n_joints} active joints ({', '.join(e.robot.joint_names)}), "
+        f"{e.base.count} base parameters of {e.robot.n_parameters} standard ones",
+        f"trajectory: {t.harmonics} harmonics at ω = {t.base_frequency:.4g} rad/s, {t.duration:g} s "
+        f"({t.boundary}), {p.variables} Fourier coefficients; cost: {t.cost_samples} samples × "
+        f"{e.robot.n_rows} rows = C of {t.cost_samples * e.robot.n_rows} × {e.base.count}",
+        *(f"excluded capsule pair: {a} – {b}" for a, b in p.excluded_pairs),
+        f"optimizer: {cfg.optimizer.method} on {cfg.optimizer.objective}, {cfg.sequence.iterations} sequential "
+        f"iteration(s) of at most {p.iterations} solver iterations each, on {p.workers} worker(s)",
+        f"estimated time: about {_duration(p.estimate)} ({p.seconds_per_iteration * 1e3:.0f} ms per "
+        f"solver iteration × every restart to its iteration limit; restarts that converge early take less)",
+        "the home posture meets every constraint: optimize would start",
+    ]
+    return [titled_table("Constraints", ("constraint", "rows", "what"), rows, caption), *lines]
+
+
+def _duration(seconds: float) -> str:
+    """``42 s``, ``3.5 min`` or ``1.2 h``."""
+    if seconds < 90:
+        return f"{seconds:.0f} s"
+    return f"{seconds / 60:.1f} min" if seconds < 5400 else f"{seconds / 3600:.1f} h"

@@ -1,5 +1,6 @@
 """One library function per study a command runs; they check their output paths before computing."""
 
+from excite_cli.workflows.check import plan_optimize
 from excite_cli.workflows.compare import run_compare_random
 from excite_cli.workflows.export import run_export
 from excite_cli.workflows.identify import run_identify
@@ -10,6 +11,7 @@ from excite_cli.workflows.verify_gradient import run_verify
 from excite_cli.workflows.view import run_view
 
 __all__ = [
+    "plan_optimize",
     "run_compare_random",
     "run_export",
     "run_identify",

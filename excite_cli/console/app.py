@@ -1,0 +1,55 @@
+"""The command line's frame: the typer app, its consoles, the options several commands share and the
+guard every command runs in (one line and exit 2 for bad input, what was kept on Ctrl-C or SIGTERM)."""
+
+import functools
+from typing import Callable, Optional
+
+import typer
+from rich.console import Console
+from rich.markup import escape
+
+from excite_cli.console.errors import printed_warnings, spellings, word
+from excite_cli.console.progress import wide_console
+from excite_cli.errors import ExciteError, Interrupted, Terminated, exit_status, sigterm_as_interrupt
+
+app = typer.Typer(add_completion=False, no_args_is_help=True)
+out, err = wide_console(), wide_console(stderr=True)
+FORCE = typer.Option(False, "--force", help="Replace existing output files.")
+WORKERS = typer.Option(
+    None, "--workers", help="Local processes for restarts and draws (optimizer.workers; default: the cores)."
+)
+SCHEDULER = typer.Option(None, "--scheduler", help="Dask scheduler, e.g. tcp://host:8786 (optimizer.scheduler).")
+
+
+def command(name: Optional[str] = None) -> Callable:
+    """A command of ``app``: ExciteError → one line, exit 2 (no traceback); Ctrl-C or SIGTERM → what
+    was kept, exit 130 or 143."""
+
+    def register(function: Callable) -> Callable:
+        @functools.wraps(function)
+        def guarded(*args, **kwargs):
+            try:
+                with sigterm_as_interrupt(), printed_warnings(err):
+                    return function(*args, **kwargs)
+            except ExciteError as exc:
+                line = word(exc, spelled, kwargs.get("config") or kwargs.get("effects"))
+                err.print(f"[bold red]error:[/] {escape(line)}", highlight=False, soft_wrap=True)
+                raise typer.Exit(2) from None
+            except Interrupted as exc:
+                err.print(str(exc), highlight=False, soft_wrap=True)
+                raise typer.Exit(exc.status) from None
+            except KeyboardInterrupt as exc:
+                err.print("terminated" if isinstance(exc, Terminated) else "interrupted", highlight=False)
+                raise typer.Exit(exit_status(exc)) from None
+
+        spelled = spellings(function)
+        return app.command(name)(guarded)
+
+    return register
+
+
+def say(*items, console: Console = out) -> None:
+    """Print tables and lines (as written, not rich markup), flattening lists."""
+    for item in items:
+        for part in item if isinstance(item, list) else [item]:
+            console.print(escape(part) if isinstance(part, str) else part, highlight=False)
