@@ -39,7 +39,10 @@ smoke: $(STAMP)
 	$(VENV)/bin/excite optimize configs/smoke.yaml --output results/smoke.h5 --force
 	$(VENV)/bin/excite export results/smoke.h5 --rate 1000 --force
 	$(VENV)/bin/excite verify-gradient configs/smoke.yaml
-	$(VENV)/bin/excite identify configs/panda_identify_simulated.yaml --output results/smoke_identify.h5 --force
+	$(VENV)/bin/excite identify configs/panda_identify_simulated.yaml --output results/smoke_identify.h5 --force \
+	  --mjcf-out results/smoke_identify.xml
+	$(VENV)/bin/excite init ur_description/urdf/ur3_robot.urdf --output results/smoke_ur3.yaml --force
+	$(VENV)/bin/excite check results/smoke_ur3.yaml
 
 # `excite view` opened in headless Chromium: the screenshot must show the robot (bench/view_check.py).
 # A browser is ~300 MB and needs root to install, so it is not part of `make test`; Debian's chromium

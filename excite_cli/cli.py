@@ -71,6 +71,22 @@ def optimize(
 
 
 @command()
+def init(
+    urdf: str = typer.Argument(..., help="URDF file, or a path in example-robot-data (ur_description/urdf/ur10.urdf)."),
+    joints: Optional[list[str]] = typer.Option(
+        None, "--joints", help="Active joints, repeatable or comma-separated (default: every revolute joint)."
+    ),
+    kind: str = typer.Option("optimize", "--kind", help="Config kind: optimize or identify."),
+    output: Optional[Path] = typer.Option(None, "--output", "-o", help="Config file (default: <URDF name>.yaml)."),
+    force: bool = FORCE,
+) -> None:
+    """A starting config for your robot from its URDF: joints, limits, capsules, mounting plane, home posture."""
+    with err.status("fitting capsules and searching postures ..."):
+        run = workflows.run_init(urdf, output or Path(f"{Path(urdf).stem}.yaml"), joints, kind, force)
+    say(tables.initialized(run))
+
+
+@command()
 def check(
     config: Path = typer.Argument(..., help="Problem YAML file."),
     iterations: Optional[int] = typer.Option(None, "--iterations", "-k", help="Sequential iterations."),

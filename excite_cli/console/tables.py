@@ -14,6 +14,7 @@ from excite_cli.optimization.sequence import IterationResult
 from excite_cli.storage.export import Export
 from excite_cli.workflows.check import Plan
 from excite_cli.workflows.compare import Comparison
+from excite_cli.workflows.init import InitRun
 from excite_cli.workflows.verify_gradient import Verification
 
 
@@ -228,6 +229,18 @@ def plan(p: Plan) -> list[Table | str]:
         "the home posture meets every constraint: optimize would start",
     ]
     return [titled_table("Constraints", ("constraint", "rows", "what"), rows, caption), *lines]
+
+
+def initialized(run: InitRun) -> list[Table | str]:
+    """What ``init`` wrote and assumed, then the dry run of an ``optimize`` config."""
+    draft = run.draft
+    lines = [f"wrote {run.target}; what it assumed (also as comments in the file):"]
+    lines += [f"  {name}: {why}" for name, why in draft.assumptions.items()]
+    lines += [f"  excluded pair {a} – {b}: {why}" for a, b, why in draft.excluded]
+    lines += [f"  mounting plane ignores {link}: {why}" for link, why in draft.ignored]
+    if run.plan is None:
+        return [*lines, f"fill in what it marks FILL IN, then: excite identify {run.target}"]
+    return [*lines, *plan(run.plan), f"next: excite optimize {run.target}"]
 
 
 def _duration(seconds: float) -> str:

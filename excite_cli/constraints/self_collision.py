@@ -105,6 +105,10 @@ class SelfCollision(Constraint):
         )
         return result
 
+    def distances(self, Q: np.ndarray) -> np.ndarray:
+        """Distances (T, P) [m] of every kept capsule pair at the configurations Q (T, n) (closed form)."""
+        return self._closest_points(Q)[0]
+
     def _closest(self, Q: np.ndarray) -> tuple[np.ndarray, ...]:
         """At the configurations Q (T, n): distances d (T, P) [m], the closest points c₁ (3, T, P) of
         each pair's first segment, the unit normals (3, T, P) from c₁ to c₂, and the joint placements

@@ -141,6 +141,10 @@ class WorldCollision(Constraint):
             ancestors[[self.capsules[c].joint for c in self._capsule]].astype(float).reshape(-1, robot.n_joints)
         )
 
+    def distances(self, Q: np.ndarray) -> np.ndarray:
+        """Distances (T, P) [m] of every (capsule, shape) pair at the configurations Q (T, n)."""
+        return self._closest_points(Q)[0]
+
     def _closest(self, Q: np.ndarray) -> tuple[np.ndarray, ...]:
         """At the configurations Q (T, n): distances d (T, P) [m], the robot's closest points (3, T, P),
         the unit normals (3, T, P) from the world shape to them, and the joint placements."""

@@ -237,7 +237,13 @@ def load_robot(
             geometry = pin.buildGeomFromUrdf(full, str(path), pin.COLLISION, package_dirs=package_dirs)
         except (RuntimeError, ValueError) as exc:
             raise ExciteError("robot.urdf", f"cannot load the collision geometry of {path}: {exc}") from None
-        model, geometry = pin.buildReducedModel(full, geometry, lock_ids, q_full)
+        try:
+            model, geometry = pin.buildReducedModel(full, geometry, lock_ids, q_full)
+        except ValueError as exc:  # a joint and a link of one name (so100's "gripper"): pinocchio cannot reduce
+            if lock_ids:
+                problem = f"pinocchio cannot hold joints of {path.name}: {exc}"
+                raise ExciteError("robot.locked_joints", problem) from None
+            model = full  # nothing to hold
     else:
         model = pin.buildReducedModel(full, lock_ids, q_full)
 

@@ -128,16 +128,18 @@ def home_posture(robot: Robot, limits: JointLimits) -> np.ndarray:
     return np.clip(robot.home, limits.centre[0] - inner, limits.centre[0] + inner)
 
 
-def build_excitation(problem: Problem, base: BaseParameters | None = None) -> Excitation:
+def build_excitation(problem: Problem, base: BaseParameters | None = None, check_home: bool = True) -> Excitation:
     """Load the robot and set up bases and constraints for ``problem``.
 
     Args:
         problem: the validated config.
         base: the robot's base parameters when already computed (a worker gets the main process's,
             so that every process optimizes in the same base); default: computed here.
+        check_home: refuse a home posture that violates a constraint (off: a caller searching for one).
 
     Raises:
-        ExciteError: bad robot or limits input (see :func:`load_robot`, :func:`joint_limit_bounds`).
+        ExciteError: bad robot or limits input (see :func:`load_robot`, :func:`joint_limit_bounds`), a
+            constraint violated at the home posture (with ``check_home``).
     """
     ccfg = problem.constraints
     collision = bool(ccfg.self_collision or ccfg.environment or (ccfg.com and ccfg.com.support_links))
@@ -186,7 +188,8 @@ def build_excitation(problem: Problem, base: BaseParameters | None = None) -> Ex
         boundary=boundary,
         scaled_frame=scaled_frame(base, parameter_magnitudes(robot)),
     )
-    _check_home_posture(excitation)
+    if check_home:
+        _check_home_posture(excitation)
     return excitation
 
 
@@ -214,18 +217,27 @@ def _boundary_conditions(
     return boundary
 
 
+def violated_at_rest(excitation: Excitation, posture: np.ndarray | None = None) -> tuple[str, str] | None:
+    """The first constraint (its field and where) that standing still at ``posture`` (n,) [rad]
+    (default: the home posture) violates, or None."""
+    static = excitation.static()
+    if posture is not None:
+        static[:, 0] = posture
+    for c in (c for c in excitation.constraints if not c.needs_motion):
+        check = c.check(static, excitation.grid_basis)
+        if check.max_violation > -c.grid_margin:
+            return c.field, check.where or "joint limits"
+    return None
+
+
 def _check_home_posture(excitation: Excitation) -> None:
     """Stop before optimizing when standing still at the home posture already violates a constraint.
 
     Raises:
         ExciteError: naming the constraint and where it fails (the capsule pair, the CoM distance).
     """
-    static = excitation.static()
-    for c in (c for c in excitation.constraints if not c.needs_motion):
-        check = c.check(static, excitation.grid_basis)
-        if check.max_violation > -c.grid_margin:
-            raise ExciteError(
-                c.field,
-                f"violated before optimization, at the home posture with the locked "
-                f"joints: {check.where or 'joint limits'}",
-            )
+    violated = violated_at_rest(excitation)
+    if violated is not None:
+        raise ExciteError(
+            violated[0], f"violated before optimization, at the home posture with the locked joints: {violated[1]}"
+        )

@@ -4,6 +4,7 @@ from excite_cli.workflows.check import plan_optimize
 from excite_cli.workflows.compare import run_compare_random
 from excite_cli.workflows.export import run_export
 from excite_cli.workflows.identify import run_identify
+from excite_cli.workflows.init import run_init
 from excite_cli.workflows.optimize import run_optimize
 from excite_cli.workflows.simulate import simulate_runs
 from excite_cli.workflows.validate import run_validate
@@ -15,6 +16,7 @@ __all__ = [
     "run_compare_random",
     "run_export",
     "run_identify",
+    "run_init",
     "run_optimize",
     "run_validate",
     "run_verify",

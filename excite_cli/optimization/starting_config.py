@@ -1,0 +1,273 @@
+"""A starting ``optimize`` config for a robot excite has never seen, from its URDF alone: which joints
+move, limits with a margin, capsules fitted to the collision meshes with the pairs that overlap at
+every posture left out, a mounting plane under the base, torque limits from the URDF's effort, and a
+home posture every constraint accepts, searched among the joint ranges' middle, zero and random
+postures. Every choice is recorded as an assumption, in words, for the written file's comments.
+"""
+
+from __future__ import annotations
+
+import math
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from excite_cli.config import Problem
+from excite_cli.errors import ExciteError
+from excite_cli.optimization.excitation import Excitation, build_excitation, violated_at_rest
+
+#: Random postures the capsule overlaps and the home posture are searched over.
+POSTURES = 300
+#: The home posture search: rounds of random steps, steps per round, clearance sought beyond the margins [m].
+HOME_ROUNDS, HOME_STEPS, HOME_CLEARANCE = 60, 64, 0.005
+#: Joint velocity limit as a fraction of the URDF's; acceleration limit per rad/s of it [1/s].
+VELOCITY_FRACTION, ACCELERATION_PER_VELOCITY = 0.5, 3.0
+#: Margins [m]: between capsules, and from the mounting plane.
+CAPSULE_MARGIN, PLANE_MARGIN = 0.01, 0.02
+#: A capsule pair never farther apart than this over the random postures [m] is left out: two
+#: neighbouring links whose fitted capsules touch wherever the joints are (the links need not).
+NEVER_APART = 2 * CAPSULE_MARGIN
+
+
+@dataclass
+class StartingConfig:
+    """A drafted config (the YAML's mapping, section by section) and the assumptions behind it:
+    {"section.field": why} for the comments, and the excluded pairs and ignored links with reasons."""
+
+    config: dict
+    assumptions: dict[str, str] = field(default_factory=dict)
+    excluded: list[tuple[str, str, str]] = field(default_factory=list)
+    ignored: list[tuple[str, str]] = field(default_factory=list)
+
+
+def _mimics(path: Path) -> set[str]:
+    """The joints of the URDF that follow another (``<mimic>``)."""
+    return {j.get("name") for j in ET.parse(path).getroot().iter("joint") if j.find("mimic") is not None}
+
+
+def joint_choice(path: Path, given: list[str] | None, draft: StartingConfig) -> tuple[list[str], dict[str, float]]:
+    """The active joints of a starting config and the others held, with the assumption in ``draft``.
+
+    Args:
+        path: the URDF; given: the active joints, or None: every revolute joint that follows no other.
+
+    Returns:
+        The active joints and {held joint: value} (0 moved inside its limits) [rad or m].
+
+    Raises:
+        ExciteError: a given joint that is not a 1-DoF joint of the URDF.
+    """
+    model = pin.buildModelFromUrdf(str(path))
+    one_dof = [n for i, n in enumerate(model.names) if i > 0 and model.joints[i].nq == 1]
+    continuous = [n for i, n in enumerate(model.names) if i > 0 and model.joints[i].nq == 2 and model.joints[i].nv == 1]
+    mimics = _mimics(path)
+    revolute = [n for n in one_dof if "R" in model.joints[model.getJointId(n)].shortname().replace("JointModel", "")]
+    active = list(given) if given else [n for n in revolute if n not in mimics]
+    unknown = [n for n in active if n not in one_dof]
+    if unknown:
+        raise ExciteError(
+            "joints", f"'{unknown[0]}' is not a 1-DoF joint of {path.name}", unknown[0], ", ".join(one_dof)
+        )
+    held = {}
+    for name in (n for n in one_dof if n not in active):
+        k = model.idx_qs[model.getJointId(name)]
+        held[name] = float(np.clip(0.0, model.lowerPositionLimit[k], model.upperPositionLimit[k]))
+    draft.assumptions["robot.active_joints"] = (
+        "the joints given" if given else "every revolute joint that follows no other (prismatic ones are held)"
+    )
+    if held:
+        draft.assumptions["robot.locked_joints"] = "the other joints, held at 0 (or their nearest limit)"
+    if continuous:
+        draft.assumptions["robot.active_joints"] += (
+            f"; continuous joints, which have no range to keep, are held at 0: {', '.join(continuous)}"
+        )
+    return active, held
+
+
+def _limits(path: Path, active: list[str], draft: StartingConfig) -> dict:
+    """Position margin, velocity and acceleration limits per joint, torque limits where the URDF has them."""
+    model = pin.buildModelFromUrdf(str(path))
+    ids = [model.getJointId(n) for n in active]
+    velocity = {
+        n: round(VELOCITY_FRACTION * float(model.velocityLimit[model.idx_vs[i]]), 3) for n, i in zip(active, ids)
+    }
+    missing = [n for n, v in velocity.items() if not 0 < v < math.inf]
+    for name in missing:
+        velocity[name] = 1.0
+    ranges = [model.upperPositionLimit[model.idx_qs[i]] - model.lowerPositionLimit[model.idx_qs[i]] for i in ids]
+    limits = {
+        "position_margin": round(min(0.1, 0.1 * float(min(ranges))), 3),
+        "velocity": velocity,
+        "acceleration": {n: round(ACCELERATION_PER_VELOCITY * v, 3) for n, v in velocity.items()},
+    }
+    draft.assumptions["limits.position_margin"] = "0.1 rad inside every URDF limit (less for a joint of short range)"
+    draft.assumptions["limits.velocity"] = f"{VELOCITY_FRACTION:g} × the URDF's velocity limit" + (
+        f" (1 rad/s where it has none: {', '.join(missing)})" if missing else ""
+    )
+    draft.assumptions["limits.acceleration"] = f"{ACCELERATION_PER_VELOCITY:g} × the velocity limit per second"
+    if all(model.effortLimit[model.idx_vs[i]] > 0 for i in ids):
+        limits["torque"] = "urdf"
+        draft.assumptions["limits.torque"] = "the URDF's effort limits"
+    return limits
+
+
+def _base_floor(path: Path, package_dirs: list[str]) -> float:
+    """Height [m] of the lowest point of the root link's collision geometry (0 without any)."""
+    model = pin.buildModelFromUrdf(str(path))
+    geometry = pin.buildGeomFromUrdf(model, str(path), pin.COLLISION, package_dirs=package_dirs)
+    data, gdata = model.createData(), pin.GeometryData(geometry)
+    pin.updateGeometryPlacements(model, data, geometry, gdata, pin.neutral(model))
+    lowest = 0.0
+    for k, g in enumerate(geometry.geometryObjects):
+        if g.parentJoint == 0 and hasattr(g.geometry, "vertices"):
+            placement = gdata.oMg[k]
+            points = np.asarray(g.geometry.vertices()) * np.asarray(g.meshScale) @ placement.rotation.T
+            lowest = min(lowest, float((points + placement.translation)[:, 2].min()))
+    return lowest
+
+
+def _random_postures(excitation: Excitation, rng: np.random.Generator) -> np.ndarray:
+    """(POSTURES, n) postures drawn uniformly inside the position bounds (their margin included)."""
+    centre, half = excitation.limits.centre[0], 0.95 * excitation.limits.half[0]
+    return centre + half * rng.uniform(-1.0, 1.0, (POSTURES, centre.size))
+
+
+def _always_overlapping(excitation: Excitation, Q: np.ndarray, draft: StartingConfig) -> None:
+    """Capsule pairs never farther apart than :data:`NEVER_APART` over the postures Q: excluded (as
+    link pairs), with why; links within a world shape's margin at every posture: ignored by the world
+    constraint, with why."""
+    for c in excitation.constraints:
+        if c.name == "self_collision" and c.pairs:
+            d = c.distances(Q)
+            for k, (i, j) in enumerate(c.pairs):
+                pair = (c.capsules[i].link, c.capsules[j].link)
+                if d[:, k].max() < NEVER_APART and pair not in [(x, y) for x, y, _ in draft.excluded]:
+                    farthest = d[:, k].max() * 100
+                    why = (
+                        f"never more than {farthest:.1f} cm apart at {len(Q)} random postures"
+                        if farthest >= 0
+                        else f"overlapping by at least {-farthest:.1f} cm at all {len(Q)} random postures"
+                    ) + ": the capsules of neighbouring links, which touch at every posture"
+                    draft.excluded.append((*pair, why))
+        if c.name == "world_collision" and c.pairs:
+            d = c.distances(Q)
+            for k, (i, s) in enumerate(c.pairs):
+                link = c.capsules[i].link
+                if np.all(d[:, k] < c.shapes[s].margin) and link not in [x for x, _ in draft.ignored]:
+                    draft.ignored.append(
+                        (link, f"within {c.shapes[s].margin:g} m of the mounting plane at all postures")
+                    )
+
+
+def _clearance(excitation: Excitation, Q: np.ndarray) -> np.ndarray:
+    """(K,) at each posture Q (K, n) the smallest distance [m] beyond its margin over every capsule
+    pair and every capsule and world shape (inf without such constraints)."""
+    out = np.full(len(Q), np.inf)
+    for c in excitation.constraints:
+        if c.name == "self_collision" and c.pairs:
+            out = np.minimum(out, (c.distances(Q) - c.margin).min(axis=1))
+        if c.name == "world_collision" and c.pairs:
+            margins = np.array([c.shapes[s].margin for _, s in c.pairs])
+            out = np.minimum(out, (c.distances(Q) - margins).min(axis=1))
+    return out
+
+
+def _home(excitation: Excitation, Q: np.ndarray, rng: np.random.Generator) -> tuple[np.ndarray, str]:
+    """A posture standing still at which every constraint holds (joint, torque and collision limits):
+    from the middle of the joint ranges (the most room to move), else from the clearest of the random
+    postures Q, random steps that increase the smallest clearance (:func:`_clearance`) until it is at
+    least ``HOME_CLEARANCE`` and nothing is violated (a torque limit: the steps go on).
+
+    Raises:
+        ExciteError: no such posture within ``HOME_ROUNDS`` rounds.
+    """
+    centre, half = excitation.limits.centre[0], 0.95 * excitation.limits.half[0]
+    scores = _clearance(excitation, Q)
+    starts = [("the middle of the joint ranges", centre), ("the clearest random posture", Q[np.argmax(scores)])]
+    score = -np.inf
+    for start, best in starts:
+        score, scale = float(_clearance(excitation, best[None])[0]), 0.3
+        for rounds in range(HOME_ROUNDS):
+            if score >= HOME_CLEARANCE and violated_at_rest(excitation, best) is None:
+                return best, (
+                    f"from {start}, {rounds} round(s) of random steps: every capsule {score * 100:.1f} cm "
+                    "beyond its margin"
+                )
+            steps = best + scale * half * rng.standard_normal((HOME_STEPS, centre.size))
+            steps = np.clip(steps, centre - half, centre + half)
+            step_scores = _clearance(excitation, steps)
+            if step_scores.max() > score or score >= HOME_CLEARANCE:
+                best, score = steps[np.argmax(step_scores)], float(step_scores.max())
+            else:
+                scale = max(0.7 * scale, 0.02)
+    raise ExciteError(
+        "robot.home_posture",
+        f"no posture found where every constraint holds at rest in {HOME_ROUNDS} rounds (best clearance "
+        f"{score * 100:.1f} cm): capsules that overlap at most postures, or torque limits gravity exceeds?",
+    )
+
+
+#: The trajectory, optimizer and sequence a starting config gets: the shipped lab arms' (10 s, 5 harmonics).
+TRAJECTORY = {
+    "harmonics": 5,
+    "base_frequency": 2 * math.pi / 10,
+    "cost_samples": 50,
+    "cost_period": 0.2,
+    "constraint_period": 0.02,
+    "boundary": "rest",
+}
+OPTIMIZER = {"objective": "log_det", "max_iterations": 200, "restarts": 4, "starts": 16, "screen_iterations": 40}
+
+
+def validated(config: dict, target: Path) -> Problem:
+    """``config`` validated as a :class:`Problem` read from ``target`` (relative paths are beside it)."""
+    problem = Problem.model_validate(config)
+    problem.source_path = Path(target).resolve()
+    return problem
+
+
+def draft_config(
+    robot: dict, urdf: Path, package_dirs: list[str], joints: list[str] | None, target: Path
+) -> StartingConfig:
+    """A starting config for the URDF of ``robot`` (the section's ``urdf`` and ``source``), to be
+    written to ``target``.
+
+    Args:
+        robot: {"urdf": ..., "source": ...} as the config will say them.
+        urdf: the URDF file; package_dirs: where its meshes are.
+        joints: the active joints, or None (see :func:`joint_choice`).
+
+    Raises:
+        ExciteError: an unknown joint; no posture where every constraint holds at rest.
+    """
+    draft = StartingConfig({"robot": dict(robot)})
+    active, held = joint_choice(urdf, joints, draft)
+    floor = round(_base_floor(urdf, package_dirs), 4) + 0.0  # no -0
+    draft.config["robot"].update(active_joints=active, locked_joints=held, home_posture={})
+    draft.config["trajectory"] = dict(TRAJECTORY)
+    draft.config["limits"] = _limits(urdf, active, draft)
+    plane = {"name": "mounting_plane", "type": "half_space", "point": [0.0, 0.0, floor], "normal": [0.0, 0.0, 1.0]}
+    draft.config["constraints"] = {
+        "self_collision": {"capsules": "auto", "margin": CAPSULE_MARGIN, "exclude_pairs": []},
+        "environment": {"shapes": [{**plane, "margin": PLANE_MARGIN}]},
+    }
+    draft.config["optimizer"] = dict(OPTIMIZER)
+    draft.config["sequence"] = {"iterations": 3}
+    draft.config["output"] = f"results/{urdf.stem}.h5"
+    draft.assumptions["constraints.environment"] = (
+        f"a plane under the base (z = {floor:g} m, the base's lowest collision point): the table top or floor"
+    )
+    excitation = build_excitation(validated(draft.config, target), check_home=False)
+    Q = _random_postures(excitation, np.random.default_rng(0))
+    _always_overlapping(excitation, Q, draft)
+    draft.config["constraints"]["self_collision"]["exclude_pairs"] = [[a, b] for a, b, _ in draft.excluded]
+    if draft.ignored:
+        draft.config["constraints"]["environment"]["ignore_links"] = [link for link, _ in draft.ignored]
+    excitation = build_excitation(validated(draft.config, target), check_home=False)
+    home, why = _home(excitation, Q, np.random.default_rng(1))
+    draft.config["robot"]["home_posture"] = {n: round(float(q), 4) for n, q in zip(active, home)}
+    draft.assumptions["robot.home_posture"] = f"searched: {why}"
+    return draft

@@ -1,0 +1,125 @@
+"""``init``: a starting config for one's own robot from its URDF, what was assumed written as comments
+in the file; an ``optimize`` config passes the dry run (:func:`plan_optimize`) before it is written."""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from datetime import date
+from pathlib import Path
+from typing import Optional
+
+import yaml
+
+from excite_cli.atomic import atomic_path
+from excite_cli.config import RobotConfig
+from excite_cli.dynamics.urdf_source import example_robot_data_root, resolve_urdf
+from excite_cli.errors import ExciteError, FileNotFound
+from excite_cli.identification.config import IdentifyProblem
+from excite_cli.optimization.starting_config import StartingConfig, draft_config, joint_choice, validated
+from excite_cli.storage.paths import check_target
+from excite_cli.workflows.check import Plan, plan_optimize
+
+KINDS = ("optimize", "identify")
+
+
+class _Dumper(yaml.SafeDumper):
+    """Sections as blocks, lists on one line ([a, b])."""
+
+
+_Dumper.add_representer(
+    list, lambda dumper, data: dumper.represent_sequence("tag:yaml.org,2002:seq", data, flow_style=True)
+)
+
+
+@dataclass
+class InitRun:
+    """What ``init`` wrote: the config file, the draft with its assumptions, and the dry run of an
+    ``optimize`` config (None for ``identify``)."""
+
+    target: Path
+    draft: StartingConfig
+    plan: Optional[Plan]
+
+
+def robot_source(urdf: str, target: Path) -> dict:
+    """``robot.urdf`` and ``robot.source`` for the URDF named ``urdf``: a file (written relative to the
+    config's folder) or a path inside example-robot-data (e.g. ``ur_description/urdf/ur10_robot.urdf``).
+
+    Raises:
+        FileNotFound: neither.
+    """
+    path = Path(urdf)
+    if path.is_file():
+        return {"urdf": os.path.relpath(path.resolve(), Path(target).resolve().parent), "source": "file"}
+    if (example_robot_data_root() / "example-robot-data" / "robots" / urdf).is_file():
+        return {"urdf": urdf, "source": "example-robot-data"}
+    raise FileNotFound("urdf", urdf, "URDF (a file, or a path inside example-robot-data's robots folder)")
+
+
+def _identify_config(robot: dict, urdf: Path, joints: Optional[list[str]], draft: StartingConfig) -> None:
+    """The identify config of the robot: its joints, and the data section a CSV of it would have."""
+    active, held = joint_choice(urdf, joints, draft)
+    draft.config = {
+        "robot": {**robot, "active_joints": active, "locked_joints": held},
+        "data": {
+            "runs": [{"file": "runs/run_1.csv", "role": "blocks"}],
+            "columns": {"time": "time", "q": [f"q_{j}" for j in active], "tau": [f"tau_{j}" for j in active]},
+        },
+        "preprocessing": {"sample_rate": 200},
+        "identification": {"method": "wls"},
+        "output": f"results/{urdf.stem}_identify.h5",
+    }
+    draft.assumptions["data.runs"] = (
+        "FILL IN: your measured runs (CSV, NPZ, MAT, HDF5 or a ROS bag), each fitted and validated on alternate "
+        "time blocks; add runs with role: fit / validation"
+    )
+    draft.assumptions["data.columns"] = (
+        "FILL IN: the column names of your files (these are the ones `excite simulate` writes); "
+        "add qd (and qdd) if you record them, factors for units other than rad and Nm"
+    )
+
+
+def _text(draft: StartingConfig, urdf: str, kind: str) -> str:
+    """The YAML with what was assumed as comments above it, one line per field."""
+    lines = [f"# excite init {urdf} ({kind} config), {date.today().isoformat()}: a starting config. What it assumed:"]
+    lines += [f"#   {name}: {why}" for name, why in draft.assumptions.items()]
+    lines += [f"#   excluded pair {a} – {b}: {why}" for a, b, why in draft.excluded]
+    lines += [f"#   mounting plane ignores {link}: {why}" for link, why in draft.ignored]
+    lines.append("# Check it with `excite check` before a run; change what your lab knows better.")
+    body = yaml.dump(
+        draft.config, Dumper=_Dumper, sort_keys=False, default_flow_style=False, width=100, allow_unicode=True
+    )
+    return "\n".join(lines) + "\n" + body
+
+
+def run_init(urdf: str, target: Path, joints: Optional[list[str]] = None, kind: str = "optimize", force: bool = False):
+    """Write a starting config of ``kind`` for ``urdf`` to ``target``.
+
+    Args:
+        urdf: a URDF file or a path inside example-robot-data's robots folder.
+        joints: the active joints (default: every revolute joint that follows no other).
+        kind: ``optimize`` (the whole problem, which passes the dry run) or ``identify`` (robot and
+            the data section to fill in).
+
+    Raises:
+        ExciteError: unknown kind or joint, a URDF not found, an output that may not be written, no
+            home posture where every constraint holds (see :func:`draft_config`).
+    """
+    if kind not in KINDS:
+        raise ExciteError("kind", f"'{kind}' is not a config kind", kind, " or ".join(KINDS))
+    target = check_target(Path(target), "output", force)
+    joints = [j.strip() for given in joints or [] for j in given.split(",") if j.strip()] or None
+    robot = robot_source(urdf, target)
+    path, package_dirs = resolve_urdf(RobotConfig.model_construct(**robot), target.resolve().parent)
+    plan = None
+    if kind == "optimize":
+        draft = draft_config(robot, path, package_dirs, joints, target)
+        plan = plan_optimize(validated(yaml.safe_load(_text(draft, urdf, kind)), target))
+    else:
+        draft = StartingConfig({})
+        _identify_config(robot, path, joints, draft)
+        IdentifyProblem.model_validate(yaml.safe_load(_text(draft, urdf, kind)))
+    with atomic_path(target, "output") as tmp:
+        Path(tmp).write_text(_text(draft, urdf, kind), encoding="utf-8")
+    return InitRun(target, draft, plan)

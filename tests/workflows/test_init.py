@@ -1,0 +1,104 @@
+"""`excite init` on an arm no shipped config uses (the UR3 of example-robot-data): the written config
+passes the dry run, its home posture is inside the URDF's limits with every link mesh apart (but the
+pairs it excluded, each with its reason) and above the mounting plane (pinocchio and coal on the
+meshes, not the capsules); the identify kind; bad input in one line."""
+
+import coal
+import numpy as np
+import pinocchio as pin
+import pytest
+from conftest import assert_refused
+from typer.testing import CliRunner
+
+from excite_cli.cli import app
+from excite_cli.config_file import load_problem
+from excite_cli.dynamics.urdf_source import example_robot_data_root
+from excite_cli.identification.config import IdentifyProblem
+from excite_cli.workflows.init import run_init
+
+UR3 = "ur_description/urdf/ur3_robot.urdf"
+
+
+@pytest.fixture(scope="module")
+def ur3(tmp_path_factory):
+    target = tmp_path_factory.mktemp("init") / "ur3.yaml"
+    return run_init(UR3, target)
+
+
+def _meshes(problem):
+    share = example_robot_data_root()
+    path = str(share / "example-robot-data" / "robots" / problem.robot.urdf)
+    model = pin.buildModelFromUrdf(path)
+    geometry = pin.buildGeomFromUrdf(model, path, pin.COLLISION, package_dirs=[str(share)])
+    return model, geometry
+
+
+def test_the_written_config_passes_the_dry_run_with_a_home_posture_every_mesh_accepts(ur3):
+    problem = load_problem(ur3.target)
+    assert ur3.plan is not None and ur3.plan.excitation.robot.joint_names == problem.robot.active_joints
+    assert len(problem.robot.active_joints) == 6 and problem.limits.torque == "urdf"
+    model, geometry = _meshes(problem)
+    q = np.array([problem.robot.home_posture[n] for n in model.names[1:]])
+    assert np.all(q >= model.lowerPositionLimit + problem.limits.position_margin - 1e-9)
+    assert np.all(q <= model.upperPositionLimit - problem.limits.position_margin + 1e-9)
+    for name in problem.robot.active_joints:  # half the URDF's velocity limit
+        assert problem.limits.velocity[name] == pytest.approx(0.5 * model.velocityLimit[model.getJointId(name) - 1])
+    excluded = {frozenset(p) for p in problem.constraints.self_collision.exclude_pairs}
+    text = ur3.target.read_text()
+    for a, b in problem.constraints.self_collision.exclude_pairs:
+        assert f"excluded pair {a} – {b}: " in text  # with its reason
+    geometry.addAllCollisionPairs()  # before its data, which sizes its results by the pairs
+    data, geometry_data = model.createData(), pin.GeometryData(geometry)
+    link = {k: model.frames[g.parentFrame].name for k, g in enumerate(geometry.geometryObjects)}
+    joint = {k: g.parentJoint for k, g in enumerate(geometry.geometryObjects)}
+    pin.computeDistances(model, data, geometry, geometry_data, q)
+    for pair, result in zip(geometry.collisionPairs, geometry_data.distanceResults):
+        a, b = pair.first, pair.second
+        if joint[a] == joint[b] or abs(joint[a] - joint[b]) == 1 or frozenset((link[a], link[b])) in excluded:
+            continue  # one body, adjacent bodies, or excluded with a reason
+        assert result.min_distance > 0, (link[a], link[b])
+    # every moving link's mesh (coal) above the mounting plane, but those the file says it ignores
+    point = problem.constraints.environment.shapes[0].point
+    plane = coal.Halfspace(np.array([0.0, 0.0, 1.0]), point[2])  # z ≤ point: the table
+    ignored = set(problem.constraints.environment.ignore_links)
+    pin.updateGeometryPlacements(model, data, geometry, geometry_data, q)
+    for k, g in enumerate(geometry.geometryObjects):
+        if g.parentJoint > 0 and link[k] not in ignored:
+            placed = coal.Transform3s(geometry_data.oMg[k].rotation, geometry_data.oMg[k].translation)
+            result = coal.DistanceResult()
+            coal.distance(g.geometry, placed, plane, coal.Transform3s(), coal.DistanceRequest(), result)
+            assert result.min_distance > 0, link[k]
+
+
+def test_the_identify_kind_names_the_columns_simulate_writes_and_what_to_fill_in(tmp_path):
+    run = run_init(UR3, tmp_path / "id.yaml", kind="identify")
+    problem = load_problem(run.target, IdentifyProblem)
+    assert problem.data.columns.q == [f"q_{j}" for j in problem.robot.active_joints]
+    assert problem.data.columns.tau == [f"tau_{j}" for j in problem.robot.active_joints]
+    assert run.plan is None and "FILL IN" in run.target.read_text()
+    assert_refused(tmp_path, ["identify", str(run.target)], "runs/run_1.csv")  # not there yet
+
+
+@pytest.mark.parametrize(
+    "argv, expected",
+    [
+        (["init", UR3, "--joints", "elbow_joint,nope"], "'nope' is not a 1-DoF joint of ur3_robot.urdf"),
+        (["init", "nothing/here.urdf"], "URDF (a file, or a path inside example-robot-data's robots folder) not found"),
+        (["init", UR3, "--kind", "simulate"], "'simulate' is not a config kind"),
+        (["init", UR3, "-o", "taken.yaml"], "taken.yaml exists"),
+    ],
+)
+def test_bad_init_input_is_one_line_and_writes_nothing(tmp_path, monkeypatch, argv, expected):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "taken.yaml").write_text("keep: me\n")
+    assert_refused(tmp_path, argv, expected)
+    assert (tmp_path / "taken.yaml").read_text() == "keep: me\n"
+
+
+def test_init_prints_its_assumptions_and_the_dry_run(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    result = CliRunner().invoke(app, ["init", UR3, "--joints", "shoulder_pan_joint", "--joints", "elbow_joint"])
+    assert result.exit_code == 0, result.output
+    assert "wrote ur3_robot.yaml" in result.output and "robot.active_joints: the joints given" in result.output
+    assert "robot.home_posture: searched" in result.output and "next: excite optimize ur3_robot.yaml" in result.output
+    assert load_problem(tmp_path / "ur3_robot.yaml").robot.active_joints == ["shoulder_pan_joint", "elbow_joint"]
