@@ -20,7 +20,7 @@ def skeleton(robot: Robot, q: np.ndarray) -> np.ndarray:
     qf = robot.q_reference.copy()
     qf[robot.q_idx] = q
     pin.framesForwardKinematics(model, data, qf)
-    ids = {name: model.getFrameId(name) for pair in robot.links for name in pair}
+    ids = {name: _joint_frame(model, name) for pair in robot.links for name in pair}
     return np.array([[data.oMf[ids[a]].translation, data.oMf[ids[b]].translation] for a, b in robot.links])
 
 
@@ -30,3 +30,12 @@ def capsule_segments(robot: Robot, capsules: list[Capsule], q: np.ndarray) -> np
         return np.zeros((0, 2, 3))
     start, end, _, _ = segment_ends(BatchKinematics(robot), capsules, q[None, :])
     return np.stack([start[:, 0].T, end[:, 0].T], axis=1)
+
+
+def _joint_frame(model: pin.Model, name: str) -> int:
+    """The joint frame (moving, or held: fixed) called ``name``; a link may have the same name (so100's
+    "gripper")."""
+    for kind in (pin.FrameType.JOINT, pin.FrameType.FIXED_JOINT):
+        if model.existFrame(name, kind):
+            return model.getFrameId(name, kind)
+    return model.getFrameId(name)

@@ -29,7 +29,8 @@ def payload_parameters(robot: Robot, payload: PayloadConfig, field_name: str) ->
         raise ExciteError(
             f"{field_name}.frame", f"'{frame}' is not a frame of the robot's model", frame, "a frame of the URDF"
         )
-    placement = robot.model.frames[robot.model.getFrameId(frame)]
+    kind = pin.FrameType.BODY if robot.model.existFrame(frame, pin.FrameType.BODY) else None  # a joint may share it
+    placement = robot.model.frames[robot.model.getFrameId(frame, kind) if kind else robot.model.getFrameId(frame)]
     xx, xy, yy, xz, yz, zz = payload.inertia
     inertia = pin.Inertia(
         payload.mass, np.asarray(payload.com, dtype=float), np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
