@@ -13,7 +13,8 @@ from excite_cli.console import identification as identify_tables
 from excite_cli.console import model_files, tables
 from excite_cli.console.app import FORCE, SCHEDULER, WORKERS, app, command, err, out, say
 from excite_cli.console.progress import Bars
-from excite_cli.identification.config import IdentifyProblem, SimulationConfig
+from excite_cli.identification.config import IdentifyProblem
+from excite_cli.identification.simulation_config import SimulationConfig
 from excite_cli.optimization.criterion import OBJECTIVES
 from excite_cli.storage.export import FORMATS
 
@@ -84,6 +85,15 @@ def init(
     with err.status("fitting capsules and searching postures ..."):
         run = workflows.run_init(urdf, output or Path(f"{Path(urdf).stem}.yaml"), joints, kind, force)
     say(tables.initialized(run))
+
+
+@command()
+def schema(
+    output_dir: Path = typer.Option(Path("schema"), "--output-dir", "-o", help="Folder for the schema files."),
+    force: bool = FORCE,
+) -> None:
+    """JSON Schema of every config kind (optimize, identify, effects), for editors and the config reference."""
+    say("wrote " + ", ".join(str(p) for p in workflows.run_schema(output_dir, force)))
 
 
 @command()

@@ -1,6 +1,6 @@
-"""The identification configs, validated once at load (pydantic): ``excite identify`` (robot, data,
-preprocessing, identification) and the effects file of ``excite simulate``. Every field is documented
-in README.md ("Identification config", "Effects file") with its unit and default."""
+"""The ``excite identify`` config (robot, data, preprocessing, identification), validated once at load
+(pydantic); each field's docstring is its description with its unit (``excite schema``, the config
+reference). The effects file of ``excite simulate``: :mod:`~excite_cli.identification.simulation_config`."""
 
 from __future__ import annotations
 
@@ -9,8 +9,9 @@ from typing import Annotated, Literal, Optional, Union
 
 import numpy as np
 from pydantic import Field, NonNegativeFloat, PositiveFloat, field_validator, model_validator
+from pydantic.json_schema import SkipJsonSchema
 
-from excite_cli.config import MAX_SEED, Problem, RobotConfig, Section
+from excite_cli.config import Problem, RobotConfig, Section
 from excite_cli.identification.effects import EFFECT_NAMES, EFFECTS, SHAPE_GRID
 
 Effect = Literal[EFFECT_NAMES]
@@ -36,12 +37,19 @@ class ColumnsConfig(Section):
     mA → A, ms → s) (README: identification config)."""
 
     time: Optional[Column] = "time"
+    """Time column [s] (name or 0-based position), or null: time is the row index / data.sample_rate."""
     q: list[Column] = Field(min_length=1)
+    """Joint position columns [rad], in active-joint order."""
     qd: Optional[list[Column]] = None
+    """Joint velocity columns [rad/s], or none: differentiated."""
     qdd: Optional[list[Column]] = None
+    """Joint acceleration columns [rad/s²], or none: differentiated."""
     tau: Optional[list[Column]] = None
+    """Joint torque columns [Nm] (or current)."""
     current: Optional[list[Column]] = None
+    """Motor current columns [A] (or tau), times data.torque_constants."""
     factors: dict[str, float] = Field(default_factory=dict)
+    """{column: factor [1]}: SI value = recorded value × factor (counts → rad, mA → A, ms → s)."""
 
     @model_validator(mode="after")
     def _torque_source(self) -> "ColumnsConfig":
@@ -64,9 +72,13 @@ class PayloadConfig(Section):
     (Ixx, Ixy, Iyy, Ixz, Iyz, Izz) in ``frame`` (default: the link of the last active joint)."""
 
     mass: float = Field(gt=0.0)
+    """Mass [kg]."""
     com: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    """Centre of mass [m] in `frame`."""
     inertia: tuple[float, float, float, float, float, float] = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    """Inertia about the CoM [kg·m²]: Ixx, Ixy, Iyy, Ixz, Iyz, Izz in `frame`."""
     frame: Optional[str] = None
+    """The link it is fixed to (default: the link of the last active joint)."""
 
     @field_validator("inertia")
     @classmethod
@@ -86,9 +98,13 @@ class RunConfig(Section):
     """One measured run: file, optional crop [s], role (fit, validation or time blocks), a known payload."""
 
     file: Union[str, list[str]]
+    """A data file (CSV, NPZ, MAT, HDF5, ROS bag), or a list of files recorded apart, joined on time."""
     crop: Optional[tuple[float, float]] = None
+    """[t0, t1] [s]: the part of the run used."""
     role: Literal["fit", "validation", "blocks"] = "blocks"
+    """`fit`, `validation` (never fitted nor seen by the selection) or `blocks` (alternate time blocks)."""
     payload: Optional[PayloadConfig] = None
+    """A known payload carried in this run, taken out of τ."""
 
     @property
     def files(self) -> list[str]:
@@ -109,7 +125,9 @@ class TransmissionConfig(Section):
     coupled wrist whose motor 6 turns with q5 + q6 has C row 6 = [0, 0, 0, 0, 1, 1]."""
 
     gear_ratios: list[float] = Field(min_length=1)
+    """Gear ratio N [1] per active joint (not 0): m = R q, R = diag(N) C."""
     coupling: Optional[list[list[float]]] = None
+    """Coupling matrix C [1] (n × n, invertible; default identity)."""
 
     @field_validator("gear_ratios")
     @classmethod
@@ -142,16 +160,27 @@ class DataConfig(Section):
     (stop with an error, or drop and count them)."""
 
     runs: list[RunConfig] = Field(min_length=1)
+    """The measured runs."""
     columns: Optional[ColumnsConfig] = None
+    """The columns of the files (ROS bags: matched by joint name)."""
     topic: str = "/joint_states"
+    """The sensor_msgs/JointState topic of ROS bags."""
     angle_unit: Literal["rad", "deg"] = "rad"
+    """`rad` or `deg`."""
     torque_constants: Optional[list[float]] = None
+    """Torque constants [Nm/A] per joint, with current columns."""
     signs: Optional[list[float]] = None
+    """1 or −1 [1] per joint, multiplying q, q̇, q̈ and τ."""
     validation_blocks: int = Field(4, ge=2, le=100)
+    """A `blocks` run is cut into this many time blocks: even ones fit, odd ones validate."""
     bad_rows: Literal["error", "drop"] = "error"
+    """`error`: a row that cannot be used stops the run; `drop`: such rows are left out and counted."""
     transmission: Optional[TransmissionConfig] = None
+    """Gear ratios and coupling of the motors, or none."""
     motor_side: bool = False
+    """The columns hold motor angles and motor torques or currents, mapped through the transmission."""
     sample_rate: Optional[PositiveFloat] = None
+    """Sample rate [Hz] of files without a time column."""
 
     @model_validator(mode="after")
     def _consistent(self) -> "DataConfig":
@@ -184,8 +213,11 @@ class PreprocessingConfig(Section):
     the bandwidth), filter order."""
 
     sample_rate: Optional[float] = Field(None, gt=0.0, le=MAX_RATE)
+    """Rate after decimation [Hz] (default min(200 Hz, the data's))."""
     cutoff: Optional[float] = Field(None, gt=0.0)
+    """Low-pass cut-off [Hz] (default 10 × the 99 % power bandwidth of q, at least 5 Hz)."""
     filter_order: int = Field(4, ge=1, le=10)
+    """Butterworth filter order."""
 
 
 class IdentificationConfig(Section):
@@ -197,20 +229,35 @@ class IdentificationConfig(Section):
     prefers together with the model) and the consistent fit's regularization weights toward the URDF."""
 
     method: Literal["wls", "ls"] = "wls"
+    """`wls` (weighted least squares) or `ls`."""
     declared_effects: dict[str, list[Effect]] = Field(default_factory=dict)
+    """{joint or '*': [effects]} in the model from the start, never removed."""
     candidates: list[Effect] = Field(default_factory=lambda: list(DEFAULT_CANDIDATES))
+    """Effects the search may add (the position-dependent ones only when listed)."""
     position_guard: bool = True
+    """Hold position-dependent effects at their value outside the fit data's q range."""
     folds_by: Literal["auto", "recording", "run", "time_block"] = "auto"
+    """What a cross-validation fold holds out: `auto`, `recording`, `run` or `time_block`."""
     folds: int = Field(6, ge=3, le=50)
+    """K, time-block folds of the cross-validation."""
     min_improvement: float = Field(0.02, ge=0.0, lt=1.0)
+    """Cut [1] of the cross-validated error every effect must buy (a fraction)."""
     coulomb_velocity: PositiveFloat = 0.01
+    """v_c of the smooth sign tanh(q̇/v_c) [rad/s]."""
     stribeck_velocity: list[PositiveFloat] = Field(default_factory=lambda: list(SHAPE_GRID), min_length=1)
+    """The grid [rad/s] the search picks Stribeck's v_s from (one value fixes it)."""
     held_velocity: list[PositiveFloat] = Field(default_factory=lambda: list(SHAPE_GRID), min_length=1)
+    """The grid [rad/s] the search picks held friction's v_h from (one value fixes it)."""
     max_effects: int = Field(60, ge=0)
+    """Cap on added effects."""
     fit: Literal["auto", "least_squares", "consistent"] = "auto"
+    """The reported fit: `auto` (chosen by cross-validation), `least_squares` or `consistent`."""
     regularization: list[NonNegativeFloat] = Field(default_factory=lambda: list(REGULARIZATION), min_length=1)
+    """λ [1] of the consistent fit (weight of the distance to the URDF's parameters); a list to pick from."""
     coupling_ratios: list[float] = Field(default_factory=lambda: list(COUPLING_RATIOS))
+    """Ratios r [1] of the coupled-motor candidates q_i + r q_(i+1) without a transmission."""
     coupling_improvement: float = Field(0.2, ge=0.0, lt=10.0)
+    """Cut [1] of the cross-validated error a coupled motor effect must buy."""
 
     @field_validator("stribeck_velocity", "held_velocity", "regularization", mode="before")
     @classmethod
@@ -222,36 +269,19 @@ class IdentifyProblem(Section):
     """``excite identify`` config: the robot as for ``optimize``, then data, preprocessing, identification."""
 
     robot: RobotConfig
+    """The robot, as in an optimize config."""
     data: DataConfig
+    """The measured runs and how to read them."""
     preprocessing: PreprocessingConfig = PreprocessingConfig()
+    """Resampling, low-pass filter and decimation."""
     identification: IdentificationConfig = IdentificationConfig()
+    """The fit and the search for effects the model lacks."""
     output: str = "results/identification.h5"
+    """Path of the HDF5 report (relative to the working directory)."""
 
-    source_path: Optional[Path] = Field(None, exclude=True)
-    source_text: str = Field("", exclude=True)
+    source_path: SkipJsonSchema[Optional[Path]] = Field(None, exclude=True)
+    """The file it was read from (set by the loader, not in the file)."""
+    source_text: SkipJsonSchema[str] = Field("", exclude=True)
+    """The file's text (set by the loader)."""
 
     folder = Problem.folder
-
-
-class SimulationConfig(Section):
-    """``excite simulate`` effects file: what the simulated robot has beyond its URDF rigid body."""
-
-    sample_rate: float = Field(1000.0, gt=0.0, le=MAX_RATE)
-    periods: int = Field(2, ge=1, le=1000)
-    timestamp_jitter: float = Field(0.0, ge=0.0, lt=0.5)
-    torque_noise: float = Field(0.0, ge=0.0)
-    position_noise: float = Field(0.0, ge=0.0)
-    seed: int = Field(0, ge=0, le=MAX_SEED)
-    effects: dict[Effect, dict[str, Union[float, tuple[float, float]]]] = Field(default_factory=dict)
-    stribeck_velocity: float = Field(0.1, gt=0.0)
-    coulomb_velocity: float = Field(0.01, gt=0.0)
-    held_velocity: float = Field(0.02, gt=0.0)
-    transmission: Optional[TransmissionConfig] = None
-    motor_effects: dict[Literal["armature", "coulomb", "viscous"], dict[str, float]] = Field(default_factory=dict)
-    motor_side: bool = False
-
-    @model_validator(mode="after")
-    def _motors_need_the_transmission(self) -> "SimulationConfig":
-        if (self.motor_effects or self.motor_side) and self.transmission is None:
-            raise ValueError("motor_effects and motor_side need a transmission (gear ratios and coupling)")
-        return self

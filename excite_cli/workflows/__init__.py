@@ -6,6 +6,7 @@ from excite_cli.workflows.export import run_export
 from excite_cli.workflows.identify import run_identify
 from excite_cli.workflows.init import run_init
 from excite_cli.workflows.optimize import run_optimize
+from excite_cli.workflows.schema import run_schema
 from excite_cli.workflows.simulate import simulate_runs
 from excite_cli.workflows.validate import run_validate
 from excite_cli.workflows.verify_gradient import run_verify
@@ -18,6 +19,7 @@ __all__ = [
     "run_identify",
     "run_init",
     "run_optimize",
+    "run_schema",
     "run_validate",
     "run_verify",
     "run_view",

@@ -19,8 +19,8 @@ import numpy as np
 from excite_cli.atomic import atomic_paths
 from excite_cli.dynamics.robot import Robot, load_robot
 from excite_cli.errors import ExciteError
-from excite_cli.identification.config import SimulationConfig
 from excite_cli.identification.effects import EFFECTS, effect_columns
+from excite_cli.identification.simulation_config import SimulationConfig
 from excite_cli.storage.paths import check_folder
 from excite_cli.storage.results import problem_of_result, read_alphas
 from excite_cli.trajectory.fourier import FourierTrajectory

@@ -15,12 +15,13 @@ from typer.testing import CliRunner
 from excite_cli.cli import app
 from excite_cli.config_file import load_problem
 from excite_cli.h5 import read_strings, write_strings
-from excite_cli.identification.config import DEFAULT_CANDIDATES, IdentifyProblem, SimulationConfig
+from excite_cli.identification.config import DEFAULT_CANDIDATES, IdentifyProblem
 from excite_cli.identification.effects import EFFECT_NAMES, EFFECTS, effect_columns
 from excite_cli.identification.fitting.dataset import run_offset_columns
 from excite_cli.identification.measured.measurements import load_run
 from excite_cli.identification.measured.preprocessing import Filter
 from excite_cli.identification.pipeline import run_identification
+from excite_cli.identification.simulation_config import SimulationConfig
 from excite_cli.identification.validate import validate_model
 from excite_cli.trajectory.fourier import FourierTrajectory
 from excite_cli.workflows.identify import run_identify, write_identified_mjcf

@@ -13,9 +13,10 @@ from typer.testing import CliRunner
 
 from excite_cli.cli import app
 from excite_cli.config_file import load_problem
-from excite_cli.identification.config import IdentifyProblem, SimulationConfig
+from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.fitting.least_squares import torque_errors
 from excite_cli.identification.pipeline import run_identification
+from excite_cli.identification.simulation_config import SimulationConfig
 from excite_cli.identification.validate import validate_model
 from excite_cli.storage.results import problem_of_result, read_alphas
 from excite_cli.trajectory.fourier import FourierTrajectory

@@ -12,12 +12,13 @@ from excite_cli.config_file import load_problem
 from excite_cli.dynamics.base_parameters import compute_base_parameters
 from excite_cli.dynamics.robot import load_robot
 from excite_cli.errors import ExciteError
-from excite_cli.identification.config import IdentifyProblem, SimulationConfig
+from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.effects import Term
 from excite_cli.identification.fitting.least_squares import joint_weights, least_squares, predict, torque_errors
 from excite_cli.identification.fitting.normal import NormalEquations
 from excite_cli.identification.measured.measurements import Run, check_against_limits
 from excite_cli.identification.pipeline import prepare_data, run_identification
+from excite_cli.identification.simulation_config import SimulationConfig
 from excite_cli.workflows.simulate import simulate_runs
 
 runner = CliRunner()

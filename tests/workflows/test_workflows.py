@@ -10,7 +10,8 @@ from conftest import CONFIGS, JOINTS, robot_of, write_config
 
 from excite_cli import workflows
 from excite_cli.config_file import load_problem
-from excite_cli.identification.config import IdentifyProblem, SimulationConfig
+from excite_cli.identification.config import IdentifyProblem
+from excite_cli.identification.simulation_config import SimulationConfig
 from excite_cli.workflows.compare import run_compare_random
 from excite_cli.workflows.export import run_export
 from excite_cli.workflows.identify import run_identify

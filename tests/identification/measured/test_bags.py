@@ -17,10 +17,11 @@ from typer.testing import CliRunner
 from excite_cli.cli import app
 from excite_cli.config_file import load_problem
 from excite_cli.errors import ExciteError
-from excite_cli.identification.config import IdentifyProblem, SimulationConfig
+from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.measured.bags import is_bag, read_bag
 from excite_cli.identification.measured.measurements import load_run
 from excite_cli.identification.pipeline import run_identification
+from excite_cli.identification.simulation_config import SimulationConfig
 from excite_cli.workflows.simulate import simulate_runs
 
 JOINTS = [f"panda_joint{k}" for k in range(1, 8)]

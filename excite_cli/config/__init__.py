@@ -1,0 +1,61 @@
+"""Configuration: the ``optimize`` problem's sections (:mod:`~excite_cli.config.problem`), its constraint
+sections (:mod:`~excite_cli.config.constraints`) and what every config shares
+(:mod:`~excite_cli.config.base`), validated once at load (pydantic)."""
+
+from excite_cli.config.base import (
+    MAX_FINE,
+    MAX_GRID,
+    MAX_HARMONICS,
+    MAX_SEED,
+    MAX_WORKERS,
+    FieldProblem,
+    Fraction,
+    PerJoint,
+    Section,
+    effective_yaml,
+    resolve_path,
+)
+from excite_cli.config.constraints import (
+    CapsuleConfig,
+    ComConfig,
+    ConstraintsConfig,
+    EnvironmentConfig,
+    SelfCollisionConfig,
+    WorldShapeConfig,
+)
+from excite_cli.config.problem import (
+    LimitsConfig,
+    OptimizerConfig,
+    Problem,
+    RandomBaselineConfig,
+    RobotConfig,
+    SequenceConfig,
+    TrajectoryConfig,
+)
+
+__all__ = [
+    "MAX_FINE",
+    "MAX_GRID",
+    "MAX_HARMONICS",
+    "MAX_SEED",
+    "MAX_WORKERS",
+    "CapsuleConfig",
+    "ComConfig",
+    "ConstraintsConfig",
+    "EnvironmentConfig",
+    "FieldProblem",
+    "Fraction",
+    "LimitsConfig",
+    "OptimizerConfig",
+    "PerJoint",
+    "Problem",
+    "RandomBaselineConfig",
+    "RobotConfig",
+    "Section",
+    "SelfCollisionConfig",
+    "SequenceConfig",
+    "TrajectoryConfig",
+    "WorldShapeConfig",
+    "effective_yaml",
+    "resolve_path",
+]
