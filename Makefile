@@ -4,14 +4,14 @@ PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 CONFIG ?= configs/g1_arms.yaml
 
-.PHONY: install ipopt optimize test lint smoke view-check bench clean
+.PHONY: install ipopt optimize test lint smoke view-check docs guide bench clean
 
 install: $(STAMP)
 
 $(STAMP): pyproject.toml
 	python3 -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e ".[test,mujoco]"
+	$(PY) -m pip install --quiet -e ".[test,mujoco,docs]"
 	$(MAKE) --no-print-directory ipopt
 	touch $(STAMP)
 
@@ -51,6 +51,14 @@ view-check: $(STAMP)
 	@command -v chromium >/dev/null || { [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null && \
 	  apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null; } || true
 	$(PY) bench/view_check.py results/smoke.h5
+
+# the documentation site (mkdocs-material) in site/, warnings as errors
+docs: $(STAMP)
+	NO_MKDOCS_2_WARNING=1 $(VENV)/bin/mkdocs build --strict --quiet
+
+# every command of docs/guide.md, in order, in an empty folder
+guide: $(STAMP)
+	$(PY) docs/run_guide.py
 
 bench: $(STAMP)
 	$(PY) bench/bench_g1_arms.py

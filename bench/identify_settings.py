@@ -3,7 +3,7 @@ run of ``../shared/data`` on its two shipped splits, identified with the default
 setting changed at a time. For each it prints the low-pass cut-off, the mean relative validation
 error of the reported model (the model and fit chosen together) and of least squares of the same
 effects, the fit chosen, the number of effects and their overlap with the default's ((effect,
-joint) pairs shared / all), and the time. These are README's figures under "Identification on real
+joint) pairs shared / all), and the time. These are the figures of docs/figures.md under "Identification on real
 data that the selection never saw".
 
     .venv/bin/python bench/identify_settings.py

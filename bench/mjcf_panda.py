@@ -4,7 +4,7 @@ MJCF (rigid body, armature and damping against excite's model, relative to the l
 Coulomb friction where both are saturated; the share of samples where the two friction models
 differ by more than 1 % of F_c), the mean validation errors of excite's consistent model, of its
 part the MJCF holds and of MuJoCo's, then the same MuJoCo error with MuJoCo's default friction
-constraint (solreffriction 0.02 s instead of 2 timesteps), and the time. README's figures under
+constraint (solreffriction 0.02 s instead of 2 timesteps), and the time. the figures of the documentation under
 "The identified model in MuJoCo".
 
     .venv/bin/python bench/mjcf_panda.py

@@ -2,7 +2,7 @@
 without the robot's meshes (the world shapes in both), takes a screenshot of each in headless Chromium (WebGL by SwiftShader)
 and counts the pixels where they differ: the robot. Exit status 1 below ``MIN_PIXELS``.
 
-Run: `make view-check` (installs Debian's chromium when missing, as root; see README) or
+Run: `make view-check` (installs Debian's chromium when missing, as root; see the Makefile) or
 `.venv/bin/python bench/view_check.py [RESULT.h5]` (default results/smoke.h5, from `make smoke`).
 The screenshots are kept beside the result for a person to look at.
 """

@@ -36,7 +36,7 @@ def main(
 
 @command()
 def optimize(
-    config: Path = typer.Argument(..., help="Problem YAML file (see README 'Config reference')."),
+    config: Path = typer.Argument(..., help="Problem YAML file (see docs/config-reference.md)."),
     output: Optional[Path] = typer.Option(None, "--output", "-o", help="HDF5 result file (overrides config 'output')."),
     iterations: Optional[int] = typer.Option(
         None, "--iterations", "-k", help="Sequential iterations (sequence.iterations)."

@@ -142,7 +142,7 @@ def _validation_error(path: Path | None, error: ValidationError) -> ExciteError:
     elif first["type"] == "missing":
         message = "is required but missing"
     elif first["type"] == "extra_forbidden":
-        message = "is not a known field (check its spelling; see README 'Config reference')"
+        message = "is not a known field (check its spelling; see docs/config-reference.md or excite schema)"
     else:
         message = f"{message} (got {reprlib.repr(first.get('input'))})"
     more = len(error.errors()) - 1
@@ -171,7 +171,7 @@ def load_problem(path: str | Path, kind: type[BaseModel] = Problem, field: str =
             field,
             f"{path}: {'empty file' if raw is None else 'not a mapping'}",
             path,
-            "a mapping of sections (see README 'Config reference')",
+            "a mapping of sections (see docs/config-reference.md or excite schema)",
         )
     try:
         problem = kind.model_validate(raw)

@@ -27,9 +27,9 @@ from excite_cli.config.constraints import ConstraintsConfig
 
 
 class RobotConfig(Section):
-    """URDF, floating or fixed base, active and locked joints, home posture (README: `robot`)."""
+    """URDF, floating or fixed base, active and locked joints, home posture."""
 
-    urdf: str = Field(description="URDF path (relative to the config file) or a path inside example-robot-data")
+    urdf: str
     """URDF file (relative to the config file), or with `source: example-robot-data` a path in its robots folder."""
     source: Literal["file", "example-robot-data"] = "file"
     """Where `urdf` is found: `file` or `example-robot-data`."""

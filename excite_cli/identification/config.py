@@ -16,7 +16,7 @@ from excite_cli.identification.effects import EFFECT_NAMES, EFFECTS, SHAPE_GRID
 
 Effect = Literal[EFFECT_NAMES]
 #: The default candidates: every effect but the position-dependent ones, which, even guarded to the fit
-#: data's q range, fitted the seen phases of the real Panda run and cost on unseen ones (README), so
+#: data's q range, fitted the seen phases of the real Panda run and cost on unseen ones (docs/figures.md), so
 #: they are opt-in.
 DEFAULT_CANDIDATES = tuple(e for e in EFFECT_NAMES if not EFFECTS[e].position)
 #: Default regularization weights λ of the consistent fit, among which the cross-validation chooses.
@@ -34,7 +34,7 @@ MAX_RATE = 100_000.0
 class ColumnsConfig(Section):
     """Columns of measured data, in active-joint order, by name or by 0-based position, and the factor
     of any column recorded in other units (SI value = recorded value × factor: encoder counts → rad,
-    mA → A, ms → s) (README: identification config)."""
+    mA → A, ms → s)."""
 
     time: Optional[Column] = "time"
     """Time column [s] (name or 0-based position), or null: time is the row index / data.sample_rate."""

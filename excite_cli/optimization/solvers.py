@@ -125,7 +125,7 @@ def _ipopt(nlp: NLP, z0: np.ndarray, max_iterations: int, tolerance: float, on_i
         raise ExciteError(
             "optimizer.method",
             "'ipopt' needs cyipopt, which `make install` builds against Debian's "
-            "coinor-libipopt-dev (see README 'Quick start')",
+            "coinor-libipopt-dev (see the Makefile's ipopt target)",
         ) from None
     last, count = [z0], [0]
 

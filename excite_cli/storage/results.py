@@ -1,4 +1,4 @@
-"""HDF5 result files (h5py), readable without excite. Schema in README.md ("Output").
+"""HDF5 result files (h5py), readable without excite. Schema in docs/output.md.
 
 The file is rewritten whole after every finished iteration into a temporary file that then replaces
 the target (``os.replace`` is atomic), so an interrupted run leaves a valid file with the finished
@@ -84,7 +84,7 @@ def write_result(
         table = f.create_dataset("table", data=results_table(results))
         table.attrs["description"] = (
             "Table I: cond of each iteration's regressor and of the stacked regressor on the base columns, "
-            "their cond(C L) and excitation e [N m], which do not depend on the base columns (README 'Output')"
+            "their cond(C L) and excitation e [N m], which do not depend on the base columns (docs/output.md)"
         )
 
 

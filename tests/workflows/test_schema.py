@@ -7,7 +7,7 @@ from conftest import CONFIGS, TESTS, assert_refused
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
-from excite_cli.workflows.schema import KINDS, config_schema
+from excite_cli.workflows.schema import KINDS, config_schema, reference_markdown
 
 
 def test_the_committed_schemas_are_the_generated_ones_and_the_configs_name_them():
@@ -31,3 +31,14 @@ def test_the_command_writes_one_schema_per_kind_and_keeps_existing_files(tmp_pat
     frequency = optimize["$defs"]["TrajectoryConfig"]["properties"]["base_frequency"]
     assert "[rad/s]" in frequency["description"] and frequency["exclusiveMinimum"] == 0.0
     assert_refused(tmp_path, ["schema", "-o", str(tmp_path / "s")], "optimize.schema.json exists")
+
+
+def test_the_config_reference_has_a_row_for_every_field_of_every_section():
+    for kind in KINDS:
+        schema, text = config_schema(kind), reference_markdown(kind)
+        for section in [schema, *schema["$defs"].values()]:
+            for field, prop in section["properties"].items():
+                rows = [line for line in text.splitlines() if line.startswith(f"| `{field}` |")]
+                assert any(prop["description"].replace("|", "\\|") in row for row in rows), (kind, field)
+    optimize = reference_markdown("optimize")
+    assert "### `constraints.environment.shapes[]`" in optimize and "| `base_frequency` | number | `0.785" in optimize
