@@ -56,7 +56,7 @@ def link_points(robot: Robot, link: str, field: str = "constraints.self_collisio
     parts, joint = [], None
     for obj in robot.collision_model.geometryObjects:
         if robot.model.frames[obj.parentFrame].name == link:
-            local = _shape_points(obj.geometry) * np.asarray(obj.meshScale)
+            local = _shape_points(obj.geometry)  # a mesh is loaded at its URDF scale already
             parts.append(local @ obj.placement.rotation.T + obj.placement.translation)
             joint = obj.parentJoint
     if joint is None:

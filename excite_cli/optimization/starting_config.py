@@ -124,7 +124,7 @@ def _base_floor(path: Path, package_dirs: list[str]) -> float:
     for k, g in enumerate(geometry.geometryObjects):
         if g.parentJoint == 0 and hasattr(g.geometry, "vertices"):
             placement = gdata.oMg[k]
-            points = np.asarray(g.geometry.vertices()) * np.asarray(g.meshScale) @ placement.rotation.T
+            points = np.asarray(g.geometry.vertices()) @ placement.rotation.T  # at its URDF scale already
             lowest = min(lowest, float((points + placement.translation)[:, 2].min()))
     return lowest
 
