@@ -4,6 +4,7 @@ paths in a config are resolved and a config is written back."""
 
 from __future__ import annotations
 
+import os
 import re
 from pathlib import Path
 from typing import Annotated, Optional, Union
@@ -46,9 +47,12 @@ class Section(BaseModel):
 
 
 def resolve_path(path: str, folder: Optional[Path]) -> Path:
-    """``path`` relative to ``folder`` (absolute paths, and any path without a folder, kept as given)."""
+    """``path`` relative to ``folder`` (absolute paths, and any path without a folder, kept as given);
+    ``..`` is taken lexically while the folder does not exist yet (a config ``init`` is about to write)."""
     p = Path(path).expanduser()
-    return p if p.is_absolute() or folder is None else folder / p
+    if p.is_absolute() or folder is None:
+        return p
+    return folder / p if folder.exists() else Path(os.path.normpath(folder / p))
 
 
 def effective_yaml(config: BaseModel) -> str:

@@ -192,10 +192,8 @@ def _home(excitation: Excitation, Q: np.ndarray, rng: np.random.Generator) -> tu
         score, scale = float(_clearance(excitation, best[None])[0]), 0.3
         for rounds in range(HOME_ROUNDS):
             if score >= HOME_CLEARANCE and violated_at_rest(excitation, best) is None:
-                return best, (
-                    f"from {start}, {rounds} round(s) of random steps: every capsule {score * 100:.1f} cm "
-                    "beyond its margin"
-                )
+                clear = f"every capsule {score * 100:.1f} cm beyond its margin" if np.isfinite(score) else "no capsule"
+                return best, f"from {start}, {rounds} round(s) of random steps: {clear}"
             steps = best + scale * half * rng.standard_normal((HOME_STEPS, centre.size))
             steps = np.clip(steps, centre - half, centre + half)
             step_scores = _clearance(excitation, steps)
@@ -261,9 +259,16 @@ def draft_config(
         f"a plane under the base (z = {floor:g} m, the base's lowest collision point): the table top or floor"
     )
     excitation = build_excitation(validated(draft.config, target), check_home=False)
+    if not any(c.name in ("self_collision", "world_collision") and c.capsules for c in excitation.constraints):
+        del draft.config["constraints"]
+        del draft.assumptions["constraints.environment"]
+        draft.assumptions["constraints"] = (
+            "none: the URDF has no collision geometry on a moving link (give capsules in constraints.self_collision)"
+        )
     Q = _random_postures(excitation, np.random.default_rng(0))
     _always_overlapping(excitation, Q, draft)
-    draft.config["constraints"]["self_collision"]["exclude_pairs"] = [[a, b] for a, b, _ in draft.excluded]
+    if "constraints" in draft.config:
+        draft.config["constraints"]["self_collision"]["exclude_pairs"] = [[a, b] for a, b, _ in draft.excluded]
     if draft.ignored:
         draft.config["constraints"]["environment"]["ignore_links"] = [link for link, _ in draft.ignored]
     excitation = build_excitation(validated(draft.config, target), check_home=False)

@@ -7,7 +7,7 @@ import coal
 import numpy as np
 import pinocchio as pin
 import pytest
-from conftest import assert_refused
+from conftest import GOOD, PENDULUM, assert_refused
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
@@ -102,3 +102,13 @@ def test_init_prints_its_assumptions_and_the_dry_run(tmp_path, monkeypatch):
     assert "wrote ur3_robot.yaml" in result.output and "robot.active_joints: the joints given" in result.output
     assert "robot.home_posture: searched" in result.output and "next: excite optimize ur3_robot.yaml" in result.output
     assert load_problem(tmp_path / "ur3_robot.yaml").robot.active_joints == ["shoulder_pan_joint", "elbow_joint"]
+
+
+def test_a_urdf_file_without_collision_geometry_gets_no_collision_constraint(tmp_path):
+    (tmp_path / "pendulum.urdf").write_text(PENDULUM.format(**{**GOOD, "mimic": ""}))
+    run = run_init(str(tmp_path / "pendulum.urdf"), tmp_path / "configs" / "pendulum.yaml")
+    problem = load_problem(run.target)
+    assert (problem.robot.urdf, problem.robot.source) == ("../pendulum.urdf", "file")  # beside the config
+    assert problem.constraints.self_collision is None and problem.constraints.environment is None
+    assert "constraints: none: the URDF has no collision geometry" in run.target.read_text()
+    assert run.plan.excitation.robot.joint_names == ["hinge", "tip_joint"]
