@@ -87,9 +87,9 @@ def joint_choice(path: Path, given: list[str] | None, draft: StartingConfig) -> 
     return active, held
 
 
-def _limits(path: Path, active: list[str], draft: StartingConfig) -> dict:
-    """Position margin, velocity and acceleration limits per joint, torque limits where the URDF has them."""
-    model = pin.buildModelFromUrdf(str(path))
+def _limits(model: pin.Model, active: list[str], draft: StartingConfig) -> dict:
+    """Position margin, velocity and acceleration limits per joint, torque limits where the URDF (its
+    ``model``) has them."""
     ids = [model.getJointId(n) for n in active]
     velocity = {
         n: round(VELOCITY_FRACTION * float(model.velocityLimit[model.idx_vs[i]]), 3) for n, i in zip(active, ids)
@@ -114,9 +114,9 @@ def _limits(path: Path, active: list[str], draft: StartingConfig) -> dict:
     return limits
 
 
-def _base_floor(path: Path, package_dirs: list[str]) -> float:
-    """Height [m] of the lowest point of the root link's collision geometry (0 without any)."""
-    model = pin.buildModelFromUrdf(str(path))
+def _base_floor(model: pin.Model, path: Path, package_dirs: list[str]) -> float:
+    """Height [m] of the lowest point of the root link's collision geometry (0 without any), from the
+    URDF ``path`` and its ``model``."""
     geometry = pin.buildGeomFromUrdf(model, str(path), pin.COLLISION, package_dirs=package_dirs)
     data, gdata = model.createData(), pin.GeometryData(geometry)
     pin.updateGeometryPlacements(model, data, geometry, gdata, pin.neutral(model))
@@ -243,10 +243,11 @@ def draft_config(
     """
     draft = StartingConfig({"robot": dict(robot)})
     active, held = joint_choice(urdf, joints, draft)
-    floor = round(_base_floor(urdf, package_dirs), 4) + 0.0  # no -0
+    model = pin.buildModelFromUrdf(str(urdf))
+    floor = round(_base_floor(model, urdf, package_dirs), 4) + 0.0  # no -0
     draft.config["robot"].update(active_joints=active, locked_joints=held, home_posture={})
     draft.config["trajectory"] = dict(TRAJECTORY)
-    draft.config["limits"] = _limits(urdf, active, draft)
+    draft.config["limits"] = _limits(model, active, draft)
     plane = {"name": "mounting_plane", "type": "half_space", "point": [0.0, 0.0, floor], "normal": [0.0, 0.0, 1.0]}
     draft.config["constraints"] = {
         "self_collision": {"capsules": "auto", "margin": CAPSULE_MARGIN, "exclude_pairs": []},

@@ -115,11 +115,13 @@ def run_init(urdf: str, target: Path, joints: Optional[list[str]] = None, kind: 
     plan = None
     if kind == "optimize":
         draft = draft_config(robot, path, package_dirs, joints, target)
-        plan = plan_optimize(validated(yaml.safe_load(_text(draft, urdf, kind)), target))
+        text = _text(draft, urdf, kind)
+        plan = plan_optimize(validated(yaml.safe_load(text), target))
     else:
         draft = StartingConfig({})
         _identify_config(robot, path, joints, draft)
-        IdentifyProblem.model_validate(yaml.safe_load(_text(draft, urdf, kind)))
+        text = _text(draft, urdf, kind)
+        IdentifyProblem.model_validate(yaml.safe_load(text))
     with atomic_path(target, "output") as tmp:
-        Path(tmp).write_text(_text(draft, urdf, kind), encoding="utf-8")
+        Path(tmp).write_text(text, encoding="utf-8")
     return InitRun(target, draft, plan)
