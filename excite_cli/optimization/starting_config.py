@@ -272,7 +272,8 @@ def draft_config(
         draft.config["constraints"]["self_collision"]["exclude_pairs"] = [[a, b] for a, b, _ in draft.excluded]
     if draft.ignored:
         draft.config["constraints"]["environment"]["ignore_links"] = [link for link, _ in draft.ignored]
-    excitation = build_excitation(validated(draft.config, target), check_home=False)
+    # the same robot: its base parameters need not be computed again
+    excitation = build_excitation(validated(draft.config, target), excitation.base, check_home=False)
     home, why = _home(excitation, Q, np.random.default_rng(1))
     draft.config["robot"]["home_posture"] = {n: round(float(q), 4) for n, q in zip(active, home)}
     draft.assumptions["robot.home_posture"] = f"searched: {why}"
