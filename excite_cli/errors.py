@@ -26,7 +26,12 @@ class ExciteError(Exception):
         value: the offending value (``NO_VALUE`` when no single value is at fault).
         expected: what would be accepted ("" when the problem says it).
         source: the file ``field`` is in, when it is a config field of a file.
+
+    Attributes:
+        status: the command line's exit status (2: bad input).
     """
+
+    status = 2
 
     def __init__(self, field: str, problem: str, value: Any = NO_VALUE, expected: str = "", source: Path | None = None):
         self.field, self.problem, self.value, self.expected, self.source = field, problem, value, expected, source
@@ -42,6 +47,13 @@ class ExciteError(Exception):
 
     def __str__(self) -> str:
         return self.describe()
+
+
+class NoSolution(ExciteError):
+    """A run that could not reach a result from valid input (no restart of an optimization succeeded):
+    exit status 1, as for a run that failed, not 2 as for bad input."""
+
+    status = 1
 
 
 class ExciteWarning(UserWarning):

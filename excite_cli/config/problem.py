@@ -8,7 +8,7 @@ import math
 from pathlib import Path
 from typing import Literal, Optional, Union
 
-from pydantic import Field, PositiveFloat, field_validator, model_validator
+from pydantic import Field, NonNegativeFloat, PositiveFloat, field_validator, model_validator
 from pydantic.json_schema import SkipJsonSchema
 
 from excite_cli.config.base import (
@@ -77,8 +77,8 @@ class LimitsConfig(Section):
     {joint: Nm}; none by default); the fraction of its torque limit each joint (or the joints named)
     must reach somewhere in the motion (none by default)."""
 
-    position_margin: float = Field(0.0, ge=0.0)
-    """Distance kept from the URDF's position limits [rad or m]."""
+    position_margin: Union[NonNegativeFloat, dict[str, NonNegativeFloat]] = 0.0
+    """Distance kept from the URDF's position limits [rad or m], one value or {joint: value} (others 0)."""
     velocity: Optional[PerJoint] = None
     """|q̇| bound [rad/s], one value or {joint: value}; default the URDF's."""
     acceleration: PerJoint
@@ -134,6 +134,8 @@ class OptimizerConfig(Section):
     """Screening: this many starts run screen_iterations, the best `restarts` go on (default: none)."""
     screen_iterations: int = Field(30, ge=1, le=100_000)
     """Solver iterations of each screened start."""
+    time_budget: float = Field(300.0, gt=0.0, le=604_800.0)
+    """Wall time [s] an iteration whose restarts all failed may spend on more starts before the run stops."""
     workers: Optional[int] = Field(None, ge=1, le=MAX_WORKERS)
     """Local processes the restarts run in (default: the machine's cores)."""
     scheduler: Optional[str] = None

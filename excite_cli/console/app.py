@@ -22,8 +22,8 @@ SCHEDULER = typer.Option(None, "--scheduler", help="Dask scheduler, e.g. tcp://h
 
 
 def command(name: Optional[str] = None) -> Callable:
-    """A command of ``app``: ExciteError → one line, exit 2 (no traceback); Ctrl-C or SIGTERM → what
-    was kept, exit 130 or 143."""
+    """A command of ``app``: ExciteError → one line, exit 2 (no traceback; 1 for a run that found no
+    solution, :class:`~excite_cli.errors.NoSolution`); Ctrl-C or SIGTERM → what was kept, exit 130 or 143."""
 
     def register(function: Callable) -> Callable:
         @functools.wraps(function)
@@ -34,7 +34,7 @@ def command(name: Optional[str] = None) -> Callable:
             except ExciteError as exc:
                 line = word(exc, spelled, kwargs.get("config") or kwargs.get("effects"))
                 err.print(f"[bold red]error:[/] {escape(line)}", highlight=False, soft_wrap=True)
-                raise typer.Exit(2) from None
+                raise typer.Exit(exc.status) from None
             except Interrupted as exc:
                 err.print(str(exc), highlight=False, soft_wrap=True)
                 raise typer.Exit(exc.status) from None

@@ -57,6 +57,7 @@ def iterations(results: Sequence[IterationResult], optimizer: OptimizerConfig | 
                 f"{r.max_violation:+.1e}",
                 *[f"{100 * float(r.checks[key]):.2f}" for key, _ in extra],
                 moves,
+                "-" if np.isnan(r.max_correlation) else f"{r.max_correlation:.2f}",
                 f"{r.wall_time_s:.0f}",
                 r.stop,
             )
@@ -72,6 +73,7 @@ def iterations(results: Sequence[IterationResult], optimizer: OptimizerConfig | 
             "max viol.",
             *[label for _, label in extra],
             "in/out [s]",
+            "corr.",
             "time [s]",
             "stop",
         ),
@@ -79,7 +81,8 @@ def iterations(results: Sequence[IterationResult], optimizer: OptimizerConfig | 
         "cond(C): on the base columns (the paper's); cond(CL) and ē: condition number and excitation "
         "(geometric mean of the singular values) of the URDF-scaled regressor, which do not depend on the "
         "choice of base columns; in/out: quintic transitions from and to the home posture at "
-        "rest (checked on the fine grid); stop: why the kept restart ended",
+        "rest (checked on the fine grid); corr.: largest correlation of the motion with an earlier iteration's "
+        "(1: the same motion again); stop: why the kept restart ended",
     )
     convergence = _restarts(results, optimizer or OptimizerConfig())
     return [table, convergence] if convergence.row_count else [table]
@@ -123,7 +126,8 @@ def _restarts(results: Sequence[IterationResult], optimizer: OptimizerConfig) ->
             "stop",
         ),
         restarts,
-        "*: kept; KKT residual: first-order optimality at the end point (0 at a local optimum); "
+        "*: kept (the best of those that succeeded: a solver failure, or an end at the start or towards "
+        "it, is never kept); KKT residual: first-order optimality at the end point (0 at a local optimum); "
         "end point: the feasible point nearest the solver's last iterate (projected), the best iterate "
         "inside (inside), towards the start (bisection) or the start",
     )
@@ -210,10 +214,17 @@ def plan(p: Plan) -> list[Table | str]:
     e, cfg = p.excitation, p.excitation.problem
     t = cfg.trajectory
     grid, fine = e.grid_basis.q.shape[0], e.fine_basis.q.shape[0]
-    rows = [(c.name, str(c.rows), c.what) for c in p.constraints]
+    rows = [(c.name, str(c.rows), f"{c.smallest_row:.2g} – {c.largest_row:.2g}", c.what) for c in p.constraints]
     caption = (
         f"each row aggregated over the {grid}-instant constraint grid ({t.constraint_period:g} s); "
-        f"the fine check: {fine} instants"
+        f"the fine check: {fine} instants; row norms: of the Jacobian rows at the first random start, in "
+        "the optimizer's variables (normalized units per half-range of motion)"
+    )
+    s = p.scaling
+    active = (
+        f"{s.active} constraint(s) active at the start, their Jacobian's condition number {s.active_condition:.3g}"
+        if s.active
+        else "no constraint active at the start"
     )
     lines = [
         f"robot: {e.robot.n_joints} active joints ({', '.join(e.robot.joint_names)}), "
@@ -224,11 +235,13 @@ def plan(p: Plan) -> list[Table | str]:
         *(f"excluded capsule pair: {a} – {b}" for a, b in p.excluded_pairs),
         f"optimizer: {cfg.optimizer.method} on {cfg.optimizer.objective}, {cfg.sequence.iterations} sequential "
         f"iteration(s) of at most {p.iterations} solver iterations each, on {p.workers} worker(s)",
+        f"scaling: the criterion's largest gradient component {s.gradient:.3g} per half-range, scaled by "
+        f"{s.scale:.3g} for the solver (a first step of at most 0.1 half-range); {active}",
         f"estimated time: about {_duration(p.estimate)} ({p.seconds_per_iteration * 1e3:.0f} ms per "
         f"solver iteration × every restart to its iteration limit; restarts that converge early take less)",
         "the home posture meets every constraint: optimize would start",
     ]
-    return [titled_table("Constraints", ("constraint", "rows", "what"), rows, caption), *lines]
+    return [titled_table("Constraints", ("constraint", "rows", "row norms", "what"), rows, caption), *lines]
 
 
 def initialized(run: InitRun) -> list[Table | str]:

@@ -91,16 +91,22 @@ class Constraint(ABC):
         return alpha
 
 
-def accepted(constraints: Sequence[Constraint], alpha: np.ndarray) -> bool:
-    """Whether every constraint accepts α (n, 2N+1) on its grid (:meth:`Constraint.accepts`)."""
-    return all(c.accepts(alpha) for c in constraints)
+def accepted(constraints: Sequence[Constraint], alpha: np.ndarray, basis: FourierBasis | None = None) -> bool:
+    """Whether every constraint accepts α (n, 2N+1): on its grid with its margin (:meth:`Constraint.accepts`),
+    or, given a ``basis``, on its instants with no violation (the fine re-check a result is judged by)."""
+    if basis is None:
+        return all(c.accepts(alpha) for c in constraints)
+    return all(c.check(alpha, basis).max_violation <= 0.0 for c in constraints)
 
 
-def farthest_accepted(constraints: Sequence[Constraint], start: np.ndarray, end: np.ndarray, steps: int) -> float:
+def farthest_accepted(
+    constraints: Sequence[Constraint], start: np.ndarray, end: np.ndarray, steps: int, basis: FourierBasis | None = None
+) -> float:
     """The largest t ∈ [0, 1] that ``steps`` bisections find with start + t (end − start) accepted by
-    every constraint (``start`` (n, 2N+1) is assumed accepted, t = 0 when nothing beyond it is)."""
+    every constraint (:func:`accepted`, on ``basis`` if given; ``start`` (n, 2N+1) is assumed accepted,
+    t = 0 when nothing beyond it is)."""
     lo, hi = 0.0, 1.0
     for _ in range(steps):
         mid = (lo + hi) / 2.0
-        lo, hi = (mid, hi) if accepted(constraints, start + mid * (end - start)) else (lo, mid)
+        lo, hi = (mid, hi) if accepted(constraints, start + mid * (end - start), basis) else (lo, mid)
     return lo

@@ -166,21 +166,26 @@ def per_joint(field: str, value: PerJoint | None, default: np.ndarray, robot: Ro
 def joint_limit_bounds(cfg: LimitsConfig, robot: Robot) -> tuple[np.ndarray, np.ndarray]:
     """Bounds (lower, upper), each (3, n), of q [rad], q̇ [rad/s], q̈ [rad/s²] for Eq. 51.
 
-    Position: the URDF limits tightened by ``position_margin``. Velocity: the config, else the URDF.
-    Acceleration: the config (URDFs have none).
+    Position: the URDF limits tightened by ``position_margin`` (one value, or per joint). Velocity: the
+    config, else the URDF. Acceleration: the config (URDFs have none).
 
     Raises:
         ExciteError: a missing or non-positive limit, an unknown joint, or a margin that leaves no range.
     """
-    lower = robot.lower + cfg.position_margin
-    upper = robot.upper - cfg.position_margin
-    for name, lo, hi in zip(robot.joint_names, lower, upper):
+    margin = np.zeros(robot.n_joints)
+    if isinstance(cfg.position_margin, dict):
+        for name, value in cfg.position_margin.items():
+            if name not in robot.joint_names:
+                raise ExciteError("limits.position_margin", f"'{name}' is not an active joint")
+            margin[robot.joint_names.index(name)] = value
+    else:
+        margin[:] = cfg.position_margin
+    lower, upper = robot.lower + margin, robot.upper - margin
+    for name, lo, hi, m in zip(robot.joint_names, lower, upper, margin):
         if not (np.isfinite(lo) and np.isfinite(hi)):
             raise ExciteError("limits", f"joint '{name}' has no finite position limits in the URDF")
         if hi <= lo:
-            raise ExciteError(
-                "limits.position_margin", f"{cfg.position_margin:g} rad leaves no range for joint '{name}'"
-            )
+            raise ExciteError("limits.position_margin", f"{m:g} rad leaves no range for joint '{name}'")
     velocity = per_joint("limits.velocity", cfg.velocity, robot.velocity_limit, robot)
     acceleration = per_joint("limits.acceleration", cfg.acceleration, np.full(robot.n_joints, np.nan), robot)
     return np.stack([lower, -velocity, -acceleration]), np.stack([upper, velocity, acceleration])

@@ -28,12 +28,13 @@ IMPROVEMENT_WINDOW = 10
 #: A decrease of the objective over that window larger than this (relative to max(1, |f|)) is progress.
 IMPROVEMENT = 1e-3
 
-#: The stop reasons a restart can end with.
-CONVERGED, STILL_IMPROVING, STALLED, SOLVER_FAILED = (
+#: The stop reasons a restart can end with (``INFEASIBLE``: no end point met a constraint that needs motion).
+CONVERGED, STILL_IMPROVING, STALLED, SOLVER_FAILED, INFEASIBLE = (
     "converged",
     "iteration limit, still improving",
     "stalled",
     "solver failed",
+    "infeasible",
 )
 
 

@@ -21,14 +21,17 @@ from scipy.optimize import minimize
 from excite_cli.config import OptimizerConfig
 from excite_cli.constraints import Constraint, accepted, farthest_accepted
 from excite_cli.optimization.criterion import Criterion
-from excite_cli.optimization.optimality import Optimality, kkt_optimality, stop_reason
+from excite_cli.optimization.optimality import INFEASIBLE, SOLVER_FAILED, Optimality, kkt_optimality, stop_reason
 from excite_cli.optimization.solvers import solve
 from excite_cli.trajectory.boundary import BoundaryConditions
+from excite_cli.trajectory.fourier import FourierBasis
 
 #: Progress hook: (restart index, solver iteration, objective at the current iterate).
 ProgressHook = Callable[[int, int, float], None]
 #: SLSQP iterations of the projection onto the feasible set (it converges in 10-50 on the G1 problem).
 PROJECTION_ITERATIONS = 60
+#: Bisection steps towards a feasible point (the segment's length / 2¹²).
+BISECTIONS = 12
 
 
 @dataclass(frozen=True)
@@ -65,11 +68,20 @@ class RestartResult:
     stop: str = ""
     end: str = ""
 
+    @property
+    def succeeded(self) -> bool:
+        """Whether the solver's run gave a result: it did not fail, and the end point is its own (the
+        feasible point nearest its last iterate, or its best iterate inside), not the start or a
+        bisection towards it."""
+        return self.stop not in (SOLVER_FAILED, INFEASIBLE) and self.end in ("projected", "inside")
+
 
 def best_restart(results: Sequence[RestartResult]) -> RestartResult:
-    """The restart with the lowest objective; ties go to the lower index (so the choice does not
-    depend on the order results arrive in)."""
-    return min(results, key=lambda r: (r.objective, r.index))
+    """The restart an iteration keeps: the lowest objective among those that succeeded
+    (:attr:`RestartResult.succeeded`), among all when none did (a result written before this rule);
+    ties go to the lower index (so the choice does not depend on the order results arrive in)."""
+    candidates = [r for r in results if r.succeeded] or list(results)
+    return min(candidates, key=lambda r: (r.objective, r.index))
 
 
 def repair(
@@ -77,7 +89,7 @@ def repair(
     alpha: np.ndarray,
     feasible: np.ndarray,
     boundary: Optional[BoundaryConditions] = None,
-    steps: int = 12,
+    steps: int = BISECTIONS,
 ) -> np.ndarray:
     """A feasible point near α: the constraints' own exact repairs, moved back onto the boundary
     conditions, then, if some constraint still rejects it, the farthest point towards it from
@@ -205,6 +217,7 @@ def optimize_restart(
     index: int = 0,
     progress: Optional[ProgressHook] = None,
     max_iterations: Optional[int] = None,
+    fine_basis: Optional[FourierBasis] = None,
 ) -> RestartResult:
     """Minimize the criterion over α with ``options.method`` from one feasible start.
 
@@ -213,6 +226,9 @@ def optimize_restart(
     sees α. The restart ends with the best of: the start, the best iterate whose aggregated
     constraints were all ≤ 0, and the feasible point nearest to the last iterate (:func:`project`;
     if the projection fails, :func:`repair`); each is confirmed by every constraint's exact grid check.
+    The one kept is confirmed on ``fine_basis`` too, the re-check its result is judged by (the grid
+    margin covers the overshoot between grid instants, but not always): where that check fails, it
+    is moved towards the start until the check holds (bisection, as in :func:`repair`).
 
     Args:
         criterion: the criterion (value and gradient).
@@ -224,6 +240,7 @@ def optimize_restart(
         index: the restart's number (passed to ``progress`` and kept in the result).
         progress: called after every solver iteration with the objective at the iterate.
         max_iterations: solver iterations (default ``options.max_iterations``).
+        fine_basis: the basis of the fine re-check (default: none).
     """
     begin = time.perf_counter()
     start_value = criterion.value(start)
@@ -260,9 +277,12 @@ def optimize_restart(
     ]  # the projection is already accepted
     # only a constraint that needs motion rejects the start: when no end point meets it, none is kept
     value, _, end, alpha = min(scored, key=lambda item: item[:2]) if scored else (np.inf, 0, "none", start)
+    if scored and fine_basis is not None and not accepted(constraints, alpha, fine_basis):
+        alpha = start + farthest_accepted(constraints, start, alpha, BISECTIONS, fine_basis) * (alpha - start)
+        value = criterion.value(alpha)
     optimality = problem.optimality(alpha)
     stop = stop_reason(optimality, [f for f, _ in history], run.limit, run.failed, options.optimality_tolerance)
-    stop = stop if scored else "infeasible"
+    stop = stop if scored else INFEASIBLE
     return RestartResult(
         index,
         alpha,

@@ -8,12 +8,13 @@ from typing import Callable, Optional, Sequence
 
 import numpy as np
 
-from excite_cli.errors import ExciteError
+from excite_cli.errors import ExciteError, NoSolution
 from excite_cli.optimization.criterion import condition_number
 from excite_cli.optimization.engine import Engine
 from excite_cli.optimization.excitation import Excitation
 from excite_cli.optimization.optimizer import ProgressHook, RestartResult, best_restart, optimize_restart
 from excite_cli.optimization.playback import check_motion, plan_playback
+from excite_cli.trajectory.similarity import correlation
 
 
 @dataclass(frozen=True)
@@ -38,6 +39,8 @@ class IterationResult:
         wall_time_s: optimization wall time [s].
         restarts: every restart of the iteration (:class:`~excite_cli.optimization.optimizer.RestartResult`:
             start and end value, solver iterations, first-order optimality, stop reason), in order.
+        correlations: ρ of q with each earlier iteration's q on the constraint grid, in order
+            (:func:`~excite_cli.trajectory.similarity.correlation`; 1: the same motion again).
     """
 
     index: int
@@ -59,6 +62,12 @@ class IterationResult:
     track_units: dict[str, str] = field(default_factory=dict)
     wall_time_s: float = 0.0
     restarts: tuple[RestartResult, ...] = ()
+    correlations: tuple[float, ...] = ()
+
+    @property
+    def max_correlation(self) -> float:
+        """The largest ρ with an earlier iteration (NaN for the first): how far from new the motion is."""
+        return max(self.correlations) if self.correlations else float("nan")
 
     @property
     def sqp_iterations(self) -> int:
@@ -87,7 +96,8 @@ class RestartTask:
         iteration: k, 1-based; index: the restart's number, 0-based.
         seed: the run's seed (``optimizer.seed``).
         prior: C₀ (m, b), the rows stacked above the trajectory's regressor (Eq. 41).
-        warm_start: (n, 2N+1) accepted α to start from instead of a random start, or None.
+        warm_start: (n, 2N+1) accepted α to start from instead of a random start (a screened start
+            that continues), or None.
         iterations: solver iterations (default ``optimizer.max_iterations``).
     """
 
@@ -114,6 +124,7 @@ class RestartTask:
             self.index,
             progress,
             self.iterations,
+            excitation.fine_basis,
         )
 
 
@@ -133,9 +144,11 @@ def describe(
     prior: np.ndarray,
     wall_time_s: float = 0.0,
     restarts: Sequence[RestartResult] = (),
+    earlier: Sequence[IterationResult] = (),
 ) -> IterationResult:
     """The :class:`IterationResult` of trajectory α (n, 2N+1) stacked under ``prior`` (m, b): its
-    regressor, condition numbers, samples on the constraint grid and every constraint's fine check."""
+    regressor, condition numbers, samples on the constraint grid, every constraint's fine check and
+    its correlation with each of the ``earlier`` iterations."""
     own = excitation.criterion().regressor(alpha)
     stacked = np.vstack([prior, own])
     checks = [c.check(alpha, excitation.fine_basis) for c in excitation.constraints]
@@ -164,6 +177,7 @@ def describe(
         track_units={key: unit for c in excitation.constraints for key, unit in c.track_units.items()},
         wall_time_s=wall_time_s,
         restarts=tuple(restarts),
+        correlations=tuple(correlation(q, r.q) for r in earlier),
     )
 
 
@@ -173,32 +187,55 @@ def run_restarts(
     k: int,
     seed: int,
     prior: np.ndarray,
-    warm_start: Optional[np.ndarray],
     hook: Optional[ProgressHook] = None,
 ) -> list[RestartResult]:
-    """The restarts of iteration k: ``optimizer.restarts`` solver runs of ``max_iterations``, the
-    first from ``warm_start`` (n, 2N+1) when given, the others from random starts.
+    """The restarts of iteration k: ``optimizer.restarts`` solver runs of ``max_iterations``, each from
+    its own random start.
 
     With screening (``optimizer.starts`` > ``restarts``), ``starts`` runs of ``screen_iterations``
-    first, then the ``restarts`` with the lowest objective continue from their end points for the
-    remaining iterations; the others are kept with the stop reason ``screened out``. Which ones
-    continue depends only on the screened results, so it does not depend on where they ran.
+    first, then the ``restarts`` with the lowest objective among those that succeeded
+    (:attr:`RestartResult.succeeded`) continue from their end points for the remaining iterations;
+    the others are kept with the stop reason ``screened out``. Which ones continue depends only on
+    the screened results, so it does not depend on where they ran.
+
+    When none succeeded, more starts run, as many at a time as the first round, each screened and
+    continued the same way, until one succeeds or ``optimizer.time_budget`` seconds have passed since
+    the iteration began. Each start's seed depends only on its index, so where it succeeds does not
+    depend on the machine (unless the budget ends the search first).
 
     Returns:
         Every start's :class:`RestartResult`, by index (a continued one with its screening's start
         value, iterations and history included).
     """
     opts = excitation.problem.optimizer
-    count, iterations = (
-        (opts.screened, min(opts.screen_iterations, opts.max_iterations)) if opts.screened else (opts.restarts, None)
-    )
-    tasks = [RestartTask(k, r, seed, prior, warm_start if r == 0 else None, iterations) for r in range(count)]
+    count = opts.screened or opts.restarts
+    deadline = time.perf_counter() + opts.time_budget
+    runs = _restart_round(excitation, engine, k, seed, prior, range(count), hook)
+    while not any(r.succeeded for r in runs) and time.perf_counter() < deadline:
+        runs += _restart_round(excitation, engine, k, seed, prior, range(len(runs), len(runs) + count), hook)
+    return runs
+
+
+def _restart_round(
+    excitation: Excitation,
+    engine: Engine,
+    k: int,
+    seed: int,
+    prior: np.ndarray,
+    indices: range,
+    hook: Optional[ProgressHook],
+) -> list[RestartResult]:
+    """The starts ``indices`` of iteration k, screened and continued as :func:`run_restarts` says."""
+    opts = excitation.problem.optimizer
+    iterations = min(opts.screen_iterations, opts.max_iterations) if opts.screened else None
+    tasks = [RestartTask(k, r, seed, prior, None, iterations) for r in indices]
     runs = engine.run(tasks, hook, (lambda r: hook(r.index, r.iterations, r.objective)) if hook else None)
     if not opts.screened or iterations >= opts.max_iterations:
         return runs
-    chosen = sorted(runs, key=lambda r: (r.objective, r.index))[: opts.restarts]
+    chosen = sorted((r for r in runs if r.succeeded), key=lambda r: (r.objective, r.index))[: opts.restarts]
     more = [RestartTask(k, r.index, seed, prior, r.alpha, opts.max_iterations - iterations) for r in chosen]
-    shifted = (lambda r, it, value: hook(count + r, it, value)) if hook else None  # continuations count on their own
+    shift = indices.stop  # continuations count on their own in the progress
+    shifted = (lambda r, it, value: hook(shift + r, it, value)) if hook else None
     continued = {
         c.index: c
         for c in engine.run(more, shifted, (lambda c: shifted(c.index, c.iterations, c.objective)) if hook else None)
@@ -253,9 +290,10 @@ def run_sequence(
 ) -> list[IterationResult]:
     """Generate ``iterations`` trajectories, each stacking the regressors of the earlier ones (Eq. 41).
 
-    From iteration 2 on, the first restart starts from the previous optimum (repeating earlier data
-    keeps cond(C) near cond(C₀), and random starts that satisfy tight balance constraints are far
-    from it); the other restarts are random, each from its own seed (:class:`RestartTask`).
+    Every restart starts from its own random start (:class:`RestartTask`). None starts from the
+    previous optimum: with C₀ holding its rows, the previous optimum is a stationary point of the
+    next iteration's criterion too (stacking C on itself scales CᵀC by 2, which moves log det by a
+    constant and leaves cond unchanged), so a solver started there stops there and the motion repeats.
 
     Args:
         excitation: the problem.
@@ -266,11 +304,15 @@ def run_sequence(
         on_iteration: called with each finished iteration (e.g. to write it to disk at once).
         engine: where the restarts run (default: serially in this process).
         finished: iterations 1..m already done (a resumed run): the sequence continues with m + 1.
-            Each restart's start depends only on (seed, iteration, restart) and the previous
-            optimum, so a resumed run ends as an uninterrupted one.
+            Each restart's start depends only on (seed, iteration, restart), so a resumed run ends
+            as an uninterrupted one.
 
     Returns:
         The K :class:`IterationResult` (the finished ones first).
+
+    Raises:
+        NoSolution: no restart of an iteration succeeded within ``optimizer.time_budget``; the
+            iterations before it were passed to ``on_iteration``.
     """
     if engine is None:
         with Engine(excitation) as serial:
@@ -278,16 +320,17 @@ def run_sequence(
     results: list[IterationResult] = list(finished)
     for k in range(len(finished) + 1, iterations + 1):
         start, stacked = time.perf_counter(), stacked_regressors(excitation, prior, results)
-        runs = run_restarts(
-            excitation,
-            engine,
-            k,
-            seed,
-            stacked,
-            results[-1].alpha if results else None,
-            progress(k) if progress else None,
-        )
-        result = describe(excitation, k, best_restart(runs).alpha, stacked, time.perf_counter() - start, runs)
+        runs = run_restarts(excitation, engine, k, seed, stacked, progress(k) if progress else None)
+        if not any(r.succeeded for r in runs):
+            failures = sorted({f"{r.stop} ({r.end})" for r in runs})
+            raise NoSolution(
+                "optimizer",
+                f"iteration {k}: none of {len(runs)} restarts reached a result within time_budget "
+                f"{excitation.problem.optimizer.time_budget:g} s ({', '.join(failures)})",
+                expected="more starts or a longer optimizer.time_budget, or limits that leave the robot room",
+            )
+        best = best_restart(runs)
+        result = describe(excitation, k, best.alpha, stacked, time.perf_counter() - start, runs, results)
         results.append(result)
         if on_iteration:
             on_iteration(result)

@@ -10,6 +10,15 @@ stacked constraints, both with analytic gradients.
 - ``trust-constr``: scipy's trust-region interior point method with BFGS Hessians;
 - ``ipopt``: IPOPT's interior point method with a limited-memory BFGS Hessian, through cyipopt (the
   solver of FIGAROH, RAPTOR and FloBaRoID for this problem).
+
+Every method sees the criterion scaled by :func:`criterion_scale` at its start. A quasi-Newton method
+starts from the Hessian I, so its first step is the gradient itself; and SLSQP's merit function
+charges a constraint nothing before its multiplier is known, so that first step is not held back by
+any constraint that is not yet active. Unscaled (log det's gradient has components of 1-3 in the
+variables, which are the joints' half-ranges), the first step doubled the motion: on a UR10 it drove
+two capsules 19 cm into each other, where their distance has no useful gradient (the segments cross),
+SLSQP's linearized constraints became inconsistent and 4 of 6 restarts ended in "More than 3*n
+iterations in LSQ subproblem" at or near their start. Scaled, none did (bench/robustness.py).
 """
 
 from __future__ import annotations
@@ -27,6 +36,10 @@ METHODS = ("SLSQP", "trust-constr", "ipopt")
 
 #: Called with each accepted iterate z of the solver.
 IterateHook = Callable[[np.ndarray], None]
+#: The largest component [1] of the scaled criterion's gradient at the start: a first step along it
+#: moves no joint's q, q̇ or q̈ by more than a tenth of its half-range (the variables are scaled so
+#: that 1 is a half-range, :meth:`~excite_cli.constraints.joint_limits.JointLimits.coefficient_scale`).
+FIRST_STEP = 0.1
 
 
 class NLP(Protocol):
@@ -62,26 +75,48 @@ class SolverRun:
     failed: bool
 
 
+def criterion_scale(gradient: np.ndarray) -> float:
+    """The factor [1] the criterion is multiplied by for the solver: ``FIRST_STEP`` over the largest
+    component of its gradient (n_z,) at the start (1 for a zero gradient)."""
+    largest = float(np.abs(gradient).max(initial=0.0))
+    return FIRST_STEP / largest if largest > 0.0 and np.isfinite(largest) else 1.0
+
+
+class _ScaledCriterion:
+    """``nlp`` with its criterion (value and gradient) multiplied by :func:`criterion_scale` of its
+    gradient at z0 (n_z,), which is handed back when the solver asks for it; constraints as they are."""
+
+    def __init__(self, nlp: NLP, z0: np.ndarray):
+        self.nlp, self._start = nlp, (z0.tobytes(), nlp.gradient(z0))
+        self.scale = criterion_scale(self._start[1])
+        self.constraint_values, self.constraint_jacobian = nlp.constraint_values, nlp.constraint_jacobian
+
+    def value(self, z: np.ndarray) -> float:
+        return self.scale * self.nlp.value(z)
+
+    def gradient(self, z: np.ndarray) -> np.ndarray:
+        return self.scale * (self._start[1] if z.tobytes() == self._start[0] else self.nlp.gradient(z))
+
+
 def solve(
     method: str, nlp: NLP, z0: np.ndarray, max_iterations: int, tolerance: float, on_iterate: IterateHook
 ) -> SolverRun:
-    """Run ``method`` (one of ``METHODS``) from z0 (n_z,) for at most ``max_iterations`` iterations.
+    """Run ``method`` (one of ``METHODS``) from z0 (n_z,) for at most ``max_iterations`` iterations, on
+    the criterion scaled by :func:`criterion_scale` at z0 (module docstring).
 
     Args:
         tolerance: the solver's own convergence tolerance (SLSQP ``ftol``, trust-constr ``gtol``,
-            IPOPT ``tol``).
+            IPOPT ``tol``) on the criterion as given: the solver gets it scaled as the criterion is.
         on_iterate: called with every accepted iterate.
 
     Raises:
         ExciteError: an unknown method, or ``ipopt`` without cyipopt installed.
     """
-    if method == "SLSQP":
-        return _slsqp(nlp, z0, max_iterations, tolerance, on_iterate)
-    if method == "trust-constr":
-        return _trust_constr(nlp, z0, max_iterations, tolerance, on_iterate)
-    if method == "ipopt":
-        return _ipopt(nlp, z0, max_iterations, tolerance, on_iterate)
-    raise ExciteError("optimizer.method", f"unknown '{method}', expected one of {', '.join(METHODS)}")
+    methods = {"SLSQP": _slsqp, "trust-constr": _trust_constr, "ipopt": _ipopt}
+    if method not in methods:
+        raise ExciteError("optimizer.method", f"unknown '{method}', expected one of {', '.join(METHODS)}")
+    scaled = _ScaledCriterion(nlp, z0)
+    return methods[method](scaled, z0, max_iterations, tolerance * scaled.scale, on_iterate)
 
 
 def _slsqp(nlp: NLP, z0: np.ndarray, max_iterations: int, tolerance: float, on_iterate: IterateHook) -> SolverRun:

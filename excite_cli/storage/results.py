@@ -37,7 +37,9 @@ UNITS = {
 def results_table(results: Sequence[IterationResult]) -> np.ndarray:
     """Table I as a structured array: iteration, cond_own, cond_stacked (on the base columns, the
     paper's), scaled_cond_own, scaled_cond_stacked (cond(C L)) and excitation_own, excitation_stacked
-    (ē [N·m]), which do not depend on the choice of base columns (:mod:`excite_cli.optimization.information`)."""
+    (ē [N·m]), which do not depend on the choice of base columns (:mod:`excite_cli.optimization.information`),
+    and max_correlation, the largest correlation of the motion with an earlier iteration's (NaN for the first,
+    :mod:`excite_cli.trajectory.similarity`)."""
     fields = (
         "cond_own",
         "cond_stacked",
@@ -45,6 +47,7 @@ def results_table(results: Sequence[IterationResult]) -> np.ndarray:
         "scaled_cond_stacked",
         "excitation_own",
         "excitation_stacked",
+        "max_correlation",
     )
     table = np.zeros(len(results), dtype=[("iteration", "i4")] + [(name, "f8") for name in fields])
     for row, r in zip(table, results):
@@ -84,7 +87,8 @@ def write_result(
         table = f.create_dataset("table", data=results_table(results))
         table.attrs["description"] = (
             "Table I: cond of each iteration's regressor and of the stacked regressor on the base columns, "
-            "their cond(C L) and excitation e [N m], which do not depend on the base columns (docs/output.md)"
+            "their cond(C L) and excitation e [N m], which do not depend on the base columns, and the largest "
+            "correlation of the motion with an earlier iteration's (docs/output.md)"
         )
 
 
@@ -117,6 +121,10 @@ def _write_iteration(group: h5py.Group, r: IterationResult) -> None:
     group.attrs["excitation_own_Nm"] = r.excitation_own
     group.attrs["excitation_stacked_Nm"] = r.excitation_stacked
     group.attrs["max_violation"] = r.max_violation
+    group.attrs["max_correlation"] = r.max_correlation
+    group.create_dataset("correlations", data=np.array(r.correlations, dtype=float)).attrs["description"] = (
+        "correlation of the mean-removed joint positions with each earlier iteration's, in order (1: the same motion)"
+    )
     group.attrs["wall_time_s"] = r.wall_time_s
     group.attrs["sqp_iterations"] = r.sqp_iterations
     group.attrs["stop"] = r.stop
@@ -254,7 +262,9 @@ def read_iterations(
                 else []
             )
             stacked = stacked_regressors(excitation, prior, results)
-            results.append(describe(excitation, int(key), alpha, stacked, float(g.attrs["wall_time_s"]), restarts))
+            results.append(
+                describe(excitation, int(key), alpha, stacked, float(g.attrs["wall_time_s"]), restarts, results)
+            )
     return results
 
 

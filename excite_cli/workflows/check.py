@@ -12,6 +12,8 @@ import numpy as np
 from excite_cli.config import Problem
 from excite_cli.optimization.engine import default_workers
 from excite_cli.optimization.excitation import Excitation, build_excitation
+from excite_cli.optimization.optimality import ACTIVE_TOLERANCE
+from excite_cli.optimization.solvers import criterion_scale
 
 #: Evaluations timed for the estimate (the median is kept).
 TIMED = 5
@@ -22,12 +24,35 @@ SOLVER_OVERHEAD = 1.5
 
 @dataclass
 class ConstraintSize:
-    """One constraint handed to the optimizer: its name, its rows (values per evaluation) and what
-    they are, in words."""
+    """One constraint handed to the optimizer: its name, its rows (values per evaluation), what they
+    are, in words, and the smallest and largest norm of its Jacobian rows in the optimizer's variables
+    at the first random start (normalized units per unit variable: 1 moves a joint by a half-range)."""
 
     name: str
     rows: int
     what: str
+    smallest_row: float = np.nan
+    largest_row: float = np.nan
+
+
+@dataclass
+class Scaling:
+    """How the problem looks to the solver at the first random start, in the optimizer's variables z
+    (:mod:`excite_cli.trajectory.boundary`).
+
+    Attributes:
+        gradient: the criterion's largest gradient component ‖∇f‖_∞.
+        scale: the factor the solver multiplies the criterion by
+            (:func:`~excite_cli.optimization.solvers.criterion_scale`).
+        active: constraints within ``ACTIVE_TOLERANCE`` of their bound.
+        active_condition: condition number of those constraints' Jacobian (NaN when none is active;
+            large: nearly parallel rows, which the solver's subproblems cannot tell apart).
+    """
+
+    gradient: float
+    scale: float
+    active: int
+    active_condition: float
 
 
 @dataclass
@@ -38,6 +63,7 @@ class Plan:
         excitation: the problem as ``optimize`` builds it.
         constraints: one :class:`ConstraintSize` per constraint.
         excluded_pairs: capsule pairs (link, link) excluded by the config.
+        scaling: the criterion's and the constraints' scale at the first random start.
         variables: Fourier coefficients the optimizer moves (n × (2N + 1)).
         seconds_per_iteration: one solver iteration [s] (criterion and gradient, every constraint
             and its Jacobian, times :data:`SOLVER_OVERHEAD`).
@@ -49,6 +75,7 @@ class Plan:
     excitation: Excitation
     constraints: list[ConstraintSize]
     excluded_pairs: list[tuple[str, str]]
+    scaling: Scaling
     variables: int
     seconds_per_iteration: float
     iterations: int
@@ -79,8 +106,26 @@ def plan_optimize(problem: Problem) -> Plan:
     excitation = build_excitation(problem)
     alpha = excitation.random_start(np.random.default_rng(problem.optimizer.seed))
     criterion = excitation.criterion()
-    n = excitation.robot.n_joints
-    sizes = [ConstraintSize(c.name, int(np.size(c.values(alpha))), _what(c, n)) for c in excitation.constraints]
+    n, chain = excitation.robot.n_joints, excitation.boundary.chain
+    sizes, values, rows = [], [], []
+    for c in excitation.constraints:
+        g, jacobian = c.evaluate(alpha)
+        norms = np.linalg.norm(chain(jacobian), axis=1)
+        sizes.append(ConstraintSize(c.name, g.size, _what(c, n), *(norms.min(), norms.max()) if g.size else ()))
+        values.append(g)
+        rows.append(chain(jacobian))
+    values, rows = np.concatenate(values), np.vstack(rows)
+    active = rows[values >= -ACTIVE_TOLERANCE]
+    singular = np.linalg.svd(active, compute_uv=False) if active.size else np.zeros(0)
+    gradient = chain(criterion.value_and_gradient(alpha)[1].ravel())
+    scaling = Scaling(
+        float(np.abs(gradient).max()),
+        criterion_scale(gradient),
+        active.shape[0],
+        float(singular[0] / singular[-1])
+        if singular.size and singular[-1] > 0
+        else (np.inf if singular.size else np.nan),
+    )
     timings = []
     for _ in range(TIMED):
         start = time.perf_counter()
@@ -97,6 +142,7 @@ def plan_optimize(problem: Problem) -> Plan:
         excitation=excitation,
         constraints=sizes,
         excluded_pairs=excluded,
+        scaling=scaling,
         variables=int(alpha.size),
         seconds_per_iteration=per_iteration,
         iterations=cfg.planned_iterations,

@@ -100,7 +100,9 @@ def run_compare_random(
     selection_s = time.perf_counter() - begin
     results = []
     for k, index in enumerate(chosen, start=1):
-        results.append(describe(excitation, k, drawn.alphas[index], stacked_regressors(excitation, None, results)))
+        results.append(
+            describe(excitation, k, drawn.alphas[index], stacked_regressors(excitation, None, results), earlier=results)
+        )
     write_result(
         target,
         excitation,

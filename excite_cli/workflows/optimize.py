@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Optional
@@ -86,7 +87,8 @@ def run_optimize(
     Raises:
         ExciteError: bad target, prior data or problem; a result to resume made with another config;
             another run writing ``target`` (:func:`output_lock`); workers lost during the run
-            (:class:`~excite_cli.optimization.engine.Engine`), with the finished iterations kept in ``target``.
+            (:class:`~excite_cli.optimization.engine.Engine`) or no restart of an iteration succeeded
+            (:class:`~excite_cli.errors.NoSolution`), with the finished iterations kept in ``target``.
         Interrupted: Ctrl-C or SIGTERM; the finished iterations are in ``target``, the workers stopped.
     """
     check_target(target, "output", force, exists_ok=resume)
@@ -122,11 +124,12 @@ def run_optimize(
                 )
         except KeyboardInterrupt as exc:
             raise Interrupted(target, len(written), exit_status(exc)) from None
-        except ExciteError as exc:  # the cluster lost its workers: what is finished stays, and says so
+        except ExciteError as exc:  # workers lost, or no restart succeeded: what is finished stays, and says so
             if not written:
                 raise
-            kept = f"; kept {len(written)} finished iteration(s) in {target}, which a resumed run continues"
-            raise ExciteError(exc.field, exc.problem + kept, exc.value, exc.expected, exc.source) from None
+            kept = copy.copy(exc)
+            kept.problem += f"; kept {len(written)} finished iteration(s) in {target}, which a resumed run continues"
+            raise kept from None
         return OptimizeRun(excitation, results, target, plot_result(target, excitation, results))
 
 

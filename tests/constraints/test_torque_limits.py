@@ -106,10 +106,12 @@ def test_the_torque_use_jacobian_matches_central_differences_and_its_maximum_nev
         assert constraint_jacobian_error(constraint, alpha) <= 1e-6
 
 
-def _smoke(tmp_path, name: str, min_torque_use) -> tuple[int, str]:
-    """Run the smoke problem (one iteration) with ``limits.min_torque_use``; exit code and output."""
+def _smoke(tmp_path, name: str, min_torque_use, **optimizer) -> tuple[int, str]:
+    """Run the smoke problem (one iteration) with ``limits.min_torque_use`` and ``optimizer`` fields;
+    exit code and output."""
     config = yaml.safe_load((CONFIGS / "smoke.yaml").read_text())
     config["limits"]["min_torque_use"] = min_torque_use
+    config["optimizer"].update(optimizer)
     config["optimizer"]["objective"] = "log_cond"  # the paper's cond: joint 1 then barely uses its torque
     config["sequence"]["iterations"] = 1
     config["output"] = str(tmp_path / f"{name}.h5")
@@ -133,10 +135,13 @@ def test_a_minimum_torque_use_is_reached_in_the_exported_motion(tmp_path):
     assert uses["free"][0] < 0.15 and uses["asked"][0] >= 0.2
 
 
-def test_a_minimum_torque_use_no_motion_can_reach_keeps_the_result_and_says_so(tmp_path):
-    code, output = _smoke(tmp_path, "strong", 0.95)
-    assert code == 1 and "violates its constraints on the fine grid" in output
-    assert (tmp_path / "strong.h5").exists()
+def test_a_minimum_torque_use_no_motion_can_reach_stops_the_run_and_writes_no_result(tmp_path):
+    """95 % of every joint's torque at 5 rad/s² is out of reach: every restart ends infeasible, no
+    more starts fit in the (short) time budget, and the run stops with one line, exit 1 (a failed
+    run, not bad input), and no result: never a start or an infeasible point written as a trajectory."""
+    code, output = _smoke(tmp_path, "strong", 0.95, time_budget=0.001)
+    assert code == 1 and "iteration 1: none of 1 restarts reached a result" in output and "infeasible" in output
+    assert "Traceback" not in output and not (tmp_path / "strong.h5").exists()
 
 
 @pytest.mark.parametrize(
