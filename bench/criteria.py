@@ -38,7 +38,8 @@ from excite_cli.config_file import load_problem
 from excite_cli.optimization.criterion import condition_number
 from excite_cli.optimization.engine import Engine, default_workers
 from excite_cli.optimization.excitation import build_excitation
-from excite_cli.optimization.sequence import RestartTask, run_sequence
+from excite_cli.optimization.restarts import RestartTask
+from excite_cli.optimization.sequence import run_sequence
 
 ROOT = Path(__file__).resolve().parent.parent
 CRITERIA = (

@@ -18,7 +18,7 @@ from threadpoolctl import threadpool_limits
 from excite_cli.config_file import load_problem, with_overrides
 from excite_cli.memory import keep_freed_memory
 from excite_cli.optimization.excitation import build_excitation
-from excite_cli.optimization.sequence import RestartTask
+from excite_cli.optimization.restarts import RestartTask
 from excite_cli.optimization.solvers import METHODS
 
 

@@ -1,7 +1,7 @@
 """Where independent pieces of work run: in this process, in a local process pool, or on a Dask
 distributed cluster.
 
-The restarts of an iteration (:class:`~excite_cli.optimization.sequence.RestartTask`) and the random candidates
+The restarts of an iteration (:class:`~excite_cli.optimization.restarts.RestartTask`) and the random candidates
 of ``compare-random`` (:class:`~excite_cli.optimization.random_baseline.DrawTask`) are tasks: each has an index
 and its own seed, and is called with the problem's :class:`~excite_cli.optimization.excitation.Excitation`, so
 its result does not depend on where or in which order it runs. Pool and cluster workers build the

@@ -1,9 +1,10 @@
-"""Sequential generation (Section IV-B): iteration i optimizes with C₀ = [C_prior; C⁽¹⁾; …; C⁽ⁱ⁻¹⁾]."""
+"""Sequential generation (Section IV-B): iteration i optimizes with C₀ = [C_prior; C⁽¹⁾; …; C⁽ⁱ⁻¹⁾],
+keeps the best restart the robot can play (:func:`kept_restart`), and describes it."""
 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from typing import Callable, Optional, Sequence
 
 import numpy as np
@@ -12,8 +13,9 @@ from excite_cli.errors import ExciteError, NoSolution
 from excite_cli.optimization.criterion import condition_number
 from excite_cli.optimization.engine import Engine
 from excite_cli.optimization.excitation import Excitation
-from excite_cli.optimization.optimizer import ProgressHook, RestartResult, best_restart, optimize_restart
+from excite_cli.optimization.optimizer import ProgressHook, RestartResult, best_restart
 from excite_cli.optimization.playback import check_motion, plan_playback
+from excite_cli.optimization.restarts import run_restarts
 from excite_cli.trajectory.similarity import correlation
 
 
@@ -41,6 +43,8 @@ class IterationResult:
             start and end value, solver iterations, first-order optimality, stop reason), in order.
         correlations: ρ of q with each earlier iteration's q on the constraint grid, in order
             (:func:`~excite_cli.trajectory.similarity.correlation`; 1: the same motion again).
+        kept: the index of the restart whose end point α is (:func:`kept_restart`); −1: none recorded,
+            the best by :func:`~excite_cli.optimization.optimizer.best_restart`.
     """
 
     index: int
@@ -63,6 +67,7 @@ class IterationResult:
     wall_time_s: float = 0.0
     restarts: tuple[RestartResult, ...] = ()
     correlations: tuple[float, ...] = ()
+    kept: int = -1
 
     @property
     def max_correlation(self) -> float:
@@ -77,55 +82,14 @@ class IterationResult:
     @property
     def best(self) -> Optional[RestartResult]:
         """The restart whose end point this iteration kept."""
+        if self.kept >= 0:
+            return next(r for r in self.restarts if r.index == self.kept)
         return best_restart(self.restarts) if self.restarts else None
 
     @property
     def stop(self) -> str:
         """Why the kept restart ended (:func:`~excite_cli.optimization.optimality.stop_reason`), or ``-``."""
         return self.best.stop if self.best else "-"
-
-
-@dataclass(frozen=True)
-class RestartTask:
-    """One restart of one iteration (a task for :class:`~excite_cli.optimization.engine.Engine`).
-
-    Its random start is drawn from its own seed, ``SeedSequence(seed, spawn_key=(iteration, index))``,
-    so the result does not depend on where or in which order the restarts run.
-
-    Attributes:
-        iteration: k, 1-based; index: the restart's number, 0-based.
-        seed: the run's seed (``optimizer.seed``).
-        prior: C₀ (m, b), the rows stacked above the trajectory's regressor (Eq. 41).
-        warm_start: (n, 2N+1) accepted α to start from instead of a random start (a screened start
-            that continues), or None.
-        iterations: solver iterations (default ``optimizer.max_iterations``).
-    """
-
-    iteration: int
-    index: int
-    seed: int
-    prior: np.ndarray
-    warm_start: Optional[np.ndarray] = None
-    iterations: Optional[int] = None
-
-    def rng(self) -> np.random.Generator:
-        """The restart's own random generator."""
-        return np.random.default_rng(np.random.SeedSequence(self.seed, spawn_key=(self.iteration, self.index)))
-
-    def __call__(self, excitation: Excitation, progress: Optional[ProgressHook] = None) -> RestartResult:
-        """Draw the start (or take the warm start) and optimize from it (:func:`optimize_restart`)."""
-        start = self.warm_start.copy() if self.warm_start is not None else excitation.random_start(self.rng())
-        return optimize_restart(
-            excitation.criterion(self.prior),
-            excitation.constraints,
-            excitation.problem.optimizer,
-            start,
-            excitation.boundary,
-            self.index,
-            progress,
-            self.iterations,
-            excitation.fine_basis,
-        )
 
 
 def stacked_regressors(
@@ -145,10 +109,11 @@ def describe(
     wall_time_s: float = 0.0,
     restarts: Sequence[RestartResult] = (),
     earlier: Sequence[IterationResult] = (),
+    kept: int = -1,
 ) -> IterationResult:
     """The :class:`IterationResult` of trajectory α (n, 2N+1) stacked under ``prior`` (m, b): its
-    regressor, condition numbers, samples on the constraint grid, every constraint's fine check and
-    its correlation with each of the ``earlier`` iterations."""
+    regressor, condition numbers, samples on the constraint grid, every constraint's fine check, its
+    correlation with each of the ``earlier`` iterations, and the index of the restart ``kept``."""
     own = excitation.criterion().regressor(alpha)
     stacked = np.vstack([prior, own])
     checks = [c.check(alpha, excitation.fine_basis) for c in excitation.constraints]
@@ -178,84 +143,26 @@ def describe(
         wall_time_s=wall_time_s,
         restarts=tuple(restarts),
         correlations=tuple(correlation(q, r.q) for r in earlier),
+        kept=kept,
     )
 
 
-def run_restarts(
-    excitation: Excitation,
-    engine: Engine,
-    k: int,
-    seed: int,
-    prior: np.ndarray,
-    hook: Optional[ProgressHook] = None,
-) -> list[RestartResult]:
-    """The restarts of iteration k: ``optimizer.restarts`` solver runs of ``max_iterations``, each from
-    its own random start.
+def kept_restart(excitation: Excitation, runs: Sequence[RestartResult]) -> RestartResult:
+    """The restart an iteration keeps: the lowest objective among those that succeeded whose
+    transitions from and to the home posture keep every constraint (:func:`transition_checks`), so
+    the robot can play it; the best that succeeded when no transition does (the table says
+    ``violated``). The transitions are not optimized: a motion whose q(0) lies across the body from
+    home can be excellent and unreachable by the straight joint-space path (seen on the G1: a wrist
+    swept through the torso).
 
-    With screening (``optimizer.starts`` > ``restarts``), ``starts`` runs of ``screen_iterations``
-    first, then the ``restarts`` with the lowest objective among those that succeeded
-    (:attr:`RestartResult.succeeded`) continue from their end points for the remaining iterations;
-    the others are kept with the stop reason ``screened out``. Which ones continue depends only on
-    the screened results, so it does not depend on where they ran.
-
-    When none succeeded, more starts run, as many at a time as the first round, each screened and
-    continued the same way, until one succeeds or ``optimizer.time_budget`` seconds have passed since
-    the iteration began. Each start's seed depends only on its index, so where it succeeds does not
-    depend on the machine (unless the budget ends the search first).
-
-    Returns:
-        Every start's :class:`RestartResult`, by index (a continued one with its screening's start
-        value, iterations and history included).
+    Raises:
+        ValueError: no restart succeeded.
     """
-    opts = excitation.problem.optimizer
-    count = opts.screened or opts.restarts
-    deadline = time.perf_counter() + opts.time_budget
-    runs = _restart_round(excitation, engine, k, seed, prior, range(count), hook)
-    while not any(r.succeeded for r in runs) and time.perf_counter() < deadline:
-        runs += _restart_round(excitation, engine, k, seed, prior, range(len(runs), len(runs) + count), hook)
-    return runs
-
-
-def _restart_round(
-    excitation: Excitation,
-    engine: Engine,
-    k: int,
-    seed: int,
-    prior: np.ndarray,
-    indices: range,
-    hook: Optional[ProgressHook],
-) -> list[RestartResult]:
-    """The starts ``indices`` of iteration k, screened and continued as :func:`run_restarts` says."""
-    opts = excitation.problem.optimizer
-    iterations = min(opts.screen_iterations, opts.max_iterations) if opts.screened else None
-    tasks = [RestartTask(k, r, seed, prior, None, iterations) for r in indices]
-    runs = engine.run(tasks, hook, (lambda r: hook(r.index, r.iterations, r.objective)) if hook else None)
-    if not opts.screened or iterations >= opts.max_iterations:
-        return runs
-    chosen = sorted((r for r in runs if r.succeeded), key=lambda r: (r.objective, r.index))[: opts.restarts]
-    more = [RestartTask(k, r.index, seed, prior, r.alpha, opts.max_iterations - iterations) for r in chosen]
-    shift = indices.stop  # continuations count on their own in the progress
-    shifted = (lambda r, it, value: hook(shift + r, it, value)) if hook else None
-    continued = {
-        c.index: c
-        for c in engine.run(more, shifted, (lambda c: shifted(c.index, c.iterations, c.objective)) if hook else None)
-    }
-    screened = {r.index: r for r in chosen}
-    return [
-        _joined(screened[r.index], continued[r.index]) if r.index in continued else replace(r, stop="screened out")
-        for r in runs
-    ]
-
-
-def _joined(screen: RestartResult, more: RestartResult) -> RestartResult:
-    """One restart of a screening and its continuation."""
-    return replace(
-        more,
-        iterations=screen.iterations + more.iterations,
-        start_objective=screen.start_objective,
-        wall_time_s=screen.wall_time_s + more.wall_time_s,
-        history=np.vstack([screen.history, more.history]),
-    )
+    ranked = sorted((r for r in runs if r.succeeded), key=lambda r: (r.objective, r.index))
+    if not ranked:
+        raise ValueError("no restart succeeded")
+    playable = (r for r in ranked if transition_checks(excitation, r.alpha)["transition_max_violation"] <= 0.0)
+    return next(playable, ranked[0])
 
 
 def transition_checks(excitation: Excitation, alpha: np.ndarray) -> dict[str, float | str]:
@@ -290,8 +197,8 @@ def run_sequence(
 ) -> list[IterationResult]:
     """Generate ``iterations`` trajectories, each stacking the regressors of the earlier ones (Eq. 41).
 
-    Every restart starts from its own random start (:class:`RestartTask`). None starts from the
-    previous optimum: with C₀ holding its rows, the previous optimum is a stationary point of the
+    Every restart starts from its own random start (:class:`~excite_cli.optimization.restarts.RestartTask`).
+    None starts from the previous optimum: with C₀ holding its rows, the previous optimum is a stationary point of the
     next iteration's criterion too (stacking C on itself scales CᵀC by 2, which moves log det by a
     constant and leaves cond unchanged), so a solver started there stops there and the motion repeats.
 
@@ -329,8 +236,8 @@ def run_sequence(
                 f"{excitation.problem.optimizer.time_budget:g} s ({', '.join(failures)})",
                 expected="more starts or a longer optimizer.time_budget, or limits that leave the robot room",
             )
-        best = best_restart(runs)
-        result = describe(excitation, k, best.alpha, stacked, time.perf_counter() - start, runs, results)
+        best = kept_restart(excitation, runs)
+        result = describe(excitation, k, best.alpha, stacked, time.perf_counter() - start, runs, results, best.index)
         results.append(result)
         if on_iteration:
             on_iteration(result)

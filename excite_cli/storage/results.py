@@ -38,17 +38,9 @@ def results_table(results: Sequence[IterationResult]) -> np.ndarray:
     """Table I as a structured array: iteration, cond_own, cond_stacked (on the base columns, the
     paper's), scaled_cond_own, scaled_cond_stacked (cond(C L)) and excitation_own, excitation_stacked
     (ē [N·m]), which do not depend on the choice of base columns (:mod:`excite_cli.optimization.information`),
-    and max_correlation, the largest correlation of the motion with an earlier iteration's (NaN for the first,
-    :mod:`excite_cli.trajectory.similarity`)."""
-    fields = (
-        "cond_own",
-        "cond_stacked",
-        "scaled_cond_own",
-        "scaled_cond_stacked",
-        "excitation_own",
-        "excitation_stacked",
-        "max_correlation",
-    )
+    and max_correlation with an earlier iteration (NaN for the first, :mod:`excite_cli.trajectory.similarity`)."""
+    fields = ("cond_own", "cond_stacked", "scaled_cond_own", "scaled_cond_stacked", "excitation_own")
+    fields += ("excitation_stacked", "max_correlation")
     table = np.zeros(len(results), dtype=[("iteration", "i4")] + [(name, "f8") for name in fields])
     for row, r in zip(table, results):
         row["iteration"] = r.index
@@ -122,9 +114,8 @@ def _write_iteration(group: h5py.Group, r: IterationResult) -> None:
     group.attrs["excitation_stacked_Nm"] = r.excitation_stacked
     group.attrs["max_violation"] = r.max_violation
     group.attrs["max_correlation"] = r.max_correlation
-    group.create_dataset("correlations", data=np.array(r.correlations, dtype=float)).attrs["description"] = (
-        "correlation of the mean-removed joint positions with each earlier iteration's, in order (1: the same motion)"
-    )
+    correlations = group.create_dataset("correlations", data=np.array(r.correlations, dtype=float))
+    correlations.attrs["description"] = "with each earlier iteration's mean-removed q, in order (1: the same motion)"
     group.attrs["wall_time_s"] = r.wall_time_s
     group.attrs["sqp_iterations"] = r.sqp_iterations
     group.attrs["stop"] = r.stop
@@ -262,8 +253,9 @@ def read_iterations(
                 else []
             )
             stacked = stacked_regressors(excitation, prior, results)
+            kept = int(g["restarts"].attrs["kept"]) if "restarts" in g else -1
             results.append(
-                describe(excitation, int(key), alpha, stacked, float(g.attrs["wall_time_s"]), restarts, results)
+                describe(excitation, int(key), alpha, stacked, float(g.attrs["wall_time_s"]), restarts, results, kept)
             )
     return results
 

@@ -138,7 +138,7 @@ def test_every_method_ends_feasible_and_below_its_start(ur5_problem, method):
     ur5_problem.optimizer.method = method
     ur5_problem.optimizer.max_iterations = 40
     excitation = build_excitation(ur5_problem)
-    from excite_cli.optimization.sequence import RestartTask
+    from excite_cli.optimization.restarts import RestartTask
 
     result = RestartTask(1, 0, 2, np.zeros((0, excitation.base.count)))(excitation)
     assert accepted(excitation.constraints, result.alpha)
@@ -168,7 +168,7 @@ def test_excitation_level_is_the_scaled_standard_regressor_and_does_not_depend_o
 
 def test_screening_continues_the_best_starts_wherever_they_run(ur5_problem):
     from excite_cli.optimization.engine import Engine
-    from excite_cli.optimization.sequence import run_restarts
+    from excite_cli.optimization.restarts import run_restarts
 
     opts = ur5_problem.optimizer
     opts.restarts, opts.starts, opts.screen_iterations, opts.max_iterations = 2, 5, 8, 30
@@ -188,3 +188,45 @@ def test_screening_continues_the_best_starts_wherever_they_run(ur5_problem):
     # the continued ones were the best two of the screening, and continuing never makes a point worse
     assert max(r.objective for r in kept) <= min(r.objective for r in out)
     assert all(accepted(excitation.constraints, r.alpha) for r in runs)
+
+
+def test_a_failed_restart_is_never_kept_when_another_succeeded():
+    """The lowest end value of a restart that failed, or that ended at its start or a bisection
+    towards it, loses to any restart whose solver gave its own end point."""
+    from excite_cli.optimization.optimizer import RestartResult, best_restart
+
+    def restart(index, objective, stop, end):
+        return RestartResult(index, np.zeros((1, 3)), objective, 10, "", 0.0, stop=stop, end=end)
+
+    failed = restart(0, -9.0, SOLVER_FAILED, "projected")
+    at_start = restart(1, -8.0, STALLED, "start")
+    towards_start = restart(2, -7.5, STALLED, "bisection")
+    solved = restart(3, -6.0, STALLED, "projected")
+    better = restart(4, -6.5, CONVERGED, "inside")
+    assert best_restart([failed, at_start, towards_start, solved]) is solved
+    assert best_restart([failed, at_start, towards_start, solved, better]) is better
+    assert not any(r.succeeded for r in (failed, at_start, towards_start))
+    assert best_restart([failed, at_start]) is failed  # a result written before the rule: the lowest
+
+
+def test_when_every_restart_fails_more_starts_run_then_the_run_stops(ur5_problem):
+    """95 % of every joint's torque is out of reach at the UR5's limits: every restart ends
+    infeasible. More starts run, each from its own seed, until the time budget is spent; then the
+    sequence stops with NoSolution (exit 1 on the command line) instead of keeping a start."""
+    from excite_cli.errors import NoSolution
+    from excite_cli.optimization.engine import Engine
+    from excite_cli.optimization.restarts import run_restarts
+    from excite_cli.optimization.sequence import run_sequence
+
+    ur5_problem.limits.torque, ur5_problem.limits.min_torque_use = "urdf", 0.95
+    opts = ur5_problem.optimizer
+    opts.restarts, opts.max_iterations, opts.time_budget = 1, 3, 8.0  # a restart: 2-4 s
+    excitation = build_excitation(ur5_problem)
+    with Engine(excitation) as serial:
+        runs = run_restarts(excitation, serial, 1, 0, np.zeros((0, excitation.base.count)))
+        assert len(runs) >= 2 and [r.index for r in runs] == list(range(len(runs)))
+        assert not any(r.succeeded for r in runs) and {r.stop for r in runs} == {"infeasible"}
+        assert len({r.start_objective for r in runs}) == len(runs)  # each from a start of its own
+        with pytest.raises(NoSolution, match="iteration 1: none of") as raised:
+            run_sequence(excitation, 2, 0, engine=serial)
+    assert raised.value.status == 1

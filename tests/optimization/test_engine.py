@@ -24,7 +24,8 @@ from excite_cli.optimization.engine import Engine
 from excite_cli.optimization.excitation import build_excitation
 from excite_cli.optimization.optimizer import RestartResult, best_restart
 from excite_cli.optimization.random_baseline import draw_pool
-from excite_cli.optimization.sequence import RestartTask, run_sequence
+from excite_cli.optimization.restarts import RestartTask
+from excite_cli.optimization.sequence import run_sequence
 
 HERE = TESTS
 

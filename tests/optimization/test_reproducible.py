@@ -17,7 +17,8 @@ from threadpoolctl import threadpool_limits
 from excite_cli.config_file import load_problem
 from excite_cli.optimization.engine import Engine
 from excite_cli.optimization.excitation import build_excitation
-from excite_cli.optimization.sequence import RestartTask, run_sequence
+from excite_cli.optimization.restarts import RestartTask
+from excite_cli.optimization.sequence import run_sequence
 
 
 def test_a_seed_gives_bit_identical_starts_with_one_and_two_blas_threads(g1_problem):

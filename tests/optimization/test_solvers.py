@@ -48,3 +48,34 @@ def test_an_iteration_limit_is_reported_as_such():
 def test_an_unknown_method_is_named():
     with pytest.raises(ExciteError, match="optimizer.method"):
         solve("newton", Disc([1.0, 1.0]), np.zeros(2), 10, 1e-6, lambda z: None)
+
+
+@pytest.mark.parametrize("units", [1e-3, 1.0, 1e4])
+def test_the_criterion_scale_makes_slsqp_blind_to_the_criterion_units(units):
+    """The disc problem's criterion in other units (× 1e-3 … 1e4) has the same optimum a/|a|; with the
+    criterion scaled at the start, SLSQP takes the same steps in every unit: the same iterates."""
+    reference, scaled = [], []
+    solve("SLSQP", Disc([3.0, 4.0]), np.array([0.1, -0.2]), 200, 1e-12, reference.append)
+
+    class Units(Disc):
+        def value(self, z):
+            return units * super().value(z)
+
+        def gradient(self, z):
+            return units * super().gradient(z)
+
+    run = solve("SLSQP", Units([3.0, 4.0]), np.array([0.1, -0.2]), 200, 1e-12 * units, scaled.append)
+    np.testing.assert_allclose(run.z, [0.6, 0.8], atol=1e-6)
+    np.testing.assert_allclose(np.array(scaled), np.array(reference), rtol=1e-6, atol=1e-9)
+
+
+def test_the_first_step_moves_no_variable_more_than_first_step():
+    """From far inside the disc towards a target 1000 away, the gradient's largest component is
+    2000; SLSQP's first step (Hessian I) is the scaled gradient itself: FIRST_STEP in its largest
+    component, not 2000 (which would leave the disc a thousand times over)."""
+    from excite_cli.optimization.solvers import FIRST_STEP
+
+    seen = []
+    z0 = np.array([0.1, 0.0])
+    solve("SLSQP", Disc([1000.1, 0.0]), z0, 1, 1e-12, seen.append)
+    assert np.abs(seen[0] - z0).max() == pytest.approx(FIRST_STEP, rel=1e-6)

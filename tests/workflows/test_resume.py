@@ -111,3 +111,19 @@ def test_effective_config_is_stored(uninterrupted, tmp_path):
     with h5py.File(out) as f:
         effective = yaml.safe_load(f.attrs["config"])
     assert effective["sequence"]["iterations"] == 1 and effective["optimizer"]["seed"] == 7  # the overrides that ran
+
+
+def test_each_iteration_is_a_new_motion_and_the_file_says_how_new(uninterrupted):
+    """The stored correlation of each iteration with the earlier ones is that of the stored joint
+    positions (numpy's corrcoef of the mean-removed samples, computed here), and no iteration repeats
+    an earlier one (correlation below 0.9)."""
+    with h5py.File(uninterrupted) as f:
+        q = {int(k): f["iterations"][k]["q"][()] for k in f["iterations"]}
+        stored = {int(k): f["iterations"][k]["correlations"][()] for k in f["iterations"]}
+        table = f["table"][()]
+    for k in sorted(q):
+        expected = [
+            np.corrcoef((q[k] - q[k].mean(0)).ravel(), (q[j] - q[j].mean(0)).ravel())[0, 1] for j in range(1, k)
+        ]
+        np.testing.assert_allclose(stored[k], expected, rtol=1e-10, atol=1e-12)
+    assert np.isnan(table["max_correlation"][0]) and np.all(table["max_correlation"][1:] < 0.9)

@@ -1,0 +1,118 @@
+"""Does `excite optimize` end every restart at a result, on any arm and any seed? The sequential
+generation of each robot's config (its iterations, restarts and screening, the default criterion),
+for several seeds, on every core.
+
+Robots: the shipped G1 arms, Panda, UR5 and UR10 with a lab's limits (configs/ur10_lab.yaml), and the
+configs `excite init` writes for the UR10, UR3, xArm 7 and Unitree Z1 of example-robot-data, as it
+writes them. Printed per robot:
+
+- failed: restarts (every start, screened ones included) whose solver failed, or that ended at their
+  start or a bisection towards it (`RestartResult.succeeded` false), of all restarts;
+- converged: kept restarts (one per iteration) whose end point meets optimizer.optimality_tolerance
+  (KKT residual), of all kept; and the largest KKT residual of a kept restart;
+- spread: how much worse the last iteration's criterion (of the stacked regressor) is on the worst
+  seed than on the best, as a ratio of exp(criterion) minus 1: for log det that of det(CᵀC)^(-1/b),
+  for log cond that of cond(C);
+- worst novelty: the largest correlation of an iteration's motion with an earlier one's;
+- wall: mean wall time of one seed's run.
+
+One line per robot: `robust ROBOT: failed F of R restarts, converged C of K kept, spread S %, worst
+novelty N, wall W s`.
+
+    .venv/bin/python bench/robustness.py [--robots G1 "UR10 lab" ...] [--seeds 0 1 ...]
+
+Asserts nothing. The identification of each seed's trajectories is bench/criteria.py's measure:
+`bench/criteria.py configs/ur10_lab.yaml --criteria log_det:none log_cond:none --seeds 0 1 2 3 4`.
+"""
+
+from __future__ import annotations
+
+import argparse
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from excite_cli.config_file import load_problem
+from excite_cli.optimization.engine import Engine, default_workers
+from excite_cli.optimization.excitation import build_excitation
+from excite_cli.optimization.optimality import CONVERGED
+from excite_cli.optimization.sequence import run_sequence
+
+ROOT = Path(__file__).resolve().parent.parent
+SHIPPED = {
+    "G1": ROOT / "configs" / "g1_arms.yaml",
+    "Panda": ROOT / "configs" / "panda.yaml",
+    "UR5": ROOT / "configs" / "ur5.yaml",
+    "UR10 lab": ROOT / "configs" / "ur10_lab.yaml",
+}
+INIT = {
+    "UR10": "ur_description/urdf/ur10_robot.urdf",
+    "UR3": "ur_description/urdf/ur3_robot.urdf",
+    "xArm 7": "xarm_description/urdf/xarm7.urdf",
+    "Z1": "z1_description/urdf/z1.urdf",
+}
+
+
+def config_of(robot: str, folder: Path) -> Path:
+    """The robot's shipped config, or the one `excite init` writes for it in ``folder``."""
+    if robot in SHIPPED:
+        return SHIPPED[robot]
+    path = folder / f"{robot.replace(' ', '_')}.yaml"
+    command = [sys.executable, "-m", "excite_cli", "init", INIT[robot], "--output", str(path), "--force"]
+    subprocess.run(command, check=True, capture_output=True, cwd=folder)
+    return path
+
+
+def run_robot(robot: str, config: Path, seeds: list[int]) -> str:
+    """The robot's line (module docstring), after one row per seed."""
+    restarts = failed = converged = kept = 0
+    worst_kkt, worst_correlation, values, walls = 0.0, -1.0, [], []
+    for seed in seeds:
+        problem = load_problem(config)
+        problem.optimizer.seed = seed
+        excitation = build_excitation(problem)
+        workers = min(default_workers(), problem.optimizer.screened or problem.optimizer.restarts)
+        begin = time.perf_counter()
+        with Engine(excitation, workers) as engine:
+            results = run_sequence(excitation, problem.sequence.iterations, seed, engine=engine)
+        walls.append(time.perf_counter() - begin)
+        for r in results:
+            restarts += len(r.restarts)
+            failed += sum(not s.succeeded for s in r.restarts)
+            kept += 1
+            converged += r.best.stop == CONVERGED
+            worst_kkt = max(worst_kkt, r.best.optimality.residual)
+            if r.correlations:
+                worst_correlation = max(worst_correlation, r.max_correlation)
+        values.append(results[-1].best.objective)
+        print(
+            f"  {robot} seed {seed}: criterion {values[-1]:.4f}, kept KKT "
+            f"{' '.join(f'{r.best.optimality.residual:.1e}' for r in results)}, stops "
+            f"{', '.join(r.stop for r in results)}, correlations "
+            f"{' '.join(f'{r.max_correlation:.2f}' for r in results[1:])}, {walls[-1]:.0f} s",
+            flush=True,
+        )
+    spread = 100.0 * (np.exp(max(values) - min(values)) - 1.0)
+    return (
+        f"robust {robot}: failed {failed} of {restarts} restarts, converged {converged} of {kept} kept "
+        f"(largest KKT {worst_kkt:.1e}), spread {spread:.1f} %, worst novelty {worst_correlation:.2f}, "
+        f"wall {np.mean(walls):.0f} s"
+    )
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--robots", nargs="+", default=[*SHIPPED, *INIT], choices=[*SHIPPED, *INIT])
+    parser.add_argument("--seeds", type=int, nargs="+", default=list(range(10)))
+    args = parser.parse_args()
+    with tempfile.TemporaryDirectory() as folder:
+        lines = [run_robot(robot, config_of(robot, Path(folder)), args.seeds) for robot in args.robots]
+    print("\n".join(lines))
+
+
+if __name__ == "__main__":
+    main()

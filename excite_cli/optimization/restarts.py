@@ -1,0 +1,134 @@
+"""The restarts of one iteration (Sec. IV-A): tasks of one solver run each, from a random start of
+their own, screened and continued, and more of them when every one failed."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, replace
+from typing import Optional
+
+import numpy as np
+
+from excite_cli.optimization.engine import Engine
+from excite_cli.optimization.excitation import Excitation
+from excite_cli.optimization.optimizer import ProgressHook, RestartResult, optimize_restart
+
+
+@dataclass(frozen=True)
+class RestartTask:
+    """One restart of one iteration (a task for :class:`~excite_cli.optimization.engine.Engine`).
+
+    Its random start is drawn from its own seed, ``SeedSequence(seed, spawn_key=(iteration, index))``,
+    so the result does not depend on where or in which order the restarts run.
+
+    Attributes:
+        iteration: k, 1-based; index: the restart's number, 0-based.
+        seed: the run's seed (``optimizer.seed``).
+        prior: C₀ (m, b), the rows stacked above the trajectory's regressor (Eq. 41).
+        warm_start: (n, 2N+1) accepted α to start from instead of a random start (a screened start
+            that continues), or None.
+        iterations: solver iterations (default ``optimizer.max_iterations``).
+    """
+
+    iteration: int
+    index: int
+    seed: int
+    prior: np.ndarray
+    warm_start: Optional[np.ndarray] = None
+    iterations: Optional[int] = None
+
+    def rng(self) -> np.random.Generator:
+        """The restart's own random generator."""
+        return np.random.default_rng(np.random.SeedSequence(self.seed, spawn_key=(self.iteration, self.index)))
+
+    def __call__(self, excitation: Excitation, progress: Optional[ProgressHook] = None) -> RestartResult:
+        """Draw the start (or take the warm start) and optimize from it (:func:`optimize_restart`)."""
+        start = self.warm_start.copy() if self.warm_start is not None else excitation.random_start(self.rng())
+        return optimize_restart(
+            excitation.criterion(self.prior),
+            excitation.constraints,
+            excitation.problem.optimizer,
+            start,
+            excitation.boundary,
+            self.index,
+            progress,
+            self.iterations,
+            excitation.fine_basis,
+        )
+
+
+def run_restarts(
+    excitation: Excitation,
+    engine: Engine,
+    k: int,
+    seed: int,
+    prior: np.ndarray,
+    hook: Optional[ProgressHook] = None,
+) -> list[RestartResult]:
+    """The restarts of iteration k: ``optimizer.restarts`` solver runs of ``max_iterations``, each from
+    its own random start.
+
+    With screening (``optimizer.starts`` > ``restarts``), ``starts`` runs of ``screen_iterations``
+    first, then the ``restarts`` with the lowest objective among those that succeeded
+    (:attr:`RestartResult.succeeded`) continue from their end points for the remaining iterations;
+    the others are kept with the stop reason ``screened out``. Which ones continue depends only on
+    the screened results, so it does not depend on where they ran.
+
+    When none succeeded, more starts run, as many at a time as the first round, each screened and
+    continued the same way, until one succeeds or ``optimizer.time_budget`` seconds have passed since
+    the iteration began. Each start's seed depends only on its index, so where it succeeds does not
+    depend on the machine (unless the budget ends the search first).
+
+    Returns:
+        Every start's :class:`RestartResult`, by index (a continued one with its screening's start
+        value, iterations and history included).
+    """
+    opts = excitation.problem.optimizer
+    count = opts.screened or opts.restarts
+    deadline = time.perf_counter() + opts.time_budget
+    runs = _restart_round(excitation, engine, k, seed, prior, range(count), hook)
+    while not any(r.succeeded for r in runs) and time.perf_counter() < deadline:
+        runs += _restart_round(excitation, engine, k, seed, prior, range(len(runs), len(runs) + count), hook)
+    return runs
+
+
+def _restart_round(
+    excitation: Excitation,
+    engine: Engine,
+    k: int,
+    seed: int,
+    prior: np.ndarray,
+    indices: range,
+    hook: Optional[ProgressHook],
+) -> list[RestartResult]:
+    """The starts ``indices`` of iteration k, screened and continued as :func:`run_restarts` says."""
+    opts = excitation.problem.optimizer
+    iterations = min(opts.screen_iterations, opts.max_iterations) if opts.screened else None
+    tasks = [RestartTask(k, r, seed, prior, None, iterations) for r in indices]
+    runs = engine.run(tasks, hook, (lambda r: hook(r.index, r.iterations, r.objective)) if hook else None)
+    if not opts.screened or iterations >= opts.max_iterations:
+        return runs
+    chosen = sorted((r for r in runs if r.succeeded), key=lambda r: (r.objective, r.index))[: opts.restarts]
+    more = [RestartTask(k, r.index, seed, prior, r.alpha, opts.max_iterations - iterations) for r in chosen]
+    shift = indices.stop  # continuations count on their own in the progress
+    shifted = (lambda r, it, value: hook(shift + r, it, value)) if hook else None
+    continued = {
+        c.index: c
+        for c in engine.run(more, shifted, (lambda c: shifted(c.index, c.iterations, c.objective)) if hook else None)
+    }
+    screened = {r.index: r for r in chosen}
+    return [
+        _joined(screened[r.index], continued[r.index]) if r.index in continued else replace(r, stop="screened out")
+        for r in runs
+    ]
+
+
+def _joined(screen: RestartResult, more: RestartResult) -> RestartResult:
+    """One restart of a screening and its continuation."""
+    return replace(
+        more,
+        iterations=screen.iterations + more.iterations,
+        start_objective=screen.start_objective,
+        wall_time_s=screen.wall_time_s + more.wall_time_s,
+        history=np.vstack([screen.history, more.history]),
+    )
