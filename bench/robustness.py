@@ -11,8 +11,9 @@ writes them. Printed per robot:
 - converged: kept restarts (one per iteration) whose end point meets optimizer.optimality_tolerance
   (KKT residual), of all kept; and the largest KKT residual of a kept restart;
 - spread: how much worse the last iteration's criterion (of the stacked regressor) is on the worst
-  seed than on the best, as a ratio of exp(criterion) minus 1: for log det that of det(CᵀC)^(-1/b),
-  for log cond that of cond(C);
+  seed than on the best, in singular values of C: for log det (−log det(CᵀC)/b, of σ²) the ratio of
+  the geometric means of σ (that of the excitation ē), exp(Δ/2), for log cond that of cond(C),
+  exp(Δ), minus 1;
 - worst novelty: the largest correlation of an iteration's motion with an earlier one's;
 - wall: mean wall time of one seed's run.
 
@@ -96,7 +97,8 @@ def run_robot(robot: str, config: Path, seeds: list[int]) -> str:
             f"{' '.join(f'{r.max_correlation:.2f}' for r in results[1:])}, {walls[-1]:.0f} s",
             flush=True,
         )
-    spread = 100.0 * (np.exp(max(values) - min(values)) - 1.0)
+    power = 0.5 if problem.optimizer.objective == "log_det" else 1.0  # log det is of σ², the others of σ
+    spread = 100.0 * (np.exp(power * (max(values) - min(values))) - 1.0)
     return (
         f"robust {robot}: failed {failed} of {restarts} restarts, converged {converged} of {kept} kept "
         f"(largest KKT {worst_kkt:.1e}), spread {spread:.1f} %, worst novelty {worst_correlation:.2f}, "
