@@ -109,6 +109,8 @@ def _restart_round(
     if not opts.screened or iterations >= opts.max_iterations:
         return runs
     chosen = sorted((r for r in runs if r.succeeded), key=lambda r: (r.objective, r.index))[: opts.restarts]
+    if not chosen:  # every screened start failed: nothing to continue
+        return runs
     more = [RestartTask(k, r.index, seed, prior, r.alpha, opts.max_iterations - iterations) for r in chosen]
     shift = indices.stop  # continuations count on their own in the progress
     shifted = (lambda r, it, value: hook(shift + r, it, value)) if hook else None

@@ -230,3 +230,7 @@ def test_when_every_restart_fails_more_starts_run_then_the_run_stops(ur5_problem
         with pytest.raises(NoSolution, match="iteration 1: none of") as raised:
             run_sequence(excitation, 2, 0, engine=serial)
     assert raised.value.status == 1
+    opts.starts, opts.screen_iterations, opts.time_budget = 2, 2, 0.001  # screened, none to continue
+    with Engine(excitation, workers=2) as pool:
+        screened = run_restarts(excitation, pool, 1, 0, np.zeros((0, excitation.base.count)))
+    assert [r.index for r in screened] == [0, 1] and not any(r.succeeded for r in screened)
