@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import copy
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Optional
@@ -127,9 +126,8 @@ def run_optimize(
         except ExciteError as exc:  # workers lost, or no restart succeeded: what is finished stays, and says so
             if not written:
                 raise
-            kept = copy.copy(exc)
-            kept.problem += f"; kept {len(written)} finished iteration(s) in {target}, which a resumed run continues"
-            raise kept from None
+            exc.problem += f"; kept {len(written)} finished iteration(s) in {target}, which a resumed run continues"
+            raise exc from None
         return OptimizeRun(excitation, results, target, plot_result(target, excitation, results))
 
 
