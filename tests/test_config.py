@@ -47,6 +47,8 @@ def test_negative_period_names_the_field(tmp_path):
         (lambda d: d["limits"].pop("acceleration"), "limits.acceleration"),
         (lambda d: d["trajectory"].update(harmonix=3), "trajectory.harmonix"),
         (lambda d: d["limits"].update(position_margin=4.0), "limits.position_margin"),
+        (lambda d: d["limits"].update(position_margin={"elbow_joint": -0.1}), "limits.position_margin"),
+        (lambda d: d["limits"].update(position_margin={"wrist_9_joint": 0.1}), "limits.position_margin"),
         (lambda d: d["limits"].update(velocity={"wrist_9_joint": 1.0}), "limits.velocity"),
         (lambda d: d["limits"].update(acceleration=-1.0), "limits.acceleration"),
         (lambda d: d["robot"].update(urdf="nowhere/robot.urdf"), "robot.urdf"),

@@ -8,7 +8,7 @@ import math
 from pathlib import Path
 from typing import Literal, Optional, Union
 
-from pydantic import Field, NonNegativeFloat, PositiveFloat, field_validator, model_validator
+from pydantic import Field, PositiveFloat, field_validator, model_validator
 from pydantic.json_schema import SkipJsonSchema
 
 from excite_cli.config.base import (
@@ -77,8 +77,8 @@ class LimitsConfig(Section):
     {joint: Nm}; none by default); the fraction of its torque limit each joint (or the joints named)
     must reach somewhere in the motion (none by default)."""
 
-    position_margin: Union[NonNegativeFloat, dict[str, NonNegativeFloat]] = 0.0
-    """Distance kept from the URDF's position limits [rad or m], one value or {joint: value} (others 0)."""
+    position_margin: PerJoint = 0.0
+    """Distance kept from the URDF's position limits [rad or m], ≥ 0, one value or {joint: value} (others 0)."""
     velocity: Optional[PerJoint] = None
     """|q̇| bound [rad/s], one value or {joint: value}; default the URDF's."""
     acceleration: PerJoint

@@ -170,7 +170,8 @@ def joint_limit_bounds(cfg: LimitsConfig, robot: Robot) -> tuple[np.ndarray, np.
     config, else the URDF. Acceleration: the config (URDFs have none).
 
     Raises:
-        ExciteError: a missing or non-positive limit, an unknown joint, or a margin that leaves no range.
+        ExciteError: a missing or non-positive limit, an unknown joint, a negative margin or one that
+            leaves no range.
     """
     margin = np.zeros(robot.n_joints)
     if isinstance(cfg.position_margin, dict):
@@ -182,6 +183,8 @@ def joint_limit_bounds(cfg: LimitsConfig, robot: Robot) -> tuple[np.ndarray, np.
         margin[:] = cfg.position_margin
     lower, upper = robot.lower + margin, robot.upper - margin
     for name, lo, hi, m in zip(robot.joint_names, lower, upper, margin):
+        if m < 0:
+            raise ExciteError("limits.position_margin", f"{m:g} rad for joint '{name}' is negative", m, "≥ 0")
         if not (np.isfinite(lo) and np.isfinite(hi)):
             raise ExciteError("limits", f"joint '{name}' has no finite position limits in the URDF")
         if hi <= lo:

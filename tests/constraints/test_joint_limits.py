@@ -70,3 +70,24 @@ def test_restore_repairs_a_violating_trajectory_minimally(panda):
     # joints that were inside stay untouched up to the common scale; shapes are kept
     ratio = repaired[:, 1:] / alpha[:, 1:]
     assert np.allclose(ratio, ratio[:, :1])
+
+
+def test_a_per_joint_position_margin_narrows_that_joint_alone(ur5_problem):
+    """limits.position_margin {joint: rad}: that joint's range is the URDF's (pinocchio's model of the
+    URDF, read here) narrowed by its margin at each end; the other joints keep the URDF's whole range."""
+    import pinocchio as pin
+
+    from excite_cli.constraints.joint_limits import joint_limit_bounds
+    from excite_cli.dynamics.robot import load_robot
+    from excite_cli.dynamics.urdf_source import example_robot_data_root
+
+    ur5_problem.limits.position_margin = {"elbow_joint": 0.6283}
+    robot = load_robot(ur5_problem.robot, ur5_problem.folder, False)
+    lower, upper = joint_limit_bounds(ur5_problem.limits, robot)
+    urdf = example_robot_data_root() / "example-robot-data" / "robots" / ur5_problem.robot.urdf
+    model = pin.buildModelFromUrdf(str(urdf))
+    for k, name in enumerate(robot.joint_names):
+        index = model.idx_qs[model.getJointId(name)]
+        margin = 0.6283 if name == "elbow_joint" else 0.0
+        assert lower[0, k] == pytest.approx(model.lowerPositionLimit[index] + margin)
+        assert upper[0, k] == pytest.approx(model.upperPositionLimit[index] - margin)
