@@ -141,12 +141,15 @@ class JointLimits(Constraint):
         return alpha
 
 
-def per_joint(field: str, value: PerJoint | None, default: np.ndarray, robot: Robot) -> np.ndarray:
+def per_joint(
+    field: str, value: PerJoint | None, default: np.ndarray, robot: Robot, zero_allowed: bool = False
+) -> np.ndarray:
     """(n,) positive limits of the config field ``field`` from a scalar, a {joint: value} map (the
-    others from ``default``) or None (all from ``default``).
+    others from ``default``) or None (all from ``default``); with ``zero_allowed``, ≥ 0 (a margin).
 
     Raises:
-        ExciteError: an unknown joint, or a joint left without a positive finite limit.
+        ExciteError: an unknown joint, or a joint left without a positive (or, with ``zero_allowed``,
+            non-negative) finite value.
     """
     out = default.astype(float).copy()
     if isinstance(value, dict):
@@ -157,9 +160,10 @@ def per_joint(field: str, value: PerJoint | None, default: np.ndarray, robot: Ro
     elif value is not None:
         out[:] = value
     for name, v in zip(robot.joint_names, out):
-        if not np.isfinite(v) or v <= 0:
+        if not np.isfinite(v) or v < 0 or (v == 0 and not zero_allowed):
             source = "the URDF has none" if value is None else f"got {v:g}"
-            raise ExciteError(field, f"joint '{name}' needs a positive finite limit ({source})")
+            kind = "non-negative finite margin" if zero_allowed else "positive finite limit"
+            raise ExciteError(field, f"joint '{name}' needs a {kind} ({source})")
     return out
 
 
@@ -173,22 +177,14 @@ def joint_limit_bounds(cfg: LimitsConfig, robot: Robot) -> tuple[np.ndarray, np.
         ExciteError: a missing or non-positive limit, an unknown joint, a negative margin or one that
             leaves no range.
     """
-    margin = np.zeros(robot.n_joints)
-    if isinstance(cfg.position_margin, dict):
-        for name, value in cfg.position_margin.items():
-            if name not in robot.joint_names:
-                raise ExciteError("limits.position_margin", f"'{name}' is not an active joint")
-            margin[robot.joint_names.index(name)] = value
-    else:
-        margin[:] = cfg.position_margin
+    field = "limits.position_margin"
+    margin = per_joint(field, cfg.position_margin, np.zeros(robot.n_joints), robot, zero_allowed=True)
     lower, upper = robot.lower + margin, robot.upper - margin
     for name, lo, hi, m in zip(robot.joint_names, lower, upper, margin):
-        if m < 0:
-            raise ExciteError("limits.position_margin", f"{m:g} rad for joint '{name}' is negative", m, "≥ 0")
         if not (np.isfinite(lo) and np.isfinite(hi)):
             raise ExciteError("limits", f"joint '{name}' has no finite position limits in the URDF")
         if hi <= lo:
-            raise ExciteError("limits.position_margin", f"{m:g} rad leaves no range for joint '{name}'")
+            raise ExciteError(field, f"{m:g} rad leaves no range for joint '{name}'")
     velocity = per_joint("limits.velocity", cfg.velocity, robot.velocity_limit, robot)
     acceleration = per_joint("limits.acceleration", cfg.acceleration, np.full(robot.n_joints, np.nan), robot)
     return np.stack([lower, -velocity, -acceleration]), np.stack([upper, velocity, acceleration])
