@@ -53,7 +53,7 @@ def identification(report: Report) -> list[Table | str]:
         + ((f"{other_name} [%]",) if extra else ()),
         [
             (
-                name,
+                name + ("" if report.live[j] else " (no signal)"),
                 f"{report.rms_torque[j]:.3f}",
                 f"{report.rms_before[j]:.3f}",
                 f"{report.rms_after[j]:.3f}",
@@ -63,8 +63,9 @@ def identification(report: Report) -> list[Table | str]:
             )
             for j, name in enumerate(report.joints)
         ],
-        f"mean: before {report.relative_before.mean():.1f} %, after {report.relative_after.mean():.1f} % "
-        f"({choice.name})" + (f", {other_name} {other.mean():.1f} %" if extra else ""),
+        f"mean{'' if report.live.all() else ' of the joints with signal'}: before "
+        f"{report.mean(report.relative_before):.1f} %, after {report.mean(report.relative_after):.1f} % "
+        f"({choice.name})" + (f", {other_name} {report.mean(other):.1f} %" if extra else ""),
     )
     return [errors, *fits(report), *_selection_tables(report)]
 
@@ -75,8 +76,8 @@ def fits(report: Report) -> list[Table]:
     if len(choice.names) < 2:
         return []
     validation = {
-        "least squares": report.relative_least_squares.mean(),
-        "consistent": None if report.relative_consistent is None else report.relative_consistent.mean(),
+        "least squares": report.mean(report.relative_least_squares),
+        "consistent": None if report.relative_consistent is None else report.mean(report.relative_consistent),
     }
     best_consistent = min(
         (k for k, lam in enumerate(choice.regularization) if not np.isnan(lam)), key=lambda k: choice.cv_error[k]
@@ -98,7 +99,14 @@ def fits(report: Report) -> list[Table]:
             "Fits of the chosen model, scored on the selection's folds",
             ("fit", "cross-validated [%]", "validation [%]"),
             rows,
-            f"chosen: {choice.name}, {choice.lead:.2f} % points below the next (cross-validated)",
+            f"chosen: {choice.name}, cross-validated {abs(choice.lead):.2f} % points "
+            f"{'below' if choice.lead >= 0 else 'above'} the next"
+            + (
+                f"; least squares must be {100 * choice.margin:.0f} % below the consistent fit's "
+                "(identification.least_squares_margin)"
+                if choice.margin
+                else ""
+            ),
         ),
     ]
 
@@ -114,7 +122,7 @@ def models(report: Report) -> list[Table]:
         rows.append(
             (
                 label + (" (chosen)" if k == choice.model else ""),
-                str(model.effects),
+                f"{model.effects:.4g}",
                 f"{choice.cv[k, 0]:.2f}" if choice.names[0] == "least squares" else "",
                 choice.names[best],
                 f"{choice.cv[k, best]:.2f}",
@@ -123,7 +131,8 @@ def models(report: Report) -> list[Table]:
         )
     return [
         titled_table(
-            "Models and fits scored together: J = log CV + effects × log(1 + min_improvement), the lowest wins",
+            "Models and fits scored together: J = log CV + effects × log(1 + min_improvement) (least squares: "
+            "+ log(1 + least_squares_margin)), the lowest wins",
             ("model", "effects", "least squares CV [%]", "best fit", "its CV [%]", "J"),
             rows,
         )

@@ -9,15 +9,16 @@ from pathlib import Path
 
 import numpy as np
 
-from excite_cli.config import resolve_path
 from excite_cli.dynamics.base_parameters import BaseParameters, compute_base_parameters
 from excite_cli.dynamics.robot import Robot, load_robot
 from excite_cli.dynamics.urdf_source import resolve_urdf
 from excite_cli.errors import ExciteError
+from excite_cli.identification.choice.crossval import fold_groups
 from excite_cli.identification.choice.fit_choice import choose_fit
 from excite_cli.identification.choice.selection import Selection, candidate_terms, motor_couplings, select_effects
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.effects import EFFECTS, Term
+from excite_cli.identification.fitting.channels import dead_channels
 from excite_cli.identification.fitting.dataset import Dataset, build_datasets, fit_position_range
 from excite_cli.identification.fitting.least_squares import joint_weights, least_squares, predict, torque_errors
 from excite_cli.identification.fitting.normal import NormalEquations, excited_rank
@@ -56,10 +57,12 @@ def declared_terms(problem: IdentifyProblem, robot: Robot) -> list[Term]:
     return out
 
 
-def error_ladder(val_data: Dataset, selection: Selection, joints: list[str]) -> list[tuple[str, float, float]]:
-    """(step, CV error [%], mean relative validation error [%]) of the rigid body, the kept search's
-    start and each of its steps, every model fitted on all fit data with the selection's weights: what
-    each effect bought."""
+def error_ladder(
+    val_data: Dataset, selection: Selection, joints: list[str], live: np.ndarray
+) -> list[tuple[str, float, float]]:
+    """(step, CV error [%], mean relative validation error [%] over the ``live`` (n,) joints) of the
+    rigid body, the kept search's start and each of its steps, every model fitted on all fit data with
+    the selection's weights: what each effect bought."""
     measured = val_data.tau.reshape(-1, val_data.n)
     search = selection.searches[selection.chosen]
     models = [("rigid body", [], selection.cv_rigid)]
@@ -70,33 +73,7 @@ def error_ladder(val_data: Dataset, selection: Selection, joints: list[str]) -> 
         (label, cv, predict(val_data, least_squares(selection.normal, terms, selection.weights).x, terms))
         for label, terms, cv in models
     )
-    return [(label, cv, float(torque_errors(measured, predicted)[2].mean())) for label, cv, predicted in fitted]
-
-
-def fold_groups(problem: IdentifyProblem, fitted: list[int]) -> np.ndarray | None:
-    """The cross-validation's groups (:class:`~excite_cli.identification.choice.crossval.CrossValidation`)
-    of ``identification.folds_by``: the recording (file) of each configured run, each run its own
-    group, or None for time blocks. ``auto``: recordings when the fit runs come from two or more
-    files, else time blocks.
-
-    Raises:
-        ExciteError: ``recording`` or ``run`` folds with fewer than two fit recordings or runs.
-    """
-    how = problem.identification.folds_by
-    recordings = [" + ".join(str(resolve_path(f, problem.folder)) for f in r.files) for r in problem.data.runs]
-    files = np.unique(recordings, return_inverse=True)[1]
-    groups = {"auto": files, "recording": files, "run": np.arange(files.size), "time_block": None}[how]
-    count = 0 if groups is None else np.unique(groups[fitted]).size
-    if how == "auto":
-        return groups if count >= 2 else None
-    if groups is not None and count < 2:
-        raise ExciteError(
-            "identification.folds_by",
-            f"{how} folds need fit data from two or more {how}s; the fit data come from {count}",
-            how,
-            "time_block or auto",
-        )
-    return groups
+    return [(label, cv, float(torque_errors(measured, predicted)[2][live].mean())) for label, cv, predicted in fitted]
 
 
 @dataclass
@@ -105,7 +82,7 @@ class Prepared:
     runs with fit instants, the cut-off [Hz] and its source, rows dropped per run, decimated rate [Hz],
     the fit data's q range per joint (n, 2) [rad] that guards the position-dependent effects (None
     with ``identification.position_guard`` off or no position effect among the terms), the joints
-    whose torque channel carries no signal (n,)."""
+    whose torque channel carries no signal (n,) and why, in words (one line per such joint)."""
 
     fit: Dataset
     validation: Dataset
@@ -116,6 +93,7 @@ class Prepared:
     rate: float
     q_range: np.ndarray | None
     silent: np.ndarray
+    silence: list[str]
 
 
 def prepare_data(problem: IdentifyProblem, robot: Robot, base: BaseParameters, terms: list[Term]) -> Prepared:
@@ -161,6 +139,7 @@ def prepare_data(problem: IdentifyProblem, robot: Robot, base: BaseParameters, t
         payloads,
         q_range=q_range,
     )
+    silent, silence = dead_channels(robot, base, silent, (fit, val))
     rigid_only = NormalEquations(fit, [])
     rank = excited_rank(rigid_only.system(None, [])[0])
     if rank < base.count:
@@ -181,6 +160,7 @@ def prepare_data(problem: IdentifyProblem, robot: Robot, base: BaseParameters, t
         rate,
         q_range,
         silent,
+        silence,
     )
 
 
@@ -235,10 +215,8 @@ def run_identification(
             val_data, np.concatenate([choice.consistent.base, choice.consistent.effects]), selection.terms
         )
     after = consistent if choice.is_consistent else plain
-    rms_after, rms_torque, relative_after = torque_errors(measured, after)
-    ladder = error_ladder(val_data, selection, robot.joint_names)
-    if choice.is_consistent:  # the reported model's step: the same effects, the consistent fit
-        ladder.append((choice.name, float(choice.cv_error[choice.chosen]), relative_after.mean()))
+    rms_after, rms_torque, _ = torque_errors(measured, after)
+    ladder = error_ladder(val_data, selection, robot.joint_names, ~data.silent | data.silent.all())
     report = Report(
         joints=robot.joint_names,
         base_names=base.names,
@@ -260,16 +238,16 @@ def run_identification(
         run_names=labels,
         offset_runs=offset_runs,
         ladder=ladder,
+        dead=data.silent,
         q_range=data.q_range,
         warnings=robot.warnings
         + in_sample_validation(problem.data.runs, problem.folder)
         + implausible(fit_data, base.from_standard(robot.urdf_parameters()), robot, choice.consistent)
-        + [
-            f"{robot.joint_names[j]}: the torque channel carries no signal (mostly exact zeros); left out of the "
-            "selection score"
-            for j in np.flatnonzero(data.silent)
-        ],
+        + data.silence,
     )
+    if choice.is_consistent:  # the reported model's step: the same effects, the consistent fit
+        ladder.append((choice.name, float(choice.cv_error[choice.chosen]), report.mean(report.relative_after)))
+    report.warnings += report.fit_disagreement()
     return report, robot, base, [fit_data.regressor, val_data.regressor]
 
 

@@ -32,6 +32,9 @@ from typing import Callable
 
 import numpy as np
 
+from excite_cli.config import resolve_path
+from excite_cli.errors import ExciteError
+from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.effects import Term
 from excite_cli.identification.fitting.dataset import Dataset
 from excite_cli.identification.fitting.normal import NormalEquations, solve
@@ -178,3 +181,29 @@ class CrossValidation:
         sse = self.fold_sse(terms, refit).sum(axis=0)
         per_joint = 100.0 * np.sqrt(sse / max(self.instants, 1)) / np.where(self.rms > 0, self.rms, 1.0)
         return float(per_joint[self.scored].mean()), per_joint
+
+
+def fold_groups(problem: IdentifyProblem, fitted: list[int]) -> np.ndarray | None:
+    """The cross-validation's groups (:class:`~excite_cli.identification.choice.crossval.CrossValidation`)
+    of ``identification.folds_by``: the recording (file) of each configured run, each run its own
+    group, or None for time blocks. ``auto``: recordings when the fit runs come from two or more
+    files, else time blocks.
+
+    Raises:
+        ExciteError: ``recording`` or ``run`` folds with fewer than two fit recordings or runs.
+    """
+    how = problem.identification.folds_by
+    recordings = [" + ".join(str(resolve_path(f, problem.folder)) for f in r.files) for r in problem.data.runs]
+    files = np.unique(recordings, return_inverse=True)[1]
+    groups = {"auto": files, "recording": files, "run": np.arange(files.size), "time_block": None}[how]
+    count = 0 if groups is None else np.unique(groups[fitted]).size
+    if how == "auto":
+        return groups if count >= 2 else None
+    if groups is not None and count < 2:
+        raise ExciteError(
+            "identification.folds_by",
+            f"{how} folds need fit data from two or more {how}s; the fit data come from {count}",
+            how,
+            "time_block or auto",
+        )
+    return groups

@@ -33,6 +33,7 @@ from excite_cli.identification.choice.crossval import CrossValidation
 from excite_cli.identification.choice.search import Search, Step, StepwiseSearch, coupling_weight
 from excite_cli.identification.config import IdentificationConfig, TransmissionConfig
 from excite_cli.identification.effects import EFFECTS, Term
+from excite_cli.identification.fitting.channels import without_dead_rows
 from excite_cli.identification.fitting.dataset import Dataset
 from excite_cli.identification.fitting.least_squares import Fit, joint_weights, least_squares
 from excite_cli.identification.fitting.normal import ABSORBED, NormalEquations, outside_fraction
@@ -165,7 +166,7 @@ def select_effects(
     n = fit_data.n
     candidates = [t for t in candidate_terms(cfg, n, couplings) if t not in declared and t in fit_data.blocks]
     total = NormalEquations(fit_data, declared + candidates)
-    weights = joint_weights(total, cfg.method == "wls")
+    weights = without_dead_rows(total, joint_weights(total, cfg.method == "wls"), scored)
     model = total.system(weights, declared)[0].shape[0]
     absorbed = [t for t in candidates if outside_fraction(total.system(weights, declared + [t])[0], model) < ABSORBED]
     candidates = [t for t in candidates if t not in absorbed]

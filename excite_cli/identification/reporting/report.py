@@ -14,6 +14,10 @@ from excite_cli.identification.fitting.dataset import Dataset
 from excite_cli.identification.fitting.least_squares import torque_errors
 from excite_cli.identification.fitting.physical import ConsistentFit
 
+#: [% points] of mean relative validation error by which the fit not chosen must beat the chosen one
+#: for a warning.
+DISAGREEMENT = 1.0
+
 
 @dataclass
 class Report:
@@ -43,6 +47,9 @@ class Report:
             candidates, or ``position_guard`` off).
         warnings: what the user should know, in words (a URDF inertia kept as a reference only, a
             torque channel without signal).
+        dead: (n,) the joints whose torque channel carries no signal
+            (:mod:`~excite_cli.identification.fitting.channels`): their relative errors are of the
+            model's predicted RMS torque instead of the measured one, and no mean includes them.
     """
 
     joints: list[str]
@@ -67,11 +74,30 @@ class Report:
     ladder: list[tuple[str, float, float]] = field(default_factory=list)
     q_range: np.ndarray | None = None
     warnings: list[str] = field(default_factory=list)
+    dead: np.ndarray | None = None
+
+    @property
+    def live(self) -> np.ndarray:
+        """(n,) the joints whose torque channel carries signal (every joint when all are dead)."""
+        live = np.ones(len(self.joints), dtype=bool) if self.dead is None else ~np.asarray(self.dead, dtype=bool)
+        return live if live.any() else np.ones_like(live)
+
+    def mean(self, relative: np.ndarray) -> float:
+        """The mean over the live joints of per-joint relative errors (n,) [%]."""
+        return float(np.asarray(relative)[self.live].mean())
+
+    @property
+    def reference(self) -> np.ndarray:
+        """(n,) the RMS torque [Nm] each relative error is of: the measured one, or for a dead channel
+        (or one without torque) the model's predicted RMS torque (1 Nm where that is zero too)."""
+        predicted = np.sqrt(np.mean(self.predicted_after**2, axis=0))
+        measured = np.where(self.live & (self.rms_torque > 0), self.rms_torque, predicted)
+        return np.where(measured > 0, measured, 1.0)
 
     @property
     def worse_than_rigid_body(self) -> np.ndarray:
-        """(n,) the joints whose validation error ends above the rigid body's."""
-        return self.rms_after > self.rms_before
+        """(n,) the joints with signal whose validation error ends above the rigid body's."""
+        return (self.rms_after > self.rms_before) & self.live
 
     @property
     def consistent(self) -> ConsistentFit | None:
@@ -87,12 +113,12 @@ class Report:
     @property
     def relative_before(self) -> np.ndarray:
         """(n,) RMS error / RMS torque [%] before."""
-        return 100.0 * self.rms_before / self.rms_torque
+        return 100.0 * self.rms_before / self.reference
 
     @property
     def relative_after(self) -> np.ndarray:
         """(n,) RMS error / RMS torque [%] after."""
-        return 100.0 * self.rms_after / self.rms_torque
+        return 100.0 * self.rms_after / self.reference
 
     def per_run(self) -> list[tuple[str, int, np.ndarray, np.ndarray, np.ndarray]]:
         """(run name, instants, RMS error before (n,) [Nm], after (n,) [Nm], RMS torque (n,) [Nm]) of
@@ -112,12 +138,32 @@ class Report:
     @property
     def relative_consistent(self) -> np.ndarray | None:
         """(n,) RMS error / RMS torque [%] of the physically consistent fit, or None."""
-        return None if self.rms_consistent is None else 100.0 * self.rms_consistent / self.rms_torque
+        return None if self.rms_consistent is None else 100.0 * self.rms_consistent / self.reference
 
     @property
     def relative_least_squares(self) -> np.ndarray:
         """(n,) RMS error / RMS torque [%] of the least-squares fit with effects."""
-        return 100.0 * self.rms_least_squares / self.rms_torque
+        return 100.0 * self.rms_least_squares / self.reference
+
+    def fit_disagreement(self) -> list[str]:
+        """A warning when the fit not chosen predicts the validation data better than the chosen one by
+        more than ``DISAGREEMENT`` points of mean relative error (the folds did not foresee the
+        validation motion), else nothing."""
+        if self.relative_consistent is None:
+            return []
+        chosen, name = self.mean(self.relative_after), self.fit_choice.name
+        other_name, other = (
+            ("least squares", self.relative_least_squares)
+            if self.fit_choice.is_consistent
+            else ("the consistent fit", self.relative_consistent)
+        )
+        if self.mean(other) >= chosen - DISAGREEMENT:
+            return []
+        return [
+            f"the chosen fit ({name}) predicts the validation data at {chosen:.1f} %, {other_name} at "
+            f"{self.mean(other):.1f} %: the fit data's folds did not foresee the validation motion (more or "
+            "longer fit runs, or identification.fit to choose)"
+        ]
 
     def effect_values(self, consistent: bool = False) -> list[tuple[Term, str, float, float]]:
         """(term, coefficient, value, std) for every chosen effect coefficient, in order: of the

@@ -77,6 +77,7 @@ def write_identification(
             g, "joints_worse_than_rigid_body", [report.joints[j] for j in np.flatnonzero(report.worse_than_rigid_body)]
         )
         write_strings(g, "joint_names", report.joints)
+        write_strings(g, "dead_channels", [report.joints[j] for j in np.flatnonzero(~report.live)])
         write_strings(g, "base_parameter_names", report.base_names)
         consistent, chosen = report.consistent, report.fit_choice.is_consistent
         g.create_dataset("base_parameters", data=consistent.base if chosen else sel.fit.x[:b])
@@ -183,6 +184,7 @@ def _write_fits(g: h5py.Group, report: Report) -> None:
     model compared under every fit, with J."""
     choice = report.fit_choice
     g.attrs["fit"], g.attrs["fit_lead"] = choice.name, choice.lead
+    g.attrs["least_squares_margin"] = choice.margin
     write_table(
         g,
         "fits",
@@ -197,7 +199,8 @@ def _write_fits(g: h5py.Group, report: Report) -> None:
         "models",
         [(label, m.effects, name, cv, J) for label, m, cvs, Js in rows for name, cv, J in zip(choice.names, cvs, Js)],
         "model:str effects:i4 fit:str cv_error:f8 objective:f8",
-        units="cv_error in %; objective J = log CV + effects × log(1 + min_improvement); the lowest wins",
+        units="cv_error in %; objective J = log CV + effects × log(1 + min_improvement) "
+        "(+ log(1 + least_squares_margin) for least squares); the lowest wins",
         chosen=choice.model * len(choice.names) + choice.chosen,
     )
     g.attrs["model"] = choice.labels[choice.model]
@@ -224,9 +227,9 @@ def _write_validation(g: h5py.Group, report: Report) -> None:
     )
     for row, (name, count, before, after, torque) in zip(table, runs):
         row["run"], row["instants"], row["rms_before"], row["rms_after"] = name, count, before, after
-        row["relative_after"] = 100.0 * after / np.where(torque > 0, torque, 1.0)
+        row["relative_after"] = 100.0 * after / np.where(report.live & (torque > 0), torque, report.reference)
     g.create_dataset("validation_runs", data=table).attrs["units"] = (
-        "rms in Nm; relative_after in % of the run's RMS torque"
+        "rms in Nm; relative_after in % of the run's RMS torque (a dead channel: of the predicted RMS torque)"
     )
     for name, values, unit in (
         ("rms_before", report.rms_before, "Nm"),
