@@ -168,9 +168,11 @@ class DataConfig(Section):
     angle_unit: Literal["rad", "deg"] = "rad"
     """`rad` or `deg`."""
     torque_constants: Optional[list[float]] = None
-    """Torque constants [Nm/A] per joint, with current columns."""
+    """Torque constants [Nm/A] per joint, with current columns: joint torque per unit of the column
+    (a vendor's reduction × motor constant; negative where the vendor's gain is, τ alone flips)."""
     signs: Optional[list[float]] = None
-    """1 or −1 [1] per joint, multiplying q, q̇, q̈ and τ."""
+    """1 or −1 [1] per joint, multiplying q, q̇, q̈ and τ (a joint whose zero or direction differs
+    from the URDF's; a current gain of the other sign is data.torque_constants)."""
     validation_blocks: int = Field(4, ge=2, le=100)
     """A `blocks` run is cut into this many time blocks: even ones fit, odd ones validate."""
     bad_rows: Literal["error", "drop"] = "error"
@@ -193,10 +195,10 @@ class DataConfig(Section):
     @field_validator("torque_constants")
     @classmethod
     def _nonzero(cls, values):
-        if values is not None and any(v <= 0.0 for v in values):
+        if values is not None and any(v == 0.0 or not np.isfinite(v) for v in values):
             raise ValueError(
-                "every torque constant must be > 0 Nm/A (the motor's, from its datasheet); "
-                "a motor mounted the other way round is data.signs: -1"
+                "every torque constant must be a finite number other than 0 Nm/A (the vendor's gain from "
+                "current to joint torque; negative where the vendor's is)"
             )
         return values
 

@@ -57,6 +57,20 @@ def test_headerless_csv_with_currents_and_torque_constants(tmp_path):
     _check(run)
 
 
+def test_a_vendors_negative_current_gain_flips_the_torque_alone(tmp_path):
+    """A mobile manipulator's arm motors 3–7 have negative gains (reduction × motor constant, e.g.
+    100 × −0.087 Nm/A): τ = gain × current, q, q̇ and q̈ as recorded (data.signs would flip them too)."""
+    gains = KT * np.array([1, 1, -1, -1, -1, -1, -1])
+    np.savetxt(tmp_path / "run.csv", np.column_stack([TIME, TAU / gains, Q]), delimiter=",", fmt="%.17g")
+    run = _load(
+        tmp_path,
+        "run.csv",
+        {"time": 0, "q": list(range(8, 15)), "current": list(range(1, 8))},
+        torque_constants=gains.tolist(),
+    )
+    _check(run)
+
+
 def test_npz_and_mat_runs(tmp_path):
     np.savez(tmp_path / "run.npz", t=TIME, q=Q, tau=TAU)
     _check(
