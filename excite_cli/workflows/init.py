@@ -66,7 +66,6 @@ def _identify_config(robot: dict, urdf: Path, joints: Optional[list[str]], draft
             "runs": [{"file": "runs/run_1.csv", "role": "blocks"}],
             "columns": {"time": "time", "q": [f"q_{j}" for j in active], "tau": [f"tau_{j}" for j in active]},
         },
-        "preprocessing": {"sample_rate": 200},
         "identification": {"method": "wls"},
         "output": f"results/{urdf.stem}_identify.h5",
     }
@@ -86,7 +85,11 @@ def _text(draft: StartingConfig, urdf: str, kind: str) -> str:
     lines += [f"#   {name}: {why}" for name, why in draft.assumptions.items()]
     lines += [f"#   excluded pair {a} – {b}: {why}" for a, b, why in draft.excluded]
     lines += [f"#   mounting plane ignores {link}: {why}" for link, why in draft.ignored]
-    lines.append("# Check it with `excite check` before a run; change what your lab knows better.")
+    lines.append(
+        "# Check it with `excite check` before a run; change what your lab knows better."
+        if kind == "optimize"
+        else "# Fill in data.runs and data.columns, then run `excite identify`; change what your lab knows better."
+    )
     body = yaml.dump(
         draft.config, Dumper=_Dumper, sort_keys=False, default_flow_style=False, width=100, allow_unicode=True
     )

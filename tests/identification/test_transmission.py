@@ -173,3 +173,17 @@ def test_runs_from_separate_files_a_file_without_time_and_unit_factors_give_the_
             np.testing.assert_allclose(ours.regressor, theirs.regressor, rtol=1e-7, atol=1e-9)
             for t in terms:
                 np.testing.assert_allclose(ours.blocks[t], theirs.blocks[t], rtol=1e-7, atol=1e-9)
+
+
+def test_a_joint_whose_urdf_gives_no_range_is_not_judged_by_it():
+    """A revolute joint without lower/upper in the URDF is read as [0, 0]: ±1.7 rad on it is data, not
+    motor angles; the joint beside it, with a range, is still judged."""
+    t = np.linspace(0.0, 1.0, 11)
+    q = np.column_stack([1.7 * np.sin(6.0 * t), np.zeros(11)])
+    run = Run("r.csv", "fit", t, q, None, None, q, 0)
+    velocity = np.zeros(2)
+    assert check_against_limits(run, ["a", "b"], np.zeros(2), np.zeros(2), velocity) is run
+    q[:, 1] = 40.0  # motor angles on b, whose range is [-3, 3] rad
+    with pytest.raises(ExciteError) as refused:
+        check_against_limits(run, ["a", "b"], np.array([0.0, -3.0]), np.array([0.0, 3.0]), velocity)
+    assert "b reaches 40 rad" in str(refused.value)

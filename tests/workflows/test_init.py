@@ -76,6 +76,8 @@ def test_the_identify_kind_names_the_columns_simulate_writes_and_what_to_fill_in
     assert problem.data.columns.q == [f"q_{j}" for j in problem.robot.active_joints]
     assert problem.data.columns.tau == [f"tau_{j}" for j in problem.robot.active_joints]
     assert run.plan is None and "FILL IN" in run.target.read_text()
+    assert "run `excite identify`" in run.target.read_text() and "excite check" not in run.target.read_text()
+    assert problem.preprocessing.sample_rate is None  # min(200 Hz, the data's): a 195 Hz file is not refused
     assert_refused(tmp_path, ["identify", str(run.target)], "runs/run_1.csv")  # not there yet
 
 

@@ -96,7 +96,8 @@ SILENT = 0.5
 def check_against_limits(
     run: Run, joints: list[str], lower: np.ndarray, upper: np.ndarray, velocity: np.ndarray
 ) -> Run:
-    """Refuse joint positions far outside the robot's limits (``RANGE_SLACK`` ranges beyond them) and
+    """Refuse joint positions far outside the robot's limits (``RANGE_SLACK`` ranges beyond them; a joint
+    whose URDF gives no range, lower = upper, is not judged) and
     given velocities far beyond them (``VELOCITY_SLACK`` times the limit): motor-side signals or
     another unit.
 
@@ -114,7 +115,8 @@ def check_against_limits(
     hint = "motor angles? (give data.transmission and data.motor_side: true, or data.angle_unit)"
     span = np.where(np.isfinite(upper - lower), upper - lower, 2 * np.pi)
     lo, hi = run.q.min(axis=0), run.q.max(axis=0)
-    far = (lo < lower - RANGE_SLACK * span) | (hi > upper + RANGE_SLACK * span)
+    ranged = upper > lower  # a URDF revolute joint without lower/upper (read as [0, 0]) has no range to judge by
+    far = ranged & ((lo < lower - RANGE_SLACK * span) | (hi > upper + RANGE_SLACK * span))
     if far.any():
         j = int(np.flatnonzero(far)[0])
         value = lo[j] if lo[j] < lower[j] - RANGE_SLACK * span[j] else hi[j]
