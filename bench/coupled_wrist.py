@@ -9,7 +9,7 @@ identified three ways:
 - joint-side data of the same arm without the coupling (every motor drives its own joint), nothing
   declared: no coupling should be proposed.
 
-Printed: the coupled coefficients against the truth, the couplings found, the mean relative
+Printed: the coupled motor's coefficients (inertia, Coulomb, viscous: one effect) against the truth, the couplings found, the mean relative
 validation error of the identified model and of the true model fitted on the same data.
 
     .venv/bin/python bench/coupled_wrist.py
@@ -41,6 +41,7 @@ JOINTS = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_j
 ROBOT = {"urdf": "ur_description/urdf/ur5_robot.urdf", "source": "example-robot-data", "active_joints": JOINTS}
 N = 101.0
 TRUTH = {"armature": 2e-5, "coulomb": 0.01, "viscous": 2e-5}
+MOTOR = {"armature": "Ia", "coulomb": "Fc", "viscous": "Fv"}  # a coupled motor's coefficients
 
 
 def coupling(coupled: bool) -> np.ndarray:
@@ -49,12 +50,17 @@ def coupling(coupled: bool) -> np.ndarray:
     return C
 
 
-def true_error(problem: IdentifyProblem, terms: list[Term]) -> float:
+def true_error(problem: IdentifyProblem, terms: list[Term], live: np.ndarray | None = None) -> float:
+    """Mean relative validation error [%] (over the ``live`` joints) of the model [Y_B, ``terms``]
+    fitted by weighted least squares on the fit data of ``problem`` (joints not live get weight 0)."""
     robot = load_robot(problem.robot, problem.folder, joint_rows_only=True)
     data = prepare_data(problem, robot, compute_base_parameters(robot), terms)
     normal = NormalEquations(data.fit, terms)
-    fit = least_squares(normal, terms, joint_weights(normal, True))
-    return float(torque_errors(data.validation.tau.reshape(-1, 6), predict(data.validation, fit.x, terms))[2].mean())
+    live = np.ones(data.fit.n, dtype=bool) if live is None else np.asarray(live)
+    weights = joint_weights(normal, True) * live
+    fit = least_squares(normal, terms, weights)
+    measured = data.validation.tau.reshape(-1, data.validation.n)
+    return float(torque_errors(measured, predict(data.validation, fit.x, terms))[2][live].mean())
 
 
 def main() -> None:
@@ -120,12 +126,16 @@ def main() -> None:
             )
             identify = load_problem(runs / "id.yaml", IdentifyProblem)
             report, *_ = run_identification(identify)
-            found = sorted({t.label(JOINTS).split(" ", 1)[1] for t in report.selection.terms if t.coupling is not None})
-            values = {t.effect: v for t, _, v, _ in report.effect_values() if t.coupling is not None}
-            ratios = ", ".join(f"{e} {values[e] / TRUTH[e]:.4f}" for e in TRUTH if e in values) if motor_side else ""
+            found = sorted({t.label(JOINTS) for t in report.selection.terms if t.coupling is not None})
+            values = {c: v for t, c, v, _ in report.effect_values() if t.coupling is not None}
+            ratios = (
+                ", ".join(f"{e} {values[c] / TRUTH[e]:.4f}" for e, c in MOTOR.items() if c in values)
+                if motor_side
+                else ""
+            )
             motor = tuple(N * C[5]) if motor_side else (0, 0, 0, 0, 1.0, 1.0)
             own = [Term(e, j) for e in TRUTH for j in range(5 if coupled else 6)]
-            truth = own + ([Term(e, 4, None, motor) for e in TRUTH] if coupled else [])
+            truth = own + ([Term("motor", 4, None, motor)] if coupled else [])
             print(
                 f"{name:<38} {'; '.join(found) or 'none':<48} {ratios:<34} {report.relative_after.mean():>16.2f}% "
                 f"{true_error(identify, truth):>10.2f}%",

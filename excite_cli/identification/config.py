@@ -12,13 +12,13 @@ from pydantic import Field, NonNegativeFloat, PositiveFloat, field_validator, mo
 from pydantic.json_schema import SkipJsonSchema
 
 from excite_cli.config import Problem, RobotConfig, Section
-from excite_cli.identification.effects import EFFECT_NAMES, EFFECTS, SHAPE_GRID
+from excite_cli.identification.effects import EFFECT_NAMES, SHAPE_GRID
 
 Effect = Literal[EFFECT_NAMES]
-#: The default candidates: every effect but the position-dependent ones, which, even guarded to the fit
-#: data's q range, fitted the seen phases of the real Panda run and cost on unseen ones (docs/figures.md), so
-#: they are opt-in.
-DEFAULT_CANDIDATES = tuple(e for e in EFFECT_NAMES if not EFFECTS[e].position)
+#: The default candidates: every effect. The position-dependent ones pay a higher price
+#: (``position_improvement``): at the price of the others they fitted the seen phases of the real Panda
+#: run and cost on unseen ones (docs/figures.md).
+DEFAULT_CANDIDATES = EFFECT_NAMES
 #: Default regularization weights λ of the consistent fit, among which the cross-validation chooses.
 REGULARIZATION = (1e-5, 1e-4, 1e-3, 1e-2, 1e-1)
 #: Default ratios r of the couplings q_i + r q_(i+1) the search proposes between neighbouring joints
@@ -235,7 +235,8 @@ class IdentificationConfig(Section):
     declared_effects: dict[str, list[Effect]] = Field(default_factory=dict)
     """{joint or '*': [effects]} in the model from the start, never removed."""
     candidates: list[Effect] = Field(default_factory=lambda: list(DEFAULT_CANDIDATES))
-    """Effects the search may add (the position-dependent ones only when listed)."""
+    """Effects the search may add (default all; `motor`: a motor turning with two joints, its inertia,
+    Coulomb and viscous friction together)."""
     position_guard: bool = True
     """Hold position-dependent effects at their value outside the fit data's q range."""
     folds_by: Literal["auto", "recording", "run", "time_block"] = "auto"
@@ -263,6 +264,8 @@ class IdentificationConfig(Section):
     """Ratios r [1] of the coupled-motor candidates q_i + r q_(i+1) without a transmission."""
     coupling_improvement: float = Field(0.2, ge=0.0, lt=10.0)
     """Cut [1] of the cross-validated error a coupled motor effect must buy."""
+    position_improvement: float = Field(0.25, ge=0.0, lt=10.0)
+    """Cut [1] of the cross-validated error a position-dependent effect must buy."""
 
     @field_validator("stribeck_velocity", "held_velocity", "regularization", mode="before")
     @classmethod

@@ -16,6 +16,9 @@ old sign until the joint really moves (presliding, stiction). Load-dependent Cou
 two-stage: τ_rigid is the rigid-body prediction of a first fit (geared joints whose friction grows
 with the gear load). An offset is one constant per fitted run (a torque sensor or current
 amplifier is zeroed per run); a run the fit never saw gets the mean of the fitted runs' offsets.
+A motor that turns with several joints (a coupled wrist: s = q5 + q6) is one effect, ``motor``: its
+rotor inertia, Coulomb and viscous friction in the motor coordinate enter and leave the model
+together, as the physical motor has all three.
 (Friction models: Armstrong-Hélouvry, Dupont, Canudas de Wit, Automatica 1994; load-dependent
 friction: Hamon, Gautier, Garrec, IROS 2011.)
 """
@@ -57,8 +60,9 @@ class Effect:
         per_run: one column per fitted run.
         position: its columns depend on the position, so they are guarded outside the fit data's
             q range.
-        motor: a motor's inertia or friction, which acts through a transmission: a candidate on
-            coupled motors too (:class:`Term` ``coupling``).
+        motor: a motor's inertia or friction, which acts through a transmission.
+        coupled: proposed only on motors that turn with several joints (:class:`Term` ``coupling``),
+            never as a joint's own candidate.
     """
 
     name: str
@@ -72,6 +76,7 @@ class Effect:
     per_run: bool = False
     position: bool = False
     motor: bool = False
+    coupled: bool = False
 
     def unit(self, coefficient: str) -> str:
         """The unit of one of its coefficients."""
@@ -104,6 +109,14 @@ EFFECTS = {
         Effect("spring", ("k",), ("Nm/rad",), lambda s: [s.q], position=True),
         Effect("gravity_compensator", ("gs", "gc"), ("Nm", "Nm"), lambda s: [np.sin(s.q), np.cos(s.q)], position=True),
         Effect("position_2", ("gs2", "gc2"), ("Nm", "Nm"), lambda s: [np.sin(2 * s.q), np.cos(2 * s.q)], position=True),
+        Effect(
+            "motor",
+            ("Ia", "Fc", "Fv"),
+            ("kg·m²", "Nm", "Nm·s/rad"),
+            lambda s: [s.qdd, s.sign, s.qd],
+            motor=True,
+            coupled=True,
+        ),
     )
 }
 EFFECT_NAMES = tuple(EFFECTS)
@@ -168,10 +181,15 @@ class Term(NamedTuple):
         return text
 
     def label(self, joints: list[str]) -> str:
-        """e.g. ``held panda_joint7 (v_h 0.1 rad/s)``, ``armature motor of j5 + j6``."""
+        """e.g. ``held panda_joint7 (v_h 0.1 rad/s)``, ``motor of j5 + j6`` (its inertia, Coulomb and
+        viscous friction), ``motor panda_joint4`` (a joint's own, declared)."""
         shape = f" ({self.kind.shape} {self.shape:g} rad/s)" if self.shape else ""
         where = self.where(joints) if self.coupling is None else f"motor of {self.where(joints)}"
-        return f"{self.effect} {where}{shape}"
+        return (
+            f"{where}{shape}"
+            if self.effect == "motor" and self.coupling is not None
+            else f"{self.effect} {where}{shape}"
+        )
 
 
 def held_sign(qd: np.ndarray, held_velocity: float) -> np.ndarray:

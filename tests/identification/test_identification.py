@@ -15,7 +15,7 @@ from typer.testing import CliRunner
 from excite_cli.cli import app
 from excite_cli.config_file import load_problem
 from excite_cli.h5 import read_strings, write_strings
-from excite_cli.identification.config import DEFAULT_CANDIDATES, IdentifyProblem
+from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.effects import EFFECT_NAMES, EFFECTS, effect_columns
 from excite_cli.identification.fitting.dataset import run_offset_columns
 from excite_cli.identification.measured.measurements import load_run
@@ -86,9 +86,11 @@ def test_run_offsets_are_indicators_or_the_mean_for_an_unfitted_run():
     np.testing.assert_array_equal(run_offset_columns(1, [0, 2], 2, 2), [[0.5, 0.5]] * 2)
 
 
-def _simulate(tmp: Path, optimized: Path, effects: dict, candidates: list | None = None, **extra) -> IdentifyProblem:
+def _simulate(
+    tmp: Path, optimized: Path, effects: dict, candidates: list | None = None, settings: dict | None = None, **extra
+) -> IdentifyProblem:
     """Three simulated runs of ``optimized`` with ``effects`` in ``tmp`` and their identify config
-    (``identify.yaml``), loaded."""
+    (``identify.yaml``, with ``candidates`` and other identification ``settings``), loaded."""
     # 8 periods per run and time blocks in every run: ~720 independent held-out samples per joint
     # at the 5 Hz cut-off, so each joint's RMS is known to ~2.6 % (1 sigma)
     sim = {
@@ -112,17 +114,22 @@ def _simulate(tmp: Path, optimized: Path, effects: dict, candidates: list | None
         },
         "output": str(tmp / "ident.h5"),
     }
-    if candidates is not None:
-        config["identification"] = {"candidates": candidates}
+    config["identification"] = {**(settings or {}), **({"candidates": candidates} if candidates is not None else {})}
     return load_problem(write_config(tmp, config, "identify.yaml"), IdentifyProblem)
 
 
 def _simulate_and_identify(
-    tmp: Path, optimized: Path, effects: dict, candidates: list | None = None, consistent: bool = False, **sim_extra
+    tmp: Path,
+    optimized: Path,
+    effects: dict,
+    candidates: list | None = None,
+    consistent: bool = False,
+    settings: dict | None = None,
+    **sim_extra,
 ):
     """:func:`_simulate` and identify (the consistent fit beside with ``consistent``): report, robot,
     base, the torque noise level after preprocessing [Nm] and the problem."""
-    problem = _simulate(tmp, optimized, effects, candidates, **sim_extra)
+    problem = _simulate(tmp, optimized, effects, candidates, settings, **sim_extra)
     report, robot, base, _ = run_identification(problem, consistent_beside=consistent)
     # noise level after the same preprocessing: white noise through the same filter
     runs = [load_run(r, problem.data, problem.robot.active_joints, problem.folder) for r in problem.data.runs]
@@ -179,8 +186,10 @@ def test_no_effect_in_the_data_adds_none(tmp_path, optimized, candidates):
     assert np.allclose(report.rms_before, report.rms_after, rtol=0.01 if report.fit_choice.is_consistent else 1e-5)
 
 
-#: Each effect undeclared in simulated data (with the simulation's shape velocities), and whether it
-#: needs to be listed in the candidates (the position-dependent ones are opt-in).
+#: Each effect undeclared in simulated data (with the simulation's shape velocities), found with the
+#: default candidates (the position-dependent ones among them since issue 42, here at the price of the
+#: others: at the default position_improvement the 0.4 / −0.3 Nm sin/cos term on joint 1 is taken as
+#: a per-run offset, −0.23 to −0.07 Nm; bench/identify_transfer.py finds a spring with the defaults).
 NEW_EFFECTS = {
     "held": ({"held": {"panda_joint4": 1.0}}, {"held_velocity": 0.1}),
     "load_coulomb": ({"load_coulomb": {"panda_joint2": 0.05, "panda_joint4": 0.05}}, {}),
@@ -195,8 +204,8 @@ NEW_EFFECTS = {
 @pytest.mark.parametrize("case", list(NEW_EFFECTS))
 def test_each_undeclared_effect_is_named_with_its_value_and_shape(tmp_path, optimized, case):
     effects, shapes = NEW_EFFECTS[case]
-    opt_in = list(DEFAULT_CANDIDATES) + [case] if EFFECTS[case].position else None
-    report, *_ = _simulate_and_identify(tmp_path, optimized, effects, opt_in, **shapes)
+    price = {"position_improvement": 0.02} if EFFECTS[case].position else {}
+    report, *_ = _simulate_and_identify(tmp_path, optimized, effects, settings=price, **shapes)
     truth = {
         (e, c, j): v
         for e, per_joint in effects.items()

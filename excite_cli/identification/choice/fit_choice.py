@@ -168,7 +168,7 @@ def compared_models(selection: Selection) -> list[Model]:
         search = selection.searches[k]
         for at_start, terms in ((False, search.terms), (True, search.initial)):
             if all(set(terms) != set(m.terms) for m in out):
-                p = effect_count(list(terms), selection.declared, selection.coupling_weight)
+                p = effect_count(list(terms), selection.declared, selection.effect_weights)
                 out.append(Model(k, search.start, at_start, list(terms), p))
     return out
 

@@ -3,7 +3,8 @@
     J(M) = log CV(M) + p(M) · log(1 + min_improvement),
 
 p(M) the effects the search added, a coupled one counting as log(1 + coupling_improvement) /
-log(1 + min_improvement) effects. A move adds a candidate whose prerequisites are in the model,
+log(1 + min_improvement) effects and a position-dependent one as log(1 + position_improvement) /
+log(1 + min_improvement). A move adds a candidate whose prerequisites are in the model,
 removes an added term nothing depends on, or moves a Stribeck or held term along its velocity grid
 or a coupled term along its ratio grid (paying an effect's price, or it would chase noise for free);
 the move that lowers J most is taken until none does.
@@ -71,16 +72,21 @@ class Search:
     stop: str = ""
 
 
-def effect_count(terms: list[Term], declared: int, coupling_weight: float) -> float:
+def effect_count(terms: list[Term], declared: int, weights: tuple[float, float]) -> float:
     """p: the effects ``terms`` add beyond their first ``declared``, a coupled one counting as
-    ``coupling_weight`` effects (its price is log(1 + ``coupling_improvement``): it ties two joints
-    and, unlike a joint's own effect, could stand in for effects of both)."""
-    return sum(coupling_weight if t.coupling is not None else 1.0 for t in terms[declared:])
+    ``weights[0]`` effects (its price is log(1 + ``coupling_improvement``): it ties two joints and,
+    unlike a joint's own effect, could stand in for effects of both) and a position-dependent one as
+    ``weights[1]`` (log(1 + ``position_improvement``): a function of q can follow a residual of the
+    positions the fit data visit, whatever its cause)."""
+    coupled, position = weights
+    return sum(coupled if t.coupling is not None else position if t.kind.position else 1.0 for t in terms[declared:])
 
 
-def coupling_weight(cfg: IdentificationConfig) -> float:
-    """How many effects a coupled one counts as: log(1 + coupling_improvement) / log(1 + min_improvement)."""
-    return float(np.log1p(cfg.coupling_improvement) / max(np.log1p(cfg.min_improvement), 1e-12))
+def effect_weights(cfg: IdentificationConfig) -> tuple[float, float]:
+    """How many effects a coupled and a position-dependent one count as: log(1 + coupling_improvement)
+    and log(1 + position_improvement) over log(1 + min_improvement)."""
+    unit = max(np.log1p(cfg.min_improvement), 1e-12)
+    return float(np.log1p(cfg.coupling_improvement) / unit), float(np.log1p(cfg.position_improvement) / unit)
 
 
 def objective(cv_error, effects, min_improvement: float):
@@ -111,7 +117,7 @@ class StepwiseSearch:
         return self.cache[key]
 
     def objective(self, terms: list[Term], error: float) -> float:
-        p = effect_count(terms, len(self.declared), coupling_weight(self.cfg))
+        p = effect_count(terms, len(self.declared), effect_weights(self.cfg))
         return float(objective(error, p, self.cfg.min_improvement))
 
     def cost(self, move: str, terms: list[Term], error: float) -> float:

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from excite_cli.identification.choice.crossval import CrossValidation
-from excite_cli.identification.choice.search import Search, Step, StepwiseSearch, coupling_weight
+from excite_cli.identification.choice.search import Search, Step, StepwiseSearch, effect_weights
 from excite_cli.identification.config import IdentificationConfig, TransmissionConfig
 from excite_cli.identification.effects import EFFECTS, Term
 from excite_cli.identification.fitting.channels import without_dead_rows
@@ -63,8 +63,8 @@ class Selection:
             :mod:`~excite_cli.identification.choice.fit_choice`).
         absorbed: candidates skipped as not separately identifiable.
         cross_validation: the folds every model was scored on, for scoring other fits of the model.
-        min_improvement: the price of an effect (a fraction); coupling_weight: the effects a coupled
-            one counts as (:func:`effect_count`).
+        min_improvement: the price of an effect (a fraction); effect_weights: the effects a coupled
+            and a position-dependent one count as (:func:`effect_count`).
         normal: the fit data's normal equations (every candidate), for refitting other models.
     """
 
@@ -82,7 +82,7 @@ class Selection:
     cross_validation: CrossValidation
     min_improvement: float
     normal: NormalEquations
-    coupling_weight: float = 1.0
+    effect_weights: tuple[float, float] = (1.0, 1.0)
     at_start: bool = False
 
     @property
@@ -103,20 +103,17 @@ class Selection:
 
 def candidate_terms(cfg: IdentificationConfig, n: int, couplings: list[tuple[float, ...]] = ()) -> list[Term]:
     """Every candidate term: each candidate effect on each joint, one per shape of shaped effects,
-    and each candidate motor effect (inertia, Coulomb and viscous friction) on each motor coordinate
-    of ``couplings`` ((n,) weights each, :func:`motor_couplings`)."""
+    and with ``motor`` among the candidates a whole motor (its inertia, Coulomb and viscous friction
+    together) on each motor coordinate of ``couplings`` ((n,) weights each, :func:`motor_couplings`)."""
     single = [
         Term(e, j, s)
         for e in cfg.candidates
+        if not EFFECTS[e].coupled
         for j in range(n)
         for s in (getattr(cfg, EFFECTS[e].shape_field) if EFFECTS[e].shape_field else [None])
     ]
-    coupled = [
-        Term(e, int(np.flatnonzero(c)[0]), None, tuple(float(x) for x in c))
-        for c in couplings
-        for e in cfg.candidates
-        if EFFECTS[e].motor and not EFFECTS[e].shape_field
-    ]
+    motors = [e for e in cfg.candidates if EFFECTS[e].coupled]
+    coupled = [Term(e, int(np.flatnonzero(c)[0]), None, tuple(float(x) for x in c)) for c in couplings for e in motors]
     return single + coupled
 
 
@@ -198,5 +195,5 @@ def select_effects(
         cross_validation=cv,
         min_improvement=cfg.min_improvement,
         normal=total,
-        coupling_weight=coupling_weight(cfg),
+        effect_weights=effect_weights(cfg),
     )
