@@ -217,6 +217,9 @@ def run_identification(
     after = consistent if choice.is_consistent else plain
     rms_after, rms_torque, _ = torque_errors(measured, after)
     ladder = error_ladder(val_data, selection, robot.joint_names, ~data.silent | data.silent.all())
+    for d in (fit_data, val_data):  # the candidates not chosen are no longer needed: released before the report
+        for t in [t for t in d.blocks if t not in selection.terms]:
+            del d.blocks[t]
     report = Report(
         joints=robot.joint_names,
         base_names=base.names,
