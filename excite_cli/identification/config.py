@@ -256,8 +256,8 @@ class IdentificationConfig(Section):
     fit: Literal["auto", "least_squares", "consistent"] = "auto"
     """The reported fit: `auto` (chosen by cross-validation), `least_squares` or `consistent`."""
     least_squares_margin: float = Field(0.5, ge=0.0, lt=10.0)
-    """Cut [1] of the cross-validated error least squares must buy over a model's best physically
-    consistent fit to be chosen with `fit: auto` (a fraction; 0: the lower error wins)."""
+    """m [1]: with `fit: auto`, least squares is chosen only where a model's best physically consistent
+    fit has a cross-validated error (1 + m) times least squares' or more (0: the lower error wins)."""
     regularization: list[NonNegativeFloat] = Field(default_factory=lambda: list(REGULARIZATION), min_length=1)
     """λ [1] of the consistent fit (weight of the distance to the URDF's parameters); a list to pick from."""
     coupling_ratios: list[float] = Field(default_factory=lambda: list(COUPLING_RATIOS))
