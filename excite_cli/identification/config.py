@@ -168,11 +168,9 @@ class DataConfig(Section):
     angle_unit: Literal["rad", "deg"] = "rad"
     """`rad` or `deg`."""
     torque_constants: Optional[list[float]] = None
-    """Torque constants [Nm/A] per joint, with current columns: joint torque per unit of the column
-    (a vendor's reduction × motor constant; negative where the vendor's gain is, τ alone flips)."""
+    """Joint torque per unit of current [Nm/A] per joint (a vendor's gain: may be negative, τ alone flips)."""
     signs: Optional[list[float]] = None
-    """1 or −1 [1] per joint, multiplying q, q̇, q̈ and τ (a joint whose zero or direction differs
-    from the URDF's; a current gain of the other sign is data.torque_constants)."""
+    """1 or −1 [1] per joint, multiplying q, q̇, q̈ and τ (a joint turning the other way than the URDF's)."""
     validation_blocks: int = Field(4, ge=2, le=100)
     """A `blocks` run is cut into this many time blocks: even ones fit, odd ones validate."""
     bad_rows: Literal["error", "drop"] = "error"
@@ -235,8 +233,7 @@ class IdentificationConfig(Section):
     declared_effects: dict[str, list[Effect]] = Field(default_factory=dict)
     """{joint or '*': [effects]} in the model from the start, never removed."""
     candidates: list[Effect] = Field(default_factory=lambda: list(DEFAULT_CANDIDATES))
-    """Effects the search may add (default all; `motor`: a motor turning with two joints, its inertia,
-    Coulomb and viscous friction together)."""
+    """Effects the search may add (default all; `motor`: a coupled motor's inertia and friction together)."""
     position_guard: bool = True
     """Hold position-dependent effects at their value outside the fit data's q range."""
     folds_by: Literal["auto", "recording", "run", "time_block"] = "auto"
@@ -256,8 +253,7 @@ class IdentificationConfig(Section):
     fit: Literal["auto", "least_squares", "consistent"] = "auto"
     """The reported fit: `auto` (chosen by cross-validation), `least_squares` or `consistent`."""
     least_squares_margin: float = Field(0.5, ge=0.0, lt=10.0)
-    """m [1]: with `fit: auto`, least squares is chosen only where a model's best physically consistent
-    fit has a cross-validated error (1 + m) times least squares' or more (0: the lower error wins)."""
+    """m [1]: `fit: auto` takes least squares only where the consistent fit's CV error is ≥ (1 + m) × its own."""
     regularization: list[NonNegativeFloat] = Field(default_factory=lambda: list(REGULARIZATION), min_length=1)
     """λ [1] of the consistent fit (weight of the distance to the URDF's parameters); a list to pick from."""
     coupling_ratios: list[float] = Field(default_factory=lambda: list(COUPLING_RATIOS))

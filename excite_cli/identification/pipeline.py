@@ -198,7 +198,7 @@ def run_identification(
         declared,
         margin=1.0 / data.cutoff,
         oversampling=oversampling,
-        recordings=fold_groups(problem, data.fitted),
+        recordings=fold_groups(problem.data.runs, problem.folder, cfg.folds_by, data.fitted),
         fitted_offsets=set(np.unique(val_data.run).tolist()) <= set(data.fitted),
         couplings=couplings,
         scored=~data.silent,

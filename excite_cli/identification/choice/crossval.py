@@ -28,13 +28,14 @@ of its own size, whatever the number of samples.
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Callable
 
 import numpy as np
 
 from excite_cli.config import resolve_path
 from excite_cli.errors import ExciteError
-from excite_cli.identification.config import IdentifyProblem
+from excite_cli.identification.config import RunConfig
 from excite_cli.identification.effects import Term
 from excite_cli.identification.fitting.dataset import Dataset
 from excite_cli.identification.fitting.normal import NormalEquations, solve
@@ -183,17 +184,16 @@ class CrossValidation:
         return float(per_joint[self.scored].mean()), per_joint
 
 
-def fold_groups(problem: IdentifyProblem, fitted: list[int]) -> np.ndarray | None:
-    """The cross-validation's groups (:class:`~excite_cli.identification.choice.crossval.CrossValidation`)
-    of ``identification.folds_by``: the recording (file) of each configured run, each run its own
-    group, or None for time blocks. ``auto``: recordings when the fit runs come from two or more
-    files, else time blocks.
+def fold_groups(runs: list[RunConfig], folder: Path | None, how: str, fitted: list[int]) -> np.ndarray | None:
+    """The cross-validation's groups (:class:`CrossValidation`) of ``identification.folds_by``
+    (``how``): the recording (file) of each configured run (``data.runs``, files relative to
+    ``folder``), each run its own group, or None for time blocks. ``auto``: recordings when the fit
+    runs (indices ``fitted``) come from two or more files, else time blocks.
 
     Raises:
         ExciteError: ``recording`` or ``run`` folds with fewer than two fit recordings or runs.
     """
-    how = problem.identification.folds_by
-    recordings = [" + ".join(str(resolve_path(f, problem.folder)) for f in r.files) for r in problem.data.runs]
+    recordings = [" + ".join(str(resolve_path(f, folder)) for f in r.files) for r in runs]
     files = np.unique(recordings, return_inverse=True)[1]
     groups = {"auto": files, "recording": files, "run": np.arange(files.size), "time_block": None}[how]
     count = 0 if groups is None else np.unique(groups[fitted]).size
