@@ -46,21 +46,11 @@ def _check(run, dropped=0):
     assert run.dropped == dropped
 
 
-def test_headerless_csv_with_currents_and_torque_constants(tmp_path):
-    np.savetxt(tmp_path / "run.csv", np.column_stack([TIME, TAU / KT, Q]), delimiter=",", fmt="%.17g")
-    run = _load(
-        tmp_path,
-        "run.csv",
-        {"time": 0, "q": list(range(8, 15)), "current": list(range(1, 8))},
-        torque_constants=KT.tolist(),
-    )
-    _check(run)
-
-
-def test_a_vendors_negative_current_gain_flips_the_torque_alone(tmp_path):
-    """A mobile manipulator's arm motors 3–7 have negative gains (reduction × motor constant, e.g.
-    100 × −0.087 Nm/A): τ = gain × current, q, q̇ and q̈ as recorded (data.signs would flip them too)."""
-    gains = KT * np.array([1, 1, -1, -1, -1, -1, -1])
+@pytest.mark.parametrize("signs", [[1] * 7, [1, 1, -1, -1, -1, -1, -1]], ids=["positive", "vendor-negative"])
+def test_headerless_csv_with_currents_and_torque_constants(tmp_path, signs):
+    """τ = gain × current; a vendor's negative gains (a mobile manipulator's arm motors 3–7: reduction ×
+    motor constant, e.g. 100 × −0.087 Nm/A) flip τ alone, q as recorded (data.signs would flip it too)."""
+    gains = KT * np.array(signs)
     np.savetxt(tmp_path / "run.csv", np.column_stack([TIME, TAU / gains, Q]), delimiter=",", fmt="%.17g")
     run = _load(
         tmp_path,
