@@ -33,7 +33,7 @@ from excite_cli.identification.measured.payload import payload_parameters
 from excite_cli.identification.measured.preprocessing import choose_cutoff, preprocess
 from excite_cli.identification.reporting.report import Report
 from excite_cli.identification.reporting.urdf_out import urdf_deviation, write_urdf
-from excite_cli.memory import return_freed_memory
+from excite_cli.memory import return_freed_memory, trim_freed_memory
 
 
 def declared_terms(problem: IdentifyProblem, robot: Robot) -> list[Term]:
@@ -220,6 +220,7 @@ def run_identification(
     for d in (fit_data, val_data):  # the candidates not chosen are no longer needed: released before the report
         for t in [t for t in d.blocks if t not in selection.terms]:
             del d.blocks[t]
+    trim_freed_memory()
     report = Report(
         joints=robot.joint_names,
         base_names=base.names,
