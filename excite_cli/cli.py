@@ -7,16 +7,18 @@ from typing import Optional
 import typer
 from rich.markup import escape
 
-from excite_cli import workflows
-from excite_cli.config_file import load_problem, with_overrides
-from excite_cli.console import identification as identify_tables
-from excite_cli.console import model_files, tables
+from excite_cli import console, workflows
 from excite_cli.console.app import FORCE, SCHEDULER, WORKERS, app, command, err, out, say
 from excite_cli.console.progress import Bars
-from excite_cli.identification.config import IdentifyProblem
-from excite_cli.identification.simulation_config import SimulationConfig
-from excite_cli.optimization.criterion import OBJECTIVES
-from excite_cli.storage.export import FORMATS
+from excite_cli.optimization.objectives import OBJECTIVES
+from excite_cli.storage.formats import FORMATS
+
+
+def _load(path: Path, overrides: Optional[dict] = None, kind: str = "optimize"):
+    """The ``kind`` config at ``path`` with the options' ``overrides`` (:func:`load_config`)."""
+    from excite_cli.config_file import load_config  # here, not at start-up
+
+    return load_config(path, overrides, kind)
 
 
 def _version(show: bool) -> None:
@@ -49,8 +51,8 @@ def optimize(
     dry_run: bool = typer.Option(False, "--dry-run", help="Build the problem and say what would run (as `check`)."),
 ) -> None:
     """Optimize Fourier trajectories minimizing cond(C), sequentially; the result is rewritten after every iteration."""
-    problem = with_overrides(
-        load_problem(config),
+    problem = _load(
+        config,
         {
             "sequence.iterations": iterations,
             "optimizer.seed": seed,
@@ -59,11 +61,11 @@ def optimize(
         },
     )
     if dry_run:
-        return say(tables.plan(workflows.plan_optimize(problem)))
+        return say(console.tables.plan(workflows.plan_optimize(problem)))
     with Bars(err) as bars:
         run = workflows.run_optimize(problem, output or Path(problem.output), force, resume, *bars.iterations(problem))
     say(
-        tables.iterations(run.results, problem.optimizer),
+        console.tables.iterations(run.results, problem.optimizer),
         f"wrote {run.target} and {', '.join(str(p) for p in run.plots)}",
     )
     if run.warning:
@@ -84,7 +86,7 @@ def init(
     """A starting config for your robot from its URDF: joints, limits, capsules, mounting plane, home posture."""
     with err.status("fitting capsules and searching postures ..."):
         run = workflows.run_init(urdf, output or Path(f"{Path(urdf).stem}.yaml"), joints, kind, force)
-    say(tables.initialized(run))
+    say(console.tables.initialized(run))
 
 
 @command()
@@ -105,8 +107,8 @@ def check(
     """What `optimize` would run, not running it: joints, base parameters, constraints, time; exit 2 if refused."""
     overrides = {"sequence.iterations": iterations, "optimizer.workers": workers}
     with err.status("building the problem ..."):
-        plan = workflows.plan_optimize(with_overrides(load_problem(config), overrides))
-    say(tables.plan(plan))
+        plan = workflows.plan_optimize(_load(config, overrides))
+    say(console.tables.plan(plan))
 
 
 @command("compare-random")
@@ -126,8 +128,8 @@ def compare_random(
     force: bool = FORCE,
 ) -> None:
     """The conventional baseline (ref. [16]): random feasible trajectories, greedy selection, beside the optimum."""
-    problem = with_overrides(
-        load_problem(config),
+    problem = _load(
+        config,
         {
             "random_baseline.pool_size": pool,
             "random_baseline.seed": seed,
@@ -146,7 +148,7 @@ def compare_random(
             progress,
             bars.draws(None if equal_effort else problem.random_baseline.pool_size),
         )
-    say(tables.comparison(comparison), f"wrote {comparison.target} and {comparison.plot}")
+    say(console.tables.comparison(comparison), f"wrote {comparison.target} and {comparison.plot}")
 
 
 @command("verify-gradient")
@@ -163,8 +165,8 @@ def verify_gradient(
     tolerance: float = typer.Option(1e-6, help="Largest relative error against central differences that passes."),
 ) -> None:
     """Analytic gradients (Eq. 49) and constraint Jacobians against finite differences; exit 1 above the tolerance."""
-    verification = workflows.run_verify(load_problem(config), result, objective or OBJECTIVES, step, seed, tolerance)
-    say(tables.verification(verification, tolerance))
+    verification = workflows.run_verify(_load(config), result, objective or OBJECTIVES, step, seed, tolerance)
+    say(console.tables.verification(verification, tolerance))
     if verification.worst > tolerance:
         raise typer.Exit(1)
 
@@ -183,15 +185,15 @@ def identify(
     force: bool = FORCE,
 ) -> None:
     """Identify base parameters (Eq. 4), trace the residual to missing effects, report the error before/after."""
-    problem = with_overrides(load_problem(config, IdentifyProblem), {"identification.fit": fit})
+    problem = _load(config, {"identification.fit": fit}, "identify")
     with err.status("preprocessing, fitting and selecting effects ..."):
         run = workflows.run_identify(problem, output or Path(problem.output), urdf_out, force, mjcf_out)
-    say(identify_tables.preprocessing_notes(run.report), console=err)
+    say(console.identification.preprocessing_notes(run.report), console=err)
     say(
-        identify_tables.identification(run.report),
-        [identify_tables.bodies(run.report, run.robot)] if run.report.consistent else [],
-        [model_files.urdf_written(run)] if urdf_out else [],
-        model_files.mjcf_written(run) if mjcf_out else [],
+        console.identification.identification(run.report),
+        [console.identification.bodies(run.report, run.robot)] if run.report.consistent else [],
+        [console.model_files.urdf_written(run)] if urdf_out else [],
+        console.model_files.mjcf_written(run) if mjcf_out else [],
         f"wrote {run.target} and {', '.join(str(p) for p in run.plots)}",
     )
 
@@ -208,7 +210,7 @@ def export(
 ) -> None:
     """Write a trajectory as a robot plays it: home → P periods → home, at the controller's rate, with torques."""
     exported, target = workflows.run_export(result, iteration, rate, periods, fmt, output, force)
-    say(tables.export_lines(exported, rate), f"wrote {target}")
+    say(console.tables.export_lines(exported, rate), f"wrote {target}")
 
 
 @command()
@@ -231,7 +233,7 @@ def validate(
     """Score an identified model on other runs: torque error per run and joint, on data its fit never saw."""
     with err.status("preprocessing and predicting ..."):
         problem, errors = workflows.run_validate(report, config)
-    say(identify_tables.validation(report.name, problem.robot.active_joints, errors))
+    say(console.identification.validation(report.name, problem.robot.active_joints, errors))
 
 
 @command()
@@ -242,5 +244,5 @@ def simulate(
     force: bool = FORCE,
 ) -> None:
     """Measured-like CSV runs (one per iteration) of a result, with the effects and noise of an effects file."""
-    files = workflows.simulate_runs(result, load_problem(effects, SimulationConfig, "effects"), output_dir, force=force)
+    files = workflows.simulate_runs(result, _load(effects, kind="effects"), output_dir, force=force)
     say("wrote " + ", ".join(str(f) for f in files))

@@ -206,3 +206,20 @@ def with_overrides(config: BaseModel, overrides: dict[str, object]) -> BaseModel
         if name in type(config).model_fields:
             setattr(copy, name, getattr(config, name))
     return copy
+
+
+def load_config(path: str | Path, overrides: dict[str, object] | None = None, kind: str = "optimize") -> BaseModel:
+    """The config of ``kind`` at ``path``: ``optimize`` (:class:`Problem`), ``identify``
+    (:class:`~excite_cli.identification.config.IdentifyProblem`) or ``effects``
+    (:class:`~excite_cli.identification.simulation_config.SimulationConfig`), validated, with the
+    command line's ``overrides`` (:func:`with_overrides`; none: the file as read).
+
+    Raises:
+        ExciteError: as :func:`load_problem` and :func:`with_overrides`.
+    """
+    from excite_cli.identification.config import IdentifyProblem
+    from excite_cli.identification.simulation_config import SimulationConfig
+
+    model = {"identify": IdentifyProblem, "effects": SimulationConfig}.get(kind, Problem)
+    problem = load_problem(path, model, "effects" if kind == "effects" else "config")
+    return with_overrides(problem, overrides) if overrides else problem

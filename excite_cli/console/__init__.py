@@ -1,1 +1,14 @@
-"""What the command line prints: tables and progress bars (rich)."""
+"""What the command line prints: tables and progress bars (rich).
+
+The table modules are imported on first use (PEP 562): they import the studies whose results they
+print, which ``excite --help`` and ``--version`` need not load."""
+
+from importlib import import_module
+
+_LAZY = ("identification", "model_files", "tables")
+
+
+def __getattr__(name: str):
+    if name not in _LAZY:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    return import_module(f"{__name__}.{name}")

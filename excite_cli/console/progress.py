@@ -4,16 +4,17 @@ when the output is a log rather than a terminal; a bar for random draws."""
 
 from __future__ import annotations
 
+import math
 import sys
-from typing import Callable
+from typing import TYPE_CHECKING, Callable
 
-import numpy as np
 from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
-from excite_cli.config import Problem
-from excite_cli.optimization.optimizer import ProgressHook
-from excite_cli.optimization.sequence import IterationResult
+if TYPE_CHECKING:  # annotations only: the command line's frame imports this module at start-up
+    from excite_cli.config import Problem
+    from excite_cli.optimization.optimizer import ProgressHook
+    from excite_cli.optimization.sequence import IterationResult
 
 #: Width of printed tables where the output is not a terminal (a log, a pipe): rich's default of 80
 #: columns would cut their numbers.
@@ -61,7 +62,7 @@ class Bars:
         (the objective at the current iterate) and ``done(result)`` per finished iteration."""
         opts, bar = problem.optimizer, self.bar
         label = "cond" if opts.objective in ("cond", "log_cond") else opts.objective
-        shown = np.exp if opts.objective == "log_cond" else (lambda v: v)
+        shown = math.exp if opts.objective == "log_cond" else (lambda v: v)
         tasks: dict[int, int] = {}
 
         def progress(k: int) -> ProgressHook:

@@ -30,6 +30,7 @@ from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.dynamics.robot import Robot
 from excite_cli.dynamics.virtual_dynamics import VirtualDynamics
 from excite_cli.errors import ExciteError
+from excite_cli.optimization.objectives import OBJECTIVES
 from excite_cli.trajectory.fourier import FourierBasis
 
 #: σ_b is floored at this fraction of σ₁, so rank loss gives a large finite value, never NaN.
@@ -42,14 +43,6 @@ def condition_number(C: np.ndarray) -> float:
         return float("inf")
     s = np.linalg.svd(C, compute_uv=False)
     return float(s[0] / s[-1]) if s[-1] > 0 else float("inf")
-
-
-#: The criteria of ``optimizer.objective``: the condition number (Eq. 5) or its log, D-optimality
-#: (−log det(CᵀC) / b, the mean log eigenvalue of the information matrix, maximized),
-#: E-optimality (−log σ_min(C), the smallest singular value maximized), after the paper's ref. [20],
-#: and A-optimality (½ log(tr((CᵀC)⁻¹) / b), the log of the RMS of 1/σ_i: least squares' RMS parameter
-#: error per unit of torque noise, minimized; Pukelsheim, Optimal Design of Experiments, 1993).
-OBJECTIVES = ("cond", "log_cond", "log_det", "sigma_min", "log_trace_inverse")
 
 
 def objective_terms(objective: str, eigenvalues: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:

@@ -19,6 +19,7 @@ from excite_cli.config_file import with_overrides
 from excite_cli.errors import ExciteError
 from excite_cli.optimization.excitation import build_excitation
 from excite_cli.optimization.playback import check_motion, plan_playback
+from excite_cli.storage.formats import FORMATS
 from excite_cli.storage.results import problem_of_result, read_alphas
 
 #: Highest export rate accepted [Hz] (memory grows with rate × duration).
@@ -27,8 +28,6 @@ MAX_RATE = 100_000.0
 MAX_PERIODS = 1000
 #: Most samples in one file (about 1.3 GB of CSV with 7 joints).
 MAX_SAMPLES = 20_000_000
-#: File formats and their file-name endings (``ros2``: a FollowJointTrajectory goal as YAML).
-FORMATS = {"csv": "csv", "npz": "npz", "ros2": "yaml"}
 
 
 @dataclass(frozen=True)

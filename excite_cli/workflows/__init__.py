@@ -1,27 +1,29 @@
-"""One library function per study a command runs; they check their output paths before computing."""
+"""One library function per study a command runs; they check their output paths before computing.
 
-from excite_cli.workflows.check import plan_optimize
-from excite_cli.workflows.compare import run_compare_random
-from excite_cli.workflows.export import run_export
-from excite_cli.workflows.identify import run_identify
-from excite_cli.workflows.init import run_init
-from excite_cli.workflows.optimize import run_optimize
-from excite_cli.workflows.schema import run_schema
-from excite_cli.workflows.simulate import simulate_runs
-from excite_cli.workflows.validate import run_validate
-from excite_cli.workflows.verify_gradient import run_verify
-from excite_cli.workflows.view import run_view
+Imported on first use (PEP 562): ``excite --help`` and ``--version`` load none of them, and a command
+loads only its own study's modules (scipy, matplotlib, cvxpy where it needs them)."""
 
-__all__ = [
-    "plan_optimize",
-    "run_compare_random",
-    "run_export",
-    "run_identify",
-    "run_init",
-    "run_optimize",
-    "run_schema",
-    "run_validate",
-    "run_verify",
-    "run_view",
-    "simulate_runs",
-]
+from importlib import import_module
+
+#: Each function and the module of this package that defines it.
+_MODULES = {
+    "plan_optimize": "check",
+    "run_compare_random": "compare",
+    "run_export": "export",
+    "run_identify": "identify",
+    "run_init": "init",
+    "run_optimize": "optimize",
+    "run_schema": "schema",
+    "run_validate": "validate",
+    "run_verify": "verify_gradient",
+    "run_view": "view",
+    "simulate_runs": "simulate",
+}
+
+__all__ = sorted(_MODULES)
+
+
+def __getattr__(name: str):
+    if name not in _MODULES:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    return getattr(import_module(f"{__name__}.{_MODULES[name]}"), name)

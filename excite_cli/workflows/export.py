@@ -5,7 +5,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from excite_cli.errors import ExciteError
-from excite_cli.storage.export import FORMATS, Export, export_trajectory, write_export
+from excite_cli.storage.export import Export, export_trajectory, write_export
+from excite_cli.storage.formats import FORMATS
 from excite_cli.storage.paths import check_target
 
 

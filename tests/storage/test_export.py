@@ -6,6 +6,7 @@ import yaml
 
 from excite_cli.errors import ExciteError
 from excite_cli.storage.export import Export, columns, write_export
+from excite_cli.storage.formats import FORMATS
 
 JOINTS = ["a", "b"]
 
@@ -53,3 +54,9 @@ def test_an_unknown_format_writes_nothing(export, tmp_path):
     with pytest.raises(ExciteError, match="format"):
         write_export(tmp_path / "m.xml", export, "xml")
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("fmt", list(FORMATS))
+def test_every_format_the_help_lists_is_written_with_its_ending(export, tmp_path, fmt):
+    path = write_export(tmp_path / f"m.{FORMATS[fmt]}", export, fmt)
+    assert path.exists() and path.suffix == f".{FORMATS[fmt]}" and path.stat().st_size > 0
