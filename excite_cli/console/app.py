@@ -12,7 +12,7 @@ from excite_cli.console.errors import printed_warnings, spellings, word
 from excite_cli.console.progress import wide_console
 from excite_cli.errors import ExciteError, Interrupted, Terminated, exit_status, sigterm_as_interrupt
 
-app = typer.Typer(add_completion=False, no_args_is_help=True)
+app = typer.Typer(no_args_is_help=True)
 out, err = wide_console(), wide_console(stderr=True)
 FORCE = typer.Option(False, "--force", help="Replace existing output files.")
 WORKERS = typer.Option(

@@ -1,11 +1,13 @@
 """Progress of long commands on the terminal: a bar per iteration with the objective at the current
-iterate, the restart, elapsed time and an ETA; a line per finished iteration (with the optimizer's stop reason)
-when the output is a log rather than a terminal; a bar for random draws."""
+iterate, the restart, elapsed time and an ETA; where the output is a log rather than a terminal, a line
+every ``LOG_PERIOD`` seconds of work (iteration, run, solver iterations, objective, elapsed, estimate)
+and one per finished iteration (with the optimizer's stop reason); a bar for random draws."""
 
 from __future__ import annotations
 
 import math
 import sys
+import time
 from typing import TYPE_CHECKING, Callable
 
 from rich.console import Console
@@ -16,6 +18,8 @@ if TYPE_CHECKING:  # annotations only: the command line's frame imports this mod
     from excite_cli.optimization.optimizer import ProgressHook
     from excite_cli.optimization.sequence import IterationResult
 
+#: [s] between two progress lines in a log (no terminal).
+LOG_PERIOD = 30.0
 #: Width of printed tables where the output is not a terminal (a log, a pipe): rich's default of 80
 #: columns would cut their numbers.
 LOG_WIDTH = 200
@@ -31,8 +35,8 @@ class Bars:
     """One live display of bars on ``console`` (a context manager); it appears with the first bar, so
     an error found before any work is the only thing printed."""
 
-    def __init__(self, console: Console):
-        self.console = console
+    def __init__(self, console: Console, clock: Callable[[], float] = time.monotonic):
+        self.console, self.clock = console, clock
         self.bar = Progress(
             TextColumn("{task.description}"),
             BarColumn(),
@@ -68,15 +72,23 @@ class Bars:
         def progress(k: int) -> ProgressHook:
             tasks[k] = self._task(f"iteration {k}", opts.planned_iterations, "starting")
             steps: dict[int, int] = {}
+            start = last = self.clock()
+            runs = opts.screened + opts.restarts if opts.screened else opts.restarts
 
             def hook(restart: int, it: int, value: float) -> None:
+                nonlocal last
                 steps[restart] = it
-                bar.update(
-                    tasks[k],
-                    completed=sum(steps.values()),
-                    status=f"run {restart + 1}/{opts.screened + opts.restarts if opts.screened else opts.restarts} · "
-                    f"{label} {shown(value):.4g}",
-                )
+                done, status = sum(steps.values()), f"run {restart + 1}/{runs} · {label} {shown(value):.4g}"
+                bar.update(tasks[k], completed=done, status=status)
+                now = self.clock()
+                if not self.console.is_terminal and now - last >= LOG_PERIOD:
+                    last, elapsed = now, now - start
+                    left = elapsed * max(opts.planned_iterations - done, 0) / max(done, 1)
+                    self.console.print(
+                        f"iteration {k}: run {restart + 1}/{runs}, {done}/{opts.planned_iterations} solver iterations, "
+                        f"{label} {shown(value):.4g}, {elapsed:.0f} s, about {left:.0f} s left",
+                        highlight=False,
+                    )
 
             return hook
 

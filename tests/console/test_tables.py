@@ -84,6 +84,22 @@ def test_a_log_gets_one_line_per_finished_iteration():
     assert "iteration 1: cond(C(i)) 12.3, cond(C) 12.3, 0 s, 200 solver iterations, stop: stalled" in out.getvalue()
 
 
+def test_a_log_gets_a_progress_line_every_log_period_while_an_iteration_runs():
+    """Without a terminal: nothing before LOG_PERIOD of work, then one line with the run, the solver
+    iterations done of those planned, the objective, the elapsed time and the estimate left."""
+    out, now = io.StringIO(), [0.0]
+    problem = load_problem(CONFIGS / "smoke.yaml")
+    with Bars(Console(file=out, width=200, force_terminal=False), clock=lambda: now[0]) as bars:
+        hook = bars.iterations(problem)[0](1)
+        for t, it in ((10.0, 5), (29.0, 10), (31.0, 20), (40.0, 25)):
+            now[0] = t
+            hook(0, it, -3.0)
+    lines = [line for line in out.getvalue().splitlines() if line.startswith("iteration 1:")]
+    planned = problem.optimizer.planned_iterations
+    left = 31.0 * (planned - 20) / 20
+    assert lines == [f"iteration 1: run 1/1, 20/{planned} solver iterations, log_det -3, 31 s, about {left:.0f} s left"]
+
+
 def test_the_command_line_words_fields_as_its_options():
     spelled = spellings(export)
     assert spelled["fmt"] == spelled["format"] == "--format" and spelled["result"] == "RESULT"
