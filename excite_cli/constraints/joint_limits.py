@@ -11,13 +11,15 @@ so SLSQP sees 6n inequalities. The final trajectory is re-checked exactly on a f
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from excite_cli.config import LimitsConfig, PerJoint
 from excite_cli.constraints.constraint import Constraint, FineCheck
 from excite_cli.constraints.lse import ACCEPT_MARGIN, GRID_MARGIN, smooth_max
 from excite_cli.dynamics.robot import Robot
-from excite_cli.errors import ExciteError
+from excite_cli.errors import ExciteError, ExciteWarning
 from excite_cli.trajectory.fourier import FourierBasis
 
 ORDERS = ("position_rad", "velocity_rad_s", "acceleration_rad_s2")
@@ -167,6 +169,25 @@ def per_joint(
     return out
 
 
+#: A configured velocity limit this many times the URDF's or more is warned about: the joint cannot
+#: move that fast, so the number is likely in another unit (deg/s is 57.3 times rad/s: a limit meant as
+#: 0.2-1 times the URDF's in deg/s reads as 11-57 times it, which the warning names).
+BEYOND_URDF = 3.0
+
+
+def _beyond_the_urdf(velocity: np.ndarray, robot: Robot) -> None:
+    """Warn (:class:`~excite_cli.errors.ExciteWarning`) of each configured velocity limit (n,) [rad/s]
+    ``BEYOND_URDF`` times the URDF's or more, naming the joint, both values and the likely unit."""
+    for name, given, urdf in zip(robot.joint_names, velocity, robot.velocity_limit):
+        if 0.0 < urdf < np.inf and given >= BEYOND_URDF * urdf:
+            unit = " (deg/s? limits are in rad/s)" if 10.0 <= given / urdf <= 100.0 else ""
+            warnings.warn(
+                f"limits.velocity: {given:g} rad/s for joint '{name}' is {given / urdf:.3g} times the URDF's "
+                f"{urdf:g} rad/s{unit}",
+                ExciteWarning,
+            )
+
+
 def joint_limit_bounds(cfg: LimitsConfig, robot: Robot) -> tuple[np.ndarray, np.ndarray]:
     """Bounds (lower, upper), each (3, n), of q [rad], q̇ [rad/s], q̈ [rad/s²] for Eq. 51.
 
@@ -186,5 +207,7 @@ def joint_limit_bounds(cfg: LimitsConfig, robot: Robot) -> tuple[np.ndarray, np.
         if hi <= lo:
             raise ExciteError(field, f"{m:g} rad leaves no range for joint '{name}'")
     velocity = per_joint("limits.velocity", cfg.velocity, robot.velocity_limit, robot)
+    if cfg.velocity is not None:
+        _beyond_the_urdf(velocity, robot)
     acceleration = per_joint("limits.acceleration", cfg.acceleration, np.full(robot.n_joints, np.nan), robot)
     return np.stack([lower, -velocity, -acceleration]), np.stack([upper, velocity, acceleration])

@@ -91,3 +91,26 @@ def test_a_per_joint_position_margin_narrows_that_joint_alone(ur5_problem):
         margin = 0.6283 if name == "elbow_joint" else 0.0
         assert lower[0, k] == pytest.approx(model.lowerPositionLimit[index] + margin)
         assert upper[0, k] == pytest.approx(model.upperPositionLimit[index] - margin)
+
+
+def test_a_velocity_limit_the_joint_cannot_reach_is_warned_about_with_the_likely_unit(ur5_problem):
+    """62 deg/s meant as rad/s on the UR5 (URDF: 3.15 rad/s): 19.7 times the URDF's, deg/s named; 1.5
+    rad/s (below the URDF's, as the shipped config) says nothing."""
+    import warnings
+
+    from excite_cli.constraints.joint_limits import joint_limit_bounds
+    from excite_cli.dynamics.robot import load_robot
+    from excite_cli.errors import ExciteWarning
+
+    robot = load_robot(ur5_problem.robot, ur5_problem.folder, False)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        ur5_problem.limits.velocity = 1.5
+        joint_limit_bounds(ur5_problem.limits, robot)
+        assert caught == []
+        ur5_problem.limits.velocity = {"elbow_joint": 62.0}
+        joint_limit_bounds(ur5_problem.limits, robot)
+    (warning,) = [w for w in caught if issubclass(w.category, ExciteWarning)]
+    urdf = robot.velocity_limit[robot.joint_names.index("elbow_joint")]
+    assert f"62 rad/s for joint 'elbow_joint' is {62.0 / urdf:.3g} times the URDF's" in str(warning.message)
+    assert "deg/s?" in str(warning.message)
