@@ -23,12 +23,11 @@ from excite_cli.identification.fitting.normal import NormalEquations, excited_ra
 WEAK = 0.05
 
 
-def weak_channels(measured: np.ndarray, predicted: np.ndarray) -> np.ndarray:
-    """(n,) the joints whose measured torques (N, n) [Nm] vary by less than ``WEAK`` times the
-    torques (N, n) [Nm] the URDF's rigid-body model predicts on the same samples (variation: RMS
-    about the mean, so that a constant sensor offset does not count as signal). A joint the model
-    predicts no variation for is never weak."""
-    spread, expected = np.std(measured, axis=0), np.std(predicted, axis=0)
+def weak_channels(spread: np.ndarray, expected: np.ndarray) -> np.ndarray:
+    """(n,) the joints whose measured torques vary by less than ``WEAK`` times the torques the URDF's
+    rigid-body model predicts on the same samples; ``spread``, ``expected``: (n,) their standard
+    deviations [Nm] (RMS about the mean, so that a constant sensor offset does not count as signal).
+    A joint the model predicts no variation for is never weak."""
     return (expected > 0.0) & (spread < WEAK * expected)
 
 
@@ -40,8 +39,8 @@ def dead_channels(
     urdf = base.from_standard(robot.urdf_parameters())
     measured = np.vstack([d.tau.reshape(-1, d.n) for d in datasets])
     predicted = np.vstack([(d.regressor @ urdf).reshape(-1, d.n) for d in datasets])
-    weak = weak_channels(measured, predicted) & ~silent
-    spread, expected = (np.std(x, axis=0) for x in (measured, predicted))
+    spread, expected = np.std(measured, axis=0), np.std(predicted, axis=0)
+    weak = weak_channels(spread, expected) & ~silent
     lines = [
         f"{robot.joint_names[j]}: the torque channel carries no signal (mostly exact zeros)"
         for j in np.flatnonzero(silent)
