@@ -10,7 +10,7 @@ from rich.markup import escape
 from excite_cli import console, workflows
 from excite_cli.console.app import FORCE, SCHEDULER, WORKERS, app, command, err, out, say
 from excite_cli.console.progress import Bars
-from excite_cli.optimization.objectives import OBJECTIVES
+from excite_cli.criteria import NAMES as OBJECTIVES
 from excite_cli.storage.formats import FORMATS
 
 

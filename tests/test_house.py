@@ -1,5 +1,5 @@
 """The house rules of the package, checked on its source: a thin command line, small modules and
-functions, imports that only run down the stack (the import graph has no cycle), and the command
+functions, imports that only run down the stack, criteria as records, (the import graph has no cycle), and the command
 line's libraries (typer, rich) only in the modules that print, modules in role folders, identification
 independent of the optimizer, no command-line flag in a library message, tests that mirror the
 package's folders with every module tested in its own, and lower floors handed values, not problems."""
@@ -98,7 +98,9 @@ ROLE_FOLDERS = {
     "dynamics",
     "collision",
     "constraints",
+    "criteria",
     "optimization",
+    "drafting",
     "identification",
     "storage",
     "plots",
@@ -205,3 +207,25 @@ def test_lower_floors_take_sections_and_values_not_whole_problems():
         and {"excite_cli.config.Problem", "excite_cli.identification.config.IdentifyProblem"} & _imports(tree)
     ]
     assert offenders == []
+
+
+def test_a_criterion_is_one_record_and_nothing_outside_its_room_branches_on_its_name():
+    """Adding a criterion is adding a record to ``excite_cli.criteria.catalogue.CRITERIA``: no module outside
+    ``excite_cli/criteria`` compares anything with a criterion's name (that is what the record says)."""
+    from excite_cli.criteria import NAMES
+
+    branching = [
+        (name, node.lineno)
+        for name, tree in _modules().items()
+        if not name.startswith("excite_cli.criteria")
+        for node in ast.walk(tree)
+        if isinstance(node, ast.Compare)
+        and any(
+            isinstance(c, ast.Constant)
+            and c.value in NAMES
+            or isinstance(c, (ast.Tuple, ast.List, ast.Set))
+            and any(isinstance(e, ast.Constant) and e.value in NAMES for e in c.elts)
+            for c in [node.left, *node.comparators]
+        )
+    ]
+    assert branching == []

@@ -24,6 +24,7 @@ from excite_cli.config.base import (
     Section,
 )
 from excite_cli.config.constraints import ConstraintsConfig
+from excite_cli.criteria import NAMES
 
 
 class RobotConfig(Section):
@@ -116,8 +117,8 @@ class OptimizerConfig(Section):
 
     method: Literal["SLSQP", "trust-constr", "ipopt"] = "SLSQP"
     """The solver: `SLSQP`, `trust-constr` or `ipopt`."""
-    objective: Literal["log_cond", "cond", "log_det", "sigma_min", "log_trace_inverse"] = "log_det"
-    """The criterion: `log_cond`, `cond`, `log_det` (D-optimal), `sigma_min` or `log_trace_inverse`."""
+    objective: Literal[NAMES] = "log_det"
+    """The criterion minimized, one record each in excite_cli/criteria (what each rewards: docs, how it works)."""
     scaling: Literal["none", "urdf"] = "none"
     """`none`: the criterion of C (the paper's); `urdf`: of C L, which does not depend on the base columns."""
     max_iterations: int = Field(200, ge=1, le=100_000)

@@ -5,13 +5,14 @@ and one per finished iteration (with the optimizer's stop reason); a bar for ran
 
 from __future__ import annotations
 
-import math
 import sys
 import time
 from typing import TYPE_CHECKING, Callable
 
 from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+
+from excite_cli.criteria import CRITERIA
 
 if TYPE_CHECKING:  # annotations only: the command line's frame imports this module at start-up
     from excite_cli.config import Problem
@@ -65,8 +66,8 @@ class Bars:
         """The hooks of :func:`~excite_cli.runs.run_optimize`: ``progress(k)`` per SLSQP iteration
         (the objective at the current iterate) and ``done(result)`` per finished iteration."""
         opts, bar = problem.optimizer, self.bar
-        label = "cond" if opts.objective in ("cond", "log_cond") else opts.objective
-        shown = math.exp if opts.objective == "log_cond" else (lambda v: v)
+        record = CRITERIA[opts.objective]
+        label, shown = record.label, record.shown
         tasks: dict[int, int] = {}
 
         def progress(k: int) -> ProgressHook:

@@ -10,6 +10,7 @@ from rich.markup import escape
 from rich.table import Table
 
 from excite_cli.config import OptimizerConfig
+from excite_cli.criteria import CRITERIA
 from excite_cli.optimization.sequence import IterationResult
 from excite_cli.storage.export import Export
 from excite_cli.workflows.check import Plan
@@ -92,11 +93,8 @@ def _restarts(results: Sequence[IterationResult], optimizer: OptimizerConfig) ->
     """Every restart of every iteration: start and end value of the criterion optimized, KKT
     residual, active constraints, solver iterations, end point, stop reason."""
     matrix = "CL" if optimizer.scaling == "urdf" else "C"
-    shown, label = (
-        (np.exp, f"cond({matrix})")
-        if optimizer.objective == "log_cond"
-        else ((lambda v: v), f"{optimizer.objective}({matrix})")
-    )
+    record = CRITERIA[optimizer.objective]
+    shown, label = record.shown, f"{record.label}({matrix})"
     restarts = [
         (
             str(r.index),

@@ -11,7 +11,7 @@ parameters X v_r (:mod:`excite_cli.dynamics.virtual_dynamics`). The result is ch
 Fourier basis (Eq. 49).
 
 D- and E-optimality have gradients of the same form, Σ_r a_r (C v_r) v_rᵀ over eigenvectors v_r of
-CᵀC (:func:`objective_terms`): −log σ_min needs one pass, −log det(CᵀC)/b all b.
+CᵀC (:meth:`~excite_cli.criteria.record.CriterionRecord.terms`): −log σ_min needs one pass, −log det(CᵀC)/b all b.
 
 With a frame L (b, b) every criterion is that of C L instead of C (``optimizer.scaling: urdf``, the
 regressor in a basis of the identifiable subspace that does not depend on the choice of base columns,
@@ -26,15 +26,12 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
+from excite_cli.criteria import CRITERIA, CriterionRecord
 from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.dynamics.robot import Robot
 from excite_cli.dynamics.virtual_dynamics import VirtualDynamics
 from excite_cli.errors import ExciteError
-from excite_cli.optimization.objectives import OBJECTIVES
 from excite_cli.trajectory.fourier import FourierBasis
-
-#: σ_b is floored at this fraction of σ₁, so rank loss gives a large finite value, never NaN.
-RANK_FLOOR = 1e-14
 
 
 def condition_number(C: np.ndarray) -> float:
@@ -45,49 +42,17 @@ def condition_number(C: np.ndarray) -> float:
     return float(s[0] / s[-1]) if s[-1] > 0 else float("inf")
 
 
-def objective_terms(objective: str, eigenvalues: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
-    """A criterion of C from the eigenvalues λ (b,) of CᵀC (ascending), and its gradient in C as
-    Σ_r a_r (C v_r) v_rᵀ over the eigenvectors v_r it needs (Eq. 17 and its D-, E-optimal analogues).
-
-    λ_min is floored at (``RANK_FLOOR`` σ_max)² so rank loss gives a large finite value.
-
-    Returns:
-        The value, the indices r (R,) of the eigenpairs used, and their coefficients a_r (R,).
-
-    Raises:
-        ExciteError: an unknown objective.
-    """
-    lam = np.maximum(eigenvalues, (RANK_FLOOR**2) * max(eigenvalues[-1], 0.0))
-    lam = np.maximum(lam, np.finfo(float).tiny)
-    last = lam.size - 1
-    if objective in ("cond", "log_cond"):
-        s_max, s_min = np.sqrt(lam[-1]), np.sqrt(lam[0])
-        c = s_max / s_min
-        coefficients = np.array([1.0 / (s_min * s_max), -s_max / s_min**3])
-        if objective == "cond":
-            return float(c), np.array([last, 0]), coefficients
-        return float(np.log(c)), np.array([last, 0]), coefficients / c
-    if objective == "sigma_min":
-        return float(-0.5 * np.log(lam[0])), np.array([0]), np.array([-1.0 / lam[0]])
-    if objective == "log_det":
-        return float(-np.log(lam).sum() / lam.size), np.arange(lam.size), -2.0 / (lam.size * lam)
-    if objective == "log_trace_inverse":
-        inverse = 1.0 / lam
-        return float(0.5 * np.log(inverse.mean())), np.arange(lam.size), -(inverse**2) / inverse.sum()
-    raise ExciteError("optimizer.objective", f"unknown '{objective}', expected one of {', '.join(OBJECTIVES)}")
-
-
 @dataclass
 class Criterion:
-    """The criterion f(α) of the stacked base regressor C = [C₀; Ŷ_B(α)] (``objective``: cond, log
-    cond, D- or E-optimality, see :func:`objective_terms`) with its gradient in the Fourier coefficients.
+    """The criterion f(α) of the stacked base regressor C = [C₀; Ŷ_B(α)] (``objective``, one record of
+    :data:`~excite_cli.criteria.CRITERIA`) with its gradient in the Fourier coefficients.
 
     Attributes:
         robot: the robot.
         base: its base parameters (composition matrix X).
         basis: Fourier basis at the T cost samples.
         prior: C₀, (m₁, b) rows stacked above the trajectory's regressor (Eq. 41), or an empty array.
-        objective: one of ``OBJECTIVES``.
+        objective: the criterion's record.
         frame: L (b, b): the criterion is that of C L (module docstring); None: of C, the paper's.
     """
 
@@ -95,7 +60,7 @@ class Criterion:
     base: BaseParameters
     basis: FourierBasis
     prior: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
-    objective: str = "log_cond"
+    objective: CriterionRecord = field(default_factory=lambda: CRITERIA["log_cond"])
     frame: np.ndarray | None = None
     _dynamics: VirtualDynamics = field(init=False, repr=False)
     _data: pin.Data = field(init=False, repr=False)
@@ -108,7 +73,6 @@ class Criterion:
             raise ExciteError(
                 "sequence.prior", f"{self.prior.shape[1]} columns, but the robot has {self.base.count} base parameters"
             )
-        objective_terms(self.objective, np.ones(1))  # fail early on an unknown objective
         self._dynamics = VirtualDynamics(self.robot)
         self._data = self.robot.model.createData()  # this criterion's own, so no result depends on other users
         self._prior_gram = self.prior.T @ self.prior
@@ -134,20 +98,20 @@ class Criterion:
         if C.shape[0] < C.shape[1]:
             return float("inf")
         s = np.linalg.svd(self.framed(C), compute_uv=False)
-        return objective_terms(self.objective, s[::-1] ** 2)[0]
+        return self.objective.terms(s[::-1] ** 2)[0]
 
     def value_and_gradient(self, alpha: np.ndarray) -> tuple[float, np.ndarray]:
         """f(α) and its gradient, shaped like α (n, 2N+1) (Eqs. 17, 45–49).
 
         Ties σ₁ = σ₂ give one valid subgradient (that of the eigenbasis); rank loss is floored
-        (``RANK_FLOOR``) so the result is finite.
+        (:data:`~excite_cli.criteria.record.RANK_FLOOR`) so the result is finite.
         """
         Q, QD, QDD = self.basis.evaluate(alpha)
         own = self._regressor(Q, QD, QDD)
         # eigenpairs of the b×b Gram matrix CᵀC = C₀ᵀC₀ + ŶᵀŶ give σ² and v; C v = σ u (Eqs. 8, 16)
         gram = self._prior_gram + own.T @ own
         eig, V = np.linalg.eigh(gram if self.frame is None else self.frame.T @ gram @ self.frame)
-        value, used, coefficients = objective_terms(self.objective, eig)
+        value, used, coefficients = self.objective.terms(eig)
         directions = V[:, used] if self.frame is None else self.frame @ V[:, used]  # v_r, or L ṽ_r
         T, rows = Q.shape[0], self.robot.n_rows
         if used.size > len(self._dynamics.slots):  # fewer passes with a virtual parameter per instant and row

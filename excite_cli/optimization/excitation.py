@@ -18,6 +18,7 @@ from excite_cli.constraints.joint_limits import joint_limit_bounds
 from excite_cli.constraints.lse import GRID_MARGIN
 from excite_cli.constraints.torque_limits import TorqueLimits, TorqueUse, torque_limit, torque_use_fraction
 from excite_cli.constraints.world_collision import WorldCollision, world_shapes
+from excite_cli.criteria import criterion_record
 from excite_cli.dynamics.base_parameters import BaseParameters, compute_base_parameters
 from excite_cli.dynamics.robot import Robot, load_robot
 from excite_cli.errors import ExciteError
@@ -71,7 +72,7 @@ class Excitation:
             self.base,
             self.cost_basis,
             prior=np.zeros((0, self.base.count)) if prior is None else prior,
-            objective=objective or self.problem.optimizer.objective,
+            objective=criterion_record(objective or self.problem.optimizer.objective),
             frame=self.scaled_frame if scaling == "urdf" else None,
         )
 

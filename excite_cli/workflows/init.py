@@ -13,10 +13,10 @@ import yaml
 
 from excite_cli.atomic import atomic_path
 from excite_cli.config import RobotConfig
+from excite_cli.drafting.starting_config import StartingConfig, draft_config, joint_choice, validated
 from excite_cli.dynamics.urdf_source import example_robot_data_root, resolve_urdf
 from excite_cli.errors import ExciteError, FileNotFound
 from excite_cli.identification.config import IdentifyProblem
-from excite_cli.optimization.starting_config import StartingConfig, draft_config, joint_choice, validated
 from excite_cli.storage.paths import check_target
 from excite_cli.workflows.check import Plan, plan_optimize
 

@@ -3,9 +3,9 @@ mimic joints held inside their limits; given joints checked by name."""
 
 import pytest
 
+from excite_cli.drafting.starting_config import StartingConfig, joint_choice
 from excite_cli.dynamics.urdf_source import example_robot_data_root
 from excite_cli.errors import ExciteError
-from excite_cli.optimization.starting_config import StartingConfig, joint_choice
 
 PANDA = example_robot_data_root() / "example-robot-data" / "robots" / "panda_description" / "urdf" / "panda.urdf"
 
