@@ -23,6 +23,7 @@ from excite_cli.config.constraints import (
     SelfCollisionConfig,
     WorldShapeConfig,
 )
+from excite_cli.config.effects import EffectsConfig, MotorConfig
 from excite_cli.config.problem import (
     LimitsConfig,
     OptimizerConfig,
@@ -42,10 +43,12 @@ __all__ = [
     "CapsuleConfig",
     "ComConfig",
     "ConstraintsConfig",
+    "EffectsConfig",
     "EnvironmentConfig",
     "FieldProblem",
     "Fraction",
     "LimitsConfig",
+    "MotorConfig",
     "OptimizerConfig",
     "PerJoint",
     "Problem",

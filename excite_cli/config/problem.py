@@ -24,6 +24,7 @@ from excite_cli.config.base import (
     Section,
 )
 from excite_cli.config.constraints import ConstraintsConfig
+from excite_cli.config.effects import EffectsConfig
 from excite_cli.criteria import NAMES
 
 
@@ -181,6 +182,8 @@ class Problem(Section):
     """Joint limits (Eq. 51) and torque limits."""
     constraints: ConstraintsConfig = ConstraintsConfig()
     """Balance, self-collision and world constraints (optional)."""
+    effects: EffectsConfig = EffectsConfig()
+    """Friction, armature, offsets and coupled motors to design for, beside the base parameters."""
     optimizer: OptimizerConfig = OptimizerConfig()
     """The solver and its starts."""
     sequence: SequenceConfig = SequenceConfig()

@@ -226,10 +226,11 @@ def plan(p: Plan) -> list[Table | str]:
     )
     lines = [
         f"robot: {e.robot.n_joints} active joints ({', '.join(e.robot.joint_names)}), "
-        f"{e.base.count} base parameters of {e.robot.n_parameters} standard ones",
+        f"{e.base.count} base parameters of {e.robot.n_parameters} standard ones"
+        + (f", and {e.effects.count} effect columns beside them ({', '.join(e.effects.names)})" if e.effects else ""),
         f"trajectory: {t.harmonics} harmonics at ω = {t.base_frequency:.4g} rad/s, {t.duration:g} s "
         f"({t.boundary}), {p.variables} Fourier coefficients; cost: {t.cost_samples} samples × "
-        f"{e.robot.n_rows} rows = C of {t.cost_samples * e.robot.n_rows} × {e.base.count}",
+        f"{e.robot.n_rows} rows = C of {t.cost_samples * e.robot.n_rows} × {e.columns}",
         *(f"excluded capsule pair: {a} – {b}" for a, b in p.excluded_pairs),
         f"optimizer: {cfg.optimizer.method} on {cfg.optimizer.objective}, {cfg.sequence.iterations} sequential "
         f"iteration(s) of at most {p.iterations} solver iterations each, on {p.workers} worker(s)",

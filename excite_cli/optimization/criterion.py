@@ -17,6 +17,12 @@ With a frame L (b, b) every criterion is that of C L instead of C (``optimizer.s
 regressor in a basis of the identifiable subspace that does not depend on the choice of base columns,
 :func:`~excite_cli.optimization.information.scaled_frame`); with eigenvectors ṽ_r of LᵀCᵀCL the
 gradient in C is Σ_r a_r (C L ṽ_r)(L ṽ_r)ᵀ, so the passes take the virtual parameters X L ṽ_r.
+
+With effect columns (``effects``: friction, armature, offsets, coupled motors) C = [Y_B | Y_E] per row
+and v_r = (v_{r,B}, v_{r,E}): the base part goes through the RNEA passes as above, the effect part
+through the effect columns' own derivatives in q̇ and q̈
+(:meth:`~excite_cli.dynamics.effect_columns.EffectColumns.chain`; Coulomb friction through the smooth
+sign tanh(q̇/v_c) with the config's ``effects.coulomb_velocity``).
 """
 
 from __future__ import annotations
@@ -28,6 +34,7 @@ import pinocchio as pin
 
 from excite_cli.criteria import CRITERIA, CriterionRecord
 from excite_cli.dynamics.base_parameters import BaseParameters
+from excite_cli.dynamics.effect_columns import EffectColumns
 from excite_cli.dynamics.robot import Robot
 from excite_cli.dynamics.virtual_dynamics import VirtualDynamics
 from excite_cli.errors import ExciteError
@@ -53,7 +60,9 @@ class Criterion:
         basis: Fourier basis at the T cost samples.
         prior: C₀, (m₁, b) rows stacked above the trajectory's regressor (Eq. 41), or an empty array.
         objective: the criterion's record.
-        frame: L (b, b): the criterion is that of C L (module docstring); None: of C, the paper's.
+        frame: L (b+e, b+e): the criterion is that of C L (module docstring); None: of C, the paper's.
+        effects: e effect columns beside the b base columns, C = [Y_B | Y_E] per row
+            (:mod:`~excite_cli.dynamics.effect_columns`), or None: the rigid body alone.
     """
 
     robot: Robot
@@ -62,31 +71,41 @@ class Criterion:
     prior: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
     objective: CriterionRecord = field(default_factory=lambda: CRITERIA["log_cond"])
     frame: np.ndarray | None = None
+    effects: EffectColumns | None = None
     _dynamics: VirtualDynamics = field(init=False, repr=False)
     _data: pin.Data = field(init=False, repr=False)
     _prior_gram: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         if self.prior.size == 0:
-            self.prior = np.zeros((0, self.base.count))
-        if self.prior.shape[1] != self.base.count:
+            self.prior = np.zeros((0, self.columns))
+        if self.prior.shape[1] != self.columns:
             raise ExciteError(
-                "sequence.prior", f"{self.prior.shape[1]} columns, but the robot has {self.base.count} base parameters"
+                "sequence.prior",
+                f"{self.prior.shape[1]} columns, but the design has {self.base.count} base parameters"
+                + (f" and {self.effects.count} effect columns" if self.effects else ""),
             )
         self._dynamics = VirtualDynamics(self.robot)
         self._data = self.robot.model.createData()  # this criterion's own, so no result depends on other users
         self._prior_gram = self.prior.T @ self.prior
+
+    @property
+    def columns(self) -> int:
+        """b + e: the base parameters and the effect columns."""
+        return self.base.count + (self.effects.count if self.effects else 0)
 
     def framed(self, C: np.ndarray) -> np.ndarray:
         """C L (M, b) with the criterion's frame L, or C without one."""
         return C if self.frame is None else C @ self.frame
 
     def regressor(self, alpha: np.ndarray) -> np.ndarray:
-        """Ŷ_B of the trajectory α (n, 2N+1): (T·n_rows, b) (Eq. 3 with Y_B = Y X)."""
+        """Ŷ_B of the trajectory α (n, 2N+1): (T·n_rows, b) (Eq. 3 with Y_B = Y X), and its effect
+        columns beside it when there are any: (T·n_rows, b+e)."""
         return self._regressor(*self.basis.evaluate(alpha))
 
     def _regressor(self, Q: np.ndarray, QD: np.ndarray, QDD: np.ndarray) -> np.ndarray:
-        return self.robot.regressor_stack(Q, QD, QDD, self._data)[:, self.base.independent]  # Y X, X a selection
+        own = self.robot.regressor_stack(Q, QD, QDD, self._data)[:, self.base.independent]  # Y X, X a selection
+        return own if self.effects is None else np.hstack([own, self.effects.columns(QD, QDD)])
 
     def stacked(self, own: np.ndarray) -> np.ndarray:
         """C = [C₀; Ŷ_B] (Eq. 41)."""
@@ -113,13 +132,18 @@ class Criterion:
         eig, V = np.linalg.eigh(gram if self.frame is None else self.frame.T @ gram @ self.frame)
         value, used, coefficients = self.objective.terms(eig)
         directions = V[:, used] if self.frame is None else self.frame @ V[:, used]  # v_r, or L ṽ_r
-        T, rows = Q.shape[0], self.robot.n_rows
+        T, rows, b = Q.shape[0], self.robot.n_rows, self.base.count
+        weighted = (own @ directions) * coefficients  # a_r (C v_r): the rows' weights (M, R)
         if used.size > len(self._dynamics.slots):  # fewer passes with a virtual parameter per instant and row
             phis = np.zeros((T, rows, self.robot.n_parameters))
-            phis[:, :, self.base.independent] = ((own @ directions) * coefficients @ directions.T).reshape(T, rows, -1)
-            return value, self.basis.chain(*self._dynamics.row_derivatives(phis, Q, QD, QDD))
-        phis = np.zeros((self.robot.n_parameters, used.size))
-        phis[self.base.independent] = directions  # X v_r
-        # row weights a_r (Ŷ_B v_r) at each instant
-        weights = ((own @ directions) * coefficients).T.reshape(used.size, T, rows)
-        return value, self.basis.chain(*self._dynamics.weighted_derivatives(phis, weights, Q, QD, QDD))
+            phis[:, :, self.base.independent] = (weighted @ directions[:b].T).reshape(T, rows, -1)
+            dq, dqd, dqdd = self._dynamics.row_derivatives(phis, Q, QD, QDD)
+        else:
+            phis = np.zeros((self.robot.n_parameters, used.size))
+            phis[self.base.independent] = directions[:b]  # X v_r
+            weights = weighted.T.reshape(used.size, T, rows)  # row weights a_r (Ŷ_B v_r) at each instant
+            dq, dqd, dqdd = self._dynamics.weighted_derivatives(phis, weights, Q, QD, QDD)
+        if self.effects is not None:  # ∂f/∂Y_E = Σ_r a_r (C v_r) v_{r,E}ᵀ, through the effect columns' motion
+            effect_qd, effect_qdd = self.effects.chain(weighted @ directions[b:].T, QD, QDD)
+            dqd, dqdd = dqd + effect_qd, dqdd + effect_qdd
+        return value, self.basis.chain(dq, dqd, dqdd)

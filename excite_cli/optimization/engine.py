@@ -17,6 +17,7 @@ import os
 import signal
 import threading
 import time
+import warnings
 from concurrent.futures import Executor, ProcessPoolExecutor, as_completed
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any, Callable, Iterator, Optional, Protocol, Sequence
@@ -25,7 +26,7 @@ from threadpoolctl import threadpool_limits
 
 from excite_cli.config import Problem
 from excite_cli.dynamics.base_parameters import BaseParameters
-from excite_cli.errors import NO_VALUE, ExciteError
+from excite_cli.errors import NO_VALUE, ExciteError, ExciteWarning
 from excite_cli.memory import keep_freed_memory
 from excite_cli.optimization.excitation import Excitation, build_excitation
 
@@ -50,11 +51,14 @@ _local = threading.local()
 
 
 def _worker_excitation(problem: Problem, base: BaseParameters) -> Excitation:
-    """The excitation of ``problem`` in ``base`` in this worker (thread), built on first use."""
+    """The excitation of ``problem`` in ``base`` in this worker (thread), built on first use, without
+    repeating the warnings the main process gave when it built its own."""
     key = (str(problem.source_path), problem.model_dump_json(), base.names)
     cache = getattr(_local, "cache", None)
     if cache is None or cache[0] != key:
-        _local.cache = cache = (key, build_excitation(problem, base))
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ExciteWarning)
+            _local.cache = cache = (key, build_excitation(problem, base))
     return cache[1]
 
 

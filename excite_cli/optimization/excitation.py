@@ -9,6 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.linalg import block_diag
 
 from excite_cli.collision.capsules import capsule_pairs, capsules_from_config
 from excite_cli.config import Problem
@@ -20,6 +21,7 @@ from excite_cli.constraints.torque_limits import TorqueLimits, TorqueUse, torque
 from excite_cli.constraints.world_collision import WorldCollision, world_shapes
 from excite_cli.criteria import criterion_record
 from excite_cli.dynamics.base_parameters import BaseParameters, compute_base_parameters
+from excite_cli.dynamics.effect_columns import EffectColumns, effect_columns
 from excite_cli.dynamics.robot import Robot, load_robot
 from excite_cli.errors import ExciteError
 from excite_cli.optimization.criterion import Criterion, condition_number
@@ -45,8 +47,10 @@ class Excitation:
         limits: joint limits (Eq. 51).
         constraints: all constraints handed to the optimizer (joint limits first).
         boundary: boundary conditions (rest or periodic) and the optimizer's coordinates.
-        scaled_frame: L (b, b): C L is the regressor in a basis that does not depend on the choice
-            of base columns (:func:`~excite_cli.optimization.information.scaled_frame`).
+        scaled_frame: L (b+e, b+e): C L is the regressor in a basis that does not depend on the choice
+            of base columns (:func:`~excite_cli.optimization.information.scaled_frame`), each effect
+            column scaled by its typical magnitude (:meth:`EffectColumns.magnitudes`).
+        effects: the effect columns designed for beside the base columns (``effects``), or None.
     """
 
     problem: Problem
@@ -60,6 +64,7 @@ class Excitation:
     constraints: list[Constraint]
     boundary: BoundaryConditions
     scaled_frame: np.ndarray
+    effects: EffectColumns | None = None
 
     def criterion(
         self, prior: np.ndarray | None = None, objective: str | None = None, scaling: str | None = None
@@ -71,20 +76,32 @@ class Excitation:
             self.robot,
             self.base,
             self.cost_basis,
-            prior=np.zeros((0, self.base.count)) if prior is None else prior,
+            prior=np.zeros((0, self.columns)) if prior is None else prior,
             objective=criterion_record(objective or self.problem.optimizer.objective),
             frame=self.scaled_frame if scaling == "urdf" else None,
+            effects=self.effects,
         )
 
     def excitation_level(self, C: np.ndarray) -> float:
-        """ē(C) [N·m] of base-regressor rows C (M, b), the excitation figure that does not depend on
+        """ē(C) [N·m] of base-regressor rows C (M, b+e), the excitation figure that does not depend on
         the choice of base columns (:mod:`excite_cli.optimization.information`)."""
-        return excitation_level(C, self.base, parameter_magnitudes(self.robot))
+        b = self.base.count
+        return excitation_level(C, self.base, parameter_magnitudes(self.robot), np.diag(self.scaled_frame)[b:])
 
     def scaled_condition_number(self, C: np.ndarray) -> float:
-        """cond(C L) of base-regressor rows C (M, b): the condition number that does not depend on
+        """cond(C L) of base-regressor rows C (M, b+e): the condition number that does not depend on
         the choice of base columns (:mod:`excite_cli.optimization.information`)."""
         return condition_number(C @ self.scaled_frame)
+
+    @property
+    def columns(self) -> int:
+        """b + e: the regressor's columns, base parameters then effect columns."""
+        return self.base.count + (self.effects.count if self.effects else 0)
+
+    @property
+    def effect_names(self) -> tuple[str, ...]:
+        """(e,) the effect columns' coefficient names (none without effects)."""
+        return self.effects.names if self.effects else ()
 
     @property
     def home(self) -> np.ndarray:
@@ -146,12 +163,14 @@ def build_excitation(problem: Problem, base: BaseParameters | None = None, check
     collision = bool(ccfg.self_collision or ccfg.environment or (ccfg.com and ccfg.com.support_links))
     robot = load_robot(problem.robot, problem.folder, collision)
     base = base or compute_base_parameters(robot)
+    effects = _design_effects(problem, robot, base)
+    columns = base.count + (effects.count if effects else 0)
     tcfg = problem.trajectory
-    if tcfg.cost_samples * robot.n_rows < base.count:
+    if tcfg.cost_samples * robot.n_rows < columns:
         raise ExciteError(
             "trajectory.cost_samples",
             f"{tcfg.cost_samples} samples × {robot.n_rows} regressor rows are fewer "
-            f"than the robot's {base.count} base parameters; cond(C) would be infinite",
+            f"than the robot's {base.count} base parameters{_and_effects(effects)}; cond(C) would be infinite",
         )
     trajectory = FourierTrajectory(tcfg.harmonics, tcfg.base_frequency)
     fine_period = tcfg.constraint_period / problem.limits.check_refinement
@@ -176,6 +195,10 @@ def build_excitation(problem: Problem, base: BaseParameters | None = None, check
         world = WorldCollision(robot, grid_basis, capsules, world_shapes(ccfg.environment))
         if world.pairs:  # else no moving capsule can come within a shape's margin
             constraints.append(world)
+    frame = scaled_frame(base, parameter_magnitudes(robot))
+    if effects is not None:
+        magnitudes = effects.magnitudes(robot.model.effortLimit[robot.v_idx], limits.upper[1], limits.upper[2])
+        frame = block_diag(frame, np.diag(magnitudes))
     excitation = Excitation(
         problem=problem,
         robot=robot,
@@ -187,11 +210,33 @@ def build_excitation(problem: Problem, base: BaseParameters | None = None, check
         limits=limits,
         constraints=constraints,
         boundary=boundary,
-        scaled_frame=scaled_frame(base, parameter_magnitudes(robot)),
+        scaled_frame=frame,
+        effects=effects,
     )
     if check_home:
         _check_home_posture(excitation)
     return excitation
+
+
+def _and_effects(effects: EffectColumns | None) -> str:
+    """`` and e effect columns`` for a message, or nothing."""
+    return f" and {effects.count} effect columns" if effects else ""
+
+
+def _design_effects(problem: Problem, robot: Robot, base: BaseParameters) -> EffectColumns | None:
+    """The effect columns of ``effects`` that the rigid body's base columns do not already hold (on
+    random states: :meth:`~excite_cli.dynamics.effect_columns.EffectColumns.beside`), or None.
+
+    Raises:
+        ExciteError: an effect on a joint that is not active (:func:`effect_columns`).
+    """
+    effects = effect_columns(problem.effects, robot.joint_names, robot.n_rows)
+    if effects is None:
+        return None
+    count = max(50, -(-(base.count + effects.count) * 2 // robot.n_rows))
+    Q, QD, QDD = robot.random_states(count, np.random.default_rng(0))
+    effects = effects.beside(robot.regressor_stack(Q, QD, QDD)[:, base.independent], QD, QDD)
+    return effects if effects.count else None
 
 
 def _boundary_conditions(

@@ -45,19 +45,27 @@ def parameter_magnitudes(robot: Robot) -> np.ndarray:
     return np.where(d > 0, d, 1.0).ravel()
 
 
-def excitation_level(C: np.ndarray, base: BaseParameters, magnitudes: np.ndarray) -> float:
+def excitation_level(
+    C: np.ndarray, base: BaseParameters, magnitudes: np.ndarray, effect_magnitudes: np.ndarray | None = None
+) -> float:
     """ē(C) [N·m] (module docstring) of a stacked base regressor C (M, b); 0 when C is rank-deficient.
+    With e effect columns beside the base columns (M, b+e), each scaled by its typical magnitude m_k,
+    the geometric mean runs over all b+e singular values of C diag(L, m).
 
     Args:
-        C: base-regressor rows (M, b) [SI].
+        C: base-regressor rows (M, b), or (M, b+e) with effect columns [SI].
         base: the base parameters C's columns belong to (regrouping K).
         magnitudes: (p,) parameter magnitudes d (:func:`parameter_magnitudes`).
+        effect_magnitudes: (e,) the effect columns' magnitudes, or None.
     """
     sign, logdet = np.linalg.slogdet(C.T @ C) if C.shape[0] >= C.shape[1] else (0.0, -np.inf)
     if sign <= 0:
         return 0.0
     K = base.regrouping * magnitudes
-    return float(np.exp((logdet + np.linalg.slogdet(K @ K.T)[1]) / (2 * base.count)))
+    scale = np.linalg.slogdet(K @ K.T)[1]
+    if effect_magnitudes is not None and effect_magnitudes.size:
+        scale += 2.0 * np.log(effect_magnitudes).sum()
+    return float(np.exp((logdet + scale) / (2 * C.shape[1])))
 
 
 def scaled_frame(base: BaseParameters, magnitudes: np.ndarray) -> np.ndarray:

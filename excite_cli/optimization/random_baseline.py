@@ -91,7 +91,7 @@ class DrawTask:
         rows = excitation.cost_basis.time.size * excitation.robot.n_rows
         return (
             np.array(alphas).reshape(-1, *shape),
-            np.array(regressors).reshape(len(alphas), rows, excitation.base.count),
+            np.array(regressors).reshape(len(alphas), rows, excitation.columns),
             drawn,
         )
 

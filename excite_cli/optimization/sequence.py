@@ -97,7 +97,7 @@ def stacked_regressors(
 ) -> np.ndarray:
     """C₀ of the next iteration (Eq. 41): the prior rows (m, b), or none, then every earlier
     iteration's regressor, in order: (m + Σ T·n_rows, b)."""
-    first = np.zeros((0, excitation.base.count)) if prior is None else prior
+    first = np.zeros((0, excitation.columns)) if prior is None else prior
     return np.vstack([first, *[r.regressor for r in results]])
 
 

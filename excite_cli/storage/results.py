@@ -98,6 +98,9 @@ def _write_robot(group: h5py.Group, excitation: Excitation) -> None:
     group.attrs["urdf"] = excitation.problem.robot.urdf
     group.attrs["floating_base"] = excitation.problem.robot.floating_base
     group.attrs["regressor_rows_per_instant"] = robot.n_rows
+    if excitation.effects is not None:
+        write_strings(group, "effect_names", excitation.effects.names)
+        write_strings(group, "effect_units", excitation.effects.units)
 
 
 def _write_iteration(group: h5py.Group, r: IterationResult) -> None:
@@ -162,35 +165,6 @@ def _read_restart(group: h5py.Group, index: int) -> RestartResult:
         str(a["stop"]),
         str(a["end"]),
     )
-
-
-def read_prior(path: Path, base: BaseParameters) -> np.ndarray:
-    """Prior data C₀ (m, b) for Eq. 41 from an excite result (all iterations' regressors stacked) or
-    an HDF5 file with a dataset ``regressor`` of base-regressor rows.
-
-    Raises:
-        ExciteError: missing or unreadable file, no regressor inside, or base parameters that differ.
-    """
-    with open_h5(path, "sequence.prior") as f:
-        if "iterations" in f:
-            keys = sorted(f["iterations"].keys(), key=int)
-            blocks = [f["iterations"][k]["regressor"][()] for k in keys]
-            prior = np.vstack(blocks) if blocks else np.zeros((0, base.count))
-        elif "regressor" in f:
-            prior = np.asarray(f["regressor"][()], dtype=float)
-        else:
-            raise ExciteError("sequence.prior", f"{path} has neither /iterations nor /regressor")
-        names = read_strings(f["robot"], "base_parameter_names") if "robot/base_parameter_names" in f else None
-    if prior.ndim != 2 or prior.shape[1] != base.count:
-        shape = "x".join(str(n) for n in prior.shape)
-        raise ExciteError(
-            "sequence.prior",
-            f"{path} has regressor rows of shape {shape}; the problem's robot needs (rows, {base.count}), one "
-            f"column per base parameter (prior data of another robot or joint set?)",
-        )
-    if not np.all(np.isfinite(prior)):
-        raise ExciteError("sequence.prior", f"{path} contains NaN or infinite values")
-    return prior if names is None else prior[:, base.column_order(names, "sequence.prior", path)]
 
 
 def check_base(f: h5py.File, base: BaseParameters, field: str, path: Path) -> None:

@@ -19,7 +19,8 @@ from excite_cli.optimization.optimizer import ProgressHook
 from excite_cli.optimization.sequence import IterationResult, run_sequence
 from excite_cli.plots.optimize import plot_result
 from excite_cli.storage.paths import check_target, output_lock
-from excite_cli.storage.results import read_iterations, read_prior, write_result
+from excite_cli.storage.prior import read_prior
+from excite_cli.storage.results import read_iterations, write_result
 
 #: The largest cond(C) of a result that identifies something: above it, noise in the torques is
 #: amplified a million times into the base parameters (Eq. 5 bounds the relative error by cond(C)).
@@ -95,7 +96,7 @@ def run_optimize(
         raise FileNotFound("resume", target, "result to continue")
     excitation = build_excitation(problem)
     prior = (
-        read_prior(resolve_path(problem.sequence.prior, problem.folder), excitation.base)
+        read_prior(resolve_path(problem.sequence.prior, problem.folder), excitation.base, excitation.effect_names)
         if problem.sequence.prior
         else None
     )

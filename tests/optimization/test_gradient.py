@@ -1,10 +1,14 @@
 """Analytic gradient of cond / log cond (Eqs. 17, 45-49) against central finite differences."""
 
+import warnings
+
 import numpy as np
 import pytest
 from conftest import small
 
+from excite_cli.config import EffectsConfig, MotorConfig
 from excite_cli.criteria import CRITERIA, NAMES
+from excite_cli.errors import ExciteWarning
 from excite_cli.optimization.criterion import Criterion, condition_number
 from excite_cli.optimization.excitation import build_excitation
 from excite_cli.optimization.verify import check_gradient, finite_difference_gradient
@@ -145,3 +149,38 @@ def test_gradient_with_a_prismatic_joint(panda_problem):
     assert not criterion._dynamics.shift_free and len(criterion._dynamics._models) == 3
     fd = finite_difference_gradient(criterion, alpha, step=1e-7, central=True)
     assert np.linalg.norm(analytic - fd) / np.linalg.norm(fd) < 1e-6
+
+
+@pytest.mark.parametrize("name", ["g1_problem", "ur5_problem"])
+@pytest.mark.parametrize("objective, scaling", [("log_det", "none"), ("log_cond", "urdf"), ("sigma_min", "none")])
+def test_gradient_with_effect_columns_matches_finite_differences(name, objective, scaling, request):
+    """C = [Y_B | Y_E] with Coulomb (smooth sign), viscous, armature and offset columns on every joint and
+    a coupled motor on the last two joints, stacked under a prior with the same columns."""
+    problem = small(request.getfixturevalue(name))
+    problem.optimizer.objective, problem.optimizer.scaling = objective, scaling
+    last = problem.robot.active_joints[-2:]
+    problem.effects = EffectsConfig(
+        joints={"*": ["coulomb", "viscous", "armature", "offset"]},
+        motors=[MotorConfig(joints=last, transmission=[1.0, 1.0])],
+        coulomb_velocity=0.05,
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ExciteWarning)  # armatures that regroup with the rigid body
+        excitation = build_excitation(problem)
+    assert excitation.effects.count >= 3 * len(problem.robot.active_joints)
+    prior = excitation.criterion().regressor(_feasible_alpha(excitation, seed=4))
+    criterion = excitation.criterion(prior)
+    assert prior.shape[1] == excitation.base.count + excitation.effects.count
+    check = check_gradient(criterion, _feasible_alpha(excitation, seed=7), repeats=1)
+    assert check.error_central < 1e-6
+
+
+def test_excitation_level_with_effects_is_the_geometric_mean_singular_value_of_the_scaled_regressor(panda_problem):
+    problem = small(panda_problem)
+    problem.effects = EffectsConfig(joints={"*": ["coulomb", "viscous"]})
+    excitation = build_excitation(problem)
+    C = excitation.criterion().regressor(_feasible_alpha(excitation, 5))
+    s = np.linalg.svd(C @ excitation.scaled_frame, compute_uv=False)
+    assert C.shape[1] == excitation.base.count + 2 * len(problem.robot.active_joints)
+    assert excitation.excitation_level(C) == pytest.approx(np.exp(np.log(s).mean()), rel=1e-9)
+    assert excitation.scaled_condition_number(C) == pytest.approx(s[0] / s[-1], rel=1e-9)

@@ -11,7 +11,8 @@ from excite_cli.errors import ExciteError
 from excite_cli.h5 import read_strings, write_strings
 from excite_cli.optimization.excitation import build_excitation
 from excite_cli.optimization.sequence import describe
-from excite_cli.storage.results import read_iterations, read_prior, write_result
+from excite_cli.storage.prior import read_prior
+from excite_cli.storage.results import read_iterations, write_result
 
 
 @pytest.fixture(scope="module")
@@ -66,3 +67,18 @@ def test_a_result_stores_its_base_and_resume_refuses_another(tmp_path, excitatio
     with pytest.raises(ExciteError) as caught:
         read_iterations(path, excitation)
     assert caught.value.field == "resume" and "mx_panda_link0" in str(caught.value)
+
+
+def test_a_prior_with_effect_columns_enters_only_a_design_with_the_same_effects(tmp_path, excitation, rows):
+    base, effects = excitation.base, ["Fc_panda_joint1", "Fv_panda_joint1"]
+    wide = np.hstack([rows, np.ones((rows.shape[0], 2))])
+    path = _prior_file(tmp_path / "prior.h5", wide, base.names)
+    with h5py.File(path, "a") as f:
+        write_strings(f["robot"], "effect_names", effects)
+    np.testing.assert_array_equal(read_prior(path, base, effects), wide)
+    for other in ([], ["Fc_panda_joint1"], effects[::-1]):
+        with pytest.raises(ExciteError, match=r"effect columns \[Fc_panda_joint1, Fv_panda_joint1\]"):
+            read_prior(path, base, other)
+    rigid = _prior_file(tmp_path / "rigid.h5", rows, base.names)
+    with pytest.raises(ExciteError, match=r"effect columns \[\]; this design has \[Fc_panda_joint1"):
+        read_prior(rigid, base, effects)

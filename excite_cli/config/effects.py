@@ -1,0 +1,48 @@
+"""The ``effects`` section of an ``optimize`` config: the identification model beyond the rigid body a
+trajectory is designed for (its effect columns stand beside the base regressor's in the criterion)."""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from pydantic import Field, PositiveFloat, field_validator
+
+from excite_cli.config.base import Section
+
+#: The effects a joint's columns can hold: linear in their coefficients and in the motion, so the
+#: optimizer can excite them (Coulomb through a smooth sign).
+JointEffect = Literal["coulomb", "viscous", "armature", "offset"]
+
+
+class MotorConfig(Section):
+    """A motor that turns with several joints (a coupled wrist: s = q5 + q6): its rotor inertia, Coulomb
+    and viscous friction in the motor coordinate s = Σ_k n_k q_k, whose torque reaches joint k times n_k."""
+
+    joints: list[str] = Field(min_length=1)
+    """The joints the motor turns with."""
+    transmission: list[float] = Field(min_length=1)
+    """n_k [1], one per joint in `joints`: s = Σ n_k q_k (the transmission row of the motor)."""
+
+    @field_validator("transmission")
+    @classmethod
+    def _nonzero(cls, value: list[float]) -> list[float]:
+        if not any(value):
+            raise ValueError("a transmission row of zeros moves no joint")
+        return value
+
+
+class EffectsConfig(Section):
+    """Effects beyond the rigid body the trajectory is designed to excite (none by default: the
+    paper's rigid-body base parameters only)."""
+
+    joints: dict[str, list[JointEffect]] = Field(default_factory=dict)
+    """{joint or '*': [coulomb, viscous, armature, offset]}: each a column on that joint's row."""
+    motors: list[MotorConfig] = Field(default_factory=list)
+    """Coupled motors, each with its inertia, Coulomb and viscous friction in the motor coordinate."""
+    coulomb_velocity: PositiveFloat = 0.01
+    """v_c [rad/s] of the smooth sign tanh(q̇/v_c) of Coulomb friction (as identify's default)."""
+
+    @property
+    def declared(self) -> bool:
+        """Whether any effect column is asked for."""
+        return any(self.joints.values()) or bool(self.motors)

@@ -1,0 +1,30 @@
+"""The ``effects`` section: what it accepts and refuses, by field."""
+
+import pytest
+from pydantic import ValidationError
+
+from excite_cli.config.effects import EffectsConfig, MotorConfig
+
+
+def test_joints_take_the_designable_effects_and_motors_a_transmission_row():
+    cfg = EffectsConfig(
+        joints={"*": ["coulomb", "viscous"], "elbow": ["armature", "offset"]},
+        motors=[MotorConfig(joints=["w2", "w3"], transmission=[1.0, 1.0])],
+    )
+    assert cfg.declared and cfg.coulomb_velocity == 0.01
+    assert not EffectsConfig().declared and not EffectsConfig(joints={"*": []}).declared
+
+
+@pytest.mark.parametrize(
+    "data, field",
+    [
+        ({"joints": {"*": ["stribeck"]}}, "joints"),  # nonlinear in its shape: identify's, not a design column
+        ({"coulomb_velocity": 0.0}, "coulomb_velocity"),
+        ({"motors": [{"joints": ["a"], "transmission": [0.0]}]}, "transmission"),
+        ({"motors": [{"joints": [], "transmission": []}]}, "joints"),
+        ({"friction": ["coulomb"]}, "friction"),
+    ],
+)
+def test_what_cannot_be_designed_for_is_refused_naming_the_field(data, field):
+    with pytest.raises(ValidationError, match=field):
+        EffectsConfig(**data)
