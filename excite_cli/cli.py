@@ -8,7 +8,7 @@ import typer
 from rich.markup import escape
 
 from excite_cli import console, workflows
-from excite_cli.console.app import FORCE, SCHEDULER, WORKERS, app, command, err, out, say
+from excite_cli.console.app import FORCE, MODEL, PRIOR, SCHEDULER, WORKERS, app, command, err, out, say
 from excite_cli.console.progress import Bars
 from excite_cli.criteria import NAMES as OBJECTIVES
 from excite_cli.storage.formats import FORMATS
@@ -29,9 +29,7 @@ def _version(show: bool) -> None:
 
 @app.callback()
 def main(
-    version: bool = typer.Option(
-        False, "--version", callback=_version, is_eager=True, help="Print the version and exit."
-    ),
+    version: bool = typer.Option(False, "--version", callback=_version, is_eager=True, help="Print the version."),
 ) -> None:
     """Persistently exciting trajectories for robot dynamic identification (Ayusawa et al. 2017)."""
 
@@ -46,6 +44,8 @@ def optimize(
     seed: Optional[int] = typer.Option(None, "--seed", help="Seed of the random starts (optimizer.seed)."),
     workers: Optional[int] = WORKERS,
     scheduler: Optional[str] = SCHEDULER,
+    prior: Optional[Path] = PRIOR,
+    model: Optional[Path] = MODEL,
     force: bool = FORCE,
     resume: bool = typer.Option(False, "--resume", help="Continue the iterations already in the output file."),
     dry_run: bool = typer.Option(False, "--dry-run", help="Build the problem and say what would run (as `check`)."),
@@ -58,6 +58,8 @@ def optimize(
             "optimizer.seed": seed,
             "optimizer.workers": workers,
             "optimizer.scheduler": scheduler,
+            "sequence.prior": prior and str(prior.resolve()),
+            "effects.model": model and str(model.resolve()),
         },
     )
     if dry_run:

@@ -3,7 +3,7 @@ trajectory is designed for (its effect columns stand beside the base regressor's
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Literal, Optional
 
 from pydantic import Field, PositiveFloat, field_validator
 
@@ -41,8 +41,5 @@ class EffectsConfig(Section):
     """Coupled motors, each with its inertia, Coulomb and viscous friction in the motor coordinate."""
     coulomb_velocity: PositiveFloat = 0.01
     """v_c [rad/s] of the smooth sign tanh(q̇/v_c) of Coulomb friction (as identify's default)."""
-
-    @property
-    def declared(self) -> bool:
-        """Whether any effect column is asked for."""
-        return any(self.joints.values()) or bool(self.motors)
+    model: Optional[str] = None
+    """An identify report whose chosen effects are added (its v_c taken); relative to this file."""

@@ -19,6 +19,8 @@ WORKERS = typer.Option(
     None, "--workers", help="Local processes for restarts and draws (optimizer.workers; default: the cores)."
 )
 SCHEDULER = typer.Option(None, "--scheduler", help="Dask scheduler, e.g. tcp://host:8786 (optimizer.scheduler).")
+PRIOR = typer.Option(None, "--prior", help="Earlier result or identify report stacked first (sequence.prior).")
+MODEL = typer.Option(None, "--model", help="Identify report whose effects to design for too (effects.model).")
 
 
 def command(name: Optional[str] = None) -> Callable:

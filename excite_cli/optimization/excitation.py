@@ -12,7 +12,7 @@ import numpy as np
 from scipy.linalg import block_diag
 
 from excite_cli.collision.capsules import capsule_pairs, capsules_from_config
-from excite_cli.config import Problem
+from excite_cli.config import Problem, resolve_path
 from excite_cli.constraints import Constraint, JointLimits, SelfCollision, accepted
 from excite_cli.constraints.com_region import com_region_from_config
 from excite_cli.constraints.joint_limits import joint_limit_bounds
@@ -24,6 +24,7 @@ from excite_cli.dynamics.base_parameters import BaseParameters, compute_base_par
 from excite_cli.dynamics.effect_columns import EffectColumns, effect_columns
 from excite_cli.dynamics.robot import Robot, load_robot
 from excite_cli.errors import ExciteError
+from excite_cli.identification.reporting.design_model import with_report_model
 from excite_cli.optimization.criterion import Criterion, condition_number
 from excite_cli.optimization.information import excitation_level, parameter_magnitudes, scaled_frame
 from excite_cli.trajectory.boundary import BoundaryConditions, boundary_rows
@@ -228,9 +229,13 @@ def _design_effects(problem: Problem, robot: Robot, base: BaseParameters) -> Eff
     random states: :meth:`~excite_cli.dynamics.effect_columns.EffectColumns.beside`), or None.
 
     Raises:
-        ExciteError: an effect on a joint that is not active (:func:`effect_columns`).
+        ExciteError: an effect on a joint that is not active (:func:`effect_columns`), an
+            ``effects.model`` that is not an identify report of this problem's joints.
     """
-    effects = effect_columns(problem.effects, robot.joint_names, robot.n_rows)
+    cfg = problem.effects
+    if cfg.model is not None:
+        cfg = with_report_model(cfg, resolve_path(cfg.model, problem.folder), robot.joint_names)
+    effects = effect_columns(cfg, robot.joint_names, robot.n_rows)
     if effects is None:
         return None
     count = max(50, -(-(base.count + effects.count) * 2 // robot.n_rows))

@@ -11,8 +11,8 @@ def test_joints_take_the_designable_effects_and_motors_a_transmission_row():
         joints={"*": ["coulomb", "viscous"], "elbow": ["armature", "offset"]},
         motors=[MotorConfig(joints=["w2", "w3"], transmission=[1.0, 1.0])],
     )
-    assert cfg.declared and cfg.coulomb_velocity == 0.01
-    assert not EffectsConfig().declared and not EffectsConfig(joints={"*": []}).declared
+    assert cfg.coulomb_velocity == 0.01 and cfg.motors[0].transmission == [1.0, 1.0] and cfg.model is None
+    assert EffectsConfig().joints == {} and EffectsConfig().motors == []
 
 
 @pytest.mark.parametrize(

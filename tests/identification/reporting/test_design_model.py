@@ -1,0 +1,74 @@
+"""An identify report's chosen effects as the next design's columns (``effects.model``)."""
+
+import h5py
+import pytest
+from conftest import CONFIGS
+from typer.testing import CliRunner
+
+from excite_cli.cli import app
+from excite_cli.config_file import load_problem
+from excite_cli.errors import ExciteError
+from excite_cli.h5 import read_strings
+from excite_cli.identification.reporting.design_model import read_report_model, with_report_model
+from excite_cli.identification.reporting.report_file import write_identification
+from excite_cli.optimization.excitation import build_excitation
+
+
+@pytest.fixture(scope="module")
+def report_file(simulated_identification, tmp_path_factory):
+    problem, report, robot, base, regressor = simulated_identification
+    path = tmp_path_factory.mktemp("report") / "report.h5"
+    write_identification(path, report, robot, base, problem, [part.copy() for part in regressor])
+    return path
+
+
+def test_the_reports_friction_becomes_the_designs_columns(report_file, simulated_identification):
+    """The shipped simulated runs hold Coulomb and viscous friction on every joint, which identify finds
+    (test_report_file); a design with the report as its model gets exactly those columns."""
+    _, report, robot, *_ = simulated_identification
+    model = read_report_model(report_file)
+    assert {j: sorted(kinds) for j, kinds in model.joints.items()} == {
+        j: ["coulomb", "viscous"] for j in robot.joint_names
+    }
+    assert model.motors == [] and model.left_out == [] and model.coulomb_velocity == 0.01
+    problem = load_problem(CONFIGS / "smoke.yaml")
+    problem.effects.model = str(report_file)
+    excitation = build_excitation(problem)
+    assert set(excitation.effect_names) == {f"{c}_{j}" for j in robot.joint_names for c in ("Fc", "Fv")}
+
+
+def test_a_report_with_a_coupled_motor_and_a_shaped_effect(report_file, tmp_path):
+    path = tmp_path / "edited.h5"
+    path.write_bytes(report_file.read_bytes())
+    with h5py.File(path, "a") as f:
+        rows, coupling = f["identification/effects"][()], f["identification/effect_coupling"][()]
+        rows["effect"][0], rows["effect"][1] = "stribeck", "motor"
+        coupling[1, 5:7] = [1.0, 1.0]
+        del f["identification/effects"], f["identification/effect_coupling"]
+        f["identification/effects"], f["identification/effect_coupling"] = rows, coupling
+    model = read_report_model(path)
+    assert model.motors == [(["panda_joint6", "panda_joint7"], [1.0, 1.0])]
+    assert model.left_out == [f"stribeck ({rows['joint'][0].decode()})"]
+
+
+def test_a_file_that_is_not_a_report_or_of_other_joints_is_refused_naming_the_field(report_file, optimized):
+    problem = load_problem(CONFIGS / "smoke.yaml")
+    with pytest.raises(ExciteError, match=r"effects\.model.*is not an identify report"):
+        with_report_model(problem.effects, optimized, ["panda_joint1"])
+    with pytest.raises(ExciteError, match=r"effects\.model.*'panda_joint\d', which is not an active joint"):
+        with_report_model(problem.effects, report_file, ["shoulder_pan_joint"])
+
+
+def test_optimize_with_the_report_as_model_designs_for_its_friction(report_file, tmp_path, monkeypatch):
+    """`excite optimize CONFIG --model REPORT.h5`, the path relative to where the user stands."""
+    monkeypatch.chdir(report_file.parent)
+    out = tmp_path / "next.h5"
+    run = CliRunner().invoke(
+        app, ["optimize", str(CONFIGS / "smoke.yaml"), "--model", report_file.name, "-o", str(out), "-k", "1"]
+    )
+    assert run.exit_code == 0, run.output
+    with h5py.File(out) as f:
+        names = read_strings(f["robot"], "effect_names")
+        assert (
+            len(names) == 14 and f["iterations/1/regressor"].shape[1] == f["robot/base_parameter_names"].shape[0] + 14
+        )
