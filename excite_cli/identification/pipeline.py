@@ -238,6 +238,7 @@ def run_identification(
         cutoff_source=data.cutoff_source,
         fit_samples=fit_data.time.size,
         validation_samples=val_data.time.size,
+        rate=data.rate,
         dropped=data.dropped,
         run_names=labels,
         offset_runs=offset_runs,

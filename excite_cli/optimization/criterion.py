@@ -63,6 +63,8 @@ class Criterion:
         frame: L (b+e, b+e): the criterion is that of C L (module docstring); None: of C, the paper's.
         effects: e effect columns beside the b base columns, C = [Y_B | Y_E] per row
             (:mod:`~excite_cli.dynamics.effect_columns`), or None: the rigid body alone.
+        row_weights: (n_rows,) each regressor row's weight in the trajectory's rows (a joint's σ̄/σ_j
+            when the prior is measured data weighed by its noise), or None: unweighted.
     """
 
     robot: Robot
@@ -72,6 +74,7 @@ class Criterion:
     objective: CriterionRecord = field(default_factory=lambda: CRITERIA["log_cond"])
     frame: np.ndarray | None = None
     effects: EffectColumns | None = None
+    row_weights: np.ndarray | None = None
     _dynamics: VirtualDynamics = field(init=False, repr=False)
     _data: pin.Data = field(init=False, repr=False)
     _prior_gram: np.ndarray = field(init=False, repr=False)
@@ -105,7 +108,8 @@ class Criterion:
 
     def _regressor(self, Q: np.ndarray, QD: np.ndarray, QDD: np.ndarray) -> np.ndarray:
         own = self.robot.regressor_stack(Q, QD, QDD, self._data)[:, self.base.independent]  # Y X, X a selection
-        return own if self.effects is None else np.hstack([own, self.effects.columns(QD, QDD)])
+        own = own if self.effects is None else np.hstack([own, self.effects.columns(QD, QDD)])
+        return own if self.row_weights is None else own * np.tile(self.row_weights, Q.shape[0])[:, None]
 
     def stacked(self, own: np.ndarray) -> np.ndarray:
         """C = [C₀; Ŷ_B] (Eq. 41)."""
@@ -134,6 +138,8 @@ class Criterion:
         directions = V[:, used] if self.frame is None else self.frame @ V[:, used]  # v_r, or L ṽ_r
         T, rows, b = Q.shape[0], self.robot.n_rows, self.base.count
         weighted = (own @ directions) * coefficients  # a_r (C v_r): the rows' weights (M, R)
+        if self.row_weights is not None:  # ∂f/∂Y of the unweighted rows: times each row's weight
+            weighted = weighted * np.tile(self.row_weights, T)[:, None]
         if used.size > len(self._dynamics.slots):  # fewer passes with a virtual parameter per instant and row
             phis = np.zeros((T, rows, self.robot.n_parameters))
             phis[:, :, self.base.independent] = (weighted @ directions[:b].T).reshape(T, rows, -1)

@@ -12,7 +12,7 @@ import numpy as np
 from scipy.linalg import block_diag
 
 from excite_cli.collision.capsules import capsule_pairs, capsules_from_config
-from excite_cli.config import Problem, resolve_path
+from excite_cli.config import Problem
 from excite_cli.constraints import Constraint, JointLimits, SelfCollision, accepted
 from excite_cli.constraints.com_region import com_region_from_config
 from excite_cli.constraints.joint_limits import joint_limit_bounds
@@ -21,12 +21,13 @@ from excite_cli.constraints.torque_limits import TorqueLimits, TorqueUse, torque
 from excite_cli.constraints.world_collision import WorldCollision, world_shapes
 from excite_cli.criteria import criterion_record
 from excite_cli.dynamics.base_parameters import BaseParameters, compute_base_parameters
-from excite_cli.dynamics.effect_columns import EffectColumns, effect_columns
+from excite_cli.dynamics.effect_columns import EffectColumns
 from excite_cli.dynamics.robot import Robot, load_robot
 from excite_cli.errors import ExciteError
-from excite_cli.identification.reporting.design_model import with_report_model
+from excite_cli.identification.reporting.design_model import MeasuredPrior
 from excite_cli.optimization.criterion import Criterion, condition_number
 from excite_cli.optimization.information import excitation_level, parameter_magnitudes, scaled_frame
+from excite_cli.optimization.model_columns import design_effects, measured_prior
 from excite_cli.trajectory.boundary import BoundaryConditions, boundary_rows
 from excite_cli.trajectory.fourier import FourierBasis, FourierTrajectory, sample_times
 
@@ -52,6 +53,8 @@ class Excitation:
             of base columns (:func:`~excite_cli.optimization.information.scaled_frame`), each effect
             column scaled by its typical magnitude (:meth:`EffectColumns.magnitudes`).
         effects: the effect columns designed for beside the base columns (``effects``), or None.
+        measured: how the rows of ``sequence.prior`` weigh when it is an identify report
+            (:class:`~excite_cli.identification.reporting.design_model.MeasuredPrior`), or None.
     """
 
     problem: Problem
@@ -66,6 +69,7 @@ class Excitation:
     boundary: BoundaryConditions
     scaled_frame: np.ndarray
     effects: EffectColumns | None = None
+    measured: MeasuredPrior | None = None
 
     def criterion(
         self, prior: np.ndarray | None = None, objective: str | None = None, scaling: str | None = None
@@ -81,6 +85,7 @@ class Excitation:
             objective=criterion_record(objective or self.problem.optimizer.objective),
             frame=self.scaled_frame if scaling == "urdf" else None,
             effects=self.effects,
+            row_weights=self.row_weights,
         )
 
     def excitation_level(self, C: np.ndarray) -> float:
@@ -98,6 +103,17 @@ class Excitation:
     def columns(self) -> int:
         """b + e: the regressor's columns, base parameters then effect columns."""
         return self.base.count + (self.effects.count if self.effects else 0)
+
+    @property
+    def row_weights(self) -> np.ndarray | None:
+        """(n_rows,) the trajectory's row weights: with a measured prior, each joint's σ̄/σ_j as the
+        prior's rows have (the base wrench rows, which no joint measures, 1); else None."""
+        if self.measured is None:
+            return None
+        weights = np.ones(self.robot.n_rows)
+        by_joint = dict(zip(self.measured.joints, self.measured.weights()))
+        weights[self.robot.n_rows - self.robot.n_joints :] = [by_joint[j] for j in self.robot.joint_names]
+        return weights
 
     @property
     def effect_names(self) -> tuple[str, ...]:
@@ -164,14 +180,15 @@ def build_excitation(problem: Problem, base: BaseParameters | None = None, check
     collision = bool(ccfg.self_collision or ccfg.environment or (ccfg.com and ccfg.com.support_links))
     robot = load_robot(problem.robot, problem.folder, collision)
     base = base or compute_base_parameters(robot)
-    effects = _design_effects(problem, robot, base)
+    effects = design_effects(problem, robot, base)
     columns = base.count + (effects.count if effects else 0)
     tcfg = problem.trajectory
     if tcfg.cost_samples * robot.n_rows < columns:
+        effect_part = f" and {effects.count} effect columns" if effects else ""
         raise ExciteError(
             "trajectory.cost_samples",
             f"{tcfg.cost_samples} samples × {robot.n_rows} regressor rows are fewer "
-            f"than the robot's {base.count} base parameters{_and_effects(effects)}; cond(C) would be infinite",
+            f"than the robot's {base.count} base parameters{effect_part}; cond(C) would be infinite",
         )
     trajectory = FourierTrajectory(tcfg.harmonics, tcfg.base_frequency)
     fine_period = tcfg.constraint_period / problem.limits.check_refinement
@@ -213,35 +230,11 @@ def build_excitation(problem: Problem, base: BaseParameters | None = None, check
         boundary=boundary,
         scaled_frame=frame,
         effects=effects,
+        measured=measured_prior(problem, robot),
     )
     if check_home:
         _check_home_posture(excitation)
     return excitation
-
-
-def _and_effects(effects: EffectColumns | None) -> str:
-    """`` and e effect columns`` for a message, or nothing."""
-    return f" and {effects.count} effect columns" if effects else ""
-
-
-def _design_effects(problem: Problem, robot: Robot, base: BaseParameters) -> EffectColumns | None:
-    """The effect columns of ``effects`` that the rigid body's base columns do not already hold (on
-    random states: :meth:`~excite_cli.dynamics.effect_columns.EffectColumns.beside`), or None.
-
-    Raises:
-        ExciteError: an effect on a joint that is not active (:func:`effect_columns`), an
-            ``effects.model`` that is not an identify report of this problem's joints.
-    """
-    cfg = problem.effects
-    if cfg.model is not None:
-        cfg = with_report_model(cfg, resolve_path(cfg.model, problem.folder), robot.joint_names)
-    effects = effect_columns(cfg, robot.joint_names, robot.n_rows)
-    if effects is None:
-        return None
-    count = max(50, -(-(base.count + effects.count) * 2 // robot.n_rows))
-    Q, QD, QDD = robot.random_states(count, np.random.default_rng(0))
-    effects = effects.beside(robot.regressor_stack(Q, QD, QDD)[:, base.independent], QD, QDD)
-    return effects if effects.count else None
 
 
 def _boundary_conditions(

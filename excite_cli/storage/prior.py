@@ -1,6 +1,6 @@
 """Prior data C₀ for the sequential generation (Eq. 41): the regressor rows of an earlier result or of
-measured data, stacked above the new trajectory's, in this design's columns (base parameters by
-name, then the same effect columns)."""
+measured data (an identify report, weighed as identification weighs it), stacked above the new
+trajectory's, in this design's columns (base parameters by name, then the same effect columns)."""
 
 from __future__ import annotations
 
@@ -12,12 +12,25 @@ import numpy as np
 from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.errors import ExciteError
 from excite_cli.h5 import open_h5, read_strings
+from excite_cli.identification.reporting.design_model import MeasuredPrior
 
 
-def read_prior(path: Path, base: BaseParameters, effect_names: Sequence[str] = ()) -> np.ndarray:
+def read_prior(
+    path: Path,
+    base: BaseParameters,
+    effect_names: Sequence[str] = (),
+    measured: MeasuredPrior | None = None,
+    cost_period: float = 1.0,
+) -> np.ndarray:
     """Prior data C₀ (m, b+e) for Eq. 41 from an excite result (all iterations' regressors stacked) or
     an HDF5 file with a dataset ``regressor`` of base-regressor rows, then the e effect columns
     ``effect_names`` of the design (``/robot/effect_names`` of a result: the same, in the same order).
+
+    An identify report's rows (``measured``, see
+    :class:`~excite_cli.identification.reporting.design_model.MeasuredPrior`) are weighed as
+    identification weighs them: each joint's rows times σ̄/σ_j, and every row times
+    √(1 / (cost_period · rate)) so that one second of recording carries the information of one second
+    of a trajectory on the cost grid (``cost_period`` [s]).
 
     Raises:
         ExciteError: missing or unreadable file, no regressor inside, or base parameters or effect
@@ -51,6 +64,9 @@ def read_prior(path: Path, base: BaseParameters, effect_names: Sequence[str] = (
         )
     if not np.all(np.isfinite(prior)):
         raise ExciteError("sequence.prior", f"{path} contains NaN or infinite values")
+    if measured is not None:
+        weights = measured.weights() * measured.time_scale(cost_period)
+        prior = (prior.reshape(-1, weights.size, prior.shape[1]) * weights[None, :, None]).reshape(prior.shape)
     if names is None:
         return prior
     order = np.concatenate(

@@ -96,7 +96,13 @@ def run_optimize(
         raise FileNotFound("resume", target, "result to continue")
     excitation = build_excitation(problem)
     prior = (
-        read_prior(resolve_path(problem.sequence.prior, problem.folder), excitation.base, excitation.effect_names)
+        read_prior(
+            resolve_path(problem.sequence.prior, problem.folder),
+            excitation.base,
+            excitation.effect_names,
+            excitation.measured,
+            problem.trajectory.cost_period,
+        )
         if problem.sequence.prior
         else None
     )

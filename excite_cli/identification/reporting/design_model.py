@@ -1,8 +1,10 @@
-"""The effects an identify report chose, as the model the next trajectory is designed for
-(``effects.model`` of an ``optimize`` config): each joint's Coulomb and viscous friction, armature and
-torque offset, and each coupled motor with its transmission row (``/identification/effect_coupling``).
-Effects the design cannot hold as columns (asymmetric, Stribeck, held and load-dependent friction:
-nonlinear in a shape or a first fit; springs and position harmonics) are named and left out."""
+"""An identify report as the next design's model and prior data. Its chosen effects are the model
+the next trajectory is designed for (``effects.model`` of an ``optimize`` config): each joint's Coulomb
+and viscous friction, armature and torque offset, and each coupled motor with its transmission row
+(``/identification/effect_coupling``). Effects the design cannot hold as columns (asymmetric,
+Stribeck, held and load-dependent friction: nonlinear in a shape or a first fit; springs and position
+harmonics) are named and left out. As ``sequence.prior`` its rows are weighed as identification
+weighs them (:class:`MeasuredPrior`)."""
 
 from __future__ import annotations
 
@@ -97,3 +99,47 @@ def with_report_model(cfg: EffectsConfig, path: Path, joint_names: list[str]) ->
         joints[name] = joints.get(name, []) + [k for k in kinds if k not in joints.get(name, [])]
     motors = list(cfg.motors) + [MotorConfig(joints=j, transmission=t) for j, t in model.motors]
     return cfg.model_copy(update={"joints": joints, "motors": motors, "coulomb_velocity": model.coulomb_velocity})
+
+
+@dataclass(frozen=True)
+class MeasuredPrior:
+    """How an identify report's rows weigh as prior data C₀ (Eq. 41) of the next design, as
+    identification weighs them: each joint's rows divided by its noise, and one second of recording
+    worth one second of a trajectory on the cost grid.
+
+    Attributes:
+        joints: (n,) the report's joints, in its rows' order.
+        sigma: (n,) σ_j [Nm]: each joint's RMS torque error of the reported model on the validation
+            data (``rms_after``), what the fit leaves unexplained, noise included.
+        rate: the report's decimated sample rate [Hz]: regressor rows per second and joint.
+    """
+
+    joints: list[str]
+    sigma: np.ndarray
+    rate: float
+
+    def weights(self) -> np.ndarray:
+        """(n,) σ̄ / σ_j, σ̄ the geometric mean of σ (1 for equal noise on every joint): weighted least
+        squares' weights (Gautier 1997), relative so the criterion keeps its scale."""
+        sigma = np.maximum(self.sigma, 1e-9 * self.sigma.max())
+        return np.exp(np.log(sigma).mean()) / sigma
+
+    def time_scale(self, cost_period: float) -> float:
+        """√(1 / (cost_period · rate)): the information of a recording is a Riemann sum of ∫ YᵀWᵀWY dt
+        at its rate and the design's at 1/cost_period rows per second, so each recorded row is scaled
+        so that both sums approximate the same integral per second (Swevers et al. 1997 take the
+        information matrix as that integral over the experiment)."""
+        return float(np.sqrt(1.0 / (cost_period * self.rate)))
+
+
+def read_measured_prior(path: Path) -> MeasuredPrior | None:
+    """The weighing of ``sequence.prior`` when it is an identify report (``/identification/rms_after``,
+    ``/identification/joint_names``, ``/regressor`` attribute ``sample_rate_Hz``); None for anything else
+    (an optimize result, a plain regressor file, or no file: whoever reads the rows says what is wrong)."""
+    if not path.is_file():
+        return None
+    with open_h5(path, "sequence.prior") as f:
+        if "identification/rms_after" not in f or "sample_rate_Hz" not in f["regressor"].attrs:
+            return None
+        joints = read_strings(f["identification"], "joint_names")
+        return MeasuredPrior(joints, f["identification/rms_after"][()], float(f["regressor"].attrs["sample_rate_Hz"]))

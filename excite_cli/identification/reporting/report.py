@@ -36,6 +36,8 @@ class Report:
         validation: the validation samples; predicted_before, predicted_after: (N, n) [Nm] on them.
         cutoff: low-pass cut-off of every run [Hz]; cutoff_source: how it was chosen, in words.
         fit_samples, validation_samples: instants used for fitting / validation.
+        rate: the decimated sample rate of the fit and validation data [Hz] (rows per second of the
+            base regressor, per joint).
         dropped: (file, rows) left out as unusable, per run with ``data.bad_rows: drop``.
         run_names: (runs,) each configured run's label (file and crop), indexed by ``Dataset.run``.
         offset_runs: the runs whose offsets the fit has (one column each), as labels.
@@ -68,6 +70,7 @@ class Report:
     cutoff_source: str
     fit_samples: int
     validation_samples: int
+    rate: float
     dropped: list[tuple[str, int]] = field(default_factory=list)
     run_names: list[str] = field(default_factory=list)
     offset_runs: list[str] = field(default_factory=list)

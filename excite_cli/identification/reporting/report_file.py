@@ -56,9 +56,9 @@ def write_identification(
         group.create_dataset("regrouping_matrix", data=base.regrouping).attrs["description"] = (
             "K (b x p): phi_B = K phi"
         )
-        write_parts(f, "regressor", regressor, b).attrs["description"] = (
-            "base regressor of all preprocessed (decimated) samples, fit then validation (prior data C0, Eq. 41)"
-        )
+        rows = write_parts(f, "regressor", regressor, b)
+        rows.attrs["description"] = "base regressor of all preprocessed (decimated) samples, fit then validation (C0)"
+        rows.attrs["sample_rate_Hz"] = report.rate
         g = f.create_group("identification")
         g.attrs["method"], g.attrs["cutoff_Hz"], g.attrs["cutoff_source"] = (
             problem.identification.method,

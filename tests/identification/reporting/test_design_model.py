@@ -1,6 +1,7 @@
 """An identify report's chosen effects as the next design's columns (``effects.model``)."""
 
 import h5py
+import numpy as np
 import pytest
 from conftest import CONFIGS
 from typer.testing import CliRunner
@@ -9,7 +10,12 @@ from excite_cli.cli import app
 from excite_cli.config_file import load_problem
 from excite_cli.errors import ExciteError
 from excite_cli.h5 import read_strings
-from excite_cli.identification.reporting.design_model import read_report_model, with_report_model
+from excite_cli.identification.reporting.design_model import (
+    MeasuredPrior,
+    read_measured_prior,
+    read_report_model,
+    with_report_model,
+)
 from excite_cli.identification.reporting.report_file import write_identification
 from excite_cli.optimization.excitation import build_excitation
 
@@ -72,3 +78,45 @@ def test_optimize_with_the_report_as_model_designs_for_its_friction(report_file,
         assert (
             len(names) == 14 and f["iterations/1/regressor"].shape[1] == f["robot/base_parameter_names"].shape[0] + 14
         )
+
+
+def test_a_second_of_recording_weighs_as_a_second_on_the_cost_grid():
+    """The same motion sampled 7 times finer than the cost grid: scaled by √(1/(cost_period·rate)) its
+    information matrix equals the cost grid's (both are Riemann sums of ∫ YᵀY dt per second)."""
+    excitation = build_excitation(load_problem(CONFIGS / "smoke.yaml"))
+    alpha = excitation.random_start(np.random.default_rng(3))
+    period = excitation.problem.trajectory.cost_period
+    duration = excitation.problem.trajectory.duration
+    fine = excitation.trajectory.basis(np.arange(0.0, duration, period / 7.0))
+    Y = excitation.robot.regressor_stack(*fine.evaluate(alpha))[:, excitation.base.independent]
+    prior = MeasuredPrior(excitation.robot.joint_names, np.ones(excitation.robot.n_joints), 7.0 / period)
+    scaled = Y * prior.time_scale(period)
+    own = excitation.criterion().regressor(alpha)
+    gram_fine, gram_cost = scaled.T @ scaled, own.T @ own
+    assert np.linalg.norm(gram_fine - gram_cost) <= 0.05 * np.linalg.norm(gram_cost)
+
+
+def test_a_joints_rows_weigh_by_its_unexplained_torque():
+    prior = MeasuredPrior(["a", "b", "c"], np.array([0.1, 0.4, 0.2]), 200.0)
+    np.testing.assert_allclose(prior.weights(), 0.2 / np.array([0.1, 0.4, 0.2]))  # σ̄ = (0.1·0.4·0.2)^⅓ = 0.2
+
+
+def test_optimize_with_the_report_as_prior_weighs_both_the_prior_and_its_own_rows(report_file, tmp_path):
+    """`excite optimize CONFIG --prior REPORT.h5`: the report's rows enter weighted by σ̄/σ_j and the time
+    rule, and the new trajectory's rows by σ̄/σ_j too (the noise the next run will see)."""
+    out = tmp_path / "next.h5"
+    run = CliRunner().invoke(
+        app, ["optimize", str(CONFIGS / "smoke.yaml"), "--prior", str(report_file), "-o", str(out), "-k", "1"]
+    )
+    assert run.exit_code == 0, run.output
+    measured = read_measured_prior(report_file)
+    assert measured is not None and measured.rate > 0
+    problem = load_problem(CONFIGS / "smoke.yaml")
+    problem.sequence.prior = str(report_file)
+    excitation = build_excitation(problem)
+    with h5py.File(out) as f:
+        alpha, own = f["iterations/1/alpha"][()], f["iterations/1/regressor"][()]
+    plain = build_excitation(load_problem(CONFIGS / "smoke.yaml")).criterion().regressor(alpha)
+    weights = np.tile(measured.weights(), own.shape[0] // measured.weights().size)
+    np.testing.assert_allclose(own, plain * weights[:, None], rtol=1e-9, atol=1e-12)
+    assert excitation.row_weights is not None and not np.allclose(excitation.row_weights, 1.0)

@@ -1,0 +1,143 @@
+"""The loop closed both ways: does designing the next trajectory for the effects identification found
+identify them better? A simulated robot with friction and rotor inertia on every joint and one coupled
+motor, for several seeds:
+
+1. trajectory 1 optimized blind (the config's rigid-body design, one iteration), and measured: sampled at
+   100 Hz over its duration, torques = RNEA with the URDF's inertias + the effects' true torques + white
+   noise of 2 % of each joint's RMS torque on an unseen motion;
+2. trajectory 2 of the same duration designed (a) blind, as today: iteration 2 of the rigid-body
+   sequence (C₀ = trajectory 1's base-regressor rows), or (b) for the identified model: its effect columns
+   beside the base columns (`effects`: Coulomb, viscous friction and armature on every joint, the
+   coupled motor's inertia and friction) with trajectory 1's rows of that model as C₀; both from the
+   same random starts (iteration 2's);
+3. both measured as run 1 and identified together with run 1: weighted least squares (1/σ_j) of the base
+   parameters and every effect coefficient.
+
+The identified model is the true one (the effects a report of run 1 names; identify finds exactly these
+on the shipped simulated Panda runs, tests), so what differs is the second trajectory alone. True
+effect coefficients: each the typical magnitude of the design's scaling (its torque at the joint's
+limits 5 % of the URDF's effort limit). Columns the base parameters already hold (a first joint's
+armature) are neither simulated nor identified.
+
+Printed per robot and seed: mean relative error of the effect coefficients [%], the base parameters'
+error (RMS over the identifiable directions of L⁻¹(β̂ − β) in the URDF-scaled frame, as
+bench/criteria.py) [%] and the unseen motion's relative torque error [%], (a) then (b); and the last
+lines, one per robot: `loop ROBOT: effects error blind X %, designed Y %; base error blind X %, designed
+Y %` (means over the seeds).
+
+    .venv/bin/python bench/loop.py [--robots G1 Panda] [--seeds 0 1 2]
+
+Asserts nothing.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+import numpy as np
+
+from excite_cli.config import EffectsConfig, MotorConfig
+from excite_cli.config_file import load_problem
+from excite_cli.optimization.engine import Engine, default_workers
+from excite_cli.optimization.excitation import build_excitation
+from excite_cli.optimization.sequence import describe, run_sequence
+
+ROOT = Path(__file__).resolve().parent.parent
+ROBOTS = {"G1": ROOT / "configs" / "g1_arms.yaml", "Panda": ROOT / "configs" / "panda_joint_limits.yaml"}
+RATE, NOISE, UNSEEN_SEED = 100.0, 0.02, 12345
+
+
+def measured(excitation, alpha: np.ndarray, truth: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """[Y_B | Y_E] (T·n, b+e) and the true torques (T, n) of α sampled at ``RATE`` (no noise yet)."""
+    robot, b = excitation.robot, excitation.base.count
+    basis = excitation.trajectory.basis(np.arange(0.0, excitation.problem.trajectory.duration, 1.0 / RATE))
+    Q, QD, QDD = basis.evaluate(alpha)
+    Y = np.hstack(
+        [robot.regressor_stack(Q, QD, QDD)[:, excitation.base.independent], excitation.effects.columns(QD, QDD)]
+    )
+    rigid = np.array([robot.torques(*x) for x in zip(Q, QD, QDD)])
+    return Y, rigid + (Y[:, b:] @ truth[b:]).reshape(rigid.shape)
+
+
+def identified(excitation, runs: list[tuple[np.ndarray, np.ndarray]], sigma: np.ndarray, seed: int) -> np.ndarray:
+    """WLS estimate of [β; c] from the runs' columns and torques with white noise σ_j (n,)."""
+    Y = np.vstack([y for y, _ in runs])
+    tau = np.vstack([t for _, t in runs])
+    noisy = tau + np.random.default_rng(seed).normal(0.0, 1.0, tau.shape) * sigma
+    w = np.tile(1.0 / sigma, tau.shape[0])
+    return np.linalg.lstsq(Y * w[:, None], noisy.ravel() * w, rcond=None)[0]
+
+
+def errors(excitation, estimate: np.ndarray, truth: np.ndarray, unseen: tuple[np.ndarray, np.ndarray]) -> tuple:
+    """Effect coefficients' mean relative error, base parameters' scaled RMS error, unseen torque error."""
+    b = excitation.base.count
+    effect = np.mean(np.abs(estimate[b:] - truth[b:]) / np.abs(truth[b:]))
+    base = np.sqrt(np.mean((np.linalg.solve(excitation.scaled_frame[:b, :b], estimate[:b] - truth[:b])) ** 2))
+    Y, tau = unseen
+    predicted = (Y @ estimate).reshape(tau.shape)
+    torque = np.mean(np.sqrt(((predicted - tau) ** 2).mean(axis=0) / (tau**2).mean(axis=0)))
+    return effect, base, torque
+
+
+def loop(config: Path, seed: int) -> tuple:
+    """(a) and (b)'s errors of one seed, and the wall time."""
+    begin = time.perf_counter()
+    problem = load_problem(config)
+    problem.optimizer.seed = seed
+    blind = build_excitation(problem)
+    joints = problem.robot.active_joints
+    design = problem.model_copy(deep=True)
+    design.effects = EffectsConfig(
+        joints={"*": ["coulomb", "viscous", "armature"]},
+        motors=[MotorConfig(joints=joints[-2:], transmission=[1.0, 1.0])],
+    )
+    model = build_excitation(design)  # the identified model's columns (those the base does not hold)
+    effort = model.robot.model.effortLimit[model.robot.v_idx]
+    magnitudes = model.effects.magnitudes(effort, model.limits.upper[1], model.limits.upper[2])
+    truth = np.concatenate([model.base.from_standard(model.robot.urdf_parameters()), magnitudes])
+    workers = min(default_workers(), problem.optimizer.restarts)
+    with Engine(blind, workers) as engine:
+        first = run_sequence(blind, 1, seed, engine=engine)
+        blind_second = run_sequence(blind, 2, seed, engine=engine, finished=first)[-1].alpha
+    alpha1 = first[0].alpha
+    with Engine(model, workers) as engine:
+        earlier = [describe(model, 1, alpha1, np.zeros((0, model.columns)))]
+        designed_second = run_sequence(model, 2, seed, engine=engine, finished=earlier)[-1].alpha
+    unseen = measured(model, model.random_start(np.random.default_rng(UNSEEN_SEED)), truth)
+    sigma = NOISE * np.sqrt((unseen[1] ** 2).mean(axis=0))
+    run1 = measured(model, alpha1, truth)
+    rows = []
+    for second in (blind_second, designed_second):
+        estimate = identified(model, [run1, measured(model, second, truth)], sigma, seed)
+        rows.append(errors(model, estimate, truth, unseen))
+    return rows[0], rows[1], time.perf_counter() - begin
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--robots", nargs="+", default=list(ROBOTS), choices=list(ROBOTS))
+    parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
+    args = parser.parse_args()
+    lines = []
+    for robot in args.robots:
+        results = []
+        for seed in args.seeds:
+            a, b, wall = loop(ROBOTS[robot], seed)
+            results.append((a, b))
+            print(
+                f"  {robot} seed {seed}: effects {a[0]:.2%} / {b[0]:.2%}, base {a[1]:.3%} / {b[1]:.3%}, "
+                f"unseen torque {a[2]:.3%} / {b[2]:.3%} (blind / designed), {wall:.0f} s",
+                flush=True,
+            )
+        mean = np.mean(np.array(results), axis=0)  # (2, 3)
+        lines.append(
+            f"loop {robot}: effects error blind {mean[0, 0]:.2%}, designed {mean[1, 0]:.2%}; "
+            f"base error blind {mean[0, 1]:.3%}, designed {mean[1, 1]:.3%}"
+        )
+    print("\n".join(lines))
+
+
+if __name__ == "__main__":
+    main()

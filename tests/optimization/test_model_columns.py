@@ -1,0 +1,43 @@
+"""The model a design is for: no effect columns without effects, and a measured prior's joints
+checked against the problem's."""
+
+import h5py
+import numpy as np
+import pytest
+from conftest import CONFIGS
+
+from excite_cli.config_file import load_problem
+from excite_cli.dynamics.base_parameters import compute_base_parameters
+from excite_cli.dynamics.robot import load_robot
+from excite_cli.errors import ExciteError
+from excite_cli.h5 import write_strings
+from excite_cli.optimization.model_columns import design_effects, measured_prior
+
+
+def _report(path, joints, sigma):
+    with h5py.File(path, "w") as f:
+        f.create_dataset("regressor", data=np.zeros((0, 1))).attrs["sample_rate_Hz"] = 200.0
+        g = f.create_group("identification")
+        write_strings(g, "joint_names", joints)
+        g["rms_after"] = sigma
+    return path
+
+
+def test_a_rigid_design_has_no_effect_columns_and_a_result_prior_no_weights(optimized):
+    problem = load_problem(CONFIGS / "smoke.yaml")
+    robot = load_robot(problem.robot, problem.folder)
+    assert design_effects(problem, robot, compute_base_parameters(robot)) is None
+    problem.sequence.prior = str(optimized)  # an optimize result: its rows are the design's own
+    assert measured_prior(problem, robot) is None
+
+
+def test_a_report_of_the_problems_joints_weighs_them_and_of_others_is_refused(tmp_path):
+    problem = load_problem(CONFIGS / "smoke.yaml")
+    robot = load_robot(problem.robot, problem.folder)
+    sigma = np.linspace(0.1, 0.7, robot.n_joints)
+    problem.sequence.prior = str(_report(tmp_path / "ok.h5", robot.joint_names[::-1], sigma))
+    measured = measured_prior(problem, robot)
+    assert measured.rate == 200.0 and measured.joints == robot.joint_names[::-1]
+    problem.sequence.prior = str(_report(tmp_path / "other.h5", ["shoulder_pan_joint"], np.ones(1)))
+    with pytest.raises(ExciteError, match=r"sequence\.prior.*identified the joints shoulder_pan_joint"):
+        measured_prior(problem, robot)
