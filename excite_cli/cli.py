@@ -67,7 +67,7 @@ def optimize(
     with Bars(err) as bars:
         run = workflows.run_optimize(problem, output or Path(problem.output), force, resume, *bars.iterations(problem))
     say(
-        console.tables.iterations(run.results, problem.optimizer),
+        console.tables.iterations(run.results, problem.optimizer, run.improved),
         f"wrote {run.target} and {', '.join(str(p) for p in run.plots)}",
     )
     if run.warning:

@@ -30,11 +30,16 @@ def titled_table(title: str, columns: Sequence[str], rows: Sequence[Sequence[str
     return table
 
 
-def iterations(results: Sequence[IterationResult], optimizer: OptimizerConfig | None = None) -> list[Table]:
+def iterations(
+    results: Sequence[IterationResult],
+    optimizer: OptimizerConfig | None = None,
+    improved: Sequence[tuple[str, float, float]] = (),
+) -> list[Table]:
     """Table I (cond per iteration, violations, CoM and capsule figures, transitions, time, stop
-    reason of the kept restart) and every restart's convergence (start and end value of the criterion
+    reason of the kept restart), every restart's convergence (start and end value of the criterion
     ``optimizer.objective`` and ``scaling`` optimized, first-order optimality, active constraints,
-    solver iterations, stop reason)."""
+    solver iterations, stop reason) and, with measured prior data, the coefficients the new
+    trajectories determine better (``improved``: name, predicted std before and after)."""
     extra = [
         (key, label)
         for key, label in (("com_max_excursion_m", "CoM [cm]"), ("min_capsule_distance_m", "dist [cm]"))
@@ -86,7 +91,18 @@ def iterations(results: Sequence[IterationResult], optimizer: OptimizerConfig | 
         "(1: the same motion again); stop: why the kept restart ended",
     )
     convergence = _restarts(results, optimizer or OptimizerConfig())
-    return [table, convergence] if convergence.row_count else [table]
+    tables = [table, convergence] if convergence.row_count else [table]
+    if improved:
+        tables.append(
+            titled_table(
+                "What the new trajectories determine better",
+                ("coefficient", "std, measured runs", "std, with the new runs", "ratio"),
+                [(escape(n), f"{b:.3g}", f"{a:.3g}", f"{b / a:.3g}×" if a > 0 else "-") for n, b, a in improved],
+                "predicted standard deviations of least squares (SI units), from the measured runs' rows alone and "
+                "stacked with the new trajectories' (recorded at the same rate, with the same noise per joint)",
+            )
+        )
+    return tables
 
 
 def _restarts(results: Sequence[IterationResult], optimizer: OptimizerConfig) -> Table:

@@ -78,3 +78,14 @@ def scaled_frame(base: BaseParameters, magnitudes: np.ndarray) -> np.ndarray:
     """
     K = base.regrouping * magnitudes
     return np.linalg.cholesky(K @ K.T)
+
+
+def predicted_std(C: np.ndarray, noise: float) -> np.ndarray:
+    """(k,) the standard deviations least squares would give each column's coefficient from rows
+    C (M, k) with white noise ``noise`` per row: √diag((CᵀC)⁻¹) · noise (Gautier 1997); inf for a
+    coefficient the rows do not determine (its column in the span of the others, or zero)."""
+    lam, V = np.linalg.eigh(C.T @ C) if C.shape[0] else (np.zeros(C.shape[1]), np.eye(C.shape[1]))
+    seen = lam > 1e-12 * max(lam.max(initial=0.0), np.finfo(float).tiny)
+    variance = (V[:, seen] ** 2 / lam[seen]).sum(axis=1)
+    unseen = (V[:, ~seen] ** 2).sum(axis=1) > 1e-6
+    return np.where(unseen, np.inf, noise * np.sqrt(variance))

@@ -15,6 +15,7 @@ from excite_cli.errors import ExciteError, FileNotFound, Interrupted, exit_statu
 from excite_cli.h5 import open_h5
 from excite_cli.optimization.engine import Engine, default_workers
 from excite_cli.optimization.excitation import Excitation, build_excitation
+from excite_cli.optimization.information import predicted_std
 from excite_cli.optimization.optimizer import ProgressHook
 from excite_cli.optimization.sequence import IterationResult, run_sequence
 from excite_cli.plots.optimize import plot_result
@@ -25,6 +26,8 @@ from excite_cli.storage.results import read_iterations, write_result
 #: The largest cond(C) of a result that identifies something: above it, noise in the torques is
 #: amplified a million times into the base parameters (Eq. 5 bounds the relative error by cond(C)).
 MAX_USEFUL_COND = 1e6
+#: Coefficients the table of improvements shows.
+IMPROVED_SHOWN = 8
 RESUMABLE_CHANGES = ("sequence.iterations", "optimizer.workers", "optimizer.scheduler", "optimizer.worker_wait")
 
 
@@ -43,6 +46,28 @@ class OptimizeRun:
     results: list[IterationResult]
     target: Path
     plots: list[Path]
+    prior: np.ndarray | None = None
+
+    @property
+    def improved(self) -> list[tuple[str, float, float]]:
+        """With measured prior data (an identify report): the coefficients (base parameters, then
+        effects) whose predicted standard deviation the new trajectories cut most, as (name, before,
+        after) in their units, most improved first (at most ``IMPROVED_SHOWN``): from the prior's rows
+        alone, then stacked with every iteration's, with the report's noise σ̄ per weighted row and its
+        rate (each trajectory recorded at the report's rate, :func:`predicted_std`)."""
+        measured = self.excitation.measured
+        if measured is None or self.prior is None or not self.results:
+            return []
+        noise = float(np.exp(np.log(np.maximum(measured.sigma, 1e-12)).mean()))
+        # C holds s·W·Y per recorded row (s the time rule), and the new runs recorded at the same rate
+        # carry (their cost-grid rows)/s² of information: std = s·σ̄·√diag((CᵀC)⁻¹)
+        noise *= measured.time_scale(self.excitation.problem.trajectory.cost_period)
+        stacked = np.vstack([self.prior, *[r.regressor for r in self.results]])
+        before, after = predicted_std(self.prior, noise), predicted_std(stacked, noise)
+        names = [*self.excitation.base.names, *self.excitation.effect_names]
+        gain = np.where(np.isinf(before), np.inf, before / after)
+        order = np.argsort(-gain, kind="stable")[:IMPROVED_SHOWN]
+        return [(names[k], float(before[k]), float(after[k])) for k in order]
 
     @property
     def warning(self) -> str:
@@ -135,7 +160,7 @@ def run_optimize(
                 raise
             exc.problem += f"; kept {len(written)} finished iteration(s) in {target}, which a resumed run continues"
             raise exc from None
-        return OptimizeRun(excitation, results, target, plot_result(target, excitation, results))
+        return OptimizeRun(excitation, results, target, plot_result(target, excitation, results), prior)
 
 
 def _resumable(target: Path, excitation: Excitation, prior: Optional[np.ndarray]) -> list[IterationResult]:

@@ -11,6 +11,7 @@ from excite_cli.dynamics.base_parameters import compute_base_parameters
 from excite_cli.dynamics.robot import load_robot
 from excite_cli.errors import ExciteError
 from excite_cli.h5 import write_strings
+from excite_cli.optimization.information import predicted_std
 from excite_cli.optimization.model_columns import design_effects, measured_prior
 
 
@@ -41,3 +42,15 @@ def test_a_report_of_the_problems_joints_weighs_them_and_of_others_is_refused(tm
     problem.sequence.prior = str(_report(tmp_path / "other.h5", ["shoulder_pan_joint"], np.ones(1)))
     with pytest.raises(ExciteError, match=r"sequence\.prior.*identified the joints shoulder_pan_joint"):
         measured_prior(problem, robot)
+
+
+def test_predicted_standard_deviations_match_least_squares_on_noisy_data():
+    """√diag((CᵀC)⁻¹)·σ against the spread of 2000 least-squares fits of noisy torques; a column the
+    rows do not determine (a copy of another) is inf."""
+    rng = np.random.default_rng(0)
+    C = rng.standard_normal((60, 3)) * [1.0, 0.2, 5.0]
+    estimates = [
+        np.linalg.lstsq(C, C @ [1.0, 2.0, 3.0] + 0.3 * rng.standard_normal(60), rcond=None)[0] for _ in range(2000)
+    ]
+    np.testing.assert_allclose(predicted_std(C, 0.3), np.std(estimates, axis=0), rtol=0.06)
+    assert np.isinf(predicted_std(np.hstack([C, C[:, :1]]), 0.3)).tolist() == [True, False, False, True]

@@ -109,6 +109,7 @@ def test_optimize_with_the_report_as_prior_weighs_both_the_prior_and_its_own_row
         app, ["optimize", str(CONFIGS / "smoke.yaml"), "--prior", str(report_file), "-o", str(out), "-k", "1"]
     )
     assert run.exit_code == 0, run.output
+    assert "What the new trajectories determine better" in run.output
     measured = read_measured_prior(report_file)
     assert measured is not None and measured.rate > 0
     problem = load_problem(CONFIGS / "smoke.yaml")
