@@ -34,7 +34,7 @@ def command(name: Optional[str] = None) -> Callable:
                 with sigterm_as_interrupt(), printed_warnings(err):
                     return function(*args, **kwargs)
             except ExciteError as exc:
-                line = word(exc, spelled, kwargs.get("config") or kwargs.get("effects"))
+                line = word(exc, spellings(function, kwargs), kwargs.get("config") or kwargs.get("effects"))
                 err.print(f"[bold red]error:[/] {escape(line)}", highlight=False, soft_wrap=True)
                 raise typer.Exit(exc.status) from None
             except Interrupted as exc:
@@ -44,7 +44,6 @@ def command(name: Optional[str] = None) -> Callable:
                 err.print("terminated" if isinstance(exc, Terminated) else "interrupted", highlight=False)
                 raise typer.Exit(exit_status(exc)) from None
 
-        spelled = spellings(function)
         return app.command(name)(guarded)
 
     return register

@@ -22,19 +22,21 @@ from excite_cli.errors import ExciteError, ExciteWarning, OutputExists
 OVERRIDDEN = re.compile(r"\(([a-z_]+(?:\.[a-z_]+)+)[;)]")
 
 
-def spellings(command: Callable) -> dict[str, str]:
+def spellings(command: Callable, given: Optional[dict] = None) -> dict[str, str]:
     """How ``command`` (a typer command function) spells its parameters: an option by its long flag
     (``--output``), an argument by its name in capitals (``REPORT``); keyed by the parameter's name,
     by the flag's name (``fmt`` and ``format`` → ``--format``) and by the config field an option
-    overrides, as its help names it (``--iterations`` for "... (sequence.iterations)")."""
+    overrides, as its help names it (``--iterations`` for "... (sequence.iterations)"), when the call's
+    arguments ``given`` hold that option (a field the config file set is named as in the file)."""
     spelled = {}
     for name, parameter in inspect.signature(command).parameters.items():
         default = parameter.default
         if isinstance(default, OptionInfo):
             flags = [d for d in default.param_decls if d.startswith("--")] or [f"--{name.replace('_', '-')}"]
             spelled[name] = spelled[flags[0][2:].replace("-", "_")] = flags[0]
-            for dotted in OVERRIDDEN.findall(default.help or ""):
-                spelled[dotted] = flags[0]
+            if given is None or given.get(name) is not None:
+                for dotted in OVERRIDDEN.findall(default.help or ""):
+                    spelled[dotted] = flags[0]
         elif isinstance(default, ArgumentInfo):
             spelled[name] = name.upper()
     return spelled
