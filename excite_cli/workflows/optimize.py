@@ -58,10 +58,9 @@ class OptimizeRun:
         measured = self.excitation.measured
         if measured is None or self.prior is None or not self.results:
             return []
-        noise = float(np.exp(np.log(np.maximum(measured.sigma, 1e-12)).mean()))
         # C holds s·W·Y per recorded row (s the time rule), and the new runs recorded at the same rate
         # carry (their cost-grid rows)/s² of information: std = s·σ̄·√diag((CᵀC)⁻¹)
-        noise *= measured.time_scale(self.excitation.problem.trajectory.cost_period)
+        noise = measured.noise * measured.time_scale(self.excitation.problem.trajectory.cost_period)
         stacked = np.vstack([self.prior, *[r.regressor for r in self.results]])
         before, after = predicted_std(self.prior, noise), predicted_std(stacked, noise)
         names = [*self.excitation.base.names, *self.excitation.effect_names]

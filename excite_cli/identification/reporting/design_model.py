@@ -118,11 +118,20 @@ class MeasuredPrior:
     sigma: np.ndarray
     rate: float
 
+    @property
+    def floored(self) -> np.ndarray:
+        """(n,) σ_j [Nm], floored at 1e-9 of the largest (a joint the model explains exactly)."""
+        return np.maximum(self.sigma, 1e-9 * self.sigma.max())
+
+    @property
+    def noise(self) -> float:
+        """σ̄ [Nm], the geometric mean of σ_j: the noise of one weighted row."""
+        return float(np.exp(np.log(self.floored).mean()))
+
     def weights(self) -> np.ndarray:
-        """(n,) σ̄ / σ_j, σ̄ the geometric mean of σ (1 for equal noise on every joint): weighted least
-        squares' weights (Gautier 1997), relative so the criterion keeps its scale."""
-        sigma = np.maximum(self.sigma, 1e-9 * self.sigma.max())
-        return np.exp(np.log(sigma).mean()) / sigma
+        """(n,) σ̄ / σ_j (1 for equal noise on every joint): weighted least squares' weights (Gautier
+        1997), relative so the criterion keeps its scale."""
+        return self.noise / self.floored
 
     def time_scale(self, cost_period: float) -> float:
         """√(1 / (cost_period · rate)): the information of a recording is a Riemann sum of ∫ YᵀWᵀWY dt
