@@ -3,7 +3,11 @@
 from __future__ import annotations
 
 import functools
+import socket
+import threading
+from contextlib import contextmanager
 from pathlib import Path
+from typing import Iterator
 
 import numpy as np
 import pytest
@@ -184,3 +188,25 @@ def simulated_identification():
 
     problem = load_problem(CONFIGS / "panda_identify_simulated.yaml", IdentifyProblem)
     return (problem, *run_identification(problem))
+
+
+@contextmanager
+def tcp_server(first_bytes: bytes) -> Iterator[str]:
+    """A TCP server on a free local port that sends ``first_bytes`` to whoever connects, then stays
+    silent: its address."""
+    listener = socket.create_server(("127.0.0.1", 0))
+    stop = threading.Event()
+
+    def serve() -> None:
+        connection, _ = listener.accept()
+        with connection:
+            connection.sendall(first_bytes)
+            stop.wait(10)
+
+    thread = threading.Thread(target=serve, daemon=True)
+    thread.start()
+    try:
+        yield f"tcp://127.0.0.1:{listener.getsockname()[1]}"
+    finally:
+        stop.set()
+        listener.close()

@@ -195,17 +195,26 @@ def test_the_identified_model_may_not_overwrite_the_report_or_its_plots(tmp_path
     assert line.startswith(f"error: {option}: ")
 
 
-@pytest.mark.parametrize("case", ["same", "folder", "unwritable", "fifo"])
+@pytest.mark.parametrize("case", ["same", "folder", "unwritable", "fifo", "proc"])
 def test_a_bad_mjcf_path_is_one_line_before_anything_runs(tmp_path, case):
+    """ "proc": a folder that access() calls writable for root, where no file can be created."""
+    if case == "proc" and not Path("/proc/self").is_dir():
+        pytest.skip("needs /proc")
     config = _identify_config(tmp_path)
     target = {"same": tmp_path / "m.xml", "folder": tmp_path, "unwritable": config / "m.xml"}.get(case)
+    target = Path("/proc/m.xml") if case == "proc" else target
     if case == "fifo":
         target = tmp_path / "m.xml"
         os.mkfifo(target)
     argv = ["identify", str(config), "-o", str(tmp_path / "r.h5"), "--mjcf-out", str(target), "--force"]
     if case == "same":
         argv += ["--urdf-out", str(target)]
-    expected = {"same": "is also the other model file", "folder": "folder", "unwritable": "is a file"}
+    expected = {
+        "same": "is also the other model file",
+        "folder": "folder",
+        "unwritable": "is a file",
+        "proc": "cannot create a file in /proc",
+    }
     assert_refused(tmp_path, argv, expected.get(case, "is not a regular file"))
 
 
@@ -227,3 +236,87 @@ def test_verify_gradient_needs_a_pass_mark_that_can_fail(tmp_path, tolerance):
 def test_an_active_mimic_joint_is_refused_by_name(tmp_path, command):
     config = pendulum_config(tmp_path, active=("tip_joint",), mimic='<mimic joint="hinge"/>')
     assert_refused(tmp_path, [command, str(config)], "joint 'tip_joint' mimics 'hinge'")
+
+
+# --- URDFs init cannot use: one line, in a bounded time, whatever pinocchio or assimp would do ------
+
+
+def _hostile_urdf(folder: Path, case: str) -> Path:
+    """A URDF of ``case``: no joint, only fixed joints, only a continuous one, a collision mesh that
+    is not a mesh, a FIFO, or too large (sparse), a chain longer than pinocchio's parser holds."""
+    inertia = '<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/>'
+    link = '<link name="{}"><inertial><mass value="1"/>' + inertia + "</inertial>{}</link>"
+    joint = (
+        '<joint name="{}" type="{}"><parent link="{}"/><child link="{}"/><origin xyz="0 0 0.1"/><axis xyz="0 0 1"/>'
+        '<limit lower="-1" upper="1" effort="10" velocity="2"/></joint>'
+    )
+
+    def two_links(kind: str, mesh: str = "") -> str:
+        collision = f'<collision><geometry><mesh filename="{mesh}"/></geometry></collision>' if mesh else ""
+        return link.format("base", "") + link.format("arm", collision) + joint.format("j1", kind, "base", "arm")
+
+    if case == "fifo":
+        os.mkfifo(folder / "fifo.stl")
+    if case == "huge-mesh":
+        with open(folder / "huge.stl", "wb") as f:
+            f.truncate(2 * 1024**3)  # sparse: no disk used
+    body = {
+        "no-joint": link.format("base", ""),
+        "fixed-only": two_links("fixed"),
+        "continuous-only": two_links("continuous"),
+        "not-a-mesh": two_links("revolute", "file:///etc/passwd"),
+        "fifo": two_links("revolute", "fifo.stl"),
+        "huge-mesh": two_links("revolute", "huge.stl"),
+        "long-chain": link.format("l0", "")
+        + "".join(
+            link.format(f"l{k}", "") + joint.format(f"j{k}", "revolute", f"l{k - 1}", f"l{k}") for k in range(1, 4001)
+        ),
+    }[case]
+    path = folder / f"{case}.urdf"
+    path.write_text(f'<robot name="hostile">{body}</robot>')
+    return path
+
+
+HOSTILE = [
+    ("no-joint", "no-joint.urdf has no revolute joint for excite to move (its joints are all fixed)"),
+    ("fixed-only", "fixed-only.urdf has no revolute joint for excite to move (its joints are all fixed)"),
+    ("continuous-only", "continuous-only.urdf has no revolute joint for excite to move (continuous: j1)"),
+    ("long-chain", "the URDF has 4001 links; expected at most 1000"),
+]
+#: Meshes matter to an optimize config only (an identify config loads none).
+HOSTILE_MESHES = [
+    ("not-a-mesh", "cannot load the collision meshes of not-a-mesh.urdf"),
+    ("fifo", "link 'arm': collision mesh fifo.stl"),
+    ("huge-mesh", "link 'arm': collision mesh huge.stl is 2147 MB"),
+]
+HOSTILE_RUNS = [(*c, k) for c in HOSTILE for k in ("optimize", "identify")] + [(*c, "optimize") for c in HOSTILE_MESHES]
+
+
+@pytest.mark.parametrize("case, expected, kind", HOSTILE_RUNS, ids=[f"{c[0]}-{c[2]}" for c in HOSTILE_RUNS])
+def test_init_on_a_urdf_it_cannot_use_is_one_line(tmp_path, case, expected, kind):
+    """Each was a traceback (min() of an empty sequence, pydantic, coal, assimp), a hang on the FIFO,
+    7.4 GB of memory on the 2 GB mesh, or a segmentation fault (a chain of 4 000 links)."""
+    urdf = _hostile_urdf(tmp_path, case)
+    process = subprocess.run(
+        [str(EXCITE), "init", str(urdf), "--kind", kind, "-o", str(tmp_path / "out.yaml")],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert process.returncode == 2, process.stderr
+    assert "Traceback" not in process.stderr + process.stdout
+    errors = [line for line in process.stderr.splitlines() if line.startswith("error:")]
+    assert len(errors) == 1 and expected in errors[0], process.stderr
+    assert not (tmp_path / "out.yaml").exists()
+
+
+def test_a_ring_of_joints_beside_the_tree_is_named(tmp_path):
+    """Two links joined both ways apart from the pendulum: pinocchio leaves them out, and the ring's
+    joint was reported as "'ab' is not a joint of the robot"."""
+    ring = (
+        '</joint><link name="a"/><link name="b"/>'
+        '<joint name="ab" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/></joint>'
+        '<joint name="ba" type="revolute"><parent link="b"/><child link="a"/><axis xyz="0 0 1"/>'
+    )
+    config = pendulum_config(tmp_path, active=("hinge", "ab"), mimic=ring)
+    assert_refused(tmp_path, ["optimize", str(config)], "joints 'ba', 'ab' form a closed kinematic chain")

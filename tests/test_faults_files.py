@@ -13,8 +13,9 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
+import scipy.io
 import yaml
-from conftest import assert_refused, pendulum_config
+from conftest import assert_refused, pendulum_config, tcp_server
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
@@ -93,8 +94,21 @@ def test_a_full_disk_is_one_line_and_leaves_nothing(pendulum_run, tmp_path, comm
     folder = _copy(pendulum_run, tmp_path / "run")
     argv, written = DISK_FULL[command]
     before = sorted(p.relative_to(folder) for p in folder.rglob("*"))
-    _one_error_line(_run(argv, folder, file_size=2000), f"cannot write {written}: File too large")
+    process = _run(argv, folder, file_size=2000)
+    _one_error_line(process, f"cannot write {written}: File too large")
+    assert "finished iteration" not in process.stderr  # nothing finished is on disk, so none is said to be kept
     assert sorted(p.relative_to(folder) for p in folder.rglob("*")) == before  # no file, no .partial, no folder
+
+
+def test_a_disk_that_fills_up_at_the_second_iteration_says_what_is_on_disk(pendulum_run, tmp_path):
+    """Room for the first iteration's file, not the second's: the message counts the file's iterations."""
+    folder = _copy(pendulum_run, tmp_path / "run")
+    process = _run(
+        ["optimize", "pendulum.yaml", "-o", "again.h5"], folder, file_size=(folder / "out.h5").stat().st_size - 1
+    )
+    _one_error_line(process, "cannot write again.h5: File too large; kept 1 finished iteration(s) in again.h5")
+    with h5py.File(folder / "again.h5") as f:
+        assert list(f["iterations"]) == ["1"]
 
 
 def test_a_disk_that_fills_up_at_the_plots_keeps_the_result(pendulum_run, tmp_path):
@@ -165,6 +179,13 @@ def test_a_number_beyond_its_bound_is_refused_by_name(tmp_path, changes, expecte
     assert_refused(tmp_path, ["optimize", str(config)], expected)
 
 
+def test_a_scheduler_that_is_a_web_server_is_one_line(tmp_path):
+    """Dask's client read the server's first bytes as a message length: MemoryError (3.07 EiB)."""
+    with tcp_server(b"HTTP/1.1 400 Bad Request\r\nContent-Length: 0\r\n\r\n") as address:
+        argv = ["optimize", str(pendulum_config(tmp_path)), "--scheduler", address]
+        assert_refused(tmp_path, argv, f"--scheduler: the server at {address} is not a Dask scheduler")
+
+
 @pytest.mark.parametrize(
     "command, option",
     [
@@ -216,6 +237,14 @@ IDENTIFY_FIELDS = [
         "payload-triangle",
         {"data": {"runs": [{"file": "sim/run_1.csv", "payload": {"mass": 1.0, "inertia": [1, 0, 1, 0, 0, 3]}}]}},
         "each at most the sum of the other two",
+    ),
+    # the coupled candidates acted on the wrong joints (accepted when the data are joint-side)
+    ("gear-ratios", {"data": {"transmission": {"gear_ratios": [100.0, 50.0]}}}, "gear_ratios: 2 values for 1 active"),
+    ("signs", {"data": {"signs": [1.0, -1.0]}}, "data.signs: 2 values for 1 active joint"),
+    (
+        "rate-1e300",  # was refused with a 300-digit sample count and no field name
+        {"data": {"sample_rate": 1e300, "columns": {"time": None, "q": ["q_hinge"], "tau": ["tau_hinge"]}}},
+        "data.sample_rate: Input should be less than or equal to 100000",
     ),
 ]
 
@@ -362,6 +391,66 @@ def test_a_csv_of_nul_bytes_is_refused(pendulum_run, tmp_path):
     with open(folder / "zeros.csv", "wb") as f:
         f.truncate(50_000_000)
     assert_refused(folder, _identify_on(folder, "zeros.csv"), "holds NUL bytes")
+
+
+@pytest.mark.parametrize("damage", ["header-kept-rest-zero", "header-kept-rest-random"])
+def test_a_corrupt_mat_file_is_one_line(pendulum_run, tmp_path, damage):
+    """scipy.io raises TypeError on these (a 135-line traceback)."""
+    folder = _copy(pendulum_run, tmp_path / "run")
+    scipy.io.savemat(folder / "run.mat", _columns(folder), format="5" if damage.endswith("random") else "4")
+    raw = (folder / "run.mat").read_bytes()
+    rest = bytes(len(raw) - 128) if damage.endswith("zero") else np.random.default_rng(0).bytes(len(raw) - 128)
+    (folder / "run.mat").write_bytes(raw[:128] + rest)
+    assert_refused(folder, _identify_on(folder, "run.mat"), "cannot read run.mat as MAT")
+
+
+# --- a run recorded in several files: paired by time stamp, sorted, cut only with a warning --------
+
+
+def _split_run(folder: Path, tau_rows: slice = slice(None), tau_order: int = 1, repeat: bool = False) -> list[str]:
+    """sim/run_1.csv as two files, ``q.csv`` and ``tau.csv`` (its rows ``tau_rows``, in time order
+    or reversed, a stamp repeated), and the identify argv of a run of both, time blocks alternating."""
+    columns = _columns(folder)
+    time, q, tau = columns["time"], columns["q_hinge"], columns["tau_hinge"]
+    np.savetxt(folder / "q.csv", np.column_stack([time, q]), delimiter=",", header="time,q", comments="")
+    stamps = time.copy()
+    if repeat:
+        stamps[5] = stamps[4]
+    rows = np.column_stack([stamps, tau])[tau_rows][::tau_order]
+    np.savetxt(folder / "tau.csv", rows, delimiter=",", header="time,tau", comments="")
+    config = yaml.safe_load((folder / "id.yaml").read_text())
+    config["data"]["runs"] = [{"file": ["q.csv", "tau.csv"]}]
+    config["data"]["columns"] = {"time": "time", "q": ["q/q"], "tau": ["tau/tau"]}
+    (folder / "split.yaml").write_text(yaml.safe_dump(config))
+    return ["identify", str(folder / "split.yaml"), "-o", str(folder / "report.h5"), "--force"]
+
+
+def _validation_error(folder: Path) -> np.ndarray:
+    """(n,) the report's relative validation error per joint [%]."""
+    with h5py.File(folder / "report.h5") as f:
+        return f["identification/relative_after"][()]
+
+
+def test_a_file_of_a_run_in_descending_time_is_paired_by_stamp(pendulum_run, tmp_path):
+    """Paired by position, the reversed torques gave 58-120 % validation error, exit 0."""
+    folder = _copy(pendulum_run, tmp_path / "run")
+    assert runner.invoke(app, _split_run(folder)).exit_code == 0
+    in_order = _validation_error(folder)
+    assert runner.invoke(app, _split_run(folder, tau_order=-1)).exit_code == 0
+    np.testing.assert_allclose(_validation_error(folder), in_order, rtol=1e-9)
+    assert in_order.max() < 1.0  # [%]
+
+
+def test_a_time_stamp_given_twice_in_a_file_of_a_run_is_one_line(pendulum_run, tmp_path):
+    folder = _copy(pendulum_run, tmp_path / "run")
+    assert_refused(folder, _split_run(folder, repeat=True), "tau.csv has two rows at time 0.04 s (lines 6 and 7)")
+
+
+def test_a_file_that_covers_part_of_a_run_cuts_it_with_a_warning_naming_the_seconds(pendulum_run, tmp_path):
+    folder = _copy(pendulum_run, tmp_path / "run")
+    result = runner.invoke(app, _split_run(folder, tau_rows=slice(0, 801)), env={"COLUMNS": "400"})
+    assert result.exit_code == 0, result.output
+    assert "warning: the run of q.csv + tau.csv is cut to the span every file covers: q.csv loses 2 s" in result.output
 
 
 def test_a_fifo_given_as_a_data_file_is_refused_at_once(pendulum_run, tmp_path):

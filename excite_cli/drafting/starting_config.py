@@ -16,6 +16,7 @@ import numpy as np
 import pinocchio as pin
 
 from excite_cli.config import Problem
+from excite_cli.dynamics.urdf_meshes import collision_geometry
 from excite_cli.errors import ExciteError
 from excite_cli.optimization.excitation import Excitation, build_excitation, violated_at_rest
 
@@ -58,7 +59,8 @@ def joint_choice(path: Path, given: list[str] | None, draft: StartingConfig) -> 
         The active joints and {held joint: value} (0 moved inside its limits) [rad or m].
 
     Raises:
-        ExciteError: a given joint that is not a 1-DoF joint of the URDF.
+        ExciteError: a given joint that is not a 1-DoF joint of the URDF; no joint given and no
+            revolute joint to move (naming the joints there are).
     """
     model = pin.buildModelFromUrdf(str(path))
     one_dof = [n for i, n in enumerate(model.names) if i > 0 and model.joints[i].nq == 1]
@@ -66,6 +68,15 @@ def joint_choice(path: Path, given: list[str] | None, draft: StartingConfig) -> 
     mimics = _mimics(path)
     revolute = [n for n in one_dof if "R" in model.joints[model.getJointId(n)].shortname().replace("JointModel", "")]
     active = list(given) if given else [n for n in revolute if n not in mimics]
+    if not active:
+        others = {"prismatic": [n for n in one_dof if n not in revolute], "continuous": continuous, "mimic": mimics}
+        said = "; ".join(f"{kind}: {', '.join(sorted(names))}" for kind, names in others.items() if names)
+        raise ExciteError(
+            "urdf",
+            f"{path.name} has no revolute joint for excite to move ({said or 'its joints are all fixed'})",
+            path.name,
+            "a URDF with a revolute joint, or the 1-DoF joints to move named",
+        )
     unknown = [n for n in active if n not in one_dof]
     if unknown:
         raise ExciteError(
@@ -117,7 +128,7 @@ def _limits(model: pin.Model, active: list[str], draft: StartingConfig) -> dict:
 def _base_floor(model: pin.Model, path: Path, package_dirs: list[str]) -> float:
     """Height [m] of the lowest point of the root link's collision geometry (0 without any), from the
     URDF ``path`` and its ``model``."""
-    geometry = pin.buildGeomFromUrdf(model, str(path), pin.COLLISION, package_dirs=package_dirs)
+    geometry = collision_geometry(model, path, package_dirs)
     data, gdata = model.createData(), pin.GeometryData(geometry)
     pin.updateGeometryPlacements(model, data, geometry, gdata, pin.neutral(model))
     lowest = 0.0

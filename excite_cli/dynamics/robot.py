@@ -18,6 +18,7 @@ import pinocchio as pin
 
 from excite_cli.config import RobotConfig
 from excite_cli.dynamics.urdf_checks import check_urdf
+from excite_cli.dynamics.urdf_meshes import collision_geometry, package_folders
 from excite_cli.dynamics.urdf_source import resolve_urdf
 from excite_cli.errors import ExciteError
 
@@ -218,7 +219,9 @@ def load_robot(
         ExciteError: missing URDF, unknown joint name, a joint that is not 1-DoF, a locked value
             outside the joint's limits, a body or active joint that cannot be (:func:`check_urdf`).
     """
-    path, package_dirs = resolve_urdf(cfg, folder) if urdf is None else (urdf, [str(urdf.parent)])
+    path, package_dirs = (
+        resolve_urdf(cfg, folder) if urdf is None else (urdf, package_folders(urdf, [str(urdf.parent)]))
+    )
     # before urdfdom, which prints what it cannot parse
     problems = check_urdf(path, list(cfg.active_joints), physical, list(cfg.locked_joints))
     try:
@@ -233,10 +236,7 @@ def load_robot(
     lock_ids = [full.getJointId(n) for n in movable if n not in cfg.active_joints]
     geometry = None
     if collision:
-        try:
-            geometry = pin.buildGeomFromUrdf(full, str(path), pin.COLLISION, package_dirs=package_dirs)
-        except (RuntimeError, ValueError) as exc:
-            raise ExciteError("robot.urdf", f"cannot load the collision geometry of {path}: {exc}") from None
+        geometry = collision_geometry(full, path, package_dirs)
         try:
             model, geometry = pin.buildReducedModel(full, geometry, lock_ids, q_full)
         except ValueError as exc:  # a joint and a link of one name (so100's "gripper"): pinocchio cannot reduce

@@ -29,6 +29,9 @@ from excite_cli.errors import ExciteError
 
 #: Relative tolerance of the principal-moment checks (CAD exports round their inertias).
 TOLERANCE = 1e-6
+#: Largest number of links of a URDF (example-robot-data's largest has 130; pinocchio's parser
+#: crashes on a chain of 4 000).
+MAX_LINKS = 1000
 INERTIA = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
 LIMITS = ("lower", "upper", "effort", "velocity")
 
@@ -120,17 +123,28 @@ def check_joints(root: ElementTree.Element, active: list[str], locked: list[str]
             )
 
 
-def check_tree(links: list[str], parents: dict[str, list[str]]) -> None:
-    """The links and joints of a URDF form one tree: no link is the child of two joints (a closed
-    kinematic chain, which a URDF cannot describe and pinocchio misreads) and one link is the root.
+def check_tree(links: list[str], parents: dict[str, list[str]], children: dict[str, list[str]]) -> None:
+    """The links and joints of a URDF form one tree of at most :data:`MAX_LINKS` links: no link is the
+    child of two joints (a closed kinematic chain, which a URDF cannot describe and pinocchio
+    misreads), one link is the root and every link hangs from it (links that do not form a ring of
+    joints beside the tree, which pinocchio leaves out).
 
     Args:
         links: every ``<link>``'s name.
         parents: the joints that have each link as their child.
+        children: the child links of each link.
 
     Raises:
-        ExciteError: (``robot.urdf``) a link with two parent joints, or no root link (a loop).
+        ExciteError: (``robot.urdf``) more links than :data:`MAX_LINKS`, a link with two parent
+            joints, no root link or links that do not hang from it (a ring, named by its joints).
     """
+    if len(links) > MAX_LINKS:
+        raise ExciteError(
+            "robot.urdf",
+            f"the URDF has {len(links)} links",
+            len(links),
+            f"at most {MAX_LINKS} (pinocchio's parser crashes)",
+        )
     for link, joints in parents.items():
         if len(joints) > 1:
             raise ExciteError(
@@ -140,9 +154,19 @@ def check_tree(links: list[str], parents: dict[str, list[str]]) -> None:
                 link,
                 "a tree of links (one parent joint per link)",
             )
-    if links and all(link in parents for link in links):
+    roots = [link for link in links if link not in parents]
+    hanging, below = set(roots[:1]), list(roots[:1])
+    while below:
+        hanging.update(below)
+        below = [c for link in below for c in children.get(link, []) if c not in hanging]
+    ring = [parents[link][0] for link in links if link not in hanging and link in parents]
+    if ring:
         raise ExciteError(
-            "robot.urdf", "every link is the child of a joint: the joints form a loop", None, "one root link"
+            "robot.urdf",
+            f"joints {', '.join(repr(j) for j in ring)} form a closed kinematic chain"
+            + (f" apart from the root link '{roots[0]}'" if roots else ""),
+            None,
+            "a tree of links (one root, one parent joint per link)",
         )
 
 
@@ -178,7 +202,7 @@ def check_urdf(path: Path, active: list[str], physical: bool = True, locked: lis
             children.setdefault(parent.get("link"), []).append(child.get("link"))
             parents.setdefault(child.get("link"), []).append(joint.get("name"))
             moved += [child.get("link")] if joint.get("name") in active else []
-    check_tree([link.get("name") for link in root.findall("link")], parents)
+    check_tree([link.get("name") for link in root.findall("link")], parents, children)
     while moved:  # every link below an active joint
         link = moved.pop()
         below.add(link)

@@ -6,6 +6,7 @@ from importlib import metadata
 from pathlib import Path
 
 from excite_cli.config import RobotConfig, resolve_path
+from excite_cli.dynamics.urdf_meshes import package_folders
 from excite_cli.errors import ExciteError
 from excite_cli.inputs import input_file
 
@@ -24,7 +25,9 @@ def example_robot_data_root() -> Path:
 
 
 def resolve_urdf(cfg: RobotConfig, folder: Path | None = None) -> tuple[Path, list[str]]:
-    """The URDF file named by ``robot.urdf`` and the package folders its meshes are found in.
+    """The URDF file named by ``robot.urdf`` and the package folders its meshes are found in: the
+    URDF's folder and the one above it, example-robot-data's, and those
+    :func:`~excite_cli.dynamics.urdf_meshes.package_folders` adds.
 
     Args:
         cfg: the ``robot`` section.
@@ -33,11 +36,12 @@ def resolve_urdf(cfg: RobotConfig, folder: Path | None = None) -> tuple[Path, li
     Raises:
         ExciteError: the file does not exist, is a folder, a FIFO or a device (:func:`~excite_cli.inputs.input_file`).
     """
+    share = example_robot_data_root()
     if cfg.source == "example-robot-data":
-        share = example_robot_data_root()
         path = share / "example-robot-data" / "robots" / cfg.urdf
         dirs = [str(share)]
     else:
         path = resolve_path(cfg.urdf, folder)
-        dirs = [str(path.parent), str(path.parent.parent)]
-    return input_file(path, "robot.urdf", "URDF"), dirs
+        dirs = [str(path.parent), str(path.parent.parent), str(share)]
+    path = input_file(path, "robot.urdf", "URDF")
+    return path, package_folders(path, dirs)

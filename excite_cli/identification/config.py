@@ -179,7 +179,7 @@ class DataConfig(Section):
     """Gear ratios and coupling of the motors, or none."""
     motor_side: bool = False
     """The columns hold motor angles and motor torques or currents, mapped through the transmission."""
-    sample_rate: Optional[PositiveFloat] = None
+    sample_rate: Optional[float] = Field(None, gt=0.0, le=MAX_RATE)
     """Sample rate [Hz] of files without a time column."""
 
     @model_validator(mode="after")

@@ -13,8 +13,11 @@ oversubscribe the cores, and keeps the memory it frees (:func:`~excite_cli.memor
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
+import socket
+import struct
 import threading
 import time
 import warnings
@@ -30,8 +33,11 @@ from excite_cli.errors import NO_VALUE, ExciteError, ExciteWarning
 from excite_cli.memory import keep_freed_memory
 from excite_cli.optimization.excitation import Excitation, build_excitation
 
-#: How long to wait for a Dask scheduler to answer.
-CONNECT_TIMEOUT = "10s"
+#: How long to wait for a Dask scheduler to answer [s].
+CONNECT_TIMEOUT = 10.0
+#: Largest first message a Dask scheduler may announce on a new connection (its handshake, a few
+#: hundred bytes) [bytes].
+HANDSHAKE_BYTES = 1 << 20
 #: Seconds a stopped worker process is given to end.
 WORKER_STOP = 5.0
 #: Seconds between looks at a Dask cluster's workers while its tasks run.
@@ -87,6 +93,39 @@ def _worker_signals() -> None:
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
+def check_scheduler(address: str, timeout: float = CONNECT_TIMEOUT) -> None:
+    """That a Dask scheduler listens at ``address`` (``[tcp://]host:port``), asked with a bound before
+    Dask's client is: a scheduler's first bytes on a new connection are its handshake's length (an
+    unsigned 64-bit count, distributed's TCP framing, ``distributed/comm/tcp.py``), and the client
+    allocates whatever another server's first bytes happen to say (3 EiB was seen). ``tls://``
+    and in-process addresses are left to Dask.
+
+    Raises:
+        ExciteError: (``optimizer.scheduler``) nothing listens there, the server says nothing within
+            ``timeout`` [s], or its first bytes announce more than :data:`HANDSHAKE_BYTES`.
+    """
+    scheme, _, rest = address.rpartition("://")
+    if scheme not in ("", "tcp"):
+        return
+    host, _, port = rest.rpartition(":")
+    try:
+        connection = socket.create_connection((host.strip("[]"), int(port)), timeout=timeout)
+    except OSError as exc:
+        raise ExciteError("optimizer.scheduler", f"cannot reach the Dask scheduler at {address}: {exc}") from None
+    head = b""
+    with connection, contextlib.suppress(OSError):  # a timeout or a reset: what came is judged
+        while len(head) < 8 and (chunk := connection.recv(8 - len(head))):
+            head += chunk
+    if len(head) < 8 or struct.unpack("Q", head)[0] > HANDSHAKE_BYTES:
+        raise ExciteError(
+            "optimizer.scheduler",
+            f"the server at {address} is not a Dask scheduler: "
+            + (f"it said nothing for {timeout:g} s" if len(head) < 8 else "its first bytes are no Dask handshake"),
+            address,
+            "the address of a Dask scheduler (dask scheduler prints it)",
+        )
+
+
 class Engine:
     """Runs tasks serially (``workers`` 1), in a local process pool of ``workers`` processes (at most
     as many as the first parallel run has tasks), or on the Dask scheduler at ``scheduler``.
@@ -115,8 +154,9 @@ class Engine:
         if self.scheduler:
             from dask.distributed import Client
 
+            check_scheduler(self.scheduler)
             try:
-                self._client = Client(self.scheduler, timeout=CONNECT_TIMEOUT)
+                self._client = Client(self.scheduler, timeout=f"{CONNECT_TIMEOUT:g}s")
             except (OSError, TimeoutError, ValueError) as exc:
                 raise ExciteError(
                     "optimizer.scheduler", f"cannot reach the Dask scheduler at {self.scheduler}: {exc}"

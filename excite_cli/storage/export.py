@@ -94,7 +94,10 @@ def export_trajectory(result: Path, iteration: int | None = None, rate: float = 
             rate,
             f"more than {excitation.trajectory.nyquist_rate:.3g} Hz",
         )
-    playback = plan_playback(excitation, alpha, periods)
+    try:
+        playback = plan_playback(excitation, alpha, periods)
+    except ExciteError as exc:  # a stored α the optimizer cannot have written (edited, corrupt)
+        raise ExciteError("result", f"{result}: iteration {k}: {exc.field}: {exc.problem}") from None
     if playback.duration * rate > MAX_SAMPLES:
         raise ExciteError(
             "rate",

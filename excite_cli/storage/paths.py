@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import fcntl
 import os
+import tempfile
 import warnings
 from contextlib import contextmanager
 from pathlib import Path
@@ -16,7 +17,7 @@ from excite_cli.errors import CannotWrite, ExciteError, ExciteWarning, OutputExi
 
 
 def check_target(path: Path, field: str, force: bool = False, exists_ok: bool = False) -> Path:
-    """Check that ``path`` can be written, without creating anything.
+    """Check that ``path`` can be written, leaving nothing behind.
 
     Args:
         path: the file to write (its folder is created later, when the result is written).
@@ -46,6 +47,11 @@ def check_target(path: Path, field: str, force: bool = False, exists_ok: bool = 
         raise ExciteError(field, f"cannot create the folder of {path}: {folder} is a file", path)
     if not os.access(folder, os.W_OK | os.X_OK):
         raise ExciteError(field, f"cannot write into {folder} (permission denied)", path)
+    try:  # what access() cannot tell (root in /proc, a read-only mount): a nameless file, gone when closed
+        with tempfile.TemporaryFile(dir=folder):
+            pass
+    except OSError as exc:
+        raise ExciteError(field, f"cannot create a file in {folder} ({exc.strerror})", path) from None
     return path
 
 

@@ -14,6 +14,7 @@ import yaml
 from excite_cli.atomic import atomic_path
 from excite_cli.config import RobotConfig
 from excite_cli.drafting.starting_config import StartingConfig, draft_config, joint_choice, validated
+from excite_cli.dynamics.urdf_checks import check_urdf
 from excite_cli.dynamics.urdf_source import example_robot_data_root, resolve_urdf
 from excite_cli.errors import ExciteError, FileNotFound
 from excite_cli.identification.config import IdentifyProblem
@@ -106,8 +107,9 @@ def run_init(urdf: str, target: Path, joints: Optional[list[str]] = None, kind: 
             the data section to fill in).
 
     Raises:
-        ExciteError: unknown kind or joint, a URDF not found, an output that may not be written, no
-            home posture where every constraint holds (see :func:`draft_config`).
+        ExciteError: unknown kind or joint, a URDF not found or that no model can have
+            (:func:`~excite_cli.dynamics.urdf_checks.check_urdf`), an output that may not be written, no
+            joint to move, no home posture where every constraint holds (see :func:`draft_config`).
     """
     if kind not in KINDS:
         raise ExciteError("kind", f"'{kind}' is not a config kind", kind, " or ".join(KINDS))
@@ -115,6 +117,7 @@ def run_init(urdf: str, target: Path, joints: Optional[list[str]] = None, kind: 
     joints = [j.strip() for given in joints or [] for j in given.split(",") if j.strip()] or None
     robot = robot_source(urdf, target)
     path, package_dirs = resolve_urdf(RobotConfig.model_construct(**robot), target.resolve().parent)
+    check_urdf(path, [], physical=False)  # before pinocchio, which crashes on some
     plan = None
     if kind == "optimize":
         draft = draft_config(robot, path, package_dirs, joints, target)

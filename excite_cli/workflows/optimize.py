@@ -133,9 +133,9 @@ def run_optimize(
     finished = _resumable(target, excitation, prior) if resume else []
     written = list(finished)
 
-    def done(result: IterationResult) -> None:
+    def done(result: IterationResult) -> None:  # ``written`` is what is on disk: a failed write adds nothing
+        write_result(target, excitation, [*written, result], problem.optimizer.seed, {"method": "optimized"})
         written.append(result)
-        write_result(target, excitation, written, problem.optimizer.seed, {"method": "optimized"})
         if on_iteration:
             on_iteration(result)
 

@@ -3,7 +3,7 @@
 import pytest
 from conftest import GOOD, PENDULUM
 
-from excite_cli.dynamics.urdf_checks import check_urdf
+from excite_cli.dynamics.urdf_checks import MAX_LINKS, check_urdf
 from excite_cli.errors import ExciteError
 
 
@@ -47,8 +47,37 @@ def test_joints_that_form_a_ring_have_no_root(tmp_path):
     path = _urdf(tmp_path)
     ring = '<joint name="ring" type="fixed"><parent link="tip"/><child link="base"/></joint>'
     path.write_text(path.read_text().replace("</robot>", ring + "</robot>"))
-    with pytest.raises(ExciteError, match="the joints form a loop"):
+    with pytest.raises(ExciteError, match="joints 'ring', 'hinge', 'tip_joint' form a closed kinematic chain"):
         check_urdf(path, ["hinge"])
+
+
+def test_a_ring_of_joints_beside_the_tree_is_named(tmp_path):
+    """Two links joined both ways, apart from the pendulum: pinocchio leaves them out, and the ring's
+    joints were then reported as 'not a joint of the robot'."""
+    path = _urdf(tmp_path)
+    ring = (
+        '<link name="a"/><link name="b"/>'
+        '<joint name="ab" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/></joint>'
+        '<joint name="ba" type="revolute"><parent link="b"/><child link="a"/><axis xyz="0 0 1"/></joint>'
+    )
+    path.write_text(path.read_text().replace("</robot>", ring + "</robot>"))
+    with pytest.raises(
+        ExciteError, match="joints 'ba', 'ab' form a closed kinematic chain apart from the root link 'base'"
+    ):
+        check_urdf(path, ["hinge"])
+
+
+def test_a_urdf_beyond_the_size_pinocchio_holds_is_refused_before_it(tmp_path):
+    """pinocchio's parser crashes (exit 139, no output) on a chain of 4 000 links."""
+    links = "".join(f'<link name="l{k}"/>' for k in range(MAX_LINKS + 1))
+    joints = "".join(
+        f'<joint name="j{k}" type="fixed"><parent link="l{k - 1}"/><child link="l{k}"/></joint>'
+        for k in range(1, MAX_LINKS + 1)
+    )
+    path = tmp_path / "chain.urdf"
+    path.write_text(f'<robot name="chain">{links}{joints}</robot>')
+    with pytest.raises(ExciteError, match=f"the URDF has {MAX_LINKS + 1} links; expected at most {MAX_LINKS}"):
+        check_urdf(path, [])
 
 
 MIMIC = '<mimic joint="hinge" multiplier="2"/>'

@@ -15,7 +15,7 @@ import h5py
 import numpy as np
 import pytest
 import yaml
-from conftest import TESTS, write_config
+from conftest import TESTS, tcp_server, write_config
 
 import excite_cli.optimization.engine as engine_module
 from excite_cli.config_file import load_problem
@@ -87,10 +87,34 @@ def test_best_restart_breaks_ties_by_index():
 
 
 def test_unreachable_scheduler_is_named(excitation, monkeypatch):
-    monkeypatch.setattr(engine_module, "CONNECT_TIMEOUT", "1s")
+    monkeypatch.setattr(engine_module, "CONNECT_TIMEOUT", 1.0)
     with pytest.raises(ExciteError, match="optimizer.scheduler: cannot reach the Dask scheduler at tcp://127.0.0.1:9"):
         with Engine(excitation, scheduler="tcp://127.0.0.1:9"):
             pass
+
+
+@pytest.mark.parametrize(
+    "first_bytes, expected",
+    [
+        (b"HTTP/1.1 400 Bad Request\r\n\r\n", "its first bytes are no Dask handshake"),
+        (b"", "it said nothing for 0.5 s"),
+    ],
+    ids=["a-web-server", "a-silent-server"],
+)
+def test_a_server_that_is_no_dask_scheduler_is_refused_before_dask_reads_from_it(first_bytes, expected):
+    """Dask's client would allocate what a web server's first bytes say (3 EiB): the handshake is
+    checked with a bound first."""
+    with tcp_server(first_bytes) as address:
+        started = time.monotonic()
+        with pytest.raises(ExciteError, match=f"is not a Dask scheduler: {expected}"):
+            engine_module.check_scheduler(address, timeout=0.5)
+        assert time.monotonic() - started < 5
+
+
+def test_a_dask_scheduler_passes_the_handshake():
+    distributed = pytest.importorskip("dask.distributed")
+    with distributed.LocalCluster(n_workers=0, processes=False, protocol="tcp://", dashboard_address=None) as cluster:
+        engine_module.check_scheduler(cluster.scheduler_address, timeout=5)
 
 
 def test_workers_optimize_in_the_main_process_base(excitation):

@@ -71,43 +71,6 @@ class Table:
         )
 
 
-def join_tables(tables: list[tuple[Path, Table]], time: int | str | None) -> Table:
-    """One table of the files of one run (positions, velocities and efforts recorded apart): the rows
-    whose ``time`` column holds the same stamp in every file, in time order (or, without a time
-    column, the rows of the same index, up to the shortest file). The columns are named
-    ``<file stem>/<column>`` (e.g. ``effort/panda_joint1``), after a first column ``time`` of the
-    common stamps; by position they count from 0 over the files in order, after that column.
-
-    Raises:
-        ExciteError: the files share fewer than half of their time stamps.
-    """
-    if time is None:
-        count = min(t.values.shape[0] for _, t in tables)
-        rows = [np.arange(count) for _ in tables]
-        stamps = np.arange(count, dtype=float)
-    else:
-        stamps_of = [t.column(time, "time", path) for path, t in tables]
-        stamps = stamps_of[0]
-        for other in stamps_of[1:]:
-            stamps = np.intersect1d(stamps, other)
-        if stamps.size < 0.5 * min(s.size for s in stamps_of):
-            raise ExciteError(
-                "data.runs.file",
-                f"{', '.join(p.name for p, _ in tables)} share {stamps.size} of their time stamps; expected files of "
-                "one recording with the same time column",
-            )
-        rows = [
-            np.searchsorted(s, stamps) if np.all(np.diff(s) > 0) else np.flatnonzero(np.isin(s, stamps))
-            for s in stamps_of
-        ]
-    return Table(
-        ["time"] + [f"{path.stem}/{name}" for path, t in tables for name in t.names],
-        np.column_stack([stamps] + [t.values[r] for (_, t), r in zip(tables, rows)]),
-        sum(t.dropped for _, t in tables),
-        tables[0][1].lines[rows[0]],
-    )
-
-
 def _number(text: str) -> bool:
     try:
         float(text)
@@ -261,7 +224,9 @@ def read_table(path: Path, drop: bool = False) -> Table:
             with h5py.File(path, "r") as f:
                 arrays, unread = _h5_datasets(f)
                 return _columns(arrays, path, unread)
-    except (OSError, ValueError, NotImplementedError) as exc:
+    except ExciteError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - a corrupt file makes the parsers raise anything (TypeError, zlib.error)
         raise ExciteError(
             "data", f"cannot read {path.name} as {suffix[1:].upper()}: {' '.join(str(exc).split())[:160]}"
         ) from None

@@ -14,7 +14,8 @@ from excite_cli.config import resolve_path
 from excite_cli.errors import ExciteError, FileNotFound
 from excite_cli.identification.config import ColumnsConfig, DataConfig, RunConfig
 from excite_cli.identification.measured.bags import bag_columns, is_bag, read_bag
-from excite_cli.identification.measured.files import Table, join_tables, read_table
+from excite_cli.identification.measured.files import Table, read_table
+from excite_cli.identification.measured.joining import join_tables
 
 
 @dataclass(frozen=True)
@@ -167,16 +168,23 @@ def silent_channels(runs: list[Run]) -> np.ndarray:
     return zeros >= SILENT * sum(r.time.size for r in runs)
 
 
-def _reduction(data: DataConfig, n: int) -> np.ndarray:
-    """R (n, n) of ``data.transmission``.
+def check_joint_lists(data: DataConfig, n: int) -> None:
+    """Every per-joint list of ``data`` (signs, torque constants, the transmission's gear ratios)
+    has one entry per active joint: a list for other joints would act on the wrong ones.
 
     Raises:
-        ExciteError: gear ratios for another number of joints.
+        ExciteError: naming the field, its length and ``n``.
     """
-    R = data.transmission.reduction()
-    if R.shape != (n, n):
-        raise ExciteError("data.transmission.gear_ratios", f"{R.shape[0]} gear ratios for {n} active joints")
-    return R
+    lists = {
+        "data.signs": data.signs,
+        "data.torque_constants": data.torque_constants,
+        "data.transmission.gear_ratios": None if data.transmission is None else data.transmission.gear_ratios,
+    }
+    for field, values in lists.items():
+        if values is not None and len(values) != n:
+            raise ExciteError(
+                field, f"{len(values)} values for {n} active joint{'s' * (n != 1)}", len(values), f"{n}, one per joint"
+            )
 
 
 def load_run(run: RunConfig, data: DataConfig, joints: list[str], folder: Path | None = None) -> Run:
@@ -196,6 +204,7 @@ def load_run(run: RunConfig, data: DataConfig, joints: list[str], folder: Path |
     """
     paths = [resolve_path(f, folder) for f in run.files]
     path, n = paths[0], len(joints)
+    check_joint_lists(data, n)
     for p in paths:
         if not p.exists():
             raise FileNotFound("data.runs", p)
@@ -203,7 +212,10 @@ def load_run(run: RunConfig, data: DataConfig, joints: list[str], folder: Path |
     if len(paths) > 1:
         if data.columns is None:
             raise ExciteError("data.columns", "is required for a run of several files")
-        table, cols = join_tables([(p, read_table(p, drop)) for p in paths], data.columns.time), data.columns
+        table, cols = (
+            join_tables([(p, read_table(p, drop)) for p in paths], data.columns.time, data.sample_rate),
+            data.columns,
+        )
         cols = cols if cols.time is None else cols.model_copy(update={"time": "time"})
     elif is_bag(path):
         table = read_bag(path, data.topic, joints)
@@ -227,10 +239,8 @@ def load_run(run: RunConfig, data: DataConfig, joints: list[str], folder: Path |
     if cols.tau:
         tau = _matrix(table, cols, "tau", path, n)
     else:
-        if data.torque_constants is None or len(data.torque_constants) != n:
+        if data.torque_constants is None:
             raise ExciteError("data.torque_constants", f"give one torque constant [Nm/A] per active joint ({n})")
-        if not np.all(np.isfinite(data.torque_constants)):
-            raise ExciteError("data.torque_constants", "every torque constant must be a finite number [Nm/A]")
         tau = _matrix(table, cols, "current", path, n) * np.asarray(data.torque_constants)
     signals = {
         name: x
@@ -243,12 +253,10 @@ def load_run(run: RunConfig, data: DataConfig, joints: list[str], folder: Path |
     if data.angle_unit == "deg":
         q, qd, qdd = (None if x is None else np.deg2rad(x) for x in (q, qd, qdd))
     if data.signs is not None:
-        if len(data.signs) != n:
-            raise ExciteError("data.signs", f"{len(data.signs)} signs for {n} active joints")
         s = np.asarray(data.signs, dtype=float)
         q, qd, qdd, tau = (None if x is None else x * s for x in (q, qd, qdd, tau))
     if data.motor_side:  # motor angles m = R q and motor torques: to the joints, q = R⁻¹ m and τ = Rᵀ τ_m
-        R = _reduction(data, n)
+        R = data.transmission.reduction()
         inverse = np.linalg.inv(R)
         q, qd, qdd = (None if x is None else x @ inverse.T for x in (q, qd, qdd))
         tau = tau @ R

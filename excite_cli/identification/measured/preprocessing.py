@@ -196,7 +196,7 @@ def preprocess(run: Run, cfg: PreprocessingConfig, cutoff: float) -> Samples:
         raise ExciteError(
             "data",
             f"{run.name}: {grid.size} samples ({grid[-1] - grid[0]:.3g} s) are fewer than the "
-            f"{needed} that the {cutoff:.3g} Hz filter needs",
+            f"{needed:.4g} that the {cutoff:.3g} Hz filter needs",
         )
     filt = Filter(sos, rate, cutoff, trim, max(1, int(round(rate / target))))
     dt = 1.0 / rate

@@ -24,6 +24,7 @@ import pinocchio as pin
 
 from excite_cli.atomic import atomic_path
 from excite_cli.dynamics.robot import Robot
+from excite_cli.dynamics.urdf_meshes import mesh_path
 from excite_cli.errors import ExciteError
 from excite_cli.identification.effects import Term
 from excite_cli.identification.reporting.urdf_out import merged_links
@@ -81,16 +82,12 @@ def import_mujoco():
 
 
 def _resolve_meshes(spec, urdf: Path, package_dirs: list[str], notes: list[str]) -> None:
-    """Give every mesh an absolute file name (``package://`` looked up in ``package_dirs``, a
-    relative one beside ``urdf``); a mesh that is missing or in a format MuJoCo does not read is
-    removed with the geoms using it."""
+    """Give every mesh an absolute file name (:func:`~excite_cli.dynamics.urdf_meshes.mesh_path`); a
+    mesh that is missing or in a format MuJoCo does not read is removed with the geoms using it."""
     for mesh in list(spec.meshes):
         name = mesh.file
-        if name.startswith("package://"):
-            candidates = [Path(d) / name[len("package://") :] for d in package_dirs]
-        else:
-            candidates = [urdf.parent / name]
-        found = next((p.resolve() for p in candidates if p.is_file()), None)
+        found = mesh_path(name, urdf, package_dirs)
+        found = found.resolve() if found is not None and found.is_file() else None
         if found is not None and found.suffix.lower() in MESH_FORMATS:
             mesh.file = str(found)
             continue

@@ -1,0 +1,72 @@
+"""The meshes of a URDF: found where ROS and pinocchio look, and checked before assimp reads them."""
+
+import os
+from pathlib import Path
+
+import pinocchio as pin
+import pytest
+
+from excite_cli.dynamics.urdf_meshes import MAX_MESH_BYTES, check_meshes, collision_geometry, mesh_path, package_folders
+from excite_cli.errors import ExciteError
+
+#: An ASCII STL of one triangle.
+BOX = (
+    "solid box\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid\n"
+)
+
+
+def _robot(folder: Path, mesh: str) -> Path:
+    """``folder/my_robot/urdf/robot.urdf``: a base and one link whose collision mesh is ``mesh``."""
+    urdf = folder / "my_robot" / "urdf" / "robot.urdf"
+    urdf.parent.mkdir(parents=True)
+    urdf.write_text(
+        '<robot name="r"><link name="base"/><link name="arm"><collision><geometry>'
+        f'<mesh filename="{mesh}"/></geometry></collision></link>'
+        '<joint name="j" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/>'
+        '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>'
+    )
+    return urdf
+
+
+def test_a_package_uri_is_found_from_the_urdf_s_own_package(tmp_path):
+    """The URDF inside its package, given as a file: the folder above the package holds it."""
+    urdf = _robot(tmp_path, "package://my_robot/meshes/arm.stl")
+    (tmp_path / "my_robot" / "meshes").mkdir()
+    (tmp_path / "my_robot" / "meshes" / "arm.stl").write_text(BOX)
+    folders = package_folders(urdf, [str(urdf.parent)])
+    assert str(tmp_path) in folders
+    assert mesh_path("package://my_robot/meshes/arm.stl", urdf, folders) == tmp_path / "my_robot/meshes/arm.stl"
+    geometry = collision_geometry(pin.buildModelFromUrdf(str(urdf)), urdf, folders)
+    assert geometry.ngeoms == 1
+
+
+def test_file_uris_absolute_and_relative_names_are_resolved(tmp_path):
+    urdf = _robot(tmp_path, "arm.stl")
+    (urdf.parent / "arm.stl").write_text(BOX)
+    assert mesh_path("arm.stl", urdf, []) == urdf.parent / "arm.stl"
+    assert mesh_path(f"file://{urdf.parent / 'arm.stl'}", urdf, []) == urdf.parent / "arm.stl"
+    assert mesh_path(str(urdf.parent / "arm.stl"), urdf, []) == urdf.parent / "arm.stl"
+    assert mesh_path("other.stl", urdf, []) is None
+
+
+def test_a_fifo_mesh_is_refused_before_anything_reads_it(tmp_path):
+    urdf = _robot(tmp_path, "arm.stl")
+    os.mkfifo(urdf.parent / "arm.stl")
+    with pytest.raises(ExciteError, match="link 'arm': collision mesh arm.stl: .* is a FIFO"):
+        check_meshes(urdf, [])
+
+
+def test_a_mesh_beyond_the_size_bound_is_refused_by_its_size(tmp_path):
+    urdf = _robot(tmp_path, "arm.stl")
+    with open(urdf.parent / "arm.stl", "wb") as f:
+        f.truncate(MAX_MESH_BYTES + 1)  # sparse
+    with pytest.raises(ExciteError, match="collision mesh arm.stl is 200 MB, more than the 200 MB"):
+        check_meshes(urdf, [])
+
+
+def test_a_file_that_is_not_a_mesh_is_one_line_naming_the_urdf(tmp_path):
+    urdf = _robot(tmp_path, "arm.stl")
+    (urdf.parent / "arm.stl").write_bytes(b"\x00\x01 not a mesh")
+    with pytest.raises(ExciteError, match="cannot load the collision meshes of robot.urdf") as caught:
+        collision_geometry(pin.buildModelFromUrdf(str(urdf)), urdf, [])
+    assert "\n" not in str(caught.value)
