@@ -8,7 +8,7 @@ import typer
 from rich.markup import escape
 
 from excite_cli import console, workflows
-from excite_cli.console.app import FORCE, MODEL, PRIOR, SCHEDULER, WORKERS, app, command, err, out, say
+from excite_cli.console.app import FORCE, JOINTS, MODEL, PRIOR, RUNS, SCHEDULER, WORKERS, app, command, err, out, say
 from excite_cli.console.progress import Bars
 from excite_cli.criteria import NAMES as OBJECTIVES
 from excite_cli.storage.formats import FORMATS
@@ -78,16 +78,15 @@ def optimize(
 @command()
 def init(
     urdf: str = typer.Argument(..., help="URDF file, or a path in example-robot-data (ur_description/urdf/ur10.urdf)."),
-    joints: Optional[list[str]] = typer.Option(
-        None, "--joints", help="Active joints, repeatable or comma-separated (default: every revolute joint)."
-    ),
+    joints: Optional[list[str]] = JOINTS,
     kind: str = typer.Option("optimize", "--kind", help="Config kind: optimize or identify."),
+    runs: Optional[list[str]] = RUNS,
     output: Optional[Path] = typer.Option(None, "--output", "-o", help="Config file (default: <URDF name>.yaml)."),
     force: bool = FORCE,
 ) -> None:
     """A starting config for your robot from its URDF: joints, limits, capsules, mounting plane, home posture."""
     with err.status("fitting capsules and searching postures ..."):
-        run = workflows.run_init(urdf, output or Path(f"{Path(urdf).stem}.yaml"), joints, kind, force)
+        run = workflows.run_init(urdf, output or Path(f"{Path(urdf).stem}.yaml"), joints, kind, force, runs)
     say(console.tables.initialized(run))
 
 
@@ -212,7 +211,7 @@ def export(
 ) -> None:
     """Write a trajectory as a robot plays it: home → P periods → home, at the controller's rate, with torques."""
     exported, target = workflows.run_export(result, iteration, rate, periods, fmt, output, force)
-    say(console.tables.export_lines(exported, rate), f"wrote {target}")
+    say(console.tables.export_lines(exported, rate, target, fmt))
 
 
 @command()

@@ -21,6 +21,10 @@ WORKERS = typer.Option(
 SCHEDULER = typer.Option(None, "--scheduler", help="Dask scheduler, e.g. tcp://host:8786 (optimizer.scheduler).")
 PRIOR = typer.Option(None, "--prior", help="Earlier result or identify report stacked first (sequence.prior).")
 MODEL = typer.Option(None, "--model", help="Identify report whose effects to design for too (effects.model).")
+JOINTS = typer.Option(
+    None, "--joints", help="Active joints, repeatable or comma-separated (default: every revolute joint)."
+)
+RUNS = typer.Option(None, "--runs", help="identify: measured runs (CSV, NPZ, MAT, HDF5, ROS bag), repeatable.")
 
 
 def command(name: Optional[str] = None) -> Callable:

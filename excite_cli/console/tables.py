@@ -3,6 +3,7 @@ from what the library returns."""
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Sequence
 
 import numpy as np
@@ -13,6 +14,7 @@ from excite_cli.config import OptimizerConfig
 from excite_cli.criteria import CRITERIA
 from excite_cli.optimization.sequence import IterationResult
 from excite_cli.storage.export import Export
+from excite_cli.storage.rosbag import TOPIC
 from excite_cli.workflows.check import Plan
 from excite_cli.workflows.compare import Comparison
 from excite_cli.workflows.init import InitRun
@@ -215,12 +217,21 @@ def verification(v: Verification, tolerance: float) -> list[Table | str]:
     return [gradients, jacobians, f"{verdict}: largest relative error {v.worst:.2e} (tolerance {tolerance:.0e})"]
 
 
-def export_lines(e: Export, rate: float) -> list[str]:
-    """The segments of an exported motion and its constraint check."""
-    return [f"{name:>15}: {start:8.3f} s → {start + duration:8.3f} s" for name, start, duration in e.segments] + [
+def export_lines(e: Export, rate: float, target: Path, fmt: str) -> list[str]:
+    """The segments of an exported motion, its constraint check, the file written and, for a ROS 2
+    bag, how to play it and record the run."""
+    lines = [f"{name:>15}: {start:8.3f} s → {start + duration:8.3f} s" for name, start, duration in e.segments] + [
         f"{e.time.size} samples at {rate:g} Hz; every constraint holds: largest normalized violation "
-        f"{e.max_violation:+.2e} (≤ 0 satisfied), closest: {e.worst}"
+        f"{e.max_violation:+.2e} (≤ 0 satisfied), closest: {e.worst}",
+        f"wrote {target}",
     ]
+    if fmt == "rosbag2":
+        lines += [
+            f"play it: ros2 bag play {target}  (another controller: --remap {TOPIC}:=/<controller>/joint_trajectory)",
+            f"record the run meanwhile: ros2 bag record /joint_states -o {target.name}_run_1  "
+            "(excite identify reads that bag folder as a data.runs file)",
+        ]
+    return lines
 
 
 def plan(p: Plan) -> list[Table | str]:
@@ -267,7 +278,8 @@ def initialized(run: InitRun) -> list[Table | str]:
     lines += [f"  excluded pair {a} – {b}: {why}" for a, b, why in draft.excluded]
     lines += [f"  mounting plane ignores {link}: {why}" for link, why in draft.ignored]
     if run.plan is None:
-        return [*lines, f"fill in what it marks FILL IN, then: excite identify {run.target}"]
+        filled = not any("FILL IN" in why for why in draft.assumptions.values())
+        return [*lines, f"{'next' if filled else 'fill in what it marks FILL IN, then'}: excite identify {run.target}"]
     return [*lines, *plan(run.plan), f"next: excite optimize {run.target}"]
 
 

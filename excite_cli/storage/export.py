@@ -21,6 +21,7 @@ from excite_cli.optimization.excitation import build_excitation
 from excite_cli.optimization.playback import check_motion, plan_playback
 from excite_cli.storage.formats import FORMATS
 from excite_cli.storage.results import problem_of_result, read_alphas
+from excite_cli.storage.rosbag import check_goal_size, write_rosbag
 
 #: Highest export rate accepted [Hz] (memory grows with rate × duration).
 MAX_RATE = 100_000.0
@@ -139,20 +140,27 @@ def columns(joint_names: list[str]) -> list[str]:
 
 def write_export(path: Path, export: Export, fmt: str = "csv") -> Path:
     """Write ``export`` as CSV (``#`` comment lines, then one header row of :func:`columns`), NPZ
-    (arrays ``time``, ``q``, ``qd``, ``qdd``, ``tau``, ``joint_names``, ``columns``) or a ROS 2
-    FollowJointTrajectory goal (:func:`ros2_goal`), atomically.
+    (arrays ``time``, ``q``, ``qd``, ``qdd``, ``tau``, ``joint_names``, ``columns``), a ROS 2
+    FollowJointTrajectory goal (:func:`ros2_goal`) or a ROS 2 bag folder
+    (:func:`~excite_cli.storage.rosbag.write_rosbag`), atomically.
 
     Raises:
-        ExciteError: an unknown format or a file that cannot be written.
+        ExciteError: an unknown format, a goal longer than one command-line argument holds
+            (:func:`~excite_cli.storage.rosbag.check_goal_size`), or a file that cannot be written.
     """
     if fmt not in FORMATS:
         raise ExciteError("format", f"must be one of {', '.join(FORMATS)} (got {fmt!r})")
     path = Path(path)
+    if fmt == "rosbag2":
+        return write_rosbag(path, export.joint_names, export.time, (export.q, export.qd, export.qdd, export.tau))
+    goal = ros2_goal(export) if fmt == "ros2" else ""
+    if goal:
+        check_goal_size(goal)
     with atomic_path(path, "output") as tmp:
         if fmt == "csv":
             _write_csv(tmp, export)
-        elif fmt == "ros2":
-            tmp.write_text(ros2_goal(export), encoding="utf-8")
+        elif goal:
+            tmp.write_text(goal, encoding="utf-8")
         else:
             with open(tmp, "wb") as f:
                 np.savez(
@@ -187,7 +195,7 @@ def ros2_goal(export: Export) -> str:
     point per sample (``positions`` [rad], ``velocities`` [rad/s], ``accelerations`` [rad/s²],
     ``effort`` [Nm]: the feed-forward torque, ``time_from_start`` as sec and nanosec), e.g. for
     ``ros2 action send_goal /<controller>/follow_joint_trajectory
-    control_msgs/action/FollowJointTrajectory "$(cat FILE)"`` at a rate the command line can hold."""
+    control_msgs/action/FollowJointTrajectory "$(cat FILE)"`` (at most 128 KiB: one argument)."""
 
     def numbers(row: np.ndarray) -> str:
         return "[" + ", ".join(f"{x:.10g}" for x in row) + "]"

@@ -8,6 +8,7 @@ from excite_cli.errors import ExciteError
 from excite_cli.storage.export import Export, export_trajectory, write_export
 from excite_cli.storage.formats import FORMATS
 from excite_cli.storage.paths import check_target
+from excite_cli.storage.rosbag import check_bag_target
 
 
 def run_export(
@@ -20,16 +21,18 @@ def run_export(
     force: bool = False,
 ) -> tuple[Export, Path]:
     """:func:`export_trajectory` written by :func:`write_export` to ``output`` (default
-    ``<result>_iteration<K>_<rate>Hz.<ending>``, the ending of :data:`FORMATS`, beside the result); a
-    given ``output`` is checked first.
+    ``<result>_iteration<K>_<rate>Hz.<ending>``, the ending of :data:`FORMATS`, beside the result; a
+    bag is a folder of that name without an ending); a given ``output`` is checked first.
 
     Raises:
         ExciteError: see both, and a bad or existing (without ``force``) output path.
     """
     if fmt not in FORMATS:
         raise ExciteError("format", f"must be one of {', '.join(FORMATS)} (got {fmt!r})")
+    check = check_bag_target if fmt == "rosbag2" else check_target
     if output is not None:
-        check_target(output, "output", force)
+        check(output, "output", force)
     export = export_trajectory(result, iteration, rate, periods)
-    target = output or result.with_name(f"{result.stem}_iteration{export.iteration}_{rate:g}Hz.{FORMATS[fmt]}")
-    return export, write_export(check_target(target, "output", force), export, fmt)
+    ending = f".{FORMATS[fmt]}" if FORMATS[fmt] else ""
+    target = output or result.with_name(f"{result.stem}_iteration{export.iteration}_{rate:g}Hz{ending}")
+    return export, write_export(check(target, "output", force), export, fmt)

@@ -5,8 +5,8 @@ import h5py
 import numpy as np
 import pinocchio as pin
 import pytest
-import yaml
 from conftest import CONFIGS
+from rosbags.highlevel import AnyReader
 from rosbags.typesys import Stores, get_typestore
 from typer.testing import CliRunner
 
@@ -15,6 +15,7 @@ from excite_cli.constraints import JointLimits
 from excite_cli.constraints.lse import GRID_MARGIN
 from excite_cli.dynamics.urdf_source import example_robot_data_root
 from excite_cli.optimization.playback import RESOLUTION, Transition, plan_transition
+from excite_cli.storage.rosbag import TOPIC
 
 runner = CliRunner()
 PANDA_URDF = "example-robot-data/robots/panda_description/urdf/panda.urdf"
@@ -129,40 +130,41 @@ def test_export_npz_has_the_same_samples(panda_runs, tmp_path):
     assert np.allclose(np.diff(data["time"]), 5e-3)
 
 
-def test_export_ros2_is_a_follow_joint_trajectory_goal_ros_accepts(panda_runs, tmp_path):
-    """The YAML goal has the fields of trajectory_msgs/JointTrajectory(Point) as ROS 2 defines them
-    (rosbags' message store, Humble), builds such a message and serializes to CDR; its samples are
-    the NPZ export's and the default file ends in .yaml."""
+def test_a_ros2_goal_longer_than_one_command_line_argument_is_refused_naming_the_bag(panda_runs):
+    """A 7-joint goal at 50 Hz is about 400 kB: ``send_goal … "$(cat FILE)"`` fails beyond 128 KiB."""
+    argv = ["export", str(panda_runs["rest"]), "-k", "1", "--rate", "50", "--format", "ros2"]
+    result = runner.invoke(app, argv, env={"COLUMNS": "400"})
+    assert result.exit_code == 2
+    assert "more than the 128 KiB one command-line argument holds" in result.output and "rosbag2" in result.output
+    assert not panda_runs["rest"].with_name(panda_runs["rest"].stem + "_iteration1_50Hz.yaml").exists()
+
+
+def test_a_rosbag2_export_plays_the_samples_of_the_csv(panda_runs, tmp_path):
+    """Read back with rosbags as ``ros2 bag play`` would: one JointTrajectory on the controller's topic
+    whose points are the CSV's rows (positions, effort = feed-forward torque, time_from_start)."""
     argv = ["export", str(panda_runs["rest"]), "-k", "1", "--rate", "50"]
-    assert runner.invoke(app, [*argv, "--format", "ros2"]).exit_code == 0
-    assert runner.invoke(app, [*argv, "--format", "npz", "-o", str(tmp_path / "a.npz")]).exit_code == 0
-    written = panda_runs["rest"].with_name(panda_runs["rest"].stem + "_iteration1_50Hz.yaml")
-    goal = yaml.safe_load(written.read_text())["trajectory"]
-    reference = np.load(tmp_path / "a.npz")
-    store = get_typestore(Stores.ROS2_HUMBLE)
-    point_fields = [name for name, _ in store.fielddefs["trajectory_msgs/msg/JointTrajectoryPoint"][1]]
-    assert set(goal["points"][0]) == set(point_fields)
-    assert goal["joint_names"] == list(reference["joint_names"])
-    assert np.allclose([p["positions"] for p in goal["points"]], reference["q"], atol=1e-9)
-    assert np.allclose([p["effort"] for p in goal["points"]], reference["tau"], atol=1e-8)
-    times = [p["time_from_start"]["sec"] + 1e-9 * p["time_from_start"]["nanosec"] for p in goal["points"]]
-    assert np.allclose(times, reference["time"], atol=1e-9)
-    Point, Duration = (
-        store.types["trajectory_msgs/msg/JointTrajectoryPoint"],
-        store.types["builtin_interfaces/msg/Duration"],
-    )
-    points = [
-        Point(
-            **{k: np.asarray(v, dtype=float) for k, v in p.items() if k != "time_from_start"},
-            time_from_start=Duration(**p["time_from_start"]),
-        )
-        for p in goal["points"][:3]
-    ]
-    Header, Time = store.types["std_msgs/msg/Header"], store.types["builtin_interfaces/msg/Time"]
-    message = store.types["trajectory_msgs/msg/JointTrajectory"](
-        header=Header(stamp=Time(sec=0, nanosec=0), frame_id=""), joint_names=goal["joint_names"], points=points
-    )
-    assert len(store.serialize_cdr(message, "trajectory_msgs/msg/JointTrajectory")) > 0
+    assert runner.invoke(app, [*argv, "-o", str(tmp_path / "play.csv")]).exit_code == 0
+    result = runner.invoke(app, [*argv, "--format", "rosbag2", "-o", str(tmp_path / "bag")], env={"COLUMNS": "400"})
+    assert result.exit_code == 0, result.output
+    assert f"ros2 bag play {tmp_path / 'bag'}" in result.output
+    time, q, _, _, tau = _csv(tmp_path / "play.csv")
+    with AnyReader([tmp_path / "bag"], default_typestore=get_typestore(Stores.ROS2_HUMBLE)) as reader:
+        assert [(c.topic, c.msgtype) for c in reader.connections] == [(TOPIC, "trajectory_msgs/msg/JointTrajectory")]
+        messages = [reader.deserialize(raw, c.msgtype) for c, _, raw in reader.messages()]
+    assert len(messages) == 1
+    message = messages[0]
+    assert list(message.joint_names) == [f"panda_joint{k}" for k in range(1, 8)]
+    np.testing.assert_allclose([p.positions for p in message.points], q, rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose([p.effort for p in message.points], tau, rtol=1e-9, atol=1e-8)
+    stamps = [p.time_from_start.sec + 1e-9 * p.time_from_start.nanosec for p in message.points]
+    np.testing.assert_allclose(stamps, time, atol=1e-9)
+
+
+def _csv(path):
+    """time (S,), q, q̇, q̈, τ (S, n) of an ``excite export`` CSV."""
+    table = np.genfromtxt(path, delimiter=",", skip_header=5)
+    n = (table.shape[1] - 1) // 4
+    return (table[:, 0], *(table[:, 1 + k * n : 1 + (k + 1) * n] for k in range(4)))
 
 
 @pytest.mark.parametrize(

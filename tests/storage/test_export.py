@@ -1,12 +1,14 @@
-"""The played file: CSV, NPZ and a ROS 2 goal written from the same samples and read back."""
+"""The played file: CSV, NPZ, a ROS 2 goal and a ROS 2 bag written from the same samples and read back."""
 
 import numpy as np
 import pytest
 import yaml
+from rosbags.typesys import Stores, get_typestore
 
 from excite_cli.errors import ExciteError
 from excite_cli.storage.export import Export, columns, write_export
 from excite_cli.storage.formats import FORMATS
+from excite_cli.storage.rosbag import MSGTYPE
 
 JOINTS = ["a", "b"]
 
@@ -41,13 +43,36 @@ def test_csv_and_npz_hold_the_same_samples_under_their_column_names(export, tmp_
     assert archive["joint_names"].tolist() == JOINTS
 
 
-def test_a_ros2_goal_has_one_point_per_sample_with_its_time(export, tmp_path):
+def test_a_ros2_goal_has_one_point_per_sample_with_its_time_and_builds_the_ros_message(export, tmp_path):
+    """The YAML goal's fields are trajectory_msgs/JointTrajectory(Point)'s as ROS 2 defines them
+    (rosbags' Humble message store): they build such a message, which serializes to CDR."""
     goal = yaml.safe_load(write_export(tmp_path / "m.yaml", export, "ros2").read_text())
     trajectory = goal["trajectory"]
     assert trajectory["joint_names"] == JOINTS and len(trajectory["points"]) == 5
     last = trajectory["points"][-1]
     assert last["time_from_start"] == {"sec": 0, "nanosec": 40_000_000}
     np.testing.assert_allclose(last["effort"], export.tau[-1])
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    types = store.types
+    points = [
+        types["trajectory_msgs/msg/JointTrajectoryPoint"](
+            **{k: np.asarray(v, dtype=float) for k, v in point.items() if k != "time_from_start"},
+            time_from_start=types["builtin_interfaces/msg/Duration"](**point["time_from_start"]),
+        )
+        for point in trajectory["points"]
+    ]
+    header = types["std_msgs/msg/Header"](stamp=types["builtin_interfaces/msg/Time"](sec=0, nanosec=0), frame_id="")
+    message = types[MSGTYPE](header=header, joint_names=trajectory["joint_names"], points=points)
+    assert len(store.serialize_cdr(message, MSGTYPE)) > 0
+
+
+def test_a_goal_longer_than_one_command_line_argument_is_refused_and_not_written(tmp_path):
+    t = np.arange(5000) / 1000.0
+    q = np.column_stack([np.sin(t), np.cos(t)])
+    long = Export(JOINTS, t, q, q, q, q, 1000.0, 1, 1, [("trajectory", 0.0, 5.0)], -0.01, "none")
+    with pytest.raises(ExciteError, match="more than the 128 KiB one command-line argument holds"):
+        write_export(tmp_path / "m.yaml", long, "ros2")
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_an_unknown_format_writes_nothing(export, tmp_path):
@@ -58,5 +83,7 @@ def test_an_unknown_format_writes_nothing(export, tmp_path):
 
 @pytest.mark.parametrize("fmt", list(FORMATS))
 def test_every_format_the_help_lists_is_written_with_its_ending(export, tmp_path, fmt):
-    path = write_export(tmp_path / f"m.{FORMATS[fmt]}", export, fmt)
-    assert path.exists() and path.suffix == f".{FORMATS[fmt]}" and path.stat().st_size > 0
+    path = write_export(tmp_path / ("m" + (f".{FORMATS[fmt]}" if FORMATS[fmt] else "")), export, fmt)
+    written = path / "metadata.yaml" if fmt == "rosbag2" else path  # a bag is a folder
+    assert written.is_file() and path.suffix == (f".{FORMATS[fmt]}" if FORMATS[fmt] else "")
+    assert written.stat().st_size > 0

@@ -1,0 +1,159 @@
+"""ROS 2 bags excite writes (a folder: ``metadata.yaml`` and an SQLite3 file, rosbag2 format version
+8, written with ``rosbags``, no ROS installation), whole or not at all.
+
+An exported motion: one ``trajectory_msgs/msg/JointTrajectory``
+on a joint trajectory controller's command topic, with one point per sample (positions [rad],
+velocities [rad/s], accelerations [rad/s²], effort [Nm]: the feed-forward torque, time_from_start)
+and a header stamp of 0 (start on arrival). ``ros2 bag play BAG`` publishes it; ``--remap`` sends it
+to another controller. A goal for ``ros2 action send_goal`` is one command-line argument, which Linux
+caps at 128 KiB (``MAX_ARG_STRLEN``): longer goals are refused in favour of the bag.
+
+A simulated run, as ``ros2 bag record /joint_states`` writes one: a ``sensor_msgs/msg/JointState``
+per sample on :data:`JOINT_STATES`, stamped with its time (from :data:`START`), joints by name,
+``position`` [rad] and ``effort`` [Nm] filled, ``velocity`` empty (what many drivers publish).
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import time
+from pathlib import Path
+
+import numpy as np
+from rosbags.rosbag2 import Writer, WriterError
+from rosbags.typesys import Stores, get_typestore
+
+from excite_cli.atomic import new_folders, partial_path
+from excite_cli.errors import CannotWrite, ExciteError, OutputExists
+from excite_cli.storage.paths import check_target
+
+#: The topic a ros2_control joint trajectory controller named ``joint_trajectory_controller`` listens on.
+TOPIC = "/joint_trajectory_controller/joint_trajectory"
+MSGTYPE = "trajectory_msgs/msg/JointTrajectory"
+#: The joint-state topic robots publish and ``ros2 bag record`` records.
+JOINT_STATES = "/joint_states"
+#: Stamp of a simulated run's first sample [ns] (2026-01-01, Unix time: a recording's clock).
+START = 1_767_225_600 * 10**9
+#: Longest single command-line argument on Linux [bytes] (``MAX_ARG_STRLEN``, 32 pages of 4 KiB).
+MAX_ARGUMENT = 131_072
+
+
+def check_goal_size(text: str) -> None:
+    """A FollowJointTrajectory goal given as one command-line argument fits Linux's limit.
+
+    Raises:
+        ExciteError: (``format``) the goal is longer than :data:`MAX_ARGUMENT`, naming the bag route.
+    """
+    size = len(text.encode("utf-8"))
+    if size > MAX_ARGUMENT:
+        raise ExciteError(
+            "format",
+            f"the ros2 goal is {size / 1024:.0f} KiB, more than the 128 KiB one command-line argument holds "
+            '(ros2 action send_goal … "$(cat FILE)" would fail: Argument list too long)',
+            "ros2",
+            "the rosbag2 format (played with ros2 bag play), or a lower rate",
+        )
+
+
+def check_bag_target(folder: Path, field: str, force: bool) -> Path:
+    """``folder`` may receive a bag: it does not exist, or with ``force`` it is a ROS 2 bag (a folder
+    with ``metadata.yaml``), which is replaced; never another folder or a file.
+
+    Raises:
+        OutputExists: it exists, without ``force``.
+        ExciteError: it is a file, a folder that is not a bag, or cannot be written
+            (:func:`~excite_cli.storage.paths.check_target`).
+    """
+    folder = Path(folder)
+    if folder.exists() and not force:
+        raise OutputExists(field, folder)
+    if folder.exists() and not (folder.is_dir() and (folder / "metadata.yaml").is_file()):
+        raise ExciteError(field, f"{folder} exists and is not a ROS 2 bag folder; not replaced", folder, "a new folder")
+    check_target(folder / "metadata.yaml", field, force=True)  # its folder (or the nearest one there is) writable
+    return folder
+
+
+def _message(types: dict, joints: list[str], time_s: np.ndarray, motion: tuple[np.ndarray, ...]) -> object:
+    """The JointTrajectory of one point per instant of ``time_s`` (S,) [s]: ``motion`` q, q̇, q̈, τ (S, n)
+    (``types``: a typestore's message classes)."""
+    Time, Duration = (types[f"builtin_interfaces/msg/{t}"] for t in ("Time", "Duration"))
+    Header, Point = types["std_msgs/msg/Header"], types["trajectory_msgs/msg/JointTrajectoryPoint"]
+    q, qd, qdd, tau = motion
+    nanoseconds = np.round(time_s * 1e9).astype(np.int64)
+    points = [
+        Point(
+            positions=q[k],
+            velocities=qd[k],
+            accelerations=qdd[k],
+            effort=tau[k],
+            time_from_start=Duration(sec=int(ns // 10**9), nanosec=int(ns % 10**9)),
+        )
+        for k, ns in enumerate(nanoseconds)
+    ]
+    header = Header(stamp=Time(sec=0, nanosec=0), frame_id="")
+    return types[MSGTYPE](header=header, joint_names=list(joints), points=points)
+
+
+def _write_bag(folder: Path, topic: str, msgtype: str, messages) -> Path:
+    """``messages`` ((recording time [ns], message) pairs) on ``topic`` as a bag at ``folder``, built
+    in a hidden ``.<name>.partial`` folder beside it and then moved onto it (an existing bag there is
+    replaced, see :func:`check_bag_target`).
+
+    Raises:
+        CannotWrite: the bag cannot be written (a full disk, permissions).
+    """
+    folder = Path(folder)
+    staging = partial_path(folder)
+    shutil.rmtree(staging, ignore_errors=True)
+    typestore = get_typestore(Stores.ROS2_HUMBLE)
+    try:
+        with new_folders([folder]):
+            try:
+                staging.mkdir()
+                with Writer(staging / folder.name, version=8) as writer:
+                    connection = writer.add_connection(topic, msgtype, typestore=typestore)
+                    for ns, message in messages(typestore.types):
+                        writer.write(connection, ns, typestore.serialize_cdr(message, msgtype))
+                if folder.exists():
+                    shutil.rmtree(folder)
+                os.replace(staging / folder.name, folder)
+            finally:
+                shutil.rmtree(staging, ignore_errors=True)
+    except (OSError, WriterError) as exc:
+        raise CannotWrite("output", folder, getattr(exc, "strerror", None) or exc) from None
+    return folder
+
+
+def write_rosbag(
+    folder: Path, joints: list[str], time_s: np.ndarray, motion: tuple[np.ndarray, ...], topic: str = TOPIC
+) -> Path:
+    """Write a played motion (``time_s`` (S,) [s] from 0; ``motion`` q, q̇, q̈, τ (S, n) [rad, rad/s,
+    rad/s², Nm] of ``joints``) as the trajectory bag of the module docstring at ``folder`` (:func:`_write_bag`).
+
+    Raises:
+        CannotWrite: the bag cannot be written.
+    """
+    return _write_bag(folder, topic, MSGTYPE, lambda types: [(time.time_ns(), _message(types, joints, time_s, motion))])
+
+
+def write_joint_states(folder: Path, joints: list[str], time_s: np.ndarray, q: np.ndarray, tau: np.ndarray) -> Path:
+    """Write a run (``time_s`` (T,) [s] from 0, ``q``, ``tau`` (T, n) [rad, Nm] of ``joints``) as the
+    recorded bag of the module docstring at ``folder`` (:func:`_write_bag`).
+
+    Raises:
+        CannotWrite: the bag cannot be written.
+    """
+
+    def messages(types):
+        Time, Header, JointState = (
+            types[t] for t in ("builtin_interfaces/msg/Time", "std_msgs/msg/Header", "sensor_msgs/msg/JointState")
+        )
+        for k, ns in enumerate(START + np.round(time_s * 1e9).astype(np.int64)):
+            header = Header(stamp=Time(sec=int(ns // 10**9), nanosec=int(ns % 10**9)), frame_id="")
+            yield (
+                int(ns),
+                JointState(header=header, name=list(joints), position=q[k], velocity=np.zeros(0), effort=tau[k]),
+            )
+
+    return _write_bag(folder, JOINT_STATES, "sensor_msgs/msg/JointState", messages)
