@@ -40,6 +40,8 @@ class SimulationConfig(Section):
     """{armature|coulomb|viscous: {motor's joint or \"*\": value}}: each motor's own [kg·m², Nm, Nm·s/rad]."""
     motor_side: bool = False
     """Write motor angles and motor torques (m = R q, τ_m = R⁻ᵀ τ)."""
+    recording: Literal["csv", "rosbag2"] = "csv"
+    """`csv` (a file per run) or `rosbag2` (a bag folder per run, as `ros2 bag record /joint_states` writes)."""
 
     @model_validator(mode="after")
     def _motors_need_the_transmission(self) -> "SimulationConfig":

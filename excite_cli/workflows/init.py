@@ -18,6 +18,7 @@ from excite_cli.dynamics.urdf_checks import check_urdf
 from excite_cli.dynamics.urdf_source import example_robot_data_root, resolve_urdf
 from excite_cli.errors import ExciteError, FileNotFound
 from excite_cli.identification.config import IdentifyProblem
+from excite_cli.identification.measured.bags import is_bag
 from excite_cli.storage.paths import check_target
 from excite_cli.workflows.check import Plan, plan_optimize
 
@@ -58,26 +59,51 @@ def robot_source(urdf: str, target: Path) -> dict:
     raise FileNotFound("urdf", urdf, "URDF (a file, or a path inside example-robot-data's robots folder)")
 
 
-def _identify_config(robot: dict, urdf: Path, joints: Optional[list[str]], draft: StartingConfig) -> None:
-    """The identify config of the robot: its joints, and the data section a CSV of it would have."""
+def _identify_config(
+    robot: dict, urdf: Path, joints: Optional[list[str]], draft: StartingConfig, runs: list[str], target: Path
+) -> None:
+    """The identify config of the robot: its joints, and the data section of ``runs`` (files as the
+    user named them, written relative to ``target``'s folder; default a CSV ``runs/run_1.csv``): ROS
+    bags need no columns (joints matched by name), other files the columns ``excite simulate`` writes."""
     active, held = joint_choice(urdf, joints, draft)
+    files = [os.path.relpath(Path(r).resolve(), target.resolve().parent) for r in runs] or ["runs/run_1.csv"]
+    bags = bool(runs) and all(is_bag(Path(r)) for r in runs)
     draft.config = {
         "robot": {**robot, "active_joints": active, "locked_joints": held},
-        "data": {
-            "runs": [{"file": "runs/run_1.csv", "role": "blocks"}],
-            "columns": {"time": "time", "q": [f"q_{j}" for j in active], "tau": [f"tau_{j}" for j in active]},
-        },
+        "data": {"runs": [{"file": f, "role": "blocks"} for f in files]},
         "identification": {"method": "wls"},
         "output": f"results/{urdf.stem}_identify.h5",
     }
     draft.assumptions["data.runs"] = (
-        "FILL IN: your measured runs (CSV, NPZ, MAT, HDF5 or a ROS bag), each fitted and validated on alternate "
-        "time blocks; add runs with role: fit / validation"
+        "each run fitted and validated on alternate time blocks; give others role: fit / validation"
+        if runs
+        else "FILL IN: your measured runs (CSV, NPZ, MAT, HDF5 or a ROS bag), each fitted and validated on "
+        "alternate time blocks; add runs with role: fit / validation"
     )
+    if bags:
+        draft.assumptions["data.topic"] = "/joint_states: the bags' sensor_msgs/JointState, joints matched by name"
+        return
+    draft.config["data"]["columns"] = {
+        "time": "time",
+        "q": [f"q_{j}" for j in active],
+        "tau": [f"tau_{j}" for j in active],
+    }
     draft.assumptions["data.columns"] = (
         "FILL IN: the column names of your files (these are the ones `excite simulate` writes); "
         "add qd (and qdd) if you record them, factors for units other than rad and Nm"
     )
+
+
+def _existing(runs: list[str]) -> list[str]:
+    """``runs`` (files, or a ROS 2 bag's folder), each checked to exist.
+
+    Raises:
+        FileNotFound: a run that does not exist.
+    """
+    for run in runs:
+        if not Path(run).exists():
+            raise FileNotFound("runs", run, "measured run (a data file or a ROS 2 bag folder)")
+    return runs
 
 
 def _text(draft: StartingConfig, urdf: str, kind: str) -> str:
@@ -89,7 +115,7 @@ def _text(draft: StartingConfig, urdf: str, kind: str) -> str:
     lines.append(
         "# Check it with `excite check` before a run; change what your lab knows better."
         if kind == "optimize"
-        else "# Fill in data.runs and data.columns, then run `excite identify`; change what your lab knows better."
+        else "# Fill in what is marked FILL IN, then run `excite identify`; change what your lab knows better."
     )
     body = yaml.dump(
         draft.config, Dumper=_Dumper, sort_keys=False, default_flow_style=False, width=100, allow_unicode=True
@@ -97,7 +123,14 @@ def _text(draft: StartingConfig, urdf: str, kind: str) -> str:
     return "\n".join(lines) + "\n" + body
 
 
-def run_init(urdf: str, target: Path, joints: Optional[list[str]] = None, kind: str = "optimize", force: bool = False):
+def run_init(
+    urdf: str,
+    target: Path,
+    joints: Optional[list[str]] = None,
+    kind: str = "optimize",
+    force: bool = False,
+    runs: Optional[list[str]] = None,
+):
     """Write a starting config of ``kind`` for ``urdf`` to ``target``.
 
     Args:
@@ -105,6 +138,7 @@ def run_init(urdf: str, target: Path, joints: Optional[list[str]] = None, kind: 
         joints: the active joints (default: every revolute joint that follows no other).
         kind: ``optimize`` (the whole problem, which passes the dry run) or ``identify`` (robot and
             the data section to fill in).
+        runs: ``identify``: the measured runs (files or ROS 2 bag folders), each must exist.
 
     Raises:
         ExciteError: unknown kind or joint, a URDF not found or that no model can have
@@ -113,6 +147,8 @@ def run_init(urdf: str, target: Path, joints: Optional[list[str]] = None, kind: 
     """
     if kind not in KINDS:
         raise ExciteError("kind", f"'{kind}' is not a config kind", kind, " or ".join(KINDS))
+    if runs and kind != "identify":
+        raise ExciteError("runs", "are the measured runs of an identify config", runs[0], "kind identify")
     target = check_target(Path(target), "output", force)
     joints = [j.strip() for given in joints or [] for j in given.split(",") if j.strip()] or None
     robot = robot_source(urdf, target)
@@ -125,7 +161,7 @@ def run_init(urdf: str, target: Path, joints: Optional[list[str]] = None, kind: 
         plan = plan_optimize(validated(yaml.safe_load(text), target))
     else:
         draft = StartingConfig({})
-        _identify_config(robot, path, joints, draft)
+        _identify_config(robot, path, joints, draft, _existing(runs or []), target)
         text = _text(draft, urdf, kind)
         IdentifyProblem.model_validate(yaml.safe_load(text))
     with atomic_path(target, "output") as tmp:

@@ -1,8 +1,9 @@
 """``excite simulate``: measured-like runs from a trajectory result and the URDF model, with effects and
-noise from a separate effects file, written as CSV in the format ``identify`` reads.
+noise from a separate effects file, written as CSV or as ROS 2 bags (``recording``), as ``identify`` reads them.
 
 τ = RNEA(q, q̇, q̈; URDF inertias) + Σ effects + Σ motor effects + N(0, σ_τ²); q is written with
-N(0, σ_q²) added and timestamps with uniform jitter. Columns: ``time, q_<joint>..., tau_<joint>...``.
+N(0, σ_q²) added and timestamps with uniform jitter. CSV columns: ``time, q_<joint>..., tau_<joint>...``;
+a bag: :func:`~excite_cli.storage.rosbag.write_joint_states`.
 
 With a ``transmission`` (m = R q, τ = Rᵀ τ_m), each motor k's effects (``motor_effects``: its rotor
 inertia and friction, the motor's own values) act in its coordinate m_k = R_k q: τ += R_kᵀ (I_k m̈_k +
@@ -12,6 +13,7 @@ controller records instead: motor angles m and motor torques τ_m = R⁻ᵀ τ, 
 
 from __future__ import annotations
 
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -23,6 +25,7 @@ from excite_cli.identification.effects import EFFECTS, effect_columns
 from excite_cli.identification.simulation_config import SimulationConfig
 from excite_cli.storage.paths import check_folder
 from excite_cli.storage.results import problem_of_result, read_alphas
+from excite_cli.storage.rosbag import check_bag_target, write_joint_states
 from excite_cli.trajectory.fourier import FourierTrajectory
 
 #: Most samples in one simulated run.
@@ -82,14 +85,14 @@ def motor_torques(sim: SimulationConfig, robot: Robot, q: np.ndarray, qd: np.nda
 def simulate_runs(
     result: Path, sim: SimulationConfig, out_dir: Path, prefix: str = "run", force: bool = False
 ) -> list[Path]:
-    """Write one CSV per iteration of ``result`` into ``out_dir``; all files or none are written
-    (:func:`atomic_paths`).
+    """Write one run per iteration of ``result`` into ``out_dir``, all or none: CSV files
+    (:func:`atomic_paths`) or ROS 2 bag folders (``sim.recording``).
 
     Args:
         result: an ``optimize`` (or ``compare-random``) HDF5 result.
         sim: the effects file.
-        out_dir: folder for ``<prefix>_<k>.csv``.
-        force: replace existing files.
+        out_dir: folder for ``<prefix>_<k>.csv`` (bags: ``<prefix>_<k>``).
+        force: replace existing files (bags: earlier bags).
 
     Returns:
         The written files.
@@ -103,7 +106,11 @@ def simulate_runs(
     trajectory = FourierTrajectory(problem.trajectory.harmonics, problem.trajectory.base_frequency)
     rng = np.random.default_rng(sim.seed)
     alphas = read_alphas(result)
-    check_folder(out_dir, [f"{prefix}_{k}.csv" for k, _ in alphas], "output_dir", force)
+    bags = sim.recording == "rosbag2"
+    names = [f"{prefix}_{k}" + ("" if bags else ".csv") for k, _ in alphas]
+    check_folder(out_dir, [] if bags else names, "output_dir", force)
+    for name in names if bags else []:
+        check_bag_target(out_dir / name, "output_dir", force)
     header = ["time"] + [f"q_{j}" for j in robot.joint_names] + [f"tau_{j}" for j in robot.joint_names]
     count = int(round(sim.periods * trajectory.period * sim.sample_rate)) + 1
     if sim.sample_rate <= trajectory.nyquist_rate:
@@ -134,8 +141,24 @@ def simulate_runs(
         tables[k] = np.column_stack([time, q + rng.normal(0.0, sim.position_noise, q.shape), tau])
         if not np.all(np.isfinite(tables[k])):
             raise ExciteError("effects", "a value makes non-finite torques (NaN or inf in the effects file?)")
-    written = [out_dir / f"{prefix}_{k}.csv" for k in tables]
+    written = [out_dir / name for name in names]
+    if bags:
+        return _write_bags(written, robot.joint_names, list(tables.values()))
     with atomic_paths(written, "output_dir") as tmps:
         for tmp, table in zip(tmps, tables.values()):
             np.savetxt(tmp, table, delimiter=",", header=",".join(header), comments="", fmt="%.10g")
     return written
+
+
+def _write_bags(folders: list[Path], joints: list[str], tables: list[np.ndarray]) -> list[Path]:
+    """Each table (time, q, τ columns) as a recorded bag in its folder; all or none (the bags of this
+    call are removed when one cannot be written)."""
+    n, done = len(joints), []
+    try:
+        for folder, table in zip(folders, tables):
+            done.append(write_joint_states(folder, joints, table[:, 0], table[:, 1 : 1 + n], table[:, 1 + n :]))
+    except BaseException:
+        for folder in done:
+            shutil.rmtree(folder, ignore_errors=True)
+        raise
+    return done

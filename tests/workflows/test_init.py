@@ -4,10 +4,12 @@ pairs it excluded, each with its reason) and above the mounting plane (pinocchio
 meshes, not the capsules); the identify kind; bad input in one line."""
 
 import coal
+import h5py
 import numpy as np
 import pinocchio as pin
 import pytest
-from conftest import GOOD, PENDULUM, assert_refused
+import yaml
+from conftest import GOOD, PENDULUM, assert_refused, pendulum_config
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
@@ -17,6 +19,7 @@ from excite_cli.identification.config import IdentifyProblem
 from excite_cli.workflows.init import run_init
 
 UR3 = "ur_description/urdf/ur3_robot.urdf"
+runner = CliRunner()
 
 
 @pytest.fixture(scope="module")
@@ -81,9 +84,37 @@ def test_the_identify_kind_names_the_columns_simulate_writes_and_what_to_fill_in
     assert_refused(tmp_path, ["identify", str(run.target)], "runs/run_1.csv")  # not there yet
 
 
+def test_recorded_bags_get_a_config_without_columns_that_identifies_the_friction(tmp_path, monkeypatch):
+    """A pendulum run simulated as ``ros2 bag record /joint_states`` writes it (viscous 0.2 Nm·s/rad),
+    ``init --kind identify --runs``, then ``identify``: the bag is read by joint name and the viscous
+    friction comes back within 5 %."""
+    monkeypatch.chdir(tmp_path)
+    config = pendulum_config(tmp_path, changes={"optimizer.max_iterations": 30})
+    assert runner.invoke(app, ["optimize", str(config)]).exit_code == 0
+    effects = {"sample_rate": 200.0, "periods": 3, "torque_noise": 0.01, "seed": 2, "recording": "rosbag2"}
+    (tmp_path / "effects.yaml").write_text(yaml.safe_dump({**effects, "effects": {"viscous": {"*": 0.2}}}))
+    assert runner.invoke(app, ["simulate", "out.h5", "effects.yaml", "-o", "bags"]).exit_code == 0
+    assert sorted(p.name for p in (tmp_path / "bags" / "run_1").iterdir()) == ["metadata.yaml", "run_1.db3"]
+    argv = ["init", "pendulum.urdf", "--kind", "identify", "--joints", "hinge", "--runs", "bags/run_1", "-o", "id.yaml"]
+    result = runner.invoke(app, argv)
+    assert result.exit_code == 0 and "next: excite identify id.yaml" in result.output, result.output
+    problem = load_problem(tmp_path / "id.yaml", IdentifyProblem)
+    assert problem.data.columns is None and problem.data.runs[0].file == "bags/run_1"
+    result = runner.invoke(app, ["identify", "id.yaml", "-o", "report.h5"])
+    assert result.exit_code == 0, result.output
+    with h5py.File(tmp_path / "report.h5") as f:
+        found = {(r["effect"].decode(), r["joint"].decode()): r["value"] for r in f["identification/effects"][()]}
+    assert found[("viscous", "hinge")] == pytest.approx(0.2, rel=0.05)
+
+
 @pytest.mark.parametrize(
     "argv, expected",
     [
+        (
+            ["init", UR3, "--runs", "x.csv"],
+            "--runs: are the measured runs of an identify config; expected kind identify",
+        ),
+        (["init", UR3, "--kind", "identify", "--runs", "none.csv"], "none.csv"),
         (["init", UR3, "--joints", "elbow_joint,nope"], "'nope' is not a 1-DoF joint of ur3_robot.urdf"),
         (["init", "nothing/here.urdf"], "URDF (a file, or a path inside example-robot-data's robots folder) not found"),
         (["init", UR3, "--kind", "simulate"], "'simulate' is not a config kind"),
