@@ -30,6 +30,7 @@ def _version(show: bool) -> None:
 @app.callback()
 def main(
     version: bool = typer.Option(False, "--version", callback=_version, is_eager=True, help="Print the version."),
+    quiet: bool = console.app.QUIET,
 ) -> None:
     """Persistently exciting trajectories for robot dynamic identification (Ayusawa et al. 2017)."""
 
@@ -64,7 +65,7 @@ def optimize(
     )
     if dry_run:
         return say(console.tables.plan(workflows.plan_optimize(problem)))
-    with Bars(err) as bars:
+    with Bars(console.app.busy) as bars:
         run = workflows.run_optimize(problem, output or Path(problem.output), force, resume, *bars.iterations(problem))
     say(
         console.tables.iterations(run.results, problem.optimizer, run.improved),
@@ -85,7 +86,7 @@ def init(
     force: bool = FORCE,
 ) -> None:
     """A starting config for your robot from its URDF: joints, limits, capsules, mounting plane, home posture."""
-    with err.status("fitting capsules and searching postures ..."):
+    with console.app.busy.status("fitting capsules and searching postures ..."):
         run = workflows.run_init(urdf, output or Path(f"{Path(urdf).stem}.yaml"), joints, kind, force, runs)
     say(console.tables.initialized(run))
 
@@ -107,7 +108,7 @@ def check(
 ) -> None:
     """What `optimize` would run, not running it: joints, base parameters, constraints, time; exit 2 if refused."""
     overrides = {"sequence.iterations": iterations, "optimizer.workers": workers}
-    with err.status("building the problem ..."):
+    with console.app.busy.status("building the problem ..."):
         plan = workflows.plan_optimize(_load(config, overrides))
     say(console.tables.plan(plan))
 
@@ -138,7 +139,7 @@ def compare_random(
             "optimizer.scheduler": scheduler,
         },
     )
-    with Bars(err) as bars:
+    with Bars(console.app.busy) as bars:
         progress = bars.iterations(problem)[0] if optimized is None else None
         comparison = workflows.run_compare_random(
             problem,
@@ -187,7 +188,7 @@ def identify(
 ) -> None:
     """Identify base parameters (Eq. 4), trace the residual to missing effects, report the error before/after."""
     problem = _load(config, {"identification.fit": fit}, "identify")
-    with err.status("preprocessing, fitting and selecting effects ..."):
+    with console.app.busy.status("preprocessing, fitting and selecting effects ..."):
         run = workflows.run_identify(problem, output or Path(problem.output), urdf_out, force, mjcf_out)
     say(console.identification.preprocessing_notes(run.report), console=err)
     say(
@@ -232,7 +233,7 @@ def validate(
     config: Path = typer.Argument(..., help="Identification YAML whose data.runs are scored (roles ignored)."),
 ) -> None:
     """Score an identified model on other runs: torque error per run and joint, on data its fit never saw."""
-    with err.status("preprocessing and predicting ..."):
+    with console.app.busy.status("preprocessing and predicting ..."):
         problem, errors = workflows.run_validate(report, config)
     say(console.identification.validation(report.name, problem.robot.active_joints, errors))
 

@@ -13,7 +13,19 @@ from excite_cli.console.progress import wide_console
 from excite_cli.errors import ExciteError, Interrupted, Terminated, exit_status, sigterm_as_interrupt
 
 app = typer.Typer(no_args_is_help=True)
-out, err = wide_console(), wide_console(stderr=True)
+#: Results (stdout), errors and warnings (stderr), and what is under way: spinners, bars and the
+#: progress lines of a run without a terminal (stderr). ``--quiet`` silences ``out`` and ``busy``.
+out, err, busy = wide_console(), wide_console(stderr=True), wide_console(stderr=True)
+
+
+def _quiet(value: bool) -> bool:
+    out.quiet = busy.quiet = value
+    return value
+
+
+QUIET = typer.Option(
+    False, "--quiet", "-q", callback=_quiet, help="Print only errors, warnings and nothing under way (for scripts)."
+)
 FORCE = typer.Option(False, "--force", help="Replace existing output files.")
 WORKERS = typer.Option(
     None, "--workers", help="Local processes for restarts and draws (optimizer.workers; default: the cores)."

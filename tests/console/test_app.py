@@ -2,9 +2,13 @@
 flattened), and a command's bad input is one line and exit 2, an interruption its own status."""
 
 import io
+import subprocess
+import sys
+from pathlib import Path
 
 import pytest
 import typer
+from conftest import pendulum_config
 from rich.console import Console
 
 from excite_cli.console import app as frame
@@ -39,3 +43,16 @@ def test_a_command_s_error_is_one_line_and_its_status(monkeypatch, raised, statu
     finally:
         del frame.app.registered_commands[count:]
     assert exit.value.exit_code == status and console.file.getvalue().strip() == line
+
+
+def test_quiet_prints_nothing_but_errors(tmp_path):
+    """``--quiet`` (scripts): no table, no progress; the result is written and an error is still its one line."""
+    config = pendulum_config(tmp_path)
+    excite = str(Path(sys.executable).with_name("excite"))
+    run = subprocess.run([excite, "--quiet", "optimize", str(config)], capture_output=True, text=True, timeout=240)
+    assert run.returncode == 0 and run.stdout == "", run.stdout
+    assert "iteration" not in run.stderr and "cond" not in run.stderr, run.stderr
+    assert (tmp_path / "out.h5").is_file()
+    run = subprocess.run([excite, "-q", "optimize", str(config)], capture_output=True, text=True, timeout=240)
+    errors = [line for line in run.stderr.splitlines() if line.startswith("error:")]
+    assert run.returncode == 2 and len(errors) == 1 and "out.h5 exists" in errors[0], run.stderr
