@@ -212,10 +212,15 @@ def _home(excitation: Excitation, Q: np.ndarray, rng: np.random.Generator) -> tu
                 best, score = steps[np.argmax(step_scores)], float(step_scores.max())
             else:
                 scale = max(0.7 * scale, 0.02)
+    joints = excitation.robot.joint_names
     raise ExciteError(
         "robot.home_posture",
-        f"no posture found where every constraint holds at rest in {HOME_ROUNDS} rounds (best clearance "
-        f"{score * 100:.1f} cm): capsules that overlap at most postures, or torque limits gravity exceeds?",
+        f"no posture found where every constraint holds at rest in {HOME_ROUNDS} rounds"
+        + (f" (best clearance {score * 100:.1f} cm)" if np.isfinite(score) else "")
+        + f" with the {len(joints)} active joints {', '.join(joints)}: capsules that overlap at most postures, "
+        "or torque limits gravity exceeds?",
+        None,
+        "the joints to move named (the joints option), e.g. one arm's",
     )
 
 
