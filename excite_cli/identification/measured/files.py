@@ -226,7 +226,7 @@ def read_table(path: Path, drop: bool = False) -> Table:
                 return _columns(arrays, path, unread)
     except ExciteError:
         raise
-    except Exception as exc:  # noqa: BLE001 - a corrupt file makes the parsers raise anything (TypeError, zlib.error)
+    except Exception as exc:  # a corrupt file makes the parsers raise anything (TypeError, zlib.error, struct.error)
         raise ExciteError(
             "data", f"cannot read {path.name} as {suffix[1:].upper()}: {' '.join(str(exc).split())[:160]}"
         ) from None
