@@ -4,7 +4,7 @@ PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 CONFIG ?= configs/g1_arms.yaml
 
-.PHONY: install ipopt optimize test lint smoke view-check docs guide bench clean
+.PHONY: install ipopt optimize test lint smoke view-check docs docs-serve figure-plots guide bench clean
 
 install: $(STAMP)
 
@@ -55,6 +55,14 @@ view-check: $(STAMP)
 # the documentation site (mkdocs-material) in site/, warnings as errors
 docs: $(STAMP)
 	NO_MKDOCS_2_WARNING=1 $(VENV)/bin/mkdocs build --strict --quiet
+
+# the site served at http://127.0.0.1:8000, with search (which browsers block on pages opened from disk)
+docs-serve: $(STAMP)
+	NO_MKDOCS_2_WARNING=1 $(VENV)/bin/mkdocs serve
+
+# the plots of docs/figures.md, drawn from its tables into docs/images
+figure-plots: $(STAMP)
+	$(PY) docs/figure_plots.py
 
 # every command of docs/guide.md, in order, in an empty folder
 guide: $(STAMP)

@@ -1,0 +1,85 @@
+"""The documentation a user reads: no issue numbers or commit hashes outside the development page,
+and the output page's Python loading block runs on files excite wrote."""
+
+import importlib.util
+import re
+from pathlib import Path
+
+import yaml
+from conftest import pendulum_config
+from typer.testing import CliRunner
+
+from excite_cli.cli import app
+
+ROOT = Path(__file__).resolve().parent.parent
+USER_PAGES = [ROOT / "README.md", *sorted(p for p in (ROOT / "docs").glob("*.md") if p.name != "development.md")]
+#: Development history: "issue 41", "#41", "commit 9dfa958", a bare short hash "at 9dfa958".
+HISTORY = re.compile(
+    r"\b[Ii]ssues? #?\d+|(?<![\w-])#\d+\b|\bcommits? [0-9a-f]{7,40}\b|\b(?=[0-9a-f]*[a-f])(?=[0-9a-f]*\d)[0-9a-f]{7}\b"
+)
+
+
+def test_user_pages_name_no_issue_numbers_or_commit_hashes():
+    found = [
+        f"{p.name}:{k}: {m.group()}"
+        for p in USER_PAGES
+        for k, line in enumerate(p.read_text().splitlines(), 1)
+        for m in HISTORY.finditer(line)
+    ]
+    assert found == []
+
+
+def test_the_history_pattern_finds_what_it_is_for():
+    assert [m.group() for m in HISTORY.finditer("after issue 41 (commit 9dfa958, at e0df957; #12)")] == [
+        "issue 41",
+        "commit 9dfa958",
+        "e0df957",
+        "#12",
+    ]
+    assert not HISTORY.search("digest 06591cc39302, 1000000 samples, 2026-11-24, panda_joint7")
+
+
+def test_the_output_page_loading_block_runs_on_what_excite_writes(tmp_path, monkeypatch):
+    """A pendulum run under the guide's file names: optimize, simulate, identify (consistent fit, so
+    the report has bodies), export; then the page's ```python block, as a user would paste it."""
+    monkeypatch.chdir(tmp_path)
+    runner = CliRunner()
+    pendulum_config(tmp_path, iterations=2, changes={"output": str(tmp_path / "ur3.h5")})
+    assert runner.invoke(app, ["optimize", "pendulum.yaml"]).exit_code == 0
+    effects = {"sample_rate": 100.0, "periods": 2, "torque_noise": 0.01, "seed": 1, "effects": {"viscous": {"*": 0.2}}}
+    (tmp_path / "effects.yaml").write_text(yaml.safe_dump(effects))
+    assert runner.invoke(app, ["simulate", "ur3.h5", "effects.yaml", "-o", "runs"]).exit_code == 0
+    identify = {
+        "robot": {"urdf": "pendulum.urdf", "active_joints": ["hinge"]},
+        "data": {"runs": [{"file": "runs/run_1.csv"}], "columns": {"q": ["q_hinge"], "tau": ["tau_hinge"]}},
+    }
+    (tmp_path / "id.yaml").write_text(yaml.safe_dump(identify))
+    result = runner.invoke(app, ["identify", "id.yaml", "-o", "ur3_identified.h5", "--urdf-out", "id.urdf"])
+    assert result.exit_code == 0, result.output
+    assert (
+        runner.invoke(app, ["export", "ur3.h5", "-k", "2", "--rate", "100", "-o", "ur3_iteration2.csv"]).exit_code == 0
+    )
+    [block] = re.findall(r"```python\n(.*?)```", (ROOT / "docs" / "output.md").read_text(), flags=re.S)
+    names: dict = {}
+    exec(compile(block, "output.md", "exec"), names)
+    assert list(names["table"]["iteration"]) == [1, 2]
+    assert names["joints"] == ["hinge"] and names["alpha"].shape == (1, 7)
+    assert "viscous" in names["effects"]["effect"].tolist() and set(names["effects"]["joint"]) == {"hinge"}
+    assert names["bodies"]["body"].tolist()[0] and names["bodies"]["com"].iloc[0].shape == (3,)
+    assert list(names["base"].index) and "tau_hinge_Nm" in names["played"].columns
+
+
+def test_the_figures_page_shows_a_plot_of_each_plotted_table_drawn_from_it(tmp_path):
+    """docs/figure_plots.py draws its plots from the tables of docs/figures.md (so they cannot
+    disagree); each plot it draws is on the page and committed."""
+    spec = importlib.util.spec_from_file_location("figure_plots", ROOT / "docs" / "figure_plots.py")
+    plots = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(plots)
+    drawn = plots.main(tmp_path)
+    page = (ROOT / "docs" / "figures.md").read_text()
+    assert len(drawn) >= 4
+    for path in drawn:
+        assert path.stat().st_size > 10_000
+        assert f"](images/{path.name})" in page and (ROOT / "docs" / "images" / path.name).is_file()
+    rows = plots.table("Random feasible motions + greedy selection", page)
+    assert rows[0][0] == "motion index" and plots.number(rows[1][2]) == 349.6
