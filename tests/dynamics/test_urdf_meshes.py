@@ -6,7 +6,9 @@ from pathlib import Path
 import pinocchio as pin
 import pytest
 
+from excite_cli.config import RobotConfig
 from excite_cli.dynamics.urdf_meshes import MAX_MESH_BYTES, check_meshes, collision_geometry, mesh_path, package_folders
+from excite_cli.dynamics.urdf_source import example_robot_data_root, resolve_urdf
 from excite_cli.errors import ExciteError
 
 #: An ASCII STL of one triangle.
@@ -70,3 +72,26 @@ def test_a_file_that_is_not_a_mesh_is_one_line_naming_the_urdf(tmp_path):
     with pytest.raises(ExciteError, match="cannot load the collision meshes of robot.urdf") as caught:
         collision_geometry(pin.buildModelFromUrdf(str(urdf)), urdf, [])
     assert "\n" not in str(caught.value)
+
+
+ARMS = [
+    "panda_description/urdf/panda.urdf",
+    "ur_description/urdf/ur3_robot.urdf",
+    "ur_description/urdf/ur10_robot.urdf",
+    "kinova_description/robots/kinova.urdf",
+    "xarm_description/urdf/xarm7.urdf",
+    "z1_description/urdf/z1.urdf",
+    "so_arm_description/urdf/so101.urdf",
+    "baxter_description/urdf/baxter.urdf",  # package://example-robot-data/...: "could not be found" before
+    "tiago_description/robots/tiago.urdf",
+]
+
+
+@pytest.mark.parametrize("arm", ARMS)
+def test_every_arm_example_robot_data_ships_loads_its_meshes_given_as_a_file(arm, tmp_path):
+    """The URDF named by its path (``source: file``, as a lab passes its own): its ``package://``
+    meshes are found from the URDF's own package and example-robot-data's folder."""
+    urdf = example_robot_data_root() / "example-robot-data" / "robots" / arm
+    path, folders = resolve_urdf(RobotConfig.model_construct(urdf=str(urdf), source="file"), tmp_path)
+    geometry = collision_geometry(pin.buildModelFromUrdf(str(path)), path, folders)
+    assert geometry.ngeoms > 0
