@@ -102,15 +102,15 @@ def schema(
 
 @command()
 def check(
-    config: Path = typer.Argument(..., help="Problem YAML file."),
+    config: Path = typer.Argument(..., help="Optimize or identify YAML file."),
     iterations: Optional[int] = typer.Option(None, "--iterations", "-k", help="Sequential iterations."),
     workers: Optional[int] = WORKERS,
 ) -> None:
-    """What `optimize` would run, not running it: joints, base parameters, constraints, time; exit 2 if refused."""
+    """What `optimize` or `identify` would run, not running it (joints, base, constraints, runs); exit 2 if refused."""
     overrides = {"sequence.iterations": iterations, "optimizer.workers": workers}
     with console.app.busy.status("building the problem ..."):
-        plan = workflows.plan_optimize(_load(config, overrides))
-    say(console.tables.plan(plan))
+        plan = workflows.plan_check(config, overrides)
+    say(console.identification.plan(plan) if hasattr(plan, "runs") else console.tables.plan(plan))
 
 
 @command("compare-random")

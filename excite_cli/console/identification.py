@@ -13,6 +13,7 @@ from excite_cli.identification.choice.search import MOVE_SIGNS
 from excite_cli.identification.fitting.physical import body_properties, pseudo_inertia
 from excite_cli.identification.reporting.report import Report
 from excite_cli.identification.validate import RunError
+from excite_cli.workflows.check_identify import IdentifyPlan
 
 
 def validation(name: str, joints: Sequence[str], errors: Sequence[RunError]) -> Table:
@@ -22,6 +23,25 @@ def validation(name: str, joints: Sequence[str], errors: Sequence[RunError]) -> 
         ("run", "instants", *joints, "mean"),
         [(e.name, str(e.instants), *[f"{x:.1f}" for x in e.relative], f"{e.relative.mean():.1f}") for e in errors],
     )
+
+
+def plan(p: IdentifyPlan) -> list[Table | str]:
+    """What ``check`` found in an identify config: the robot, the runs as read, what would be fitted."""
+    cfg = p.problem.identification
+    rows = [
+        (r.label, r.role, str(r.samples), f"{r.seconds:.2f}", f"{r.rate:.4g}", ", ".join(r.signals), str(r.dropped))
+        for r in p.runs
+    ]
+    return [
+        f"robot: {len(p.joints)} active joints ({', '.join(p.joints)}), {p.base_parameters} base parameters",
+        titled_table(
+            "Runs, read as identify reads them", ("run", "role", "samples", "s", "Hz", "signals", "dropped"), rows
+        ),
+        f"fit: {cfg.method}, {cfg.fit}; declared effects: {', '.join(p.declared) or 'none'}; "
+        f"{p.candidates} candidate terms the search may add",
+        *[f"warning: {w}" for w in p.warnings],
+        "identify would start",
+    ]
 
 
 def preprocessing_notes(report: Report) -> list[str]:

@@ -7,6 +7,7 @@ from importlib import import_module
 
 #: Each function and the module of this package that defines it.
 _MODULES = {
+    "plan_check": "check_identify",
     "plan_optimize": "check",
     "run_compare_random": "compare",
     "run_export": "export",

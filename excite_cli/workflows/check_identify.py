@@ -1,0 +1,104 @@
+"""``check`` on an ``identify`` config (one with a ``data`` section; :func:`plan_check` tells the kinds
+apart): what the identification would read and fit, without fitting.
+Each run is read exactly as ``identify`` reads it (so a missing file, a wrong column, NaN or
+motor-side signals are refused as the run would refuse them) and summarized: samples, duration,
+rate, the signals found; then the robot's base parameters and the effects declared and searched."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from excite_cli.config_file import load_config, read_yaml
+from excite_cli.dynamics.base_parameters import compute_base_parameters
+from excite_cli.dynamics.robot import load_robot
+from excite_cli.errors import ExciteError
+from excite_cli.identification.choice.selection import candidate_terms, motor_couplings
+from excite_cli.identification.config import IdentifyProblem
+from excite_cli.identification.measured.measurements import check_against_limits, load_run
+from excite_cli.identification.pipeline import declared_terms
+from excite_cli.workflows.check import Plan, plan_optimize
+
+
+@dataclass(frozen=True)
+class RunSummary:
+    """One measured run as ``identify`` reads it: its label (file and crop), role, samples, duration
+    [s], median sample rate [Hz], the signals found (``q``, ``qd`` or ``qdd`` when recorded, ``tau``)
+    and the rows left out (``data.bad_rows: drop``)."""
+
+    label: str
+    role: str
+    samples: int
+    seconds: float
+    rate: float
+    signals: tuple[str, ...]
+    dropped: int
+
+
+@dataclass
+class IdentifyPlan:
+    """What ``identify`` would do with ``problem``: the active joints, the base parameters' count,
+    the effects declared (labels) and the candidate terms the search may add, the runs, and what the
+    robot's URDF made it warn about."""
+
+    problem: IdentifyProblem
+    joints: list[str]
+    base_parameters: int
+    declared: list[str]
+    candidates: int
+    runs: list[RunSummary]
+    warnings: list[str]
+
+
+def plan_identify(problem: IdentifyProblem) -> IdentifyPlan:
+    """Read every run of ``problem`` and build what the identification starts from (module docstring).
+
+    Raises:
+        ExciteError: what ``identify`` would refuse before fitting: the robot (:func:`load_robot`),
+            a declared effect on a joint that is not active, a run (:func:`load_run`,
+            :func:`check_against_limits`).
+    """
+    robot = load_robot(problem.robot, problem.folder, joint_rows_only=True, physical=False)
+    cfg = problem.identification
+    declared = declared_terms(problem, robot)
+    couplings = motor_couplings(problem.data.transmission, cfg.coupling_ratios, robot.n_joints)
+    runs = []
+    for config in problem.data.runs:
+        run = load_run(config, problem.data, robot.joint_names, problem.folder)
+        check_against_limits(run, robot.joint_names, robot.lower, robot.upper, robot.velocity_limit)
+        signals = ("q",) + tuple(s for s in ("qd", "qdd") if getattr(run, s) is not None) + ("tau",)
+        steps = np.diff(run.time)
+        rate = float(1.0 / np.median(steps)) if steps.size else float("nan")
+        runs.append(
+            RunSummary(
+                config.label, run.role, run.time.size, float(run.time[-1] - run.time[0]), rate, signals, run.dropped
+            )
+        )
+    return IdentifyPlan(
+        problem,
+        list(robot.joint_names),
+        compute_base_parameters(robot).count,
+        [t.label(robot.joint_names) for t in declared],
+        len([t for t in candidate_terms(cfg, robot.n_joints, couplings) if t not in declared]),
+        runs,
+        list(robot.warnings),
+    )
+
+
+def plan_check(path: Path, overrides: dict[str, object]) -> Plan | IdentifyPlan:
+    """``check``'s plan of the config at ``path``: :func:`plan_identify` for an identify config (one
+    with a ``data`` section), else :func:`~excite_cli.workflows.check.plan_optimize` with the command
+    line's ``overrides`` (optimize fields).
+
+    Raises:
+        ExciteError: an unreadable config; overrides given for an identify config; see both plans.
+    """
+    value, _ = read_yaml(Path(path))
+    if not (isinstance(value, dict) and "data" in value):
+        return plan_optimize(load_config(path, overrides))
+    given = [name.split(".")[-1] for name, v in overrides.items() if v is not None]  # the option's own name
+    if given:
+        raise ExciteError(given[0], "applies to an optimize config; this is an identify config (it has a data section)")
+    return plan_identify(load_config(path, None, "identify"))
