@@ -7,21 +7,28 @@ from rosbags.highlevel import AnyReader
 from rosbags.typesys import Stores, get_typestore
 
 from excite_cli.errors import ExciteError, OutputExists
-from excite_cli.storage.export import Export
-from excite_cli.storage.rosbag import MSGTYPE, TOPIC, check_bag_target, write_rosbag
+from excite_cli.identification.measured.bags import read_bag
+from excite_cli.storage.rosbag import (
+    JOINT_STATES,
+    MSGTYPE,
+    START,
+    TOPIC,
+    check_bag_target,
+    write_joint_states,
+    write_rosbag,
+)
 
 JOINTS = ["shoulder", "elbow"]
 
 
-@pytest.fixture
-def export():
-    t = np.arange(7) / 100.0
-    q = np.column_stack([np.sin(t), np.cos(t)])
-    return Export(JOINTS, t, q, 2 * q, 3 * q, 4 * q, 100.0, 3, 1, [("trajectory", 0.0, 0.06)], -0.01, "none")
+#: Seven samples at 100 Hz: time [s], then q, q̇, q̈, τ (7, 2) told apart by their factors.
+TIME = np.arange(7) / 100.0
+Q = np.column_stack([np.sin(TIME), np.cos(TIME)])
+MOTION = (Q, 2 * Q, 3 * Q, 4 * Q)
 
 
-def _bag(folder, e):
-    return write_rosbag(folder, e.joint_names, e.time, (e.q, e.qd, e.qdd, e.tau))
+def _bag(folder):
+    return write_rosbag(folder, JOINTS, TIME, MOTION)
 
 
 def _read(bag):
@@ -29,28 +36,39 @@ def _read(bag):
         return [(c.topic, c.msgtype, reader.deserialize(raw, c.msgtype)) for c, _, raw in reader.messages()]
 
 
-def test_the_bag_holds_one_joint_trajectory_with_every_sample(export, tmp_path):
-    [(topic, msgtype, message)] = _read(_bag(tmp_path / "bag", export))
+def test_the_bag_holds_one_joint_trajectory_with_every_sample(tmp_path):
+    [(topic, msgtype, message)] = _read(_bag(tmp_path / "bag"))
     assert (topic, msgtype) == (TOPIC, MSGTYPE)
     assert list(message.joint_names) == JOINTS
     assert (message.header.stamp.sec, message.header.stamp.nanosec) == (0, 0)  # start on arrival
-    np.testing.assert_array_equal([p.positions for p in message.points], export.q)
-    np.testing.assert_array_equal([p.velocities for p in message.points], export.qd)
-    np.testing.assert_array_equal([p.accelerations for p in message.points], export.qdd)
-    np.testing.assert_array_equal([p.effort for p in message.points], export.tau)
+    np.testing.assert_array_equal([p.positions for p in message.points], MOTION[0])
+    np.testing.assert_array_equal([p.velocities for p in message.points], MOTION[1])
+    np.testing.assert_array_equal([p.accelerations for p in message.points], MOTION[2])
+    np.testing.assert_array_equal([p.effort for p in message.points], MOTION[3])
     assert [(p.time_from_start.sec, p.time_from_start.nanosec) for p in message.points][-1] == (0, 60_000_000)
     assert sorted(p.name for p in (tmp_path / "bag").iterdir()) == ["bag.db3", "metadata.yaml"]
     assert [p.name for p in tmp_path.iterdir()] == ["bag"]  # nothing left beside it
 
 
-def test_force_replaces_a_bag_and_never_another_folder(export, tmp_path):
-    bag = _bag(tmp_path / "bag", export)
+def test_force_replaces_a_bag_and_never_another_folder(tmp_path):
+    bag = _bag(tmp_path / "bag")
     with pytest.raises(OutputExists):
         check_bag_target(bag, "output", force=False)
     check_bag_target(bag, "output", force=True)
-    _bag(bag, export)
+    _bag(bag)
     assert len(_read(bag)) == 1
     (tmp_path / "notes").mkdir()
     (tmp_path / "notes" / "keep.txt").write_text("mine")
     with pytest.raises(ExciteError, match="is not a ROS 2 bag folder; not replaced"):
         check_bag_target(tmp_path / "notes", "output", force=True)
+
+
+def test_a_recorded_run_reads_back_through_identify_s_bag_reader(tmp_path):
+    """What ``simulate`` writes with ``recording: rosbag2``: one JointState per sample on /joint_states,
+    stamped from START; identify's reader gives back the samples and their times."""
+    bag = write_joint_states(tmp_path / "run_1", JOINTS, TIME, Q, MOTION[3])
+    table = read_bag(bag, JOINT_STATES, JOINTS[::-1])  # joints matched by name, in any order
+    np.testing.assert_allclose(table.column("time", "time", bag) - START / 1e9, TIME, atol=1e-6)
+    np.testing.assert_array_equal(table.column("position/elbow", "q", bag), Q[:, 1])
+    np.testing.assert_array_equal(table.column("effort/shoulder", "tau", bag), MOTION[3][:, 0])
+    assert "velocity/elbow" not in table.names  # left empty, as many drivers publish it
