@@ -176,14 +176,17 @@ BEYOND_URDF = 3.0
 
 
 def _beyond_the_urdf(velocity: np.ndarray, robot: Robot) -> None:
-    """Warn (:class:`~excite_cli.errors.ExciteWarning`) of each configured velocity limit (n,) [rad/s]
-    ``BEYOND_URDF`` times the URDF's or more, naming the joint, both values and the likely unit."""
+    """Warn (:class:`~excite_cli.errors.ExciteWarning`) of each configured velocity limit (n,) [rad/s,
+    m/s for a prismatic joint] ``BEYOND_URDF`` times the URDF's or more, naming the joint, both values
+    and the likely unit."""
     for name, given, urdf in zip(robot.joint_names, velocity, robot.velocity_limit):
         if 0.0 < urdf < np.inf and given >= BEYOND_URDF * urdf:
-            unit = " (deg/s? limits are in rad/s)" if 10.0 <= given / urdf <= 100.0 else ""
+            kind = robot.model.joints[robot.model.getJointId(name)].shortname().removeprefix("JointModel")
+            unit = "m/s" if kind.startswith("P") else "rad/s"  # a prismatic joint's limit is a speed
+            hint = " (deg/s? limits are in rad/s)" if unit == "rad/s" and 10.0 <= given / urdf <= 100.0 else ""
             warnings.warn(
-                f"limits.velocity: {given:g} rad/s for joint '{name}' is {given / urdf:.3g} times the URDF's "
-                f"{urdf:g} rad/s{unit}",
+                f"limits.velocity: {given:g} {unit} for joint '{name}' is {given / urdf:.3g} times the URDF's "
+                f"{urdf:g} {unit}{hint}",
                 ExciteWarning,
             )
 

@@ -114,3 +114,28 @@ def test_a_velocity_limit_the_joint_cannot_reach_is_warned_about_with_the_likely
     urdf = robot.velocity_limit[robot.joint_names.index("elbow_joint")]
     assert f"62 rad/s for joint 'elbow_joint' is {62.0 / urdf:.3g} times the URDF's" in str(warning.message)
     assert "deg/s?" in str(warning.message)
+
+
+def test_a_prismatic_joint_s_velocity_limit_is_warned_about_in_m_per_s():
+    """The Panda's finger (URDF: 0.2 m/s) given 5: the warning speaks of m/s and suggests no deg/s."""
+    import warnings
+
+    from excite_cli.config import LimitsConfig, RobotConfig
+    from excite_cli.constraints.joint_limits import joint_limit_bounds
+    from excite_cli.dynamics.robot import load_robot
+    from excite_cli.errors import ExciteWarning
+
+    finger = RobotConfig(
+        urdf="panda_description/urdf/panda.urdf",
+        source="example-robot-data",
+        active_joints=["panda_finger_joint1"],
+        locked_joints={"panda_finger_joint2": 0.0},
+    )
+    robot = load_robot(finger)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        joint_limit_bounds(LimitsConfig(velocity={"panda_finger_joint1": 5.0}, acceleration=1.0), robot)
+    (warning,) = [w for w in caught if issubclass(w.category, ExciteWarning)]
+    assert (
+        "5 m/s for joint 'panda_finger_joint1' is 25 times the URDF's 0.2 m/s" == str(warning.message).split(": ", 1)[1]
+    )
