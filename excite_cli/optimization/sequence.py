@@ -28,7 +28,7 @@ class IterationResult:
         alpha: (n, 2N+1) Fourier coefficients.
         time: (T_grid,) constraint grid [s]; q, qd, qdd: (T_grid, n) [rad, rad/s, rad/s²] on it.
         regressor: C⁽ᵏ⁾, (T·n_rows, b) base regressor at the cost samples.
-        cond_own: cond(C⁽ᵏ⁾); cond_stacked: cond([C₀; C⁽ᵏ⁾]) (Table I), on the base columns.
+        cond_own: cond(C⁽ᵏ⁾); cond_stacked: cond([C₀; C⁽ᵏ⁾]) (Table I), on the base (and effect) columns.
         scaled_cond_own, scaled_cond_stacked: cond(C L) of the same, the condition number that does
             not depend on the choice of base columns (:mod:`excite_cli.optimization.information`).
         excitation_own, excitation_stacked: ē of the same [N·m], the excitation figure that does

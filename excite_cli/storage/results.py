@@ -35,7 +35,7 @@ UNITS = {
 
 
 def results_table(results: Sequence[IterationResult]) -> np.ndarray:
-    """Table I as a structured array: iteration, cond_own, cond_stacked (on the base columns, the
+    """Table I as a structured array: iteration, cond_own, cond_stacked (on the base and effect columns, the
     paper's), scaled_cond_own, scaled_cond_stacked (cond(C L)) and excitation_own, excitation_stacked
     (ē [N·m]), which do not depend on the choice of base columns (:mod:`excite_cli.optimization.information`),
     and max_correlation with an earlier iteration (NaN for the first, :mod:`excite_cli.trajectory.similarity`)."""
@@ -78,7 +78,8 @@ def write_result(
             _write_iteration(iterations.create_group(str(r.index)), r)
         table = f.create_dataset("table", data=results_table(results))
         table.attrs["description"] = (
-            "Table I: cond of each iteration's regressor and of the stacked regressor on the base columns, "
+            "Table I: cond of each iteration's regressor and of the stacked regressor on the base columns "
+            "(and the effect columns, with effects), "
             "their cond(C L) and excitation e [N m], which do not depend on the base columns, and the largest "
             "correlation of the motion with an earlier iteration's (docs/output.md)"
         )
