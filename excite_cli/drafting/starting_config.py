@@ -1,8 +1,7 @@
 """A starting ``optimize`` config for a robot excite has never seen, from its URDF alone: which joints
 move, limits with a margin, capsules fitted to the collision meshes with the pairs that overlap at
 every posture left out, a mounting plane under the base, torque limits from the URDF's effort, and a
-home posture every constraint accepts, searched among the joint ranges' middle, zero and random
-postures. Every choice is recorded as an assumption, in words, for the written file's comments.
+home posture every constraint accepts (:mod:`~excite_cli.drafting.home_posture`). Every choice is recorded as an assumption, in words, for the written file's comments.
 """
 
 from __future__ import annotations
@@ -16,14 +15,13 @@ import numpy as np
 import pinocchio as pin
 
 from excite_cli.config import Problem
+from excite_cli.drafting.home_posture import home_posture
 from excite_cli.dynamics.urdf_meshes import collision_geometry
 from excite_cli.errors import ExciteError
-from excite_cli.optimization.excitation import Excitation, build_excitation, violated_at_rest
+from excite_cli.optimization.excitation import Excitation, build_excitation
 
 #: Random postures the capsule overlaps and the home posture are searched over.
 POSTURES = 300
-#: The home posture search: rounds of random steps, steps per round, clearance sought beyond the margins [m].
-HOME_ROUNDS, HOME_STEPS, HOME_CLEARANCE = 60, 64, 0.005
 #: Joint velocity limit as a fraction of the URDF's; acceleration limit per rad/s of it [1/s].
 VELOCITY_FRACTION, ACCELERATION_PER_VELOCITY = 0.5, 3.0
 #: Margins [m]: between capsules, and from the mounting plane.
@@ -100,7 +98,11 @@ def joint_choice(path: Path, given: list[str] | None, draft: StartingConfig) -> 
 
 def _limits(model: pin.Model, active: list[str], draft: StartingConfig) -> dict:
     """Position margin, velocity and acceleration limits per joint, torque limits where the URDF (its
-    ``model``) has them."""
+    ``model``) has them.
+
+    Raises:
+        ExciteError: an active joint whose URDF limits leave no range.
+    """
     ids = [model.getJointId(n) for n in active]
     velocity = {
         n: round(VELOCITY_FRACTION * float(model.velocityLimit[model.idx_vs[i]]), 3) for n, i in zip(active, ids)
@@ -109,6 +111,15 @@ def _limits(model: pin.Model, active: list[str], draft: StartingConfig) -> dict:
     for name in missing:
         velocity[name] = 1.0
     ranges = [model.upperPositionLimit[model.idx_qs[i]] - model.lowerPositionLimit[model.idx_qs[i]] for i in ids]
+    still = [n for n, r in zip(active, ranges) if not r > 0]
+    if still:
+        raise ExciteError(
+            "urdf",
+            f"the URDF gives {', '.join(still)} no position range (lower = upper): excite moves joints inside "
+            "their URDF limits",
+            still[0],
+            "a <limit lower upper> on each joint to move, or other joints named (the joints option)",
+        )
     limits = {
         "position_margin": round(min(0.1, 0.1 * float(min(ranges))), 3),
         "velocity": velocity,
@@ -171,57 +182,6 @@ def _always_overlapping(excitation: Excitation, Q: np.ndarray, draft: StartingCo
                     draft.ignored.append(
                         (link, f"within {c.shapes[s].margin:g} m of the mounting plane at all postures")
                     )
-
-
-def _clearance(excitation: Excitation, Q: np.ndarray) -> np.ndarray:
-    """(K,) at each posture Q (K, n) the smallest distance [m] beyond its margin over every capsule
-    pair and every capsule and world shape (inf without such constraints)."""
-    out = np.full(len(Q), np.inf)
-    for c in excitation.constraints:
-        if c.name == "self_collision" and c.pairs:
-            out = np.minimum(out, (c.distances(Q) - c.margin).min(axis=1))
-        if c.name == "world_collision" and c.pairs:
-            margins = np.array([c.shapes[s].margin for _, s in c.pairs])
-            out = np.minimum(out, (c.distances(Q) - margins).min(axis=1))
-    return out
-
-
-def _home(excitation: Excitation, Q: np.ndarray, rng: np.random.Generator) -> tuple[np.ndarray, str]:
-    """A posture standing still at which every constraint holds (joint, torque and collision limits):
-    from the middle of the joint ranges (the most room to move), else from the clearest of the random
-    postures Q, random steps that increase the smallest clearance (:func:`_clearance`) until it is at
-    least ``HOME_CLEARANCE`` and nothing is violated (a torque limit: the steps go on).
-
-    Raises:
-        ExciteError: no such posture within ``HOME_ROUNDS`` rounds.
-    """
-    centre, half = excitation.limits.centre[0], 0.95 * excitation.limits.half[0]
-    scores = _clearance(excitation, Q)
-    starts = [("the middle of the joint ranges", centre), ("the clearest random posture", Q[np.argmax(scores)])]
-    score = -np.inf
-    for start, best in starts:
-        score, scale = float(_clearance(excitation, best[None])[0]), 0.3
-        for rounds in range(HOME_ROUNDS):
-            if score >= HOME_CLEARANCE and violated_at_rest(excitation, best) is None:
-                clear = f"every capsule {score * 100:.1f} cm beyond its margin" if np.isfinite(score) else "no capsule"
-                return best, f"from {start}, {rounds} round(s) of random steps: {clear}"
-            steps = best + scale * half * rng.standard_normal((HOME_STEPS, centre.size))
-            steps = np.clip(steps, centre - half, centre + half)
-            step_scores = _clearance(excitation, steps)
-            if step_scores.max() > score or score >= HOME_CLEARANCE:
-                best, score = steps[np.argmax(step_scores)], float(step_scores.max())
-            else:
-                scale = max(0.7 * scale, 0.02)
-    joints = excitation.robot.joint_names
-    raise ExciteError(
-        "robot.home_posture",
-        f"no posture found where every constraint holds at rest in {HOME_ROUNDS} rounds"
-        + (f" (best clearance {score * 100:.1f} cm)" if np.isfinite(score) else "")
-        + f" with the {len(joints)} active joints {', '.join(joints)}: capsules that overlap at most postures, "
-        "or torque limits gravity exceeds?",
-        None,
-        "the joints to move named (the joints option), e.g. one arm's",
-    )
 
 
 #: The trajectory, optimizer and sequence a starting config gets: the shipped lab arms' (10 s, 5 harmonics).
@@ -290,7 +250,7 @@ def draft_config(
         draft.config["constraints"]["environment"]["ignore_links"] = [link for link, _ in draft.ignored]
     # the same robot: its base parameters need not be computed again
     excitation = build_excitation(validated(draft.config, target), excitation.base, check_home=False)
-    home, why = _home(excitation, Q, np.random.default_rng(1))
+    home, why = home_posture(excitation, Q, np.random.default_rng(1))
     draft.config["robot"]["home_posture"] = {n: round(float(q), 4) for n, q in zip(active, home)}
     draft.assumptions["robot.home_posture"] = f"searched: {why}"
     return draft

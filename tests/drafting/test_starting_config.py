@@ -28,17 +28,10 @@ def test_given_joints_are_checked_by_name_and_the_others_held_inside_their_limit
         joint_choice(PANDA, ["panda_hand"], StartingConfig({}))
 
 
-def test_no_home_posture_names_the_joints_it_chose_and_what_to_give(tmp_path):
-    """The pendulum held away from hanging (lower limit 0.5 rad) with 0.01 Nm efforts: gravity exceeds
-    the torque limits at every posture at rest."""
-    urdf = tmp_path / "weak.urdf"
-    urdf.write_text(
-        PENDULUM.format(**{**GOOD, "mimic": "", "lower": "0.5"})
-        .replace('effort="20"', 'effort="0.01"')
-        .replace('effort="5"', 'effort="0.01"')
-    )
-    with pytest.raises(
-        ExciteError, match="with the 2 active joints hinge, tip_joint: .*the joints to move named"
-    ) as caught:
-        draft_config({"urdf": "weak.urdf", "source": "file"}, urdf, [str(tmp_path)], None, tmp_path / "weak.yaml")
-    assert "clearance" not in str(caught.value)  # no capsule: no clearance to speak of
+def test_a_joint_the_urdf_gives_no_range_is_named(tmp_path):
+    """The double pendulum of example-robot-data has lower = upper = 0: it was refused as 'position_margin:
+    0 rad leaves no range', far from the cause."""
+    urdf = tmp_path / "still.urdf"
+    urdf.write_text(PENDULUM.format(**{**GOOD, "mimic": "", "lower": "2.0"}))  # upper is 2.0 too
+    with pytest.raises(ExciteError, match="the URDF gives hinge no position range"):
+        draft_config({"urdf": "still.urdf", "source": "file"}, urdf, [str(tmp_path)], ["hinge"], tmp_path / "s.yaml")

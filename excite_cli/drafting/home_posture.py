@@ -1,0 +1,65 @@
+"""The home posture of a starting config: standing still where every constraint holds (joint,
+torque and collision limits), searched from the middle of the joint ranges and from the clearest
+of random postures by random steps that increase the smallest clearance to the capsule and world
+margins."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from excite_cli.errors import ExciteError
+from excite_cli.optimization.excitation import Excitation, violated_at_rest
+
+#: Rounds of random steps, steps per round, clearance sought beyond the margins [m].
+HOME_ROUNDS, HOME_STEPS, HOME_CLEARANCE = 60, 64, 0.005
+
+
+def clearance(excitation: Excitation, Q: np.ndarray) -> np.ndarray:
+    """(K,) at each posture Q (K, n) the smallest distance [m] beyond its margin over every capsule
+    pair and every capsule and world shape (inf without such constraints)."""
+    out = np.full(len(Q), np.inf)
+    for c in excitation.constraints:
+        if c.name == "self_collision" and c.pairs:
+            out = np.minimum(out, (c.distances(Q) - c.margin).min(axis=1))
+        if c.name == "world_collision" and c.pairs:
+            margins = np.array([c.shapes[s].margin for _, s in c.pairs])
+            out = np.minimum(out, (c.distances(Q) - margins).min(axis=1))
+    return out
+
+
+def home_posture(excitation: Excitation, Q: np.ndarray, rng: np.random.Generator) -> tuple[np.ndarray, str]:
+    """A posture standing still at which every constraint holds (joint, torque and collision limits):
+    from the middle of the joint ranges (the most room to move), else from the clearest of the random
+    postures Q, random steps that increase the smallest clearance (:func:`clearance`) until it is at
+    least ``HOME_CLEARANCE`` and nothing is violated (a torque limit: the steps go on).
+
+    Raises:
+        ExciteError: no such posture within ``HOME_ROUNDS`` rounds.
+    """
+    centre, half = excitation.limits.centre[0], 0.95 * excitation.limits.half[0]
+    scores = clearance(excitation, Q)
+    starts = [("the middle of the joint ranges", centre), ("the clearest random posture", Q[np.argmax(scores)])]
+    score = -np.inf
+    for start, best in starts:
+        score, scale = float(clearance(excitation, best[None])[0]), 0.3
+        for rounds in range(HOME_ROUNDS):
+            if score >= HOME_CLEARANCE and violated_at_rest(excitation, best) is None:
+                clear = f"every capsule {score * 100:.1f} cm beyond its margin" if np.isfinite(score) else "no capsule"
+                return best, f"from {start}, {rounds} round(s) of random steps: {clear}"
+            steps = best + scale * half * rng.standard_normal((HOME_STEPS, centre.size))
+            steps = np.clip(steps, centre - half, centre + half)
+            step_scores = clearance(excitation, steps)
+            if step_scores.max() > score or score >= HOME_CLEARANCE:
+                best, score = steps[np.argmax(step_scores)], float(step_scores.max())
+            else:
+                scale = max(0.7 * scale, 0.02)
+    joints = excitation.robot.joint_names
+    raise ExciteError(
+        "robot.home_posture",
+        f"no posture found where every constraint holds at rest in {HOME_ROUNDS} rounds"
+        + (f" (best clearance {score * 100:.1f} cm)" if np.isfinite(score) else "")
+        + f" with the {len(joints)} active joints {', '.join(joints)}: capsules that overlap at most postures, "
+        "or torque limits gravity exceeds?",
+        None,
+        "the joints to move named (the joints option), e.g. one arm's",
+    )
