@@ -242,8 +242,9 @@ def test_an_active_mimic_joint_is_refused_by_name(tmp_path, command):
 
 
 def _hostile_urdf(folder: Path, case: str) -> Path:
-    """A URDF of ``case``: no joint, only fixed joints, only a continuous one, a collision mesh that
-    is not a mesh, a FIFO, or too large (sparse), a chain longer than pinocchio's parser holds."""
+    """A URDF of ``case``: no joint, only fixed joints, only a continuous one, a joint type urdfdom does
+    not know, a collision mesh that is not a mesh, a FIFO, or too large (sparse), a chain longer than
+    pinocchio's parser holds."""
     inertia = '<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/>'
     link = '<link name="{}"><inertial><mass value="1"/>' + inertia + "</inertial>{}</link>"
     joint = (
@@ -267,6 +268,7 @@ def _hostile_urdf(folder: Path, case: str) -> Path:
         "not-a-mesh": two_links("revolute", "file:///etc/passwd"),
         "fifo": two_links("revolute", "fifo.stl"),
         "huge-mesh": two_links("revolute", "huge.stl"),
+        "unknown-joint-type": two_links("bogus"),
         "long-chain": link.format("l0", "")
         + "".join(
             link.format(f"l{k}", "") + joint.format(f"j{k}", "revolute", f"l{k - 1}", f"l{k}") for k in range(1, 4001)
@@ -282,6 +284,7 @@ HOSTILE = [
     ("fixed-only", "fixed-only.urdf has no revolute joint for excite to move (its joints are all fixed)"),
     ("continuous-only", "continuous-only.urdf has no revolute joint for excite to move (continuous: j1)"),
     ("long-chain", "the URDF has 4001 links; expected at most 1000"),
+    ("unknown-joint-type", "does not contain a valid URDF model"),  # pinocchio's ValueError was a traceback
 ]
 #: Meshes matter to an optimize config only (an identify config loads none).
 HOSTILE_MESHES = [

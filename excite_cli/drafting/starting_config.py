@@ -1,7 +1,8 @@
 """A starting ``optimize`` config for a robot excite has never seen, from its URDF alone: which joints
 move, limits with a margin, capsules fitted to the collision meshes with the pairs that overlap at
 every posture left out, a mounting plane under the base, torque limits from the URDF's effort, and a
-home posture every constraint accepts (:mod:`~excite_cli.drafting.home_posture`). Every choice is recorded as an assumption, in words, for the written file's comments.
+home posture every constraint accepts (:mod:`~excite_cli.drafting.home_posture`). Every choice is
+recorded as an assumption, in words, for the written file's comments.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ import pinocchio as pin
 from excite_cli.config import Problem
 from excite_cli.drafting.home_posture import home_posture
 from excite_cli.dynamics.urdf_meshes import collision_geometry
+from excite_cli.dynamics.urdf_source import urdf_model
 from excite_cli.errors import ExciteError
 from excite_cli.optimization.excitation import Excitation, build_excitation
 
@@ -60,7 +62,7 @@ def joint_choice(path: Path, given: list[str] | None, draft: StartingConfig) -> 
         ExciteError: a given joint that is not a 1-DoF joint of the URDF; no joint given and no
             revolute joint to move (naming the joints there are).
     """
-    model = pin.buildModelFromUrdf(str(path))
+    model = urdf_model(path)
     one_dof = [n for i, n in enumerate(model.names) if i > 0 and model.joints[i].nq == 1]
     continuous = [n for i, n in enumerate(model.names) if i > 0 and model.joints[i].nq == 2 and model.joints[i].nv == 1]
     mimics = _mimics(path)
@@ -219,7 +221,7 @@ def draft_config(
     """
     draft = StartingConfig({"robot": dict(robot)})
     active, held = joint_choice(urdf, joints, draft)
-    model = pin.buildModelFromUrdf(str(urdf))
+    model = urdf_model(urdf)
     floor = round(_base_floor(model, urdf, package_dirs), 4) + 0.0  # no -0
     draft.config["robot"].update(active_joints=active, locked_joints=held, home_posture={})
     draft.config["trajectory"] = dict(TRAJECTORY)

@@ -19,7 +19,7 @@ import pinocchio as pin
 from excite_cli.config import RobotConfig
 from excite_cli.dynamics.urdf_checks import check_urdf
 from excite_cli.dynamics.urdf_meshes import collision_geometry, package_folders
-from excite_cli.dynamics.urdf_source import resolve_urdf
+from excite_cli.dynamics.urdf_source import resolve_urdf, urdf_model
 from excite_cli.errors import ExciteError
 
 #: Order of pinocchio's 10 dynamic parameters of one body (``Inertia.toDynamicParameters``).
@@ -224,10 +224,7 @@ def load_robot(
     )
     # before urdfdom, which prints what it cannot parse
     problems = check_urdf(path, list(cfg.active_joints), physical, list(cfg.locked_joints))
-    try:
-        full = pin.buildModelFromUrdf(str(path), *([pin.JointModelFreeFlyer()] if cfg.floating_base else []))
-    except (RuntimeError, ValueError) as exc:
-        raise ExciteError("robot.urdf", f"cannot read {path}: {exc}") from None
+    full = urdf_model(path, *([pin.JointModelFreeFlyer()] if cfg.floating_base else []))
 
     movable = _check_joints(cfg, full)
     q_full = pin.neutral(full)

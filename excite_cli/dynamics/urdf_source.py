@@ -1,9 +1,12 @@
-"""Where a robot's URDF is: inside the installed example-robot-data package, or a file beside the config."""
+"""Where a robot's URDF is (inside the installed example-robot-data package, or a file beside the config),
+and pinocchio's model of it."""
 
 from __future__ import annotations
 
 from importlib import metadata
 from pathlib import Path
+
+import pinocchio as pin
 
 from excite_cli.config import RobotConfig, resolve_path
 from excite_cli.dynamics.urdf_meshes import package_folders
@@ -45,3 +48,16 @@ def resolve_urdf(cfg: RobotConfig, folder: Path | None = None) -> tuple[Path, li
         dirs = [str(path.parent), str(path.parent.parent), str(share)]
     path = input_file(path, "robot.urdf", "URDF")
     return path, package_folders(path, dirs)
+
+
+def urdf_model(path: Path, *root_joint) -> pin.Model:
+    """pinocchio's model of the URDF at ``path`` (with ``root_joint``, e.g. a free flyer, under its root).
+
+    Raises:
+        ExciteError: (``robot.urdf``) a file urdfdom or pinocchio cannot make a model of (an unknown
+            joint type, a missing attribute), in one line.
+    """
+    try:
+        return pin.buildModelFromUrdf(str(path), *root_joint)
+    except (RuntimeError, ValueError) as exc:
+        raise ExciteError("robot.urdf", f"cannot read {path}: {' '.join(str(exc).split())[:300]}") from None
