@@ -1,10 +1,11 @@
 """Files written whole or not at all: every file excite writes (HDF5, PNG, HTML, CSV, URDF) goes
 through a temporary ``.<name>.partial`` beside ``<path>`` moved onto its path only when it is complete, and the folders
-made for it are removed again when nothing was written."""
+made for it are removed again when nothing was written; a folder written as one (a ROS 2 bag) the same way."""
 
 from __future__ import annotations
 
 import os
+import shutil
 import warnings
 from contextlib import contextmanager, suppress
 from pathlib import Path
@@ -89,6 +90,36 @@ def atomic_path(path: Path, field: str = "output") -> Iterator[Path]:
     """
     with atomic_paths([path], field) as (tmp,):
         yield tmp
+
+
+@contextmanager
+def atomic_folder(path: Path, field: str = "output") -> Iterator[Path]:
+    """A folder written whole or not at all: the block fills ``.<name>.partial/<name>`` beside ``path``
+    (the inner folder has the target's own name, for writers that name their files after their
+    folder, as rosbag2 does), which is moved onto ``path`` when the block ends without error (a folder
+    already there is replaced: the caller has checked that it may be) and removed otherwise, with any
+    folder made for it (:func:`new_folders`); one a killed run left is removed first, with a warning.
+
+    Raises:
+        CannotWrite: the folder cannot be written (``OSError`` in the block or in the move).
+    """
+    path = Path(path)
+    staging = partial_path(path)
+    if staging.exists():
+        shutil.rmtree(staging, ignore_errors=True)
+        warnings.warn(f"removed {staging}, left by an interrupted run", ExciteWarning, stacklevel=3)
+    try:
+        with new_folders([path], field):
+            try:
+                staging.mkdir()
+                yield staging / path.name
+                if path.exists():
+                    shutil.rmtree(path)
+                os.replace(staging / path.name, path)
+            finally:
+                shutil.rmtree(staging, ignore_errors=True)
+    except OSError as exc:
+        raise CannotWrite(field, path, exc.strerror or exc) from None
 
 
 def atomic_bytes(path: Path, data: bytes | memoryview, field: str = "output") -> Path:

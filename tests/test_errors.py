@@ -5,9 +5,9 @@ import pytest
 import yaml
 from conftest import UR5, write_config
 
-from excite_cli.atomic import atomic_path
+from excite_cli.atomic import atomic_folder, atomic_path
 from excite_cli.config_file import load_problem
-from excite_cli.errors import CannotWrite, ExciteError, FileNotFound, OutputExists
+from excite_cli.errors import CannotWrite, ExciteError, ExciteWarning, FileNotFound, OutputExists
 from excite_cli.h5 import open_h5
 from excite_cli.storage.export import export_trajectory
 from excite_cli.storage.paths import check_target
@@ -46,6 +46,27 @@ def test_an_atomic_write_that_fails_leaves_nothing_and_names_its_field(tmp_path)
     with atomic_path(target) as tmp:
         tmp.write_text("whole")
     assert target.read_text() == "whole" and list(tmp_path.iterdir()) == [target]
+
+
+def test_an_atomic_folder_is_whole_or_absent_and_replaces_the_one_there(tmp_path):
+    target = tmp_path / "new" / "bag"
+    with pytest.raises(CannotWrite) as caught:
+        with atomic_folder(target) as staging:
+            staging.mkdir()
+            (staging / "half.db3").write_text("half")
+            raise OSError(28, "No space left on device")
+    assert "No space left" in caught.value.reason and list(tmp_path.iterdir()) == []  # nor the folder made for it
+    for text in ("first", "second"):
+        with atomic_folder(target) as staging:
+            staging.mkdir()
+            (staging / "bag.db3").write_text(text)
+    assert [p.name for p in target.iterdir()] == ["bag.db3"] and (target / "bag.db3").read_text() == "second"
+    assert [p.name for p in target.parent.iterdir()] == ["bag"]
+    (target.parent / ".bag.partial").mkdir()  # left by a killed run
+    with pytest.warns(ExciteWarning, match="left by an interrupted run"):
+        with atomic_folder(target) as staging:
+            staging.mkdir()
+    assert [p.name for p in target.parent.iterdir()] == ["bag"]
 
 
 def test_a_file_that_is_not_hdf5_is_named_with_the_field_that_gave_it(tmp_path):

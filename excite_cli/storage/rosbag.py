@@ -15,8 +15,6 @@ per sample on :data:`JOINT_STATES`, stamped with its time (from :data:`START`), 
 
 from __future__ import annotations
 
-import os
-import shutil
 import time
 from pathlib import Path
 
@@ -24,7 +22,7 @@ import numpy as np
 from rosbags.rosbag2 import Writer, WriterError
 from rosbags.typesys import Stores, get_typestore
 
-from excite_cli.atomic import new_folders, partial_path
+from excite_cli.atomic import atomic_folder
 from excite_cli.errors import CannotWrite, ExciteError, OutputExists
 from excite_cli.storage.paths import check_target
 
@@ -96,33 +94,22 @@ def _message(types: dict, joints: list[str], time_s: np.ndarray, motion: tuple[n
 
 
 def _write_bag(folder: Path, topic: str, msgtype: str, messages) -> Path:
-    """``messages`` ((recording time [ns], message) pairs) on ``topic`` as a bag at ``folder``, built
-    in a hidden ``.<name>.partial`` folder beside it and then moved onto it (an existing bag there is
-    replaced, see :func:`check_bag_target`).
+    """``messages`` ((recording time [ns], message) pairs) on ``topic`` as a bag at ``folder``, whole
+    or not at all (:func:`~excite_cli.atomic.atomic_folder`; an existing bag there is replaced, see
+    :func:`check_bag_target`).
 
     Raises:
         CannotWrite: the bag cannot be written (a full disk, permissions).
     """
-    folder = Path(folder)
-    staging = partial_path(folder)
-    shutil.rmtree(staging, ignore_errors=True)
     typestore = get_typestore(Stores.ROS2_HUMBLE)
     try:
-        with new_folders([folder]):
-            try:
-                staging.mkdir()
-                with Writer(staging / folder.name, version=8) as writer:
-                    connection = writer.add_connection(topic, msgtype, typestore=typestore)
-                    for ns, message in messages(typestore.types):
-                        writer.write(connection, ns, typestore.serialize_cdr(message, msgtype))
-                if folder.exists():
-                    shutil.rmtree(folder)
-                os.replace(staging / folder.name, folder)
-            finally:
-                shutil.rmtree(staging, ignore_errors=True)
-    except (OSError, WriterError) as exc:
-        raise CannotWrite("output", folder, getattr(exc, "strerror", None) or exc) from None
-    return folder
+        with atomic_folder(folder) as staging, Writer(staging, version=8) as writer:
+            connection = writer.add_connection(topic, msgtype, typestore=typestore)
+            for ns, message in messages(typestore.types):
+                writer.write(connection, ns, typestore.serialize_cdr(message, msgtype))
+    except WriterError as exc:
+        raise CannotWrite("output", folder, exc) from None
+    return Path(folder)
 
 
 def write_rosbag(
