@@ -6,6 +6,7 @@ import functools
 import socket
 import threading
 from contextlib import contextmanager
+from dataclasses import replace
 from pathlib import Path
 from typing import Iterator
 
@@ -182,7 +183,8 @@ def optimized(tmp_path_factory):
 @pytest.fixture(scope="session")
 def simulated_identification():
     """``identify`` of the shipped simulated Panda runs (Coulomb and viscous friction undeclared):
-    (problem, report, robot, base, regressor parts), as the pipeline returns them."""
+    (problem, report, robot, base, prior rows), as the pipeline returns them (the report file empties
+    the rows' parts it writes: give it :func:`rows_copy`)."""
     from excite_cli.identification.config import IdentifyProblem
     from excite_cli.identification.pipeline import run_identification
 
@@ -210,3 +212,8 @@ def tcp_server(first_bytes: bytes) -> Iterator[str]:
     finally:
         stop.set()
         listener.close()
+
+
+def rows_copy(rows):
+    """A copy of an identification's prior rows (``PriorRows``) whose parts the report file may empty."""
+    return replace(rows, regressor=[part.copy() for part in rows.regressor], effects=[p.copy() for p in rows.effects])

@@ -31,6 +31,7 @@ from excite_cli.identification.measured.measurements import (
 )
 from excite_cli.identification.measured.payload import payload_parameters
 from excite_cli.identification.measured.preprocessing import choose_cutoff, preprocess
+from excite_cli.identification.reporting.design_model import PriorRows, prior_rows
 from excite_cli.identification.reporting.report import Report
 from excite_cli.identification.reporting.urdf_out import urdf_deviation, write_urdf
 from excite_cli.memory import return_freed_memory, trim_freed_memory
@@ -166,7 +167,7 @@ def prepare_data(problem: IdentifyProblem, robot: Robot, base: BaseParameters, t
 
 def run_identification(
     problem: IdentifyProblem, consistent_beside: bool = False
-) -> tuple[Report, Robot, BaseParameters, list[np.ndarray]]:
+) -> tuple[Report, Robot, BaseParameters, PriorRows]:
     """The whole loop on ``problem``'s data; memory follows the decimated data.
 
     Args:
@@ -174,9 +175,9 @@ def run_identification(
             ``least_squares`` (the identified URDF needs it).
 
     Returns:
-        The :class:`Report`, the robot, its base parameters and the base regressor rows of all
-        samples, fit then validation ((M_fit, b), (M_val, b)), which can serve as prior data C₀ for
-        ``optimize`` (Eq. 41).
+        The :class:`Report`, the robot, its base parameters and the rows of all samples, fit then
+        validation, as prior data C₀ for ``optimize`` (Eq. 41): the base regressor and the chosen
+        effects' design columns (:class:`~excite_cli.identification.reporting.design_model.PriorRows`).
 
     Raises:
         ExciteError: bad data or config (see :func:`prepare_data`), or a consistent fit without a
@@ -253,7 +254,7 @@ def run_identification(
     if choice.is_consistent:  # the reported model's step: the same effects, the consistent fit
         ladder.append((choice.name, float(choice.cv_error[choice.chosen]), report.mean(report.relative_after)))
     report.warnings += report.fit_disagreement()
-    return report, robot, base, [fit_data.regressor, val_data.regressor]
+    return report, robot, base, prior_rows([fit_data, val_data], selection.terms, robot.joint_names)
 
 
 def write_identified_urdf(

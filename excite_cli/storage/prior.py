@@ -24,7 +24,8 @@ def read_prior(
 ) -> np.ndarray:
     """Prior data C₀ (m, b+e) for Eq. 41 from an excite result (all iterations' regressors stacked) or
     an HDF5 file with a dataset ``regressor`` of base-regressor rows, then the e effect columns
-    ``effect_names`` of the design (``/robot/effect_names`` of a result: the same, in the same order).
+    ``effect_names`` of the design (``/robot/effect_names`` of a result: the same, in the same order;
+    an identify report's ``/effect_regressor``: those it holds, taken by name).
 
     An identify report's rows (``measured``, see
     :class:`~excite_cli.identification.reporting.design_model.MeasuredPrior`) are weighed as
@@ -47,6 +48,9 @@ def read_prior(
             raise ExciteError("sequence.prior", f"{path} has neither /iterations nor /regressor")
         names = read_strings(f["robot"], "base_parameter_names") if "robot/base_parameter_names" in f else None
         effects = read_strings(f["robot"], "effect_names") if "robot/effect_names" in f else None
+        if effect_names and "effect_regressor" in f:  # an identify report's effect columns, taken by name
+            prior = np.hstack([prior, _report_effects(f["effect_regressor"], effect_names, path)])
+            effects = list(effect_names)
     columns = base.count + len(effect_names)
     if (effects is not None and list(effects) != list(effect_names)) or (effects is None and names and effect_names):
         raise ExciteError(
@@ -73,3 +77,21 @@ def read_prior(
         [base.column_order(names, "sequence.prior", path), base.count + np.arange(len(effect_names))]
     )
     return prior[:, order]
+
+
+def _report_effects(dataset, effect_names: Sequence[str], path: Path) -> np.ndarray:
+    """The columns ``effect_names`` of an identify report's ``/effect_regressor`` (M, e), by its names.
+
+    Raises:
+        ExciteError: a design effect the report did not identify.
+    """
+    held = [str(name) for name in dataset.attrs.get("names", [])]
+    missing = [name for name in effect_names if name not in held]
+    if missing:
+        raise ExciteError(
+            "sequence.prior",
+            f"{path} holds the effect columns [{', '.join(held)}], not this design's {', '.join(missing)} (design "
+            "for the report's own effects, effects.model, or leave those effects out)",
+        )
+    rows = np.asarray(dataset[()], dtype=float)
+    return rows[:, [held.index(name) for name in effect_names]]

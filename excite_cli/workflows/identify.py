@@ -87,13 +87,13 @@ def run_identify(
     plots = [target.with_name(target.stem + suffix) for suffix in ("_residuals.png", "_ladder.png")]
     _check_model_paths(target, plots, {"urdf_out": urdf_out, "mjcf_out": mjcf_out}, force)
     with output_lock(target, "output"):
-        report, robot, base, regressor = run_identification(
+        report, robot, base, rows = run_identification(
             problem, consistent_beside=urdf_out is not None or mjcf_out is not None
         )
         run = IdentifyRun(report, robot, base, target, plots, urdf_out)
         if mjcf_out is not None:
             run.mjcf, run.mujoco = write_identified_mjcf(problem, report, robot, base, mjcf_out)
-        write_identification(target, report, robot, base, problem, regressor, run.mjcf, run.mujoco)
+        write_identification(target, report, robot, base, problem, rows, run.mjcf, run.mujoco)
         if urdf_out is not None:
             run.urdf_deviation = write_identified_urdf(problem, report, robot, base, urdf_out)
         run.plots = [plot_identification(plots[0], report), plot_ladder(plots[1], report)]

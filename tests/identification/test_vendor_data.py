@@ -80,7 +80,7 @@ def test_a_torque_channel_without_signal_is_reported_left_out_and_every_mean_fin
     assert np.isclose(report.selection.cv_error, np.delete(report.selection.cv_joint, 3).mean())
     assert report.mean(report.relative_after) < 1.5  # the other joints as with the sensor
     assert not report.worse_than_rigid_body[3]
-    write_identification(tmp_path / "id.h5", report, robot, base, problem, list(parts))
+    write_identification(tmp_path / "id.h5", report, robot, base, problem, parts)
     with h5py.File(tmp_path / "id.h5") as f:
         g = f["identification"]
         assert [s.decode() for s in g["dead_channels"][()]] == ["panda_joint4"]

@@ -4,7 +4,8 @@ and viscous friction, armature and torque offset, and each coupled motor with it
 (``/identification/effect_coupling``). Effects the design cannot hold as columns (asymmetric,
 Stribeck, held and load-dependent friction: nonlinear in a shape or a first fit; springs and position
 harmonics) are named and left out. As ``sequence.prior`` its rows are weighed as identification
-weighs them (:class:`MeasuredPrior`)."""
+weighs them (:class:`MeasuredPrior`), and hold the columns of those effects too (:func:`prior_rows`), so
+one report is both the model and the prior data of the next design."""
 
 from __future__ import annotations
 
@@ -15,8 +16,11 @@ from pathlib import Path
 import numpy as np
 
 from excite_cli.config import EffectsConfig, MotorConfig
+from excite_cli.dynamics.effect_columns import SYMBOLS
 from excite_cli.errors import ExciteError, ExciteWarning
 from excite_cli.h5 import open_h5, read_strings
+from excite_cli.identification.effects import Term
+from excite_cli.identification.fitting.dataset import Dataset
 
 #: The report's effects that are design columns (:data:`excite_cli.config.effects.JointEffect`).
 DESIGNED = ("coulomb", "viscous", "armature", "offset")
@@ -152,3 +156,59 @@ def read_measured_prior(path: Path) -> MeasuredPrior | None:
             return None
         joints = read_strings(f["identification"], "joint_names")
         return MeasuredPrior(joints, f["identification/rms_after"][()], float(f["regressor"].attrs["sample_rate_Hz"]))
+
+
+@dataclass
+class PriorRows:
+    """An identify report's rows as prior data: the base regressor and the design's effect columns of
+    the same samples, in parts (fit, then validation), which the report file writes and empties.
+
+    Attributes:
+        regressor: (M_k, b) base regressor rows per part.
+        effects: (M_k, e) effect columns per part, named ``effect_names`` as a design names them
+            (:func:`~excite_cli.dynamics.effect_columns.effect_columns`: ``Fc_panda_joint4``,
+            ``Ia_motor_wrist_2+wrist_3``).
+        effect_names: (e,) the names.
+    """
+
+    regressor: list[np.ndarray]
+    effects: list[np.ndarray]
+    effect_names: list[str]
+
+
+def _design_names(term: Term, joints: list[str]) -> list[str] | None:
+    """The design's names of ``term``'s columns, or None for an effect a design does not hold (module
+    docstring) or a coupled joint effect (the design couples only motors)."""
+    if term.effect == "motor":
+        motor = "+".join(joints[j] for j in term.joints)
+        return [f"{symbol}_motor_{motor}" for symbol in term.kind.coefficients]
+    if term.effect in DESIGNED and term.coupling is None:
+        return [f"{SYMBOLS[term.effect][0]}_{joints[term.joint]}"]
+    return None
+
+
+def prior_rows(parts: list[Dataset], terms: list[Term], joints: list[str]) -> PriorRows:
+    """The rows of ``parts`` (the identification's fit and validation data) as prior data: their base
+    regressor, and the columns of the chosen ``terms`` a design holds, taken from the parts' own
+    low-passed and decimated effect blocks (the columns identification fitted, weighed as it weighed
+    them), an offset as one column of ones on its joint's rows (the design's, not one per run).
+
+    Args:
+        parts: datasets with the blocks of ``terms``; joints: the active joints (n), in the rows' order.
+    """
+    names: list[str] = []
+    columns: list[list[np.ndarray]] = [[] for _ in parts]
+    for term in terms:
+        named = _design_names(term, joints)
+        if named is None:
+            continue
+        names += named
+        for out, data in zip(columns, parts):
+            if term.effect == "offset":
+                block = np.zeros((data.tau.size, 1))
+                block[term.joint :: data.n] = 1.0
+            else:
+                block = data.block(term)
+            out.append(block)
+    effects = [np.hstack(c) if c else np.zeros((d.tau.size, 0)) for c, d in zip(columns, parts)]
+    return PriorRows([d.regressor for d in parts], effects, names)

@@ -16,6 +16,7 @@ from excite_cli.dynamics.robot import Robot
 from excite_cli.h5 import atomic_h5, write_parts, write_strings, write_table
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.fitting.physical import body_properties
+from excite_cli.identification.reporting.design_model import PriorRows
 from excite_cli.identification.reporting.mjcf_check import MujocoCheck, write_mujoco_group
 from excite_cli.identification.reporting.mjcf_out import MjcfModel
 from excite_cli.identification.reporting.report import Report
@@ -29,7 +30,7 @@ def write_identification(
     robot: Robot,
     base: BaseParameters,
     problem: IdentifyProblem,
-    regressor: list[np.ndarray],
+    rows: PriorRows,
     mjcf: MjcfModel | None = None,
     mujoco: MujocoCheck | None = None,
 ) -> None:
@@ -39,8 +40,8 @@ def write_identification(
         report: the :class:`~excite_cli.identification.pipeline.Report`.
         problem: the identify config that ran (stored as the effective config, every default filled
             in, beside the file's original text).
-        regressor: base regressor rows of all samples, in parts ((M_k, b) each, e.g. fit and validation);
-            emptied as the parts are written.
+        rows: the rows of all samples as prior data (base regressor and the design's effect columns, in
+            parts: fit, then validation); emptied as the parts are written.
         mjcf, mujoco: the MJCF written and MuJoCo's check of it (``/mujoco``), or None.
 
     Raises:
@@ -56,9 +57,14 @@ def write_identification(
         group.create_dataset("regrouping_matrix", data=base.regrouping).attrs["description"] = (
             "K (b x p): phi_B = K phi"
         )
-        rows = write_parts(f, "regressor", regressor, b)
-        rows.attrs["description"] = "base regressor of all preprocessed (decimated) samples, fit then validation (C0)"
-        rows.attrs["sample_rate_Hz"] = report.rate
+        regressor = write_parts(f, "regressor", rows.regressor, b)
+        regressor.attrs["description"] = (
+            "base regressor of all preprocessed (decimated) samples, fit then validation (C0)"
+        )
+        regressor.attrs["sample_rate_Hz"] = report.rate
+        effects = write_parts(f, "effect_regressor", rows.effects, len(rows.effect_names))
+        effects.attrs["description"] = "the chosen effects' columns a design holds, rows as /regressor's (C0)"
+        effects.attrs.create("names", rows.effect_names, dtype=STR)
         g = f.create_group("identification")
         g.attrs["method"], g.attrs["cutoff_Hz"], g.attrs["cutoff_source"] = (
             problem.identification.method,

@@ -3,7 +3,7 @@
 import h5py
 import numpy as np
 import pytest
-from conftest import CONFIGS
+from conftest import CONFIGS, rows_copy
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
@@ -18,13 +18,14 @@ from excite_cli.identification.reporting.design_model import (
 )
 from excite_cli.identification.reporting.report_file import write_identification
 from excite_cli.optimization.excitation import build_excitation
+from excite_cli.storage.prior import read_prior
 
 
 @pytest.fixture(scope="module")
 def report_file(simulated_identification, tmp_path_factory):
-    problem, report, robot, base, regressor = simulated_identification
+    problem, report, robot, base, rows = simulated_identification
     path = tmp_path_factory.mktemp("report") / "report.h5"
-    write_identification(path, report, robot, base, problem, [part.copy() for part in regressor])
+    write_identification(path, report, robot, base, problem, rows_copy(rows))
     return path
 
 
@@ -121,3 +122,44 @@ def test_optimize_with_the_report_as_prior_weighs_both_the_prior_and_its_own_row
     weights = np.tile(measured.weights(), own.shape[0] // measured.weights().size)
     np.testing.assert_allclose(own, plain * weights[:, None], rtol=1e-9, atol=1e-12)
     assert excitation.row_weights is not None and not np.allclose(excitation.row_weights, 1.0)
+
+
+def test_the_reports_rows_hold_its_effects_as_the_fit_saw_them(simulated_identification):
+    """The effect columns beside the base regressor are the chosen model's own: with the fitted
+    coefficients, [Y_B | Y_E] reproduces the model's prediction on the validation rows (Coulomb and
+    viscous friction, all of which a design holds, in the fit's order)."""
+    from excite_cli.identification.fitting.least_squares import predict
+
+    _, report, robot, _, rows = simulated_identification
+    fit = report.selection.fit
+    assert rows.effect_names == [
+        f"{'Fc' if t.effect == 'coulomb' else 'Fv'}_{robot.joint_names[t.joint]}" for t in report.selection.terms
+    ]
+    stacked = np.hstack([rows.regressor[1], rows.effects[1]])
+    predicted = predict(report.validation, fit.x, report.selection.terms).ravel()
+    np.testing.assert_allclose(stacked @ fit.x, predicted, atol=1e-9)
+
+
+def test_one_report_is_the_model_and_the_prior_data(report_file, tmp_path):
+    """`excite optimize CONFIG --model REPORT.h5 --prior REPORT.h5`: C₀ holds the report's friction
+    columns beside its base columns, those columns weighed as the base columns are; a design effect
+    the report did not identify is refused naming it."""
+    problem = load_problem(CONFIGS / "smoke.yaml")
+    problem.effects.model = problem.sequence.prior = str(report_file)
+    excitation = build_excitation(problem)
+    prior = read_prior(report_file, excitation.base, excitation.effect_names, excitation.measured, 0.2)
+    with h5py.File(report_file) as f:
+        held = [str(name) for name in f["effect_regressor"].attrs["names"]]
+        raw = f["effect_regressor"][()][:, [held.index(name) for name in excitation.effect_names]]
+    measured = excitation.measured
+    weights = np.tile(measured.weights(), raw.shape[0] // len(measured.joints)) * measured.time_scale(0.2)
+    np.testing.assert_allclose(prior[:, excitation.base.count :], raw * weights[:, None], rtol=1e-12)
+    assert np.abs(prior[:, excitation.base.count :]).max(axis=0).min() > 0.0
+    out = tmp_path / "next.h5"
+    cli = ["optimize", str(CONFIGS / "smoke.yaml"), "--model", str(report_file), "--prior", str(report_file)]
+    run = CliRunner().invoke(app, [*cli, "-o", str(out), "-k", "1"])
+    assert run.exit_code == 0, run.output
+    problem.effects.joints = {"panda_joint2": ["offset"]}
+    extra = build_excitation(problem)
+    with pytest.raises(ExciteError, match=r"sequence\.prior.*not this design's tau0_panda_joint2"):
+        read_prior(report_file, extra.base, extra.effect_names, extra.measured, 0.2)

@@ -4,6 +4,7 @@ within 1 point, the report records it, and a file that is not the identified mod
 
 import h5py
 import numpy as np
+from conftest import rows_copy
 
 from excite_cli.dynamics.urdf_source import resolve_urdf
 from excite_cli.identification.reporting.mjcf_check import check_mjcf
@@ -29,7 +30,7 @@ def test_mujoco_reproduces_the_identified_model_and_its_validation_error(simulat
     assert abs(check.relative_mujoco.mean() - check.relative_excite.mean()) <= 1.0
     assert check.friction_differs < 20.0
     path = tmp_path / "report.h5"
-    write_identification(path, report, robot, base, problem, list(regressor), model, check)
+    write_identification(path, report, robot, base, problem, rows_copy(regressor), model, check)
     with h5py.File(path) as f:
         g = f["mujoco"]
         assert g.attrs["mjcf"] == str(model.path) and g.attrs["rigid_deviation"] == check.rigid

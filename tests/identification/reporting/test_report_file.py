@@ -4,6 +4,7 @@ back, and the identified URDF that pinocchio loads with the consistent fit's tor
 import h5py
 import numpy as np
 import pinocchio as pin
+from conftest import rows_copy
 
 from excite_cli.dynamics.urdf_source import resolve_urdf
 from excite_cli.h5 import read_strings
@@ -26,7 +27,7 @@ def test_effect_values_name_every_coefficient_in_the_order_of_the_fit(simulated_
 def test_the_report_file_reads_back_what_the_report_holds(simulated_identification, tmp_path):
     problem, report, robot, base, regressor = simulated_identification
     path = tmp_path / "report.h5"
-    write_identification(path, report, robot, base, problem, list(regressor))  # it empties the list it writes
+    write_identification(path, report, robot, base, problem, rows_copy(regressor))  # it empties what it writes
     with h5py.File(path) as f:
         g = f["identification"]
         assert read_strings(g, "base_parameter_names") == report.base_names
@@ -36,7 +37,7 @@ def test_the_report_file_reads_back_what_the_report_holds(simulated_identificati
         np.testing.assert_array_equal(f["robot/regrouping_matrix"][()], base.regrouping)
         rows = g["effects"][()]
         assert [float(v) for v in rows["value"]] == [v for _, _, v, _ in report.effect_values()]
-        np.testing.assert_array_equal(f["regressor"][()], np.vstack(regressor))  # written in slices, fit first
+        np.testing.assert_array_equal(f["regressor"][()], np.vstack(regressor.regressor))  # in slices, fit first
 
 
 def test_the_identified_urdf_loads_and_reproduces_the_consistent_torques(simulated_identification, tmp_path):
