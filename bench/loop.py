@@ -11,7 +11,8 @@ motor, for several seeds:
    coupled motor's inertia and friction) with trajectory 1's rows of that model as C₀; both from the
    same random starts (iteration 2's);
 3. both measured as run 1 and identified together with run 1: weighted least squares (1/σ_j) of the base
-   parameters and every effect coefficient.
+   parameters and every effect coefficient, over ``NOISE_DRAWS`` draws of the noise (the errors are
+   their means: one draw's error is itself noisy at the 10 % level).
 
 The identified model is the true one (the effects a report of run 1 names; identify finds exactly these
 on the shipped simulated Panda runs, tests), so what differs is the second trajectory alone. True
@@ -21,11 +22,14 @@ armature) are neither simulated nor identified.
 
 Printed per robot and seed: mean relative error of the effect coefficients [%], the base parameters'
 error (RMS over the identifiable directions of L⁻¹(β̂ − β) in the URDF-scaled frame, as
-bench/criteria.py) [%] and the unseen motion's relative torque error [%], (a) then (b); and the last
-lines, one per robot: `loop ROBOT: effects error blind X %, designed Y %; base error blind X %, designed
-Y %` (means over the seeds).
+bench/criteria.py) [%], the unseen motion's relative torque error [%] and the effects' predicted
+relative standard deviation (from the weighted information matrix, no noise drawn) [%], (a) then (b);
+and the last lines, one per robot: `loop ROBOT: effects error blind X %, designed Y %; base error blind
+X %, designed Y %` (means over the seeds). ``--design`` designs (b) with another criterion (and
+scaling), e.g. ``log_trace_inverse:urdf``, A-optimality in the URDF-scaled frame: the sum of the
+relative variances.
 
-    .venv/bin/python bench/loop.py [--robots G1 Panda] [--seeds 0 1 2]
+    .venv/bin/python bench/loop.py [--robots G1 Panda] [--seeds 0 1 2] [--design OBJECTIVE:SCALING]
 
 Asserts nothing.
 """
@@ -46,7 +50,7 @@ from excite_cli.optimization.sequence import describe, run_sequence
 
 ROOT = Path(__file__).resolve().parent.parent
 ROBOTS = {"G1": ROOT / "configs" / "g1_arms.yaml", "Panda": ROOT / "configs" / "panda_joint_limits.yaml"}
-RATE, NOISE, UNSEEN_SEED = 100.0, 0.02, 12345
+RATE, NOISE, UNSEEN_SEED, NOISE_DRAWS = 100.0, 0.02, 12345, 20
 
 
 def measured(excitation, alpha: np.ndarray, truth: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -62,27 +66,43 @@ def measured(excitation, alpha: np.ndarray, truth: np.ndarray) -> tuple[np.ndarr
 
 
 def identified(excitation, runs: list[tuple[np.ndarray, np.ndarray]], sigma: np.ndarray, seed: int) -> np.ndarray:
-    """WLS estimate of [β; c] from the runs' columns and torques with white noise σ_j (n,)."""
+    """WLS estimates of [β; c] (b+e, ``NOISE_DRAWS``) from the runs' columns and torques, each with its
+    own draw of white noise σ_j (n,)."""
     Y = np.vstack([y for y, _ in runs])
     tau = np.vstack([t for _, t in runs])
-    noisy = tau + np.random.default_rng(seed).normal(0.0, 1.0, tau.shape) * sigma
+    noise = np.random.default_rng(seed).normal(0.0, 1.0, (NOISE_DRAWS, *tau.shape)) * sigma
     w = np.tile(1.0 / sigma, tau.shape[0])
-    return np.linalg.lstsq(Y * w[:, None], noisy.ravel() * w, rcond=None)[0]
+    noisy = (tau[None] + noise).reshape(NOISE_DRAWS, -1).T * w[:, None]
+    return np.linalg.lstsq(Y * w[:, None], noisy, rcond=None)[0]
 
 
-def errors(excitation, estimate: np.ndarray, truth: np.ndarray, unseen: tuple[np.ndarray, np.ndarray]) -> tuple:
-    """Effect coefficients' mean relative error, base parameters' scaled RMS error, unseen torque error."""
+def errors(
+    excitation, estimates: np.ndarray, truth: np.ndarray, unseen: tuple[np.ndarray, np.ndarray], std: np.ndarray
+) -> tuple:
+    """Means over the draws ``estimates`` (b+e, draws) of the effect coefficients' mean relative error,
+    the base parameters' scaled RMS error and the unseen torque error; and the effects' mean predicted
+    relative standard deviation from ``std`` (b+e,)."""
     b = excitation.base.count
-    effect = np.mean(np.abs(estimate[b:] - truth[b:]) / np.abs(truth[b:]))
-    base = np.sqrt(np.mean((np.linalg.solve(excitation.scaled_frame[:b, :b], estimate[:b] - truth[:b])) ** 2))
+    effect = np.mean(np.abs(estimates[b:] - truth[b:, None]) / np.abs(truth[b:, None]))
+    scaled = np.linalg.solve(excitation.scaled_frame[:b, :b], estimates[:b] - truth[:b, None])
+    base = np.mean(np.sqrt(np.mean(scaled**2, axis=0)))
     Y, tau = unseen
-    predicted = (Y @ estimate).reshape(tau.shape)
-    torque = np.mean(np.sqrt(((predicted - tau) ** 2).mean(axis=0) / (tau**2).mean(axis=0)))
-    return effect, base, torque
+    predicted = (Y @ estimates).T.reshape(-1, *tau.shape)
+    torque = np.mean(np.sqrt(((predicted - tau) ** 2).mean(axis=1) / (tau**2).mean(axis=0)))
+    return effect, base, torque, np.mean(std[b:] / np.abs(truth[b:]))
 
 
-def loop(config: Path, seed: int) -> tuple:
-    """(a) and (b)'s errors of one seed, and the wall time."""
+def predicted_std(runs: list[tuple[np.ndarray, np.ndarray]], sigma: np.ndarray) -> np.ndarray:
+    """(b+e,) the estimates' standard deviations of weighted least squares on the runs' columns with
+    noise σ_j (n,): the square roots of the diagonal of (YᵀWᵀWY)⁻¹."""
+    Y = np.vstack([y for y, _ in runs])
+    w = np.tile(1.0 / sigma, Y.shape[0] // sigma.size)
+    return np.sqrt(np.diag(np.linalg.inv((Y * w[:, None]).T @ (Y * w[:, None]))))
+
+
+def loop(config: Path, seed: int, design_criterion: tuple[str, str] | None = None) -> tuple:
+    """(a) and (b)'s errors of one seed, and the wall time; (b) designed with ``design_criterion``
+    (objective, scaling), default the config's."""
     begin = time.perf_counter()
     problem = load_problem(config)
     problem.optimizer.seed = seed
@@ -94,6 +114,9 @@ def loop(config: Path, seed: int) -> tuple:
         motors=[MotorConfig(joints=joints[-2:], transmission=[1.0, 1.0])],
     )
     model = build_excitation(design)  # the identified model's columns (those the base does not hold)
+    if design_criterion is not None:
+        design.optimizer.objective, design.optimizer.scaling = design_criterion
+    designer = build_excitation(design) if design_criterion is not None else model
     effort = model.robot.model.effortLimit[model.robot.v_idx]
     magnitudes = model.effects.magnitudes(effort, model.limits.upper[1], model.limits.upper[2])
     truth = np.concatenate([model.base.from_standard(model.robot.urdf_parameters()), magnitudes])
@@ -102,16 +125,16 @@ def loop(config: Path, seed: int) -> tuple:
         first = run_sequence(blind, 1, seed, engine=engine)
         blind_second = run_sequence(blind, 2, seed, engine=engine, finished=first)[-1].alpha
     alpha1 = first[0].alpha
-    with Engine(model, workers) as engine:
-        earlier = [describe(model, 1, alpha1, np.zeros((0, model.columns)))]
-        designed_second = run_sequence(model, 2, seed, engine=engine, finished=earlier)[-1].alpha
+    with Engine(designer, workers) as engine:
+        earlier = [describe(designer, 1, alpha1, np.zeros((0, designer.columns)))]
+        designed_second = run_sequence(designer, 2, seed, engine=engine, finished=earlier)[-1].alpha
     unseen = measured(model, model.random_start(np.random.default_rng(UNSEEN_SEED)), truth)
     sigma = NOISE * np.sqrt((unseen[1] ** 2).mean(axis=0))
     run1 = measured(model, alpha1, truth)
     rows = []
     for second in (blind_second, designed_second):
-        estimate = identified(model, [run1, measured(model, second, truth)], sigma, seed)
-        rows.append(errors(model, estimate, truth, unseen))
+        runs = [run1, measured(model, second, truth)]
+        rows.append(errors(model, identified(model, runs, sigma, seed), truth, unseen, predicted_std(runs, sigma)))
     return rows[0], rows[1], time.perf_counter() - begin
 
 
@@ -119,19 +142,22 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--robots", nargs="+", default=list(ROBOTS), choices=list(ROBOTS))
     parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
+    parser.add_argument("--design", default=None, help="OBJECTIVE:SCALING of (b), e.g. log_trace_inverse:urdf")
     args = parser.parse_args()
+    design = tuple(args.design.split(":")) if args.design else None
     lines = []
     for robot in args.robots:
         results = []
         for seed in args.seeds:
-            a, b, wall = loop(ROBOTS[robot], seed)
+            a, b, wall = loop(ROBOTS[robot], seed, design)
             results.append((a, b))
             print(
                 f"  {robot} seed {seed}: effects {a[0]:.2%} / {b[0]:.2%}, base {a[1]:.3%} / {b[1]:.3%}, "
-                f"unseen torque {a[2]:.3%} / {b[2]:.3%} (blind / designed), {wall:.0f} s",
+                f"unseen torque {a[2]:.3%} / {b[2]:.3%}, predicted effect std {a[3]:.3%} / {b[3]:.3%} "
+                f"(blind / designed), {wall:.0f} s",
                 flush=True,
             )
-        mean = np.mean(np.array(results), axis=0)  # (2, 3)
+        mean = np.mean(np.array(results), axis=0)  # (2, 4)
         lines.append(
             f"loop {robot}: effects error blind {mean[0, 0]:.2%}, designed {mean[1, 0]:.2%}; "
             f"base error blind {mean[0, 1]:.3%}, designed {mean[1, 1]:.3%}"
