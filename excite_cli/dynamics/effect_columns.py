@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass, replace
+from typing import Sequence
 
 import numpy as np
 
@@ -31,6 +32,8 @@ SYMBOLS = {
     "armature": ("Ia", "kg·m²"),
     "offset": ("tau0", "Nm"),
 }
+#: A coupled motor's columns, in order: its rotor inertia, Coulomb and viscous friction (identify's too).
+MOTOR_KINDS = ("armature", "coulomb", "viscous")
 #: A typical effect's torque at the joint's limits, as a fraction of its effort limit (the scaled
 #: criterion's magnitude of an effect coefficient, :meth:`EffectColumns.magnitudes`).
 TYPICAL_SHARE = 0.05
@@ -142,6 +145,12 @@ class EffectColumns:
         return self.subset(keep)
 
 
+def coefficient_name(kind: str, joints: Sequence[str], motor: bool = False) -> str:
+    """The name of an effect coefficient (a key of ``SYMBOLS``): ``Fc_elbow_joint`` on a joint's own
+    row, ``Ia_motor_wrist_2+wrist_3`` for a motor that turns with the ``joints`` named."""
+    return f"{SYMBOLS[kind][0]}_motor_{'+'.join(joints)}" if motor else f"{SYMBOLS[kind][0]}_{joints[0]}"
+
+
 def effect_columns(cfg: EffectsConfig, joint_names: list[str], n_rows: int) -> EffectColumns | None:
     """The effect columns ``cfg`` asks for over the active joints ``joint_names`` (n), each joint's in
     ``SYMBOLS``'s order, joints in their order, then each motor's armature, Coulomb and viscous
@@ -160,7 +169,7 @@ def effect_columns(cfg: EffectsConfig, joint_names: list[str], n_rows: int) -> E
         for kind in (k for k in SYMBOLS if k in wanted):
             kinds.append(kind)
             rows.append(np.eye(n)[j])
-            names.append(f"{SYMBOLS[kind][0]}_{joint}")
+            names.append(coefficient_name(kind, [joint]))
     for i, motor in enumerate(cfg.motors):
         field = f"effects.motors[{i}]"
         unknown = [name for name in motor.joints if name not in joint_names]
@@ -173,10 +182,10 @@ def effect_columns(cfg: EffectsConfig, joint_names: list[str], n_rows: int) -> E
         row = np.zeros(n)
         for name, ratio in zip(motor.joints, motor.transmission):
             row[joint_names.index(name)] += ratio
-        for kind in ("armature", "coulomb", "viscous"):
+        for kind in MOTOR_KINDS:
             kinds.append(kind)
             rows.append(row)
-            names.append(f"{SYMBOLS[kind][0]}_motor_{'+'.join(motor.joints)}")
+            names.append(coefficient_name(kind, motor.joints, motor=True))
     if not kinds:
         return None
     return EffectColumns(tuple(kinds), np.array(rows), tuple(names), cfg.coulomb_velocity, n_rows)

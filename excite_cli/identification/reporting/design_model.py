@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from excite_cli.config import EffectsConfig, MotorConfig
-from excite_cli.dynamics.effect_columns import SYMBOLS
+from excite_cli.dynamics.effect_columns import MOTOR_KINDS, coefficient_name
 from excite_cli.errors import ExciteError, ExciteWarning
 from excite_cli.h5 import open_h5, read_strings
 from excite_cli.identification.effects import Term
@@ -179,11 +179,10 @@ class PriorRows:
 def _design_names(term: Term, joints: list[str]) -> list[str] | None:
     """The design's names of ``term``'s columns, or None for an effect a design does not hold (module
     docstring) or a coupled joint effect (the design couples only motors)."""
-    if term.effect == "motor":
-        motor = "+".join(joints[j] for j in term.joints)
-        return [f"{symbol}_motor_{motor}" for symbol in term.kind.coefficients]
+    if term.effect == "motor":  # its columns are MOTOR_KINDS', in that order
+        return [coefficient_name(kind, [joints[j] for j in term.joints], motor=True) for kind in MOTOR_KINDS]
     if term.effect in DESIGNED and term.coupling is None:
-        return [f"{SYMBOLS[term.effect][0]}_{joints[term.joint]}"]
+        return [coefficient_name(term.effect, [joints[term.joint]])]
     return None
 
 
