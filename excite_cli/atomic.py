@@ -20,11 +20,17 @@ def partial_path(path: Path) -> Path:
 
 
 def remove_stale(path: Path) -> None:
-    """Remove ``path`` if it exists, with an :class:`~excite_cli.errors.ExciteWarning` saying so
-    (a temporary file of a run that was killed: nothing else writes it now)."""
-    with suppress(FileNotFoundError):
-        path.unlink()
-        warnings.warn(f"removed {path}, left by an interrupted run", ExciteWarning, stacklevel=2)
+    """Remove ``path`` (a file, or a folder with what it holds) if it exists, with an
+    :class:`~excite_cli.errors.ExciteWarning` saying so (a temporary file or folder of a run that was
+    killed: nothing else writes it now)."""
+    if path.is_dir() and not path.is_symlink():
+        shutil.rmtree(path, ignore_errors=True)
+    else:
+        try:
+            path.unlink()
+        except FileNotFoundError:
+            return
+    warnings.warn(f"removed {path}, left by an interrupted run", ExciteWarning, stacklevel=2)
 
 
 @contextmanager
@@ -98,16 +104,15 @@ def atomic_folder(path: Path, field: str = "output") -> Iterator[Path]:
     (the inner folder has the target's own name, for writers that name their files after their
     folder, as rosbag2 does), which is moved onto ``path`` when the block ends without error (a folder
     already there is replaced: the caller has checked that it may be) and removed otherwise, with any
-    folder made for it (:func:`new_folders`); one a killed run left is removed first, with a warning.
+    folder made for it (:func:`new_folders`); one a killed run left is removed first, with a warning
+    (:func:`remove_stale`).
 
     Raises:
         CannotWrite: the folder cannot be written (``OSError`` in the block or in the move).
     """
     path = Path(path)
     staging = partial_path(path)
-    if staging.exists():
-        shutil.rmtree(staging, ignore_errors=True)
-        warnings.warn(f"removed {staging}, left by an interrupted run", ExciteWarning, stacklevel=3)
+    remove_stale(staging)
     try:
         with new_folders([path], field):
             try:
