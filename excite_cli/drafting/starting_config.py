@@ -49,11 +49,14 @@ def _mimics(path: Path) -> set[str]:
     return {j.get("name") for j in ET.parse(path).getroot().iter("joint") if j.find("mimic") is not None}
 
 
-def joint_choice(path: Path, given: list[str] | None, draft: StartingConfig) -> tuple[list[str], dict[str, float]]:
+def joint_choice(
+    path: Path, given: list[str] | None, draft: StartingConfig, model: pin.Model | None = None
+) -> tuple[list[str], dict[str, float]]:
     """The active joints of a starting config and the others held, with the assumption in ``draft``.
 
     Args:
         path: the URDF; given: the active joints, or None: every revolute joint that follows no other.
+        model: pinocchio's model of the URDF, when the caller has built it already.
 
     Returns:
         The active joints and {held joint: value} (0 moved inside its limits) [rad or m].
@@ -62,7 +65,7 @@ def joint_choice(path: Path, given: list[str] | None, draft: StartingConfig) -> 
         ExciteError: a given joint that is not a 1-DoF joint of the URDF; no joint given and no
             revolute joint to move (naming the joints there are).
     """
-    model = urdf_model(path)
+    model = urdf_model(path) if model is None else model
     one_dof = [n for i, n in enumerate(model.names) if i > 0 and model.joints[i].nq == 1]
     continuous = [n for i, n in enumerate(model.names) if i > 0 and model.joints[i].nq == 2 and model.joints[i].nv == 1]
     mimics = _mimics(path)
@@ -220,8 +223,8 @@ def draft_config(
         ExciteError: an unknown joint; no posture where every constraint holds at rest.
     """
     draft = StartingConfig({"robot": dict(robot)})
-    active, held = joint_choice(urdf, joints, draft)
     model = urdf_model(urdf)
+    active, held = joint_choice(urdf, joints, draft, model)
     floor = round(_base_floor(model, urdf, package_dirs), 4) + 0.0  # no -0
     draft.config["robot"].update(active_joints=active, locked_joints=held, home_posture={})
     draft.config["trajectory"] = dict(TRAJECTORY)
