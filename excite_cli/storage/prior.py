@@ -49,7 +49,7 @@ def read_prior(
         names = read_strings(f["robot"], "base_parameter_names") if "robot/base_parameter_names" in f else None
         effects = read_strings(f["robot"], "effect_names") if "robot/effect_names" in f else None
         if effect_names and "effect_regressor" in f:  # an identify report's effect columns, taken by name
-            prior = np.hstack([prior, _report_effects(f["effect_regressor"], effect_names, path)])
+            prior = np.hstack([prior, _report_effects(f["effect_regressor"], effect_names, path, len(prior))])
             effects = list(effect_names)
     columns = base.count + len(effect_names)
     if (effects is not None and list(effects) != list(effect_names)) or (effects is None and names and effect_names):
@@ -69,6 +69,12 @@ def read_prior(
     if not np.all(np.isfinite(prior)):
         raise ExciteError("sequence.prior", f"{path} contains NaN or infinite values")
     if measured is not None:
+        if len(prior) % measured.weights().size:
+            raise ExciteError(
+                "sequence.prior",
+                f"{path} has {len(prior)} regressor rows, not a whole number of instants of its "
+                f"{measured.weights().size} joints",
+            )
         weights = measured.weights() * measured.time_scale(cost_period)
         prior = (prior.reshape(-1, weights.size, prior.shape[1]) * weights[None, :, None]).reshape(prior.shape)
     if names is None:
@@ -79,11 +85,12 @@ def read_prior(
     return prior[:, order]
 
 
-def _report_effects(dataset, effect_names: Sequence[str], path: Path) -> np.ndarray:
-    """The columns ``effect_names`` of an identify report's ``/effect_regressor`` (M, e), by its names.
+def _report_effects(dataset, effect_names: Sequence[str], path: Path, rows: int) -> np.ndarray:
+    """The columns ``effect_names`` of an identify report's ``/effect_regressor`` (M, e), by its names;
+    M must be ``rows``, the report's ``/regressor`` rows.
 
     Raises:
-        ExciteError: a design effect the report did not identify.
+        ExciteError: a design effect the report did not identify, or a dataset of another shape.
     """
     held = [str(name) for name in dataset.attrs.get("names", [])]
     missing = [name for name in effect_names if name not in held]
@@ -93,5 +100,11 @@ def _report_effects(dataset, effect_names: Sequence[str], path: Path) -> np.ndar
             f"{path} holds the effect columns [{', '.join(held)}], not this design's {', '.join(missing)} (design "
             "for the report's own effects, effects.model, or leave those effects out)",
         )
-    rows = np.asarray(dataset[()], dtype=float)
-    return rows[:, [held.index(name) for name in effect_names]]
+    columns = np.asarray(dataset[()], dtype=float)
+    if columns.shape != (rows, len(held)):
+        shape = "x".join(str(n) for n in columns.shape)
+        raise ExciteError(
+            "sequence.prior",
+            f"{path} has /effect_regressor of shape {shape}; its /regressor and names need ({rows}, {len(held)})",
+        )
+    return columns[:, [held.index(name) for name in effect_names]]

@@ -165,6 +165,33 @@ def test_one_report_is_the_model_and_the_prior_data(report_file, tmp_path):
         read_prior(report_file, extra.base, extra.effect_names, extra.measured, 0.2)
 
 
+def test_a_report_whose_rows_do_not_match_is_refused_in_one_line(report_file, tmp_path):
+    """A hand-edited report: /effect_regressor with fewer rows than /regressor, then /regressor cut
+    to a row count that is no whole number of instants; each is refused naming the prior, not a
+    numpy error."""
+    import shutil
+
+    problem = load_problem(CONFIGS / "smoke.yaml")
+    problem.effects.model = problem.sequence.prior = str(report_file)
+    excitation = build_excitation(problem)
+    edited = tmp_path / "edited.h5"
+    shutil.copy(report_file, edited)
+    with h5py.File(edited, "a") as f:
+        names = f["effect_regressor"].attrs["names"]
+        short = f["effect_regressor"][()][:-7]
+        del f["effect_regressor"]
+        f.create_dataset("effect_regressor", data=short).attrs["names"] = names
+    args = (excitation.base, excitation.effect_names, excitation.measured, 0.2)
+    with pytest.raises(ExciteError, match=r"sequence\.prior.*effect_regressor of shape"):
+        read_prior(edited, *args)
+    with h5py.File(edited, "a") as f:
+        rows = f["regressor"][()][:-3]
+        del f["regressor"]
+        f["regressor"] = rows
+    with pytest.raises(ExciteError, match=r"sequence\.prior.*not a whole number of instants"):
+        read_prior(edited, excitation.base, (), excitation.measured, 0.2)
+
+
 def test_a_coupled_motor_and_an_offset_are_named_and_placed_as_a_design_has_them():
     """prior_rows of a two-joint dataset with a motor turning with both joints and an offset on the
     first: the names are those a design of the same model gives (effect_columns), the motor's block
