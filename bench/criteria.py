@@ -12,7 +12,10 @@ Then, for 5 noise seeds:
 - parameter error: the RMS over the b identifiable directions of L⁻¹(β̂ − β), the error in an
   orthonormal basis of the identifiable subspace of the standard parameters each scaled by its URDF
   magnitude (:mod:`excite_cli.optimization.information`; a value of 1 is an error as large as the
-  parameters themselves), and the largest such direction error;
+  parameters themselves), and the largest such direction error; beside it the error the noise
+  gives on average, without drawing any: √(trace(L⁻¹ (YᵀWᵀWY)⁻¹ L⁻ᵀ)/b), W the weights (the
+  standard deviations of weighted least squares; one seed's trajectories are then judged by what they
+  are, not by 5 draws of noise);
 - torque error: the identified model's torques on an unseen motion (a random feasible trajectory of
   the same problem, seed 12345, not in any sequence) against the true ones, relative RMS per joint,
   mean over joints.
@@ -66,8 +69,9 @@ def samples(excitation, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return Y, np.array([robot.torques(*x) for x in zip(Q, QD, QDD)])
 
 
-def in_the_loop(excitation, alphas: list[np.ndarray], unseen: np.ndarray) -> tuple[float, float, float]:
-    """Mean over noise seeds of the RMS and largest scaled parameter error, and the unseen torque error."""
+def in_the_loop(excitation, alphas: list[np.ndarray], unseen: np.ndarray) -> tuple[float, float, float, float]:
+    """Mean over noise seeds of the RMS and largest scaled parameter error, and the unseen torque error;
+    and the RMS parameter error the noise gives on average (predicted, no noise drawn)."""
     truth = excitation.base.from_standard(excitation.robot.urdf_parameters())
     Y_unseen, tau_unseen = samples(excitation, unseen)
     sigma = NOISE * np.sqrt((tau_unseen**2).mean(axis=0))  # (n,)
@@ -76,6 +80,8 @@ def in_the_loop(excitation, alphas: list[np.ndarray], unseen: np.ndarray) -> tup
     tau = np.vstack([t for _, t in data])
     weights = np.tile(1.0 / sigma, tau.shape[0])
     inverse_frame = np.linalg.inv(excitation.scaled_frame)
+    covariance = inverse_frame @ np.linalg.inv((Y * weights[:, None]).T @ (Y * weights[:, None])) @ inverse_frame.T
+    expected = float(np.sqrt(np.trace(covariance) / covariance.shape[0]))
     rms, worst, torque = [], [], []
     for seed in range(SEEDS):
         noisy = tau + np.random.default_rng(seed).normal(0.0, 1.0, tau.shape) * sigma
@@ -85,7 +91,7 @@ def in_the_loop(excitation, alphas: list[np.ndarray], unseen: np.ndarray) -> tup
         worst.append(np.abs(error).max())
         predicted = (Y_unseen @ estimate).reshape(tau_unseen.shape)
         torque.append(np.mean(np.sqrt(((predicted - tau_unseen) ** 2).mean(axis=0) / (tau_unseen**2).mean(axis=0))))
-    return float(np.mean(rms)), float(np.mean(worst)), float(np.mean(torque))
+    return float(np.mean(rms)), float(np.mean(worst)), float(np.mean(torque)), expected
 
 
 def run(config: Path, objective: str, scaling: str, seed: int) -> tuple:
@@ -116,21 +122,22 @@ def main() -> None:
     parser.add_argument("--criteria", nargs="+", default=[f"{o}:{s}" for o, s in CRITERIA] + ["random:none"])
     parser.add_argument("--seeds", type=int, nargs="+", default=[0])
     args = parser.parse_args()
-    header = f"{'criterion':<22} {'cond(C)':>8} {'cond(CL)':>9} {'e [Nm]':>8} {'param err RMS':>14} {'worst dir.':>11} {'unseen torque':>14} {'wall [s]':>9}"
+    header = f"{'criterion':<22} {'cond(C)':>8} {'cond(CL)':>9} {'e [Nm]':>8} {'param err RMS':>14} {'worst dir.':>11} {'unseen torque':>14} {'predicted':>10} {'wall [s]':>9}"
     for config in args.configs:
         print(f"\n{config.name}, optimizer seeds {args.seeds} (means)\n{header}")
         for criterion in args.criteria:
             objective, scaling = criterion.split(":")
             rows = np.array([run(config, objective, scaling, seed) for seed in args.seeds])
-            cond, scaled, level, rms, worst, torque, wall = rows.mean(axis=0)
+            cond, scaled, level, rms, worst, torque, predicted, wall = rows.mean(axis=0)
             label = objective if objective in ("random", "log_det") else f"{objective}, {scaling}"
             print(
-                f"{label:<22} {cond:>8.1f} {scaled:>9.0f} {level:>8.4f} {rms:>14.2%} {worst:>11.1%} {torque:>14.3%} {wall:>9.0f}",
+                f"{label:<22} {cond:>8.1f} {scaled:>9.0f} {level:>8.4f} {rms:>14.2%} {worst:>11.1%} {torque:>14.3%} {predicted:>10.2%} {wall:>9.0f}",
                 flush=True,
             )
             if len(args.seeds) > 1:
                 print(
-                    f"{'  per seed':<22} param err {' '.join(f'{x:.2%}' for x in rows[:, 3])}; torque {' '.join(f'{x:.3%}' for x in rows[:, 5])}"
+                    f"{'  per seed':<22} param err {' '.join(f'{x:.2%}' for x in rows[:, 3])}; torque {' '.join(f'{x:.3%}' for x in rows[:, 5])}; "
+                    f"predicted {' '.join(f'{x:.2%}' for x in rows[:, 6])}"
                 )
 
 

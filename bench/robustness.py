@@ -1,6 +1,7 @@
 """Does `excite optimize` end every restart at a result, on any arm and any seed? The sequential
-generation of each robot's config (its iterations, restarts and screening, the default criterion),
-for several seeds, on every core.
+generation of each robot's config (its iterations, restarts and screening) with excite's default
+criterion, whatever the config names (the Panda's and UR5's name the paper's log cond), for several
+seeds, on every core.
 
 Robots: the shipped G1 arms, Panda, UR5 and UR10 with a lab's limits (configs/ur10_lab.yaml), and the
 configs `excite init` writes for the UR10, UR3, xArm 7 and Unitree Z1 of example-robot-data, as it
@@ -37,6 +38,7 @@ from pathlib import Path
 
 import numpy as np
 
+from excite_cli.config import OptimizerConfig
 from excite_cli.config_file import load_problem
 from excite_cli.optimization.engine import Engine, default_workers
 from excite_cli.optimization.excitation import build_excitation
@@ -44,6 +46,7 @@ from excite_cli.optimization.optimality import CONVERGED
 from excite_cli.optimization.sequence import run_sequence
 
 ROOT = Path(__file__).resolve().parent.parent
+DEFAULT_OBJECTIVE = OptimizerConfig.model_fields["objective"].default
 SHIPPED = {
     "G1": ROOT / "configs" / "g1_arms.yaml",
     "Panda": ROOT / "configs" / "panda.yaml",
@@ -75,6 +78,7 @@ def run_robot(robot: str, config: Path, seeds: list[int]) -> str:
     for seed in seeds:
         problem = load_problem(config)
         problem.optimizer.seed = seed
+        problem.optimizer.objective = DEFAULT_OBJECTIVE
         excitation = build_excitation(problem)
         workers = min(default_workers(), problem.optimizer.screened or problem.optimizer.restarts)
         begin = time.perf_counter()
