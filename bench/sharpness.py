@@ -24,8 +24,8 @@ import excite_cli.constraints.lse as lse
 from excite_cli.config_file import load_problem
 from excite_cli.memory import keep_freed_memory
 from excite_cli.optimization.excitation import build_excitation
+from excite_cli.optimization.nlp import Evaluations
 from excite_cli.optimization.optimality import kkt_optimality
-from excite_cli.optimization.optimizer import _Evaluations
 from excite_cli.optimization.restarts import RestartTask
 from excite_cli.optimization.solvers import solve
 
@@ -35,7 +35,7 @@ def first_converged(excitation, seed: int, iterations: int, every: int, toleranc
     at the end, wall time [s]) of one restart at the current β."""
     criterion = excitation.criterion(np.zeros((0, excitation.base.count)))
     start = excitation.random_start(RestartTask(1, 0, seed, np.zeros((0, excitation.base.count))).rng())
-    problem = _Evaluations(criterion, excitation.constraints, excitation.boundary, criterion.value(start))
+    problem = Evaluations(criterion, excitation.constraints, excitation.boundary, criterion.value(start))
     seen, met = [0], [None, np.nan]
     begin = time.perf_counter()
 

@@ -123,7 +123,7 @@ class OptimizerConfig(Section):
     scaling: Literal["none", "urdf"] = "none"
     """`none`: the criterion of C (the paper's); `urdf`: of C L, which does not depend on the base columns."""
     max_iterations: int = Field(200, ge=1, le=100_000)
-    """Solver iterations per restart."""
+    """Solver iterations per restart at most (a restart stops earlier once it meets optimality_tolerance)."""
     tolerance: float = Field(1e-6, gt=0.0)
     """The solver's own tolerance [1] (SLSQP ftol, trust-constr gtol, IPOPT tol)."""
     optimality_tolerance: float = Field(1e-3, gt=0.0)
@@ -137,7 +137,8 @@ class OptimizerConfig(Section):
     screen_iterations: int = Field(30, ge=1, le=100_000)
     """Solver iterations of each screened start."""
     time_budget: float = Field(300.0, gt=0.0, le=604_800.0)
-    """Wall time [s] an iteration whose restarts all failed may spend on more starts before the run stops."""
+    """Wall time [s] an iteration may spend: its solver runs stop there, and, when every restart failed,
+    more starts run until then before the run stops."""
     workers: Optional[int] = Field(None, ge=1, le=MAX_WORKERS)
     """Local processes the restarts run in (default: the machine's cores)."""
     scheduler: Optional[str] = None

@@ -5,8 +5,9 @@ The solver (``optimizer.method``, :mod:`excite_cli.optimization.solvers`) works 
 analytic gradients. Quasi-Newton iterates of this problem approach the constraint boundary from
 outside (on the G1 problem SLSQP's iterates stay up to 3 cm outside the CoM region for most of
 the run), so a restart ends at the feasible point nearest to the solver's last iterate
-(:func:`project`): what the restart found is then judged by a point every constraint accepts, with
-its first-order optimality (:mod:`excite_cli.optimization.optimality`) and an honest stop reason.
+(:func:`~excite_cli.optimization.nlp.project`): what the restart found is then judged by a point
+every constraint accepts, with its first-order optimality (:mod:`excite_cli.optimization.optimality`)
+and an honest stop reason.
 """
 
 from __future__ import annotations
@@ -16,22 +17,23 @@ from dataclasses import dataclass, field
 from typing import Callable, Optional, Sequence
 
 import numpy as np
-from scipy.optimize import minimize
 
 from excite_cli.config import OptimizerConfig
 from excite_cli.constraints import Constraint, accepted, farthest_accepted
+from excite_cli.constraints.lse import GRID_MARGIN
 from excite_cli.optimization.criterion import Criterion
-from excite_cli.optimization.optimality import INFEASIBLE, SOLVER_FAILED, Optimality, kkt_optimality, stop_reason
+from excite_cli.optimization.nlp import Evaluations, project
+from excite_cli.optimization.optimality import INFEASIBLE, SOLVER_FAILED, Optimality, stop_reason
 from excite_cli.optimization.solvers import solve
 from excite_cli.trajectory.boundary import BoundaryConditions
 from excite_cli.trajectory.fourier import FourierBasis
 
 #: Progress hook: (restart index, solver iteration, objective at the current iterate).
 ProgressHook = Callable[[int, int, float], None]
-#: SLSQP iterations of the projection onto the feasible set (it converges in 10-50 on the G1 problem).
-PROJECTION_ITERATIONS = 60
 #: Bisection steps towards a feasible point (the segment's length / 2¹²).
 BISECTIONS = 12
+#: The solver's iterate is tested against the KKT tolerance (and the time limit) every this many iterations.
+CHECK_EVERY = 10
 
 
 @dataclass(frozen=True)
@@ -111,101 +113,26 @@ def repair(
     return feasible + farthest_accepted(constraints, feasible, alpha, steps) * (alpha - feasible)
 
 
-class _Evaluations:
-    """The solver's callbacks in its variables z: the objective, its gradient, the stacked constraint
-    values and their Jacobian, each computed once per point and only when asked for (a line search's
-    trial points need values only); remembers the best point whose aggregated constraints all hold.
+def _until_done(
+    problem: Evaluations, on_iterate: Callable[[np.ndarray], None], tolerance: float, deadline: float
+) -> Callable[[np.ndarray], None]:
+    """The solver's callback: ``on_iterate(z)``, then every ``CHECK_EVERY`` iterations StopIteration
+    (which every solver honours) once the iterate is inside every aggregated constraint (up to the
+    aggregation's margin) and its KKT residual is at most ``tolerance``, or ``deadline``
+    (``time.perf_counter``) has passed."""
+    count = [0]
 
-    Attributes:
-        best_value: the lowest objective at such a point (``start_value`` until one is seen).
-        best_inside: its α (n, 2N+1), or None.
-    """
+    def callback(z: np.ndarray) -> None:
+        on_iterate(z)
+        count[0] += 1
+        if count[0] % CHECK_EVERY:
+            return
+        if time.perf_counter() > deadline:
+            raise StopIteration
+        if problem.constraint_values(z).max() <= GRID_MARGIN and problem.kkt(z).residual <= tolerance:
+            raise StopIteration
 
-    def __init__(
-        self, criterion: Criterion, constraints: Sequence[Constraint], boundary: BoundaryConditions, start_value: float
-    ):
-        self.criterion, self.all, self.boundary = criterion, constraints, boundary
-        self.best_value, self.best_inside = start_value, None
-        self._last: dict[str, tuple[bytes, object]] = {}
-
-    def _once(self, name: str, z: np.ndarray, compute: Callable[[], object]):
-        """``compute()``, or what it gave at the same z the last time ``name`` was asked for."""
-        key = z.tobytes()
-        if name not in self._last or self._last[name][0] != key:
-            self._last[name] = (key, compute())
-        return self._last[name][1]
-
-    def value(self, z: np.ndarray) -> float:
-        """The criterion at z."""
-
-        def compute() -> float:
-            alpha = self.boundary.to_alpha(z)
-            value = self.criterion.value(alpha)
-            if (
-                value < (self.best_value if self.best_inside is not None else np.inf)
-                and self.constraint_values(z).max() <= 0.0
-            ):
-                self.best_value, self.best_inside = value, alpha.copy()
-            return value
-
-        return self._once("value", z, compute)
-
-    def gradient(self, z: np.ndarray) -> np.ndarray:
-        """The criterion's gradient in z (n_z,)."""
-        return self._once(
-            "gradient",
-            z,
-            lambda: self.boundary.chain(self.criterion.value_and_gradient(self.boundary.to_alpha(z))[1].ravel()),
-        )
-
-    def constraint_values(self, z: np.ndarray) -> np.ndarray:
-        """Stacked constraint values g (m,)."""
-        alpha = self.boundary.to_alpha(z)
-        return self._once("values", z, lambda: np.concatenate([c.values(alpha) for c in self.all]))
-
-    def constraint_jacobian(self, z: np.ndarray) -> np.ndarray:
-        """Their Jacobian in z (m, n_z)."""
-        alpha = self.boundary.to_alpha(z)
-        return self._once("jacobian", z, lambda: self.boundary.chain(np.vstack([c.jacobian(alpha) for c in self.all])))
-
-    def objective(self, z: np.ndarray) -> tuple[float, np.ndarray]:
-        """The criterion and its gradient in z."""
-        return self.value(z), self.gradient(z)
-
-    def constraints(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Stacked values g (m,) and Jacobian in z."""
-        return self.constraint_values(z), self.constraint_jacobian(z)
-
-    def optimality(self, alpha: np.ndarray) -> Optimality:
-        """First-order optimality at α (n, 2N+1), in the variables z."""
-        z = self.boundary.to_variables(alpha)
-        return kkt_optimality(self.gradient(z), *self.constraints(z))
-
-
-def project(problem: _Evaluations, z: np.ndarray, iterations: int = PROJECTION_ITERATIONS) -> Optional[np.ndarray]:
-    """The feasible point nearest to z (n_z,) in the optimizer's (preconditioned) variables:
-    argmin ½‖y − z‖² s.t. g(y) ≤ 0, by SLSQP from z (a convex objective: it converges where the
-    criterion's problem does not), then the constraints' own exact repairs. Returns its α (n, 2N+1)
-    if every constraint accepts it, else None."""
-    result = minimize(
-        lambda y: (0.5 * float((y - z) @ (y - z)), y - z),
-        z,
-        jac=True,
-        method="SLSQP",
-        constraints=[
-            {
-                "type": "ineq",
-                "fun": lambda y: -problem.constraint_values(y),
-                "jac": lambda y: -problem.constraint_jacobian(y),
-            }
-        ],
-        options={"maxiter": iterations, "ftol": 1e-12},
-    )
-    alpha = problem.boundary.to_alpha(result.x)
-    for c in problem.all:
-        alpha = c.restore(alpha)
-    alpha = problem.boundary.project(alpha)
-    return alpha if accepted(problem.all, alpha) else None
+    return callback
 
 
 def optimize_restart(
@@ -218,14 +145,21 @@ def optimize_restart(
     progress: Optional[ProgressHook] = None,
     max_iterations: Optional[int] = None,
     fine_basis: Optional[FourierBasis] = None,
+    time_limit: Optional[float] = None,
 ) -> RestartResult:
     """Minimize the criterion over α with ``options.method`` from one feasible start.
+
+    The solver stops at its own convergence test, at ``max_iterations``, or, tested every
+    ``CHECK_EVERY`` iterations (:func:`_until_done`), at an iterate inside the constraints that meets
+    ``options.optimality_tolerance`` (the KKT residual the result is judged by) or once ``time_limit``
+    has passed.
 
     The solver works on the variables z of ``boundary`` (α = s ⊙ (w* + Z z): the boundary conditions
     hold exactly, with diagonal preconditioning s, see :mod:`excite_cli.trajectory.boundary`); everything else
     sees α. The restart ends with the best of: the start, the best iterate whose aggregated
-    constraints were all ≤ 0, and the feasible point nearest to the last iterate (:func:`project`;
-    if the projection fails, :func:`repair`); each is confirmed by every constraint's exact grid check.
+    constraints were all ≤ 0, and the feasible point nearest to the last iterate
+    (:func:`~excite_cli.optimization.nlp.project`; if the projection fails, :func:`repair`); each is
+    confirmed by every constraint's exact grid check.
     The one kept is confirmed on ``fine_basis`` too, the re-check its result is judged by (the grid
     margin covers the overshoot between grid instants, but not always): where that check fails, it
     is moved towards the start until the check holds (bisection, as in :func:`repair`).
@@ -241,10 +175,11 @@ def optimize_restart(
         progress: called after every solver iteration with the objective at the iterate.
         max_iterations: solver iterations (default ``options.max_iterations``).
         fine_basis: the basis of the fine re-check (default: none).
+        time_limit: wall time [s] after which the solver stops (default: none).
     """
     begin = time.perf_counter()
     start_value = criterion.value(start)
-    problem = _Evaluations(criterion, constraints, boundary, start_value)
+    problem = Evaluations(criterion, constraints, boundary, start_value)
     history: list[tuple[float, float]] = []
 
     def on_iterate(z: np.ndarray) -> None:
@@ -258,7 +193,9 @@ def optimize_restart(
         boundary.to_variables(start),
         max_iterations or options.max_iterations,
         options.tolerance,
-        on_iterate,
+        _until_done(
+            problem, on_iterate, options.optimality_tolerance, begin + (np.inf if time_limit is None else time_limit)
+        ),
     )
     if len(history) < run.iterations:  # a solver that ends inside an iteration calls back no more: its last iterate
         on_iterate(run.z)

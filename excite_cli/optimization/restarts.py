@@ -28,6 +28,7 @@ class RestartTask:
         warm_start: (n, 2N+1) accepted α to start from instead of a random start (a screened start
             that continues), or None.
         iterations: solver iterations (default ``optimizer.max_iterations``).
+        time_limit: wall time [s] after which its solver stops (default: none).
     """
 
     iteration: int
@@ -36,6 +37,7 @@ class RestartTask:
     prior: np.ndarray
     warm_start: Optional[np.ndarray] = None
     iterations: Optional[int] = None
+    time_limit: Optional[float] = None
 
     def rng(self) -> np.random.Generator:
         """The restart's own random generator."""
@@ -54,6 +56,7 @@ class RestartTask:
             progress,
             self.iterations,
             excitation.fine_basis,
+            self.time_limit,
         )
 
 
@@ -74,6 +77,9 @@ def run_restarts(
     the others are kept with the stop reason ``screened out``. Which ones continue depends only on
     the screened results, so it does not depend on where they ran.
 
+    Every solver run stops once ``optimizer.time_budget`` seconds have passed since the iteration
+    began (its time limit is what remains of the budget when its round begins).
+
     When none succeeded, more starts run, as many at a time as the first round, each screened and
     continued the same way, until one succeeds or ``optimizer.time_budget`` seconds have passed since
     the iteration began. Each start's seed depends only on its index, so where it succeeds does not
@@ -86,9 +92,10 @@ def run_restarts(
     opts = excitation.problem.optimizer
     count = opts.screened or opts.restarts
     deadline = time.perf_counter() + opts.time_budget
-    runs = _restart_round(excitation, engine, k, seed, prior, range(count), hook)
+    runs = _restart_round(excitation, engine, k, seed, prior, range(count), hook, deadline)
     while not any(r.succeeded for r in runs) and time.perf_counter() < deadline:
-        runs += _restart_round(excitation, engine, k, seed, prior, range(len(runs), len(runs) + count), hook)
+        more = range(len(runs), len(runs) + count)
+        runs += _restart_round(excitation, engine, k, seed, prior, more, hook, deadline)
     return runs
 
 
@@ -100,18 +107,21 @@ def _restart_round(
     prior: np.ndarray,
     indices: range,
     hook: Optional[ProgressHook],
+    deadline: float,
 ) -> list[RestartResult]:
     """The starts ``indices`` of iteration k, screened and continued as :func:`run_restarts` says."""
     opts = excitation.problem.optimizer
     iterations = min(opts.screen_iterations, opts.max_iterations) if opts.screened else None
-    tasks = [RestartTask(k, r, seed, prior, None, iterations) for r in indices]
+    tasks = [RestartTask(k, r, seed, prior, None, iterations, _left(deadline)) for r in indices]
     runs = engine.run(tasks, hook, (lambda r: hook(r.index, r.iterations, r.objective)) if hook else None)
     if not opts.screened or iterations >= opts.max_iterations:
         return runs
     chosen = sorted((r for r in runs if r.succeeded), key=lambda r: (r.objective, r.index))[: opts.restarts]
     if not chosen:  # every screened start failed: nothing to continue
         return runs
-    more = [RestartTask(k, r.index, seed, prior, r.alpha, opts.max_iterations - iterations) for r in chosen]
+    more = [
+        RestartTask(k, r.index, seed, prior, r.alpha, opts.max_iterations - iterations, _left(deadline)) for r in chosen
+    ]
     shift = indices.stop  # continuations count on their own in the progress
     shifted = (lambda r, it, value: hook(shift + r, it, value)) if hook else None
     continued = {
@@ -123,6 +133,11 @@ def _restart_round(
         _joined(screened[r.index], continued[r.index]) if r.index in continued else replace(r, stop="screened out")
         for r in runs
     ]
+
+
+def _left(deadline: float) -> float:
+    """Seconds left until ``deadline`` (``time.perf_counter``), at least 0."""
+    return max(0.0, deadline - time.perf_counter())
 
 
 def _joined(screen: RestartResult, more: RestartResult) -> RestartResult:

@@ -34,7 +34,7 @@ from excite_cli.errors import ExciteError
 #: The methods of ``optimizer.method``.
 METHODS = ("SLSQP", "trust-constr", "ipopt")
 
-#: Called with each accepted iterate z of the solver.
+#: Called with each accepted iterate z of the solver; raising StopIteration ends the run there.
 IterateHook = Callable[[np.ndarray], None]
 #: The largest component [1] of the scaled criterion's gradient at the start: a first step along it
 #: moves no joint's q, q̇ or q̈ by more than a tenth of its half-range (the variables are scaled so
@@ -131,8 +131,10 @@ def _slsqp(nlp: NLP, z0: np.ndarray, max_iterations: int, tolerance: float, on_i
         options={"maxiter": max_iterations, "ftol": tolerance},
         callback=lambda z, *_: on_iterate(z),
     )
-    # scipy's SLSQP exit modes: 0 converged (ftol), 9 iteration limit, anything else a failure
-    return SolverRun(result.x, int(result.nit), str(result.message), result.status == 9, result.status not in (0, 9))
+    # scipy's SLSQP exit modes: 0 converged (ftol), 9 iteration limit, 99 stopped by on_iterate, others failures
+    return SolverRun(
+        result.x, int(result.nit), str(result.message), result.status in (9, 99), result.status not in (0, 9, 99)
+    )
 
 
 def _trust_constr(
@@ -149,8 +151,8 @@ def _trust_constr(
         options={"maxiter": max_iterations, "gtol": tolerance, "xtol": 1e-10},
         callback=lambda z, *_: on_iterate(z),
     )
-    # trust-constr's status: 0 iteration limit, 1 gtol met, 2 xtol met (steps too small)
-    return SolverRun(result.x, int(result.nit), str(result.message), result.status == 0, False)
+    # trust-constr's status: 0 iteration limit, 1 gtol met, 2 xtol met (steps too small), 3 stopped by on_iterate
+    return SolverRun(result.x, int(result.nit), str(result.message), result.status in (0, 3), False)
 
 
 def _ipopt(nlp: NLP, z0: np.ndarray, max_iterations: int, tolerance: float, on_iterate: IterateHook) -> SolverRun:
@@ -181,7 +183,10 @@ def _ipopt(nlp: NLP, z0: np.ndarray, max_iterations: int, tolerance: float, on_i
         def intermediate(self, _mode, iteration, *_):
             if iteration > 0:  # IPOPT evaluates f last at the trial point it accepts
                 count[0] = iteration
-                on_iterate(last[0])
+                try:
+                    on_iterate(last[0])
+                except StopIteration:
+                    return False  # IPOPT's User_Requested_Stop (5)
             return True
 
     m = nlp.constraint_values(z0).size
@@ -199,5 +204,6 @@ def _ipopt(nlp: NLP, z0: np.ndarray, max_iterations: int, tolerance: float, on_i
     z, info = problem.solve(z0)
     status = int(info["status"])
     message = info["status_msg"].decode() if isinstance(info["status_msg"], bytes) else str(info["status_msg"])
-    # IPOPT's status: 0 solved, 1 solved to an acceptable level, -1 iteration limit, others failures
-    return SolverRun(np.asarray(z), count[0], message, status == -1, status not in (0, 1, -1))
+    # IPOPT's status: 0 solved, 1 solved to an acceptable level, -1 iteration limit, 5 stopped by on_iterate,
+    # others failures
+    return SolverRun(np.asarray(z), count[0], message, status in (-1, 5), status not in (0, 1, -1, 5))

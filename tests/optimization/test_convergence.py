@@ -16,6 +16,7 @@ from excite_cli.cli import app
 from excite_cli.config_file import load_problem
 from excite_cli.constraints import accepted
 from excite_cli.optimization.excitation import build_excitation
+from excite_cli.optimization.nlp import Evaluations, project
 from excite_cli.optimization.optimality import (
     ACTIVE_TOLERANCE,
     CONVERGED,
@@ -26,7 +27,7 @@ from excite_cli.optimization.optimality import (
     kkt_optimality,
     stop_reason,
 )
-from excite_cli.optimization.optimizer import _Evaluations, project, repair
+from excite_cli.optimization.optimizer import repair
 
 runner = CliRunner()
 
@@ -114,6 +115,26 @@ def test_a_restart_reported_converged_meets_its_tolerance(tmp_path):
     assert converged >= 1  # the smooth D-optimal criterion converges on this small problem
 
 
+def test_a_restart_stops_where_it_meets_the_kkt_tolerance_or_its_time_limit(tmp_path):
+    """With the solver's own test out of play (ftol 1e-14), a restart on the small problem stops at
+    a check (every CHECK_EVERY iterations) whose iterate meets the KKT tolerance, not at its 300
+    iterations; its end point meets the tolerance by central differences. With no time left it
+    stops at the first check."""
+    from excite_cli.optimization.optimizer import CHECK_EVERY
+    from excite_cli.optimization.restarts import RestartTask
+
+    problem = load_problem(_small_problem(tmp_path, "log_det"))
+    problem.optimizer.tolerance = 1e-14
+    excitation = build_excitation(problem)
+    prior = np.zeros((0, excitation.base.count))
+    result = RestartTask(1, 0, 1, prior)(excitation)
+    assert result.stop == CONVERGED and "StopIteration" in result.message
+    assert result.iterations < 300
+    assert _fd_kkt(excitation, prior, result.alpha) <= 1.01 * problem.optimizer.optimality_tolerance
+    hurried = RestartTask(1, 0, 1, prior, time_limit=0.0)(excitation)
+    assert hurried.iterations <= CHECK_EVERY + 1 and hurried.stop != CONVERGED and hurried.succeeded
+
+
 def test_projection_ends_inside_and_nearer_than_bisection(ur5_problem):
     excitation = build_excitation(ur5_problem)
     start = excitation.random_start(np.random.default_rng(3))
@@ -122,7 +143,7 @@ def test_projection_ends_inside_and_nearer_than_bisection(ur5_problem):
     outside = excitation.boundary.project(outside)
     assert not accepted(excitation.constraints, outside)
     criterion = excitation.criterion()
-    problem = _Evaluations(criterion, excitation.constraints, excitation.boundary, criterion.value(start))
+    problem = Evaluations(criterion, excitation.constraints, excitation.boundary, criterion.value(start))
     z = excitation.boundary.to_variables(outside)
     projected = project(problem, z)
     assert projected is not None and accepted(excitation.constraints, projected)

@@ -1,0 +1,118 @@
+"""The optimization problem as a solver sees it: the criterion and the stacked constraints in the
+optimizer's variables z (:mod:`excite_cli.trajectory.boundary`), each evaluated once per point, and
+the feasible point nearest to a solver's iterate."""
+
+from __future__ import annotations
+
+from typing import Callable, Optional, Sequence
+
+import numpy as np
+from scipy.optimize import minimize
+
+from excite_cli.constraints import Constraint, accepted
+from excite_cli.optimization.criterion import Criterion
+from excite_cli.optimization.optimality import Optimality, kkt_optimality
+from excite_cli.trajectory.boundary import BoundaryConditions
+
+#: SLSQP iterations of the projection onto the feasible set (it converges in 10-50 on the G1 problem).
+PROJECTION_ITERATIONS = 60
+
+
+class Evaluations:
+    """The solver's callbacks in its variables z: the objective, its gradient, the stacked constraint
+    values and their Jacobian, each computed once per point and only when asked for (a line search's
+    trial points need values only); remembers the best point whose aggregated constraints all hold.
+
+    Attributes:
+        best_value: the lowest objective at such a point (``start_value`` until one is seen).
+        best_inside: its α (n, 2N+1), or None.
+    """
+
+    def __init__(
+        self, criterion: Criterion, constraints: Sequence[Constraint], boundary: BoundaryConditions, start_value: float
+    ):
+        self.criterion, self.all, self.boundary = criterion, constraints, boundary
+        self.best_value, self.best_inside = start_value, None
+        self._last: dict[str, tuple[bytes, object]] = {}
+
+    def _once(self, name: str, z: np.ndarray, compute: Callable[[], object]):
+        """``compute()``, or what it gave at the same z the last time ``name`` was asked for."""
+        key = z.tobytes()
+        if name not in self._last or self._last[name][0] != key:
+            self._last[name] = (key, compute())
+        return self._last[name][1]
+
+    def value(self, z: np.ndarray) -> float:
+        """The criterion at z."""
+
+        def compute() -> float:
+            alpha = self.boundary.to_alpha(z)
+            value = self.criterion.value(alpha)
+            if (
+                value < (self.best_value if self.best_inside is not None else np.inf)
+                and self.constraint_values(z).max() <= 0.0
+            ):
+                self.best_value, self.best_inside = value, alpha.copy()
+            return value
+
+        return self._once("value", z, compute)
+
+    def gradient(self, z: np.ndarray) -> np.ndarray:
+        """The criterion's gradient in z (n_z,)."""
+        return self._once(
+            "gradient",
+            z,
+            lambda: self.boundary.chain(self.criterion.value_and_gradient(self.boundary.to_alpha(z))[1].ravel()),
+        )
+
+    def constraint_values(self, z: np.ndarray) -> np.ndarray:
+        """Stacked constraint values g (m,)."""
+        alpha = self.boundary.to_alpha(z)
+        return self._once("values", z, lambda: np.concatenate([c.values(alpha) for c in self.all]))
+
+    def constraint_jacobian(self, z: np.ndarray) -> np.ndarray:
+        """Their Jacobian in z (m, n_z)."""
+        alpha = self.boundary.to_alpha(z)
+        return self._once("jacobian", z, lambda: self.boundary.chain(np.vstack([c.jacobian(alpha) for c in self.all])))
+
+    def objective(self, z: np.ndarray) -> tuple[float, np.ndarray]:
+        """The criterion and its gradient in z."""
+        return self.value(z), self.gradient(z)
+
+    def constraints(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Stacked values g (m,) and Jacobian in z."""
+        return self.constraint_values(z), self.constraint_jacobian(z)
+
+    def optimality(self, alpha: np.ndarray) -> Optimality:
+        """First-order optimality at α (n, 2N+1), in the variables z."""
+        return self.kkt(self.boundary.to_variables(alpha))
+
+    def kkt(self, z: np.ndarray) -> Optimality:
+        """First-order optimality at z (n_z,)."""
+        return kkt_optimality(self.gradient(z), *self.constraints(z))
+
+
+def project(problem: Evaluations, z: np.ndarray, iterations: int = PROJECTION_ITERATIONS) -> Optional[np.ndarray]:
+    """The feasible point nearest to z (n_z,) in the optimizer's (preconditioned) variables:
+    argmin ½‖y − z‖² s.t. g(y) ≤ 0, by SLSQP from z (a convex objective: it converges where the
+    criterion's problem does not), then the constraints' own exact repairs. Returns its α (n, 2N+1)
+    if every constraint accepts it, else None."""
+    result = minimize(
+        lambda y: (0.5 * float((y - z) @ (y - z)), y - z),
+        z,
+        jac=True,
+        method="SLSQP",
+        constraints=[
+            {
+                "type": "ineq",
+                "fun": lambda y: -problem.constraint_values(y),
+                "jac": lambda y: -problem.constraint_jacobian(y),
+            }
+        ],
+        options={"maxiter": iterations, "ftol": 1e-12},
+    )
+    alpha = problem.boundary.to_alpha(result.x)
+    for c in problem.all:
+        alpha = c.restore(alpha)
+    alpha = problem.boundary.project(alpha)
+    return alpha if accepted(problem.all, alpha) else None
