@@ -137,8 +137,7 @@ class OptimizerConfig(Section):
     screen_iterations: int = Field(30, ge=1, le=100_000)
     """Solver iterations of each screened start."""
     time_budget: float = Field(300.0, gt=0.0, le=604_800.0)
-    """Wall time [s] an iteration may spend: its solver runs stop there, and, when every restart failed,
-    more starts run until then before the run stops."""
+    """Wall time [s] an iteration may spend: its solver runs stop there; if all fail, more starts run until then."""
     workers: Optional[int] = Field(None, ge=1, le=MAX_WORKERS)
     """Local processes the restarts run in (default: the machine's cores)."""
     scheduler: Optional[str] = None
