@@ -69,13 +69,12 @@ def read_prior(
     if not np.all(np.isfinite(prior)):
         raise ExciteError("sequence.prior", f"{path} contains NaN or infinite values")
     if measured is not None:
-        if len(prior) % measured.weights().size:
+        weights = measured.weights() * measured.time_scale(cost_period)
+        if len(prior) % weights.size:
             raise ExciteError(
                 "sequence.prior",
-                f"{path} has {len(prior)} regressor rows, not a whole number of instants of its "
-                f"{measured.weights().size} joints",
+                f"{path} has {len(prior)} regressor rows, not a whole number of instants of its {weights.size} joints",
             )
-        weights = measured.weights() * measured.time_scale(cost_period)
         prior = (prior.reshape(-1, weights.size, prior.shape[1]) * weights[None, :, None]).reshape(prior.shape)
     if names is None:
         return prior
