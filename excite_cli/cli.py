@@ -159,7 +159,7 @@ def verify_gradient(
     result: Optional[Path] = typer.Option(
         None, "--result", "-r", help="Also check at the last optimum of this result."
     ),
-    step: float = typer.Option(1e-6, help="Finite-difference step [rad]."),
+    step: float = typer.Option(1e-6, help="Finite-difference step (rad)."),
     seed: int = typer.Option(0, help="Seed of the random α."),
     objective: Optional[list[str]] = typer.Option(
         None, "--objective", help=f"Criteria (repeatable; default all: {', '.join(OBJECTIVES)})."
@@ -204,7 +204,7 @@ def identify(
 def export(
     result: Path = typer.Argument(..., help="An optimize (or compare-random) HDF5 result."),
     iteration: Optional[int] = typer.Option(None, "--iteration", "-k", help="Iteration (default: the last)."),
-    rate: float = typer.Option(1000.0, "--rate", help="Controller rate [Hz]."),
+    rate: float = typer.Option(1000.0, "--rate", help="Controller rate (Hz)."),
     periods: int = typer.Option(1, "--periods", help="Periods to play."),
     fmt: str = typer.Option("csv", "--format", help=f"File format: {' or '.join(FORMATS)}."),
     force: bool = FORCE,
