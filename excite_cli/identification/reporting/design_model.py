@@ -194,6 +194,11 @@ def prior_rows(parts: list[Dataset], terms: list[Term], joints: list[str]) -> Pr
 
     Args:
         parts: datasets with the blocks of ``terms``; joints: the active joints (n), in the rows' order.
+
+    Returns:
+        Per part, (M_k, b) base regressor rows and (M_k, e) effect columns: the prior data C₀ of the
+        paper's sequential generation (Eq. 41) once :func:`~excite_cli.storage.prior.read_prior` weighs
+        them as identification did.
     """
     names: list[str] = []
     columns: list[list[np.ndarray]] = [[] for _ in parts]
