@@ -181,11 +181,24 @@ def segment_closest_points(
     """Closest points c1 on segment [p1, q1] and c2 on [p2, q2] [m], vectorized: every array has its
     coordinates on the first axis, (3, ...) (contiguous coordinate planes are faster here).
 
-    Ericson, Real-Time Collision Detection, 2005, Sec. 5.1.9, degenerate (point) segments included.
+    Ericson, Real-Time Collision Detection, 2005, Sec. 5.1.9 (:func:`segment_parameters`).
     The distance of two capsules is |c2 − c1| minus their radii, its normal (c2 − c1)/|c2 − c1|.
     """
-    d1, d2, r = q1 - p1, q2 - p2, p1 - p2
-    a, e, f, c, b = _dot(d1, d1), _dot(d2, d2), _dot(d2, r), _dot(d1, r), _dot(d1, d2)
+    d1, d2 = q1 - p1, q2 - p2
+    s, t = segment_parameters(p1 - p2, d1, d2, _dot(d1, d1), _dot(d2, d2))
+    return p1 + s * d1, p2 + t * d2
+
+
+def segment_parameters(
+    r: np.ndarray, d1: np.ndarray, d2: np.ndarray, a: np.ndarray, e: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Where the closest points of two segments p1 + s·d1 and p2 + t·d2 lie, s, t in [0, 1], from
+    r = p1 − p2 and the directions d1, d2 (3, ...) [m] and their squared lengths a = |d1|², e = |d2|²
+    (broadcastable to (...)) [m²], which a caller with rigid segments knows once and for all.
+
+    Ericson, Real-Time Collision Detection, 2005, Sec. 5.1.9, degenerate (point) segments included.
+    """
+    f, c, b = _dot(d2, r), _dot(d1, r), _dot(d1, d2)
     tiny = 1e-12
     safe_a, safe_e = np.where(a > tiny, a, 1.0), np.where(e > tiny, e, 1.0)
     denom = a * e - b * b
@@ -196,7 +209,7 @@ def segment_closest_points(
     # degenerate segments: the first a point (s = 0), the second a point (t = 0), or both
     s = np.where(a <= tiny, 0.0, np.where(e <= tiny, np.clip(-c / safe_a, 0.0, 1.0), s))
     t = np.where(e <= tiny, 0.0, np.where(a <= tiny, np.clip(f / safe_e, 0.0, 1.0), t))
-    return p1 + s * d1, p2 + t * d2
+    return s, t
 
 
 def _dot(x: np.ndarray, y: np.ndarray) -> np.ndarray:

@@ -93,11 +93,11 @@ class ComRegion(Constraint):
         r, data = self.robot, self._data
         configurations = np.tile(r.q_reference, (len(Q), 1))
         configurations[:, r.q_idx] = Q
-        P, J = np.empty((len(Q), 2)), np.empty((len(Q), 2, r.n_joints))
+        P, J = np.empty((len(Q), 3)), np.empty((len(Q), 3, r.model.nv))
         for t, q in enumerate(configurations):  # Robot.com's pinocchio calls, without its per-call set-up
-            J[t] = pin.jacobianCenterOfMass(r.model, data, q, False).reshape(3, r.model.nv)[:2, r.v_idx]
-            P[t] = data.com[0][:2]
-        return P, J
+            J[t] = pin.jacobianCenterOfMass(r.model, data, q, False)
+            P[t] = data.com[0]
+        return P[:, :2], J[:, :2, r.v_idx]
 
     def _normalized(self, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """s (T, K) and ∂s/∂p (T, K, 2)."""

@@ -20,4 +20,9 @@ ACCEPT_MARGIN = GRID_MARGIN / 2.0
 
 def smooth_max(values: np.ndarray, axis: int | tuple[int, ...]) -> tuple[np.ndarray, np.ndarray]:
     """Aggregate g over ``axis`` of ``values`` and the weights ∂g/∂values (shaped like ``values``)."""
-    return logsumexp(SHARPNESS * values, axis=axis) / SHARPNESS + GRID_MARGIN, softmax(SHARPNESS * values, axis=axis)
+    return smooth_max_value(values, axis), softmax(SHARPNESS * values, axis=axis)
+
+
+def smooth_max_value(values: np.ndarray, axis: int | tuple[int, ...]) -> np.ndarray:
+    """The aggregated g of :func:`smooth_max` alone (a line search's trial points need no weights)."""
+    return logsumexp(SHARPNESS * values, axis=axis) / SHARPNESS + GRID_MARGIN

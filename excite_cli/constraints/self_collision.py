@@ -3,7 +3,7 @@ safety margin over the constraint grid.
 
 In the optimizer, every (instant, pair) distance is computed at once in vectorized numpy: the joint
 placements at all grid instants (:class:`~excite_cli.dynamics.kinematics.BatchKinematics`), each capsule's
-segment, and the closest points of the two segments in closed form (``segment_closest_points``);
+segment, and the closest points of the two segments in closed form (``segment_parameters``);
 the capsule distance is d = |c₂ − c₁| − r₁ − r₂ with normal n = (c₂ − c₁)/|c₂ − c₁|. It varies as
 ∂d = nᵀ(J_{c₂} − J_{c₁}) ∂q, J_c the velocity Jacobian of the closest point fixed to its body
 (``BatchKinematics.distance_rates``). Per pair, s_t = (margin − d_t) / L with L = ``LENGTH_SCALE``
@@ -17,9 +17,9 @@ from __future__ import annotations
 import coal
 import numpy as np
 
-from excite_cli.collision.capsules import Capsule, capsule_frames, segment_closest_points, segment_ends
+from excite_cli.collision.capsules import Capsule, capsule_frames, segment_ends, segment_parameters
 from excite_cli.constraints.constraint import Constraint, FineCheck
-from excite_cli.constraints.lse import ACCEPT_MARGIN, smooth_max
+from excite_cli.constraints.lse import ACCEPT_MARGIN, smooth_max, smooth_max_value
 from excite_cli.dynamics.kinematics import BatchKinematics
 from excite_cli.dynamics.robot import Robot
 from excite_cli.trajectory.fourier import FourierBasis
@@ -28,6 +28,8 @@ from excite_cli.trajectory.fourier import FourierBasis
 LENGTH_SCALE = 0.05
 #: The fine check asks coal for every sample screened within this of the smallest distance [m].
 CONFIRM = 1e-3
+#: Instants screened at a time: a fine grid's (3, T, P) arrays at once outgrow the processor's caches.
+BLOCK = 512
 
 
 def aggregated_distances(
@@ -106,8 +108,11 @@ class SelfCollision(Constraint):
         return result
 
     def distances(self, Q: np.ndarray) -> np.ndarray:
-        """Distances (T, P) [m] of every kept capsule pair at the configurations Q (T, n) (closed form)."""
-        return self._closest_points(Q)[0]
+        """Distances (T, P) [m] of every kept capsule pair at the configurations Q (T, n) (closed form),
+        ``BLOCK`` instants at a time."""
+        if len(Q) <= BLOCK:
+            return self._closest(Q)[0]
+        return np.concatenate([self._closest_points(Q[k : k + BLOCK])[0] for k in range(0, len(Q), BLOCK)])
 
     def _closest(self, Q: np.ndarray) -> tuple[np.ndarray, ...]:
         """At the configurations Q (T, n): distances d (T, P) [m], the closest points c₁ (3, T, P) of
@@ -122,8 +127,12 @@ class SelfCollision(Constraint):
         """:meth:`_closest`, computed."""
         start, end, R, p = segment_ends(self.kinematics, self.capsules, Q)
         i, j = self._first, self._second
-        c1, c2 = segment_closest_points(start[..., i], end[..., i], start[..., j], end[..., j])
-        gap = c2 - c1
+        d = end - start  # per capsule, then per pair: (3, T, C) before (3, T, P)
+        squared = d[0] ** 2 + d[1] ** 2 + d[2] ** 2
+        p1, p2, d1, d2 = start[..., i], start[..., j], d[..., i], d[..., j]
+        s, t = segment_parameters(p1 - p2, d1, d2, squared[:, i], squared[:, j])
+        c1 = p1 + s * d1
+        gap = (p2 + t * d2) - c1
         length = np.sqrt(gap[0] ** 2 + gap[1] ** 2 + gap[2] ** 2)
         return length - self._radii[i] - self._radii[j], c1, gap / np.maximum(length, 1e-12), R, p
 
@@ -141,7 +150,7 @@ class SelfCollision(Constraint):
         """The aggregated values of :meth:`evaluate` (P,) without the Jacobian."""
         if not self.pairs:
             return np.zeros(0)
-        return smooth_max((self.margin - self._closest(self.basis.q @ alpha.T)[0]) / LENGTH_SCALE, axis=0)[0]
+        return smooth_max_value((self.margin - self._closest(self.basis.q @ alpha.T)[0]) / LENGTH_SCALE, axis=0)
 
     track_units = {"min_capsule_distance": "m"}
 
@@ -149,18 +158,20 @@ class SelfCollision(Constraint):
         """``min_capsule_distance``: (T,) smallest distance over the pairs at each instant [m]."""
         if not self.pairs:
             return {}
-        return {"min_capsule_distance": self._closest(basis.q @ alpha.T)[0].min(axis=1)}
+        return {"min_capsule_distance": self.distances(basis.q @ alpha.T).min(axis=1)}
 
     def check_samples(self, time: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> FineCheck:
         """Smallest distance over the postures q (T, n) and all pairs: the screen locates it, coal
         gives it (for every sample screened within ``CONFIRM`` of the smallest)."""
         if not self.pairs:
             return FineCheck(max_violation=-np.inf, details={}, where="no capsule pair")
-        screened, _, _, R, p = self._closest(q)
-        rotations, centres = capsule_frames(R, p, self.capsules)
+        screened = self.distances(q)
+        times, pairs = np.nonzero(screened <= screened.min() + CONFIRM)
+        instants = np.unique(times)  # the placements of those instants alone
+        rotations, centres = capsule_frames(*self.kinematics.placements(q[instants]), self.capsules)
         best, where = np.inf, (0, 0)
-        for t, p in zip(*np.nonzero(screened <= screened.min() + CONFIRM)):
-            d = self._distance(rotations, centres, t, p).min_distance
+        for t, p in zip(times, pairs):
+            d = self._distance(rotations, centres, int(np.searchsorted(instants, t)), p).min_distance
             if d < best:
                 best, where = d, (t, p)
         i, j = self.pairs[where[1]]

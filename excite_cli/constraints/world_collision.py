@@ -23,7 +23,7 @@ import pinocchio as pin
 from excite_cli.collision.capsules import Capsule, capsule_frames, segment_closest_points, segment_ends
 from excite_cli.config import EnvironmentConfig
 from excite_cli.constraints.constraint import Constraint, FineCheck
-from excite_cli.constraints.lse import ACCEPT_MARGIN, smooth_max
+from excite_cli.constraints.lse import ACCEPT_MARGIN, smooth_max_value
 from excite_cli.constraints.self_collision import LENGTH_SCALE, aggregated_distances
 from excite_cli.dynamics.kinematics import BatchKinematics
 from excite_cli.dynamics.robot import Robot
@@ -213,7 +213,7 @@ class WorldCollision(Constraint):
         """The aggregated values of :meth:`evaluate` (P,) without the Jacobian."""
         if not self.pairs:
             return np.zeros(0)
-        return smooth_max((self._margin - self._closest(self.basis.q @ alpha.T)[0]) / LENGTH_SCALE, axis=0)[0]
+        return smooth_max_value((self._margin - self._closest(self.basis.q @ alpha.T)[0]) / LENGTH_SCALE, axis=0)
 
     def track(self, alpha: np.ndarray, basis: FourierBasis) -> dict[str, np.ndarray]:
         """``min_world_distance``: (T,) the smallest distance over (capsule, shape) at each instant [m]."""

@@ -64,6 +64,8 @@ def test_closed_form_distances_and_witness_points_equal_coal(robot, request):
     assert isinstance(constraint, SelfCollision)
     Q = excitation.grid_basis.q @ _lively(excitation, 3).T
     d, c1, normal, _, _ = constraint._closest(Q)
+    alpha = _lively(excitation, 3)
+    assert np.array_equal(constraint.values(alpha), constraint.evaluate(alpha)[0])  # values alone: the same g
     rotations, centres = capsule_frames(*constraint.kinematics.placements(Q), constraint.capsules)
     radii = np.array([c.radius for c in constraint.capsules])
     for t in range(0, d.shape[0], 7):

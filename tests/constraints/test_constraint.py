@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from excite_cli.constraints.constraint import Constraint, FineCheck, accepted, farthest_accepted
-from excite_cli.constraints.lse import ACCEPT_MARGIN, GRID_MARGIN, SHARPNESS, smooth_max
+from excite_cli.constraints.lse import ACCEPT_MARGIN, GRID_MARGIN, SHARPNESS, smooth_max, smooth_max_value
 
 
 class Ball(Constraint):
@@ -41,4 +41,5 @@ def test_smooth_max_never_underestimates_and_overshoots_by_at_most_log_count_ove
     assert np.all(g >= values.max(axis=0) + GRID_MARGIN - 1e-15)
     assert np.all(g <= values.max(axis=0) + GRID_MARGIN + np.log(50) / SHARPNESS)
     np.testing.assert_allclose(weights.sum(axis=0), 1.0)
+    assert np.array_equal(smooth_max_value(values, axis=0), g)  # the values-only path gives the same g
     assert ACCEPT_MARGIN == GRID_MARGIN / 2
