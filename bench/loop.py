@@ -27,9 +27,12 @@ relative standard deviation (from the weighted information matrix, no noise draw
 and the last lines, one per robot: `loop ROBOT: effects error blind X %, designed Y %; base error blind
 X %, designed Y %` (means over the seeds). ``--design`` designs (b) with another criterion (and
 scaling), e.g. ``log_trace_inverse:urdf``, A-optimality in the URDF-scaled frame: the sum of the
-relative variances.
+relative variances. ``--effects-weight K`` divides the effect coefficients' magnitudes in that frame
+by K, so each effect's relative variance counts K² times a base parameter's: how far a design that
+asks for the effects above all can take them.
 
     .venv/bin/python bench/loop.py [--robots G1 Panda] [--seeds 0 1 2] [--design OBJECTIVE:SCALING]
+        [--effects-weight K]
 
 Asserts nothing.
 """
@@ -38,6 +41,7 @@ from __future__ import annotations
 
 import argparse
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -100,9 +104,9 @@ def predicted_std(runs: list[tuple[np.ndarray, np.ndarray]], sigma: np.ndarray) 
     return np.sqrt(np.diag(np.linalg.inv((Y * w[:, None]).T @ (Y * w[:, None]))))
 
 
-def loop(config: Path, seed: int, design_criterion: tuple[str, str] | None = None) -> tuple:
+def loop(config: Path, seed: int, design_criterion: tuple[str, str] | None = None, weight: float = 1.0) -> tuple:
     """(a) and (b)'s errors of one seed, and the wall time; (b) designed with ``design_criterion``
-    (objective, scaling), default the config's."""
+    (objective, scaling), default the config's, the effects' magnitudes in its frame divided by ``weight``."""
     begin = time.perf_counter()
     problem = load_problem(config)
     problem.optimizer.seed = seed
@@ -117,6 +121,9 @@ def loop(config: Path, seed: int, design_criterion: tuple[str, str] | None = Non
     if design_criterion is not None:
         design.optimizer.objective, design.optimizer.scaling = design_criterion
     designer = build_excitation(design) if design_criterion is not None else model
+    if weight != 1.0:
+        emphasis = np.concatenate([np.ones(model.base.count), np.full(model.effects.count, 1.0 / weight)])
+        designer = replace(designer, scaled_frame=designer.scaled_frame * emphasis)
     effort = model.robot.model.effortLimit[model.robot.v_idx]
     magnitudes = model.effects.magnitudes(effort, model.limits.upper[1], model.limits.upper[2])
     truth = np.concatenate([model.base.from_standard(model.robot.urdf_parameters()), magnitudes])
@@ -143,13 +150,14 @@ def main() -> None:
     parser.add_argument("--robots", nargs="+", default=list(ROBOTS), choices=list(ROBOTS))
     parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
     parser.add_argument("--design", default=None, help="OBJECTIVE:SCALING of (b), e.g. log_trace_inverse:urdf")
+    parser.add_argument("--effects-weight", type=float, default=1.0, help="K: (b)'s effect magnitudes divided by K")
     args = parser.parse_args()
     design = tuple(args.design.split(":")) if args.design else None
     lines = []
     for robot in args.robots:
         results = []
         for seed in args.seeds:
-            a, b, wall = loop(ROBOTS[robot], seed, design)
+            a, b, wall = loop(ROBOTS[robot], seed, design, args.effects_weight)
             results.append((a, b))
             print(
                 f"  {robot} seed {seed}: effects {a[0]:.2%} / {b[0]:.2%}, base {a[1]:.3%} / {b[1]:.3%}, "
