@@ -194,7 +194,8 @@ def segment_parameters(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Where the closest points of two segments p1 + s·d1 and p2 + t·d2 lie, s, t in [0, 1], from
     r = p1 − p2 and the directions d1, d2 (3, ...) [m] and their squared lengths a = |d1|², e = |d2|²
-    (broadcastable to (...)) [m²], which a caller with rigid segments knows once and for all.
+    (broadcastable to (...)) [m²], which a caller pairing few segments many ways computes once per
+    segment (:class:`~excite_cli.constraints.self_collision.SelfCollision`: per capsule, not per pair).
 
     Ericson, Real-Time Collision Detection, 2005, Sec. 5.1.9, degenerate (point) segments included.
     """
