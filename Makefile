@@ -8,10 +8,10 @@ CONFIG ?= configs/g1_arms.yaml
 
 install: $(STAMP)
 
-$(STAMP): pyproject.toml
+$(STAMP): pyproject.toml constraints.txt
 	python3 -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e ".[test,mujoco,docs]"
+	$(PY) -m pip install --quiet -c constraints.txt -e ".[test,mujoco,docs]"
 	$(MAKE) --no-print-directory ipopt
 	touch $(STAMP)
 
@@ -22,7 +22,7 @@ ipopt:
 	@pkg-config --exists ipopt 2>/dev/null || { [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null && \
 	  apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq \
 	  coinor-libipopt-dev liblapack-dev libblas-dev pkg-config >/dev/null; } || true
-	@if pkg-config --exists ipopt 2>/dev/null; then $(PY) -m pip install --quiet -e ".[ipopt]"; \
+	@if pkg-config --exists ipopt 2>/dev/null; then $(PY) -m pip install --quiet -c constraints.txt -e ".[ipopt]"; \
 	  else echo "IPOPT not found: optimizer.method 'ipopt' is unavailable (SLSQP, the default, works)"; fi
 
 optimize: $(STAMP)

@@ -7,6 +7,10 @@ The optimize result is kept in results/bench_<config>.h5.
 
 from __future__ import annotations
 
+import excite_cli  # noqa: F401  (before NumPy: the kernels of the command line, excite_cli/kernels.py)
+
+# isort: split
+
 import subprocess
 import sys
 import time

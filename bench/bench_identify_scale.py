@@ -6,6 +6,10 @@ is read from the OS. Usage: python bench/bench_identify_scale.py [ROWS ...] (def
 
 from __future__ import annotations
 
+import excite_cli  # noqa: F401  (before NumPy: the kernels of the command line, excite_cli/kernels.py)
+
+# isort: split
+
 import subprocess
 import sys
 import tempfile

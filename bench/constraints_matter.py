@@ -7,6 +7,10 @@ Run: `.venv/bin/python bench/constraints_matter.py [CONFIG]` (default configs/g1
 
 from __future__ import annotations
 
+import excite_cli  # noqa: F401  (before NumPy: the kernels of the command line, excite_cli/kernels.py)
+
+# isort: split
+
 import copy
 import sys
 from pathlib import Path

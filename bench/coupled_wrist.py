@@ -17,6 +17,10 @@ validation error of the identified model and of the true model fitted on the sam
 
 from __future__ import annotations
 
+import excite_cli  # noqa: F401  (before NumPy: the kernels of the command line, excite_cli/kernels.py)
+
+# isort: split
+
 import tempfile
 from pathlib import Path
 

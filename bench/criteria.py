@@ -31,6 +31,10 @@ means over the seeds). Asserts nothing.
 
 from __future__ import annotations
 
+import excite_cli  # noqa: F401  (before NumPy: the kernels of the command line, excite_cli/kernels.py)
+
+# isort: split
+
 import argparse
 import time
 from pathlib import Path

@@ -23,6 +23,10 @@ declared, fitted by weighted least squares on the same data) where there is one;
 
 from __future__ import annotations
 
+import excite_cli  # noqa: F401  (before NumPy: the kernels of the command line, excite_cli/kernels.py)
+
+# isort: split
+
 import sys
 import tempfile
 from pathlib import Path

@@ -11,6 +11,10 @@ capsules; links the config says the plane ignores are reported apart). the figur
 
 from __future__ import annotations
 
+import excite_cli  # noqa: F401  (before NumPy: the kernels of the command line, excite_cli/kernels.py)
+
+# isort: split
+
 import subprocess
 import sys
 import tempfile

@@ -10,6 +10,10 @@ Prints a table.
 
 from __future__ import annotations
 
+import excite_cli  # noqa: F401  (before NumPy: the kernels of the command line, excite_cli/kernels.py)
+
+# isort: split
+
 import copy
 import sys
 import tempfile

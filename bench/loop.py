@@ -39,6 +39,10 @@ Asserts nothing.
 
 from __future__ import annotations
 
+import excite_cli  # noqa: F401  (before NumPy: the kernels of the command line, excite_cli/kernels.py)
+
+# isort: split
+
 import argparse
 import time
 from dataclasses import replace

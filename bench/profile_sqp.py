@@ -11,6 +11,10 @@ Run: `.venv/bin/python bench/profile_sqp.py [CONFIG] [ITERATIONS]`. Prints table
 
 from __future__ import annotations
 
+import excite_cli  # noqa: F401  (before NumPy: the kernels of the command line, excite_cli/kernels.py)
+
+# isort: split
+
 import sys
 import time
 from collections import defaultdict

@@ -29,6 +29,10 @@ Asserts nothing. The identification of each seed's trajectories is bench/criteri
 
 from __future__ import annotations
 
+import excite_cli  # noqa: F401  (before NumPy: the kernels of the command line, excite_cli/kernels.py)
+
+# isort: split
+
 import argparse
 import subprocess
 import sys

@@ -14,6 +14,10 @@ picked (threadpoolctl) is printed first: other processors round otherwise.
 
 from __future__ import annotations
 
+import excite_cli  # noqa: F401  (before NumPy: the kernels of the command line, excite_cli/kernels.py)
+
+# isort: split
+
 import argparse
 import hashlib
 import os

@@ -15,6 +15,10 @@ and every difference; exits 1 when there is one.
 
 from __future__ import annotations
 
+import excite_cli  # noqa: F401  (before NumPy: the kernels of the command line, excite_cli/kernels.py)
+
+# isort: split
+
 import argparse
 import os
 import subprocess

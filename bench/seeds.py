@@ -12,6 +12,10 @@ stop reason and KKT residual per iteration, and the wall time; then the median a
 
 from __future__ import annotations
 
+import excite_cli  # noqa: F401  (before NumPy: the kernels of the command line, excite_cli/kernels.py)
+
+# isort: split
+
 import argparse
 import os
 import subprocess

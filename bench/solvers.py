@@ -8,6 +8,10 @@ residual at the end point, the stop reason, the solver's iterations and the wall
 
 from __future__ import annotations
 
+import excite_cli  # noqa: F401  (before NumPy: the kernels of the command line, excite_cli/kernels.py)
+
+# isort: split
+
 import argparse
 import time
 from pathlib import Path

@@ -9,6 +9,10 @@ The screenshots are kept beside the result for a person to look at.
 
 from __future__ import annotations
 
+import excite_cli  # noqa: F401  (before NumPy: the kernels of the command line, excite_cli/kernels.py)
+
+# isort: split
+
 import shutil
 import subprocess
 import sys

@@ -18,6 +18,7 @@ import numpy as np
 from excite_cli.atomic import atomic_bytes
 from excite_cli.errors import ExciteError
 from excite_cli.inputs import input_file
+from excite_cli.kernels import describe
 
 #: Rows written at once by :func:`write_parts` (16 chunks of 4096; a few MB).
 WRITE_ROWS = 65536
@@ -27,7 +28,8 @@ VERSIONED_PACKAGES = ("excite", "pin", "coal", "numpy", "scipy", "h5py", "exampl
 @contextmanager
 def atomic_h5(path: Path, field: str = "output") -> Iterator[h5py.File]:
     """An HDF5 file built in memory, with its creation time (UTC, ISO 8601) and the versions of the
-    packages results depend on as root attributes, then written whole by :func:`atomic_bytes`. HDF5
+    packages results depend on and the kernels it computed with (:func:`~excite_cli.kernels.describe`) as
+    root attributes, then written whole by :func:`atomic_bytes`. HDF5
     never writes to the disk itself: its write errors (a full disk) end in a crash or in unraisable
     errors at close, Python's in one :class:`CannotWrite`.
 
@@ -39,6 +41,7 @@ def atomic_h5(path: Path, field: str = "output") -> Iterator[h5py.File]:
         f.attrs["created"] = datetime.now(timezone.utc).isoformat(timespec="seconds")
         for name, version in package_versions().items():
             f.attrs[f"version_{name}"] = version
+        f.attrs["kernels"] = describe()
         yield f
     with buffer.getbuffer() as view:  # the file's bytes without a copy of them (it can be most of the memory)
         atomic_bytes(path, view, field)

@@ -293,7 +293,8 @@ def test_offsets_per_run_and_a_known_payload(tmp_path, optimized):
 
 
 def test_identify_command_writes_report_and_prior(tmp_path, optimized):
-    _simulate(tmp_path, optimized, {"coulomb": {"*": 0.5}})
+    # viscous friction on one joint: every search (declared, Coulomb, Coulomb and viscous) must move
+    _simulate(tmp_path, optimized, {"coulomb": {"*": 0.5}, "viscous": {"panda_joint4": 0.3}})
     config = yaml.safe_load((tmp_path / "identify.yaml").read_text())
     config["identification"] = {"declared_effects": {"panda_joint1": ["viscous"]}}  # not in the data
     result = runner.invoke(

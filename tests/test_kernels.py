@@ -1,0 +1,64 @@
+"""The common kernels: which processors get them, and that NumPy loaded after excite computes with them."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+
+import pytest
+
+from excite_cli.kernels import ABOVE_AVX2, CORETYPE, common_kernels, cpu_flags
+
+HASWELL = {"avx2", "fma", "sse4_2"}
+#: exp and a matrix product of fixed numbers, their bits, under the kernels the subprocess loads.
+PROBE = """
+import json, os, sys
+if sys.argv[1] == "excite":
+    import excite_cli  # noqa: F401
+import numpy as np
+from threadpoolctl import threadpool_info
+x = np.linspace(-30.0, 30.0, 4001)
+a = np.sin(np.arange(60 * 60.0)).reshape(60, 60)
+print(json.dumps({"exp": np.exp(x).tobytes().hex(), "mm": (a @ a @ a).tobytes().hex(),
+                  "blas": sorted({i["architecture"] for i in threadpool_info() if i["internal_api"] == "openblas"})}))
+"""
+
+
+def _probe(first: str, env: dict[str, str]) -> dict:
+    clean = {k: v for k, v in os.environ.items() if k not in ("OPENBLAS_CORETYPE", "NPY_DISABLE_CPU_FEATURES")}
+    out = subprocess.run(
+        [sys.executable, "-c", PROBE, first], env={**clean, **env}, capture_output=True, text=True, check=True
+    )
+    return json.loads(out.stdout)
+
+
+def test_only_x86_64_with_avx2_and_fma_gets_them_and_a_choice_of_the_user_wins():
+    both = {"OPENBLAS_CORETYPE": CORETYPE, "NPY_DISABLE_CPU_FEATURES": ABOVE_AVX2}
+    assert common_kernels({}, "x86_64", HASWELL) == both
+    assert common_kernels({}, "AMD64", HASWELL | {"avx512f"}) == both
+    assert common_kernels({}, "x86_64", {"sse4_2", "avx"}) == {}  # no AVX2: its own kernels
+    assert common_kernels({}, "aarch64", HASWELL) == {}
+    for name in ("OPENBLAS_CORETYPE", "NPY_DISABLE_CPU_FEATURES", "EXCITE_NATIVE_KERNELS"):
+        assert common_kernels({name: "x"}, "x86_64", HASWELL) == {}
+
+
+def test_cpu_flags_reads_linux_s_list(tmp_path):
+    info = tmp_path / "cpuinfo"
+    info.write_text("processor\t: 0\nflags\t\t: fpu sse2 avx2 fma\nbugs\t\t: none\n")
+    assert cpu_flags(str(info)) == {"fpu", "sse2", "avx2", "fma"}
+    assert cpu_flags(str(tmp_path / "missing")) == set()
+
+
+@pytest.mark.skipif(not common_kernels({}, "x86_64", cpu_flags()), reason="the processor has no AVX2 and FMA")
+def test_numpy_loaded_after_excite_computes_as_with_the_kernels_asked_for_by_hand():
+    """Importing excite first gives the bits of OpenBLAS's Haswell kernels and NumPy without AVX-512
+    asked for explicitly; on a processor with AVX-512 its own kernels give other bits."""
+    by_hand = _probe("numpy", {"OPENBLAS_CORETYPE": CORETYPE, "NPY_DISABLE_CPU_FEATURES": ABOVE_AVX2})
+    excite = _probe("excite", {})
+    assert excite == by_hand and excite["blas"] == [CORETYPE]
+    native = _probe("numpy", {"EXCITE_NATIVE_KERNELS": "1"})
+    if "avx512f" in cpu_flags():
+        assert native["blas"] != [CORETYPE] and (native["exp"], native["mm"]) != (excite["exp"], excite["mm"])
+    assert _probe("excite", {"EXCITE_NATIVE_KERNELS": "1"}) == native  # the opt-out keeps them
