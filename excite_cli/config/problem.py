@@ -98,8 +98,9 @@ class OptimizerConfig(Section):
     tolerance and the first-order optimality tolerance a restart must meet to count as converged
     (:mod:`excite_cli.optimization.optimality`), seed, restarts, the random starts screened for
     ``screen_iterations`` before the best ``restarts`` continue (``starts``, default: no
-    screening), and where restarts run (``workers`` local processes, default the machine's cores;
-    or a Dask ``scheduler`` address: a run stops after ``worker_wait`` seconds without any worker)."""
+    screening), the runs the kept restart continues by until it converges (``polish_rounds``), and
+    where restarts run (``workers`` local processes, default the machine's cores; or a Dask
+    ``scheduler`` address: a run stops after ``worker_wait`` seconds without any worker)."""
 
     @property
     def screened(self) -> int:
@@ -108,13 +109,15 @@ class OptimizerConfig(Section):
 
     @property
     def planned_iterations(self) -> int:
-        """Solver iterations one sequential iteration runs at most (all starts and restarts)."""
+        """Solver iterations one sequential iteration runs at most (all starts and restarts, and the kept
+        restart's polish rounds)."""
         screen = min(self.screen_iterations, self.max_iterations)
-        return (
+        runs = (
             self.screened * screen + self.restarts * (self.max_iterations - screen)
             if self.screened
             else self.restarts * self.max_iterations
         )
+        return runs + self.polish_rounds * self.max_iterations
 
     method: Literal["SLSQP", "trust-constr", "ipopt"] = "SLSQP"
     """The solver: `SLSQP`, `trust-constr` or `ipopt`."""
@@ -136,6 +139,8 @@ class OptimizerConfig(Section):
     """Screening: this many starts run screen_iterations, the best `restarts` go on (default: none)."""
     screen_iterations: int = Field(30, ge=1, le=100_000)
     """Solver iterations of each screened start."""
+    polish_rounds: int = Field(3, ge=0, le=100)
+    """Runs of max_iterations the kept restart continues by, each from a fresh quasi-Newton matrix, until converged."""
     time_budget: float = Field(300.0, gt=0.0, le=604_800.0)
     """Wall time [s] an iteration may spend: its solver runs stop there; if all fail, more starts run until then."""
     workers: Optional[int] = Field(None, ge=1, le=MAX_WORKERS)

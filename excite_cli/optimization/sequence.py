@@ -1,5 +1,6 @@
 """Sequential generation (Section IV-B): iteration i optimizes with C₀ = [C_prior; C⁽¹⁾; …; C⁽ⁱ⁻¹⁾],
-keeps the best restart the robot can play (:func:`kept_restart`), and describes it."""
+continues the best restart the robot can play until it converges (:func:`~excite_cli.optimization.restarts.polish`),
+keeps it (:func:`kept_restart`), and describes it."""
 
 from __future__ import annotations
 
@@ -15,7 +16,7 @@ from excite_cli.optimization.engine import Engine
 from excite_cli.optimization.excitation import Excitation
 from excite_cli.optimization.optimizer import ProgressHook, RestartResult, best_restart
 from excite_cli.optimization.playback import check_motion, plan_playback
-from excite_cli.optimization.restarts import run_restarts
+from excite_cli.optimization.restarts import polish, run_restarts
 from excite_cli.trajectory.similarity import correlation
 
 
@@ -227,7 +228,8 @@ def run_sequence(
     results: list[IterationResult] = list(finished)
     for k in range(len(finished) + 1, iterations + 1):
         start, stacked = time.perf_counter(), stacked_regressors(excitation, prior, results)
-        runs = run_restarts(excitation, engine, k, seed, stacked, progress(k) if progress else None)
+        hook = progress(k) if progress else None
+        runs = run_restarts(excitation, engine, k, seed, stacked, hook)
         if not any(r.succeeded for r in runs):
             failures = sorted({f"{r.stop} ({r.end})" for r in runs})
             raise NoSolution(
@@ -236,6 +238,8 @@ def run_sequence(
                 f"{excitation.problem.optimizer.time_budget:g} s ({', '.join(failures)})",
                 expected="more starts or a longer optimizer.time_budget, or limits that leave the robot room",
             )
+        deadline = start + excitation.problem.optimizer.time_budget
+        runs = polish(excitation, engine, k, seed, stacked, runs, kept_restart(excitation, runs).index, deadline, hook)
         best = kept_restart(excitation, runs)
         result = describe(excitation, k, best.alpha, stacked, time.perf_counter() - start, runs, results, best.index)
         results.append(result)

@@ -4,6 +4,7 @@ reasons, restarts stored and printed, a restart reported as converged meets its 
 set that ends every restart."""
 
 import copy
+import time
 
 import h5py
 import numpy as np
@@ -133,6 +134,35 @@ def test_a_restart_stops_where_it_meets_the_kkt_tolerance_or_its_time_limit(tmp_
     assert _fd_kkt(excitation, prior, result.alpha) <= 1.01 * problem.optimizer.optimality_tolerance
     hurried = RestartTask(1, 0, 1, prior, time_limit=0.0)(excitation)
     assert hurried.iterations <= CHECK_EVERY + 1 and hurried.stop != CONVERGED and hurried.succeeded
+
+
+def test_the_kept_restart_continues_from_a_fresh_matrix_until_it_converges(tmp_path):
+    """A restart stopped at 15 iterations short of the tolerance, polished in rounds of 15: each round
+    starts at the end point of the one before (iterations and history joined), none ends higher, and
+    the last converges, its KKT residual recomputed by central differences. A converged restart, or
+    polish_rounds 0, is left as it is."""
+    from excite_cli.optimization.engine import Engine
+    from excite_cli.optimization.restarts import RestartTask, polish
+
+    problem = load_problem(_small_problem(tmp_path, "log_det"))
+    opts = problem.optimizer
+    opts.max_iterations, opts.polish_rounds = 15, 20
+    excitation = build_excitation(problem)
+    prior = np.zeros((0, excitation.base.count))
+    first = RestartTask(1, 0, 1, prior)(excitation)
+    assert first.succeeded and first.stop != CONVERGED and first.iterations == 15
+    deadline = time.perf_counter() + 600.0
+    with Engine(excitation) as serial:
+        polished = polish(excitation, serial, 1, 1, prior, [first], 0, deadline)[0]
+        assert polish(excitation, serial, 1, 1, prior, [polished], 0, deadline)[0] is polished
+        opts.polish_rounds = 0
+        assert polish(excitation, serial, 1, 1, prior, [first], 0, deadline)[0] is first
+    assert polished.stop == CONVERGED and polished.objective < first.objective
+    assert polished.iterations > 15 and polished.history.shape == (polished.iterations, 2)
+    np.testing.assert_array_equal(polished.history[:15], first.history)
+    assert polished.start_objective == first.start_objective and polished.index == 0
+    assert _fd_kkt(excitation, prior, polished.alpha) <= 1.01 * opts.optimality_tolerance
+    assert accepted(excitation.constraints, polished.alpha)
 
 
 def test_projection_ends_inside_and_nearer_than_bisection(ur5_problem):

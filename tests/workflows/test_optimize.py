@@ -107,13 +107,11 @@ def test_prior_rows_are_stacked_first(result, tmp_path):
 
 def test_interrupted_run_keeps_finished_iterations(tmp_path, monkeypatch):
     real = Engine.run
-    calls = []
 
-    def interrupt_second(*args, **kwargs):
-        calls.append(1)
-        if len(calls) == 2:
+    def interrupt_second(self, tasks, *args, **kwargs):  # Ctrl-C once iteration 2's restarts run
+        if tasks[0].iteration == 2:
             raise KeyboardInterrupt
-        return real(*args, **kwargs)
+        return real(self, tasks, *args, **kwargs)
 
     monkeypatch.setattr(Engine, "run", interrupt_second)
     out = tmp_path / "cut.h5"
