@@ -28,10 +28,10 @@ VERSIONED_PACKAGES = ("excite", "pin", "coal", "numpy", "scipy", "h5py", "exampl
 @contextmanager
 def atomic_h5(path: Path, field: str = "output") -> Iterator[h5py.File]:
     """An HDF5 file built in memory, with its creation time (UTC, ISO 8601) and the versions of the
-    packages results depend on and the kernels it computed with (:func:`~excite_cli.kernels.describe`) as
-    root attributes, then written whole by :func:`atomic_bytes`. HDF5
-    never writes to the disk itself: its write errors (a full disk) end in a crash or in unraisable
-    errors at close, Python's in one :class:`CannotWrite`.
+    packages results depend on and the kernels it computed with (:func:`~excite_cli.kernels.describe`)
+    as root attributes, then written whole by :func:`atomic_bytes`. HDF5 never writes to the disk
+    itself: its write errors (a full disk) end in a crash or in unraisable errors at close, Python's
+    in one :class:`CannotWrite`.
 
     Raises:
         CannotWrite: the file cannot be written.

@@ -121,6 +121,15 @@ def polish(
     Numerical Optimization, 2nd ed., Sec. 6.1, on restarting quasi-Newton methods), it converges:
     on the Panda (iteration 2, seed 0) a restart stalled at KKT 5.1e-2 converged in 70 more
     iterations, to a lower value. A continuation that fails or ends higher is not kept.
+
+    Args:
+        k: the iteration, 1-based; seed: the run's seed; prior: C₀ (m, b) of the iteration.
+        runs: every restart of the iteration (:func:`run_restarts`); kept: the index of the one to polish.
+        deadline: the iteration's time budget ends here [s, ``time.perf_counter``].
+        hook: progress, the polished restart's iterations counted on from where it stopped.
+
+    Returns:
+        ``runs`` with the polished restart in its place, its iterations and history joined.
     """
     opts, runs = excitation.problem.optimizer, list(runs)
     at = next(i for i, r in enumerate(runs) if r.index == kept)
