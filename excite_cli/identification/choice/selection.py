@@ -16,11 +16,11 @@ a model no single move improves and cannot cycle. Greedy forward selection alone
 its path: a joint whose Coulomb friction is missing bends the shared base parameters, and adding it
 later can make another joint's error worse first. So the search runs from three starts (the declared
 effects alone, plus Coulomb friction on every joint, plus Coulomb and viscous friction on every
-joint) and keeps the end with the lowest J. Candidates whose columns lie in the span of the
-rigid-body model (e.g. the armature of a joint whose rotor inertia regroups with a link's) are not
-separately identifiable and are skipped. Every fit, in the folds and the final one, uses the same
-per-joint weights (WLS: 1/σ_j of the rigid-body fit, Gautier 1997), so the reported model is exactly
-the one the search scored.
+joint) and keeps the end with the lowest J (of searches ending at the same model, the first).
+Candidates whose columns lie in the span of the rigid-body model (e.g. the armature of a joint whose
+rotor inertia regroups with a link's) are not separately identifiable and are skipped. Every fit,
+in the folds and the final one, uses the same per-joint weights (WLS: 1/σ_j of the rigid-body fit,
+Gautier 1997), so the reported model is exactly the one the search scored.
 """
 
 from __future__ import annotations
@@ -133,6 +133,20 @@ def motor_couplings(transmission: TransmissionConfig | None, ratios: list[float]
     return out
 
 
+def kept_search(searches: list[Search]) -> int:
+    """The index of the search whose end model has the lowest objective J; of searches ending at the
+    same model (the same terms in any order) the first counts, so that the rounding of J, which depends
+    on the order the terms were added in, never decides which search's steps a report shows.
+
+    Raises:
+        ValueError: no searches.
+    """
+    first: dict[frozenset[Term], int] = {}
+    for k, search in enumerate(searches):
+        first.setdefault(frozenset(search.terms), k)
+    return min(first.values(), key=lambda k: (searches[k].objective, k))
+
+
 def select_effects(
     fit_data: Dataset,
     cfg: IdentificationConfig,
@@ -178,7 +192,7 @@ def select_effects(
             continue
         seen.append(start)
         searches.append(search.run(name, start))
-    chosen = min(range(len(searches)), key=lambda k: searches[k].objective)
+    chosen = kept_search(searches)
     terms = searches[chosen].terms
     return Selection(
         terms=terms,

@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from excite_cli.identification.choice.crossval import CrossValidation, fold_assignment
-from excite_cli.identification.choice.search import StepwiseSearch
-from excite_cli.identification.choice.selection import candidate_terms, select_effects
+from excite_cli.identification.choice.search import Search, StepwiseSearch
+from excite_cli.identification.choice.selection import STARTS, candidate_terms, kept_search, select_effects
 from excite_cli.identification.config import IdentificationConfig
 from excite_cli.identification.effects import Term, effect_columns
 from excite_cli.identification.fitting.dataset import Dataset, run_offset_columns
@@ -168,3 +168,23 @@ def test_an_effect_of_one_run_only_is_dropped_by_run_folds_and_kept_by_time_bloc
     assert blocks.error(spurious)[0] < blocks.error(true)[0]
     assert runs.error(spurious)[0] > runs.error(true)[0]
     assert set(select_effects(data, cfg, [], margin=0.05, recordings=np.arange(2)).terms) == set(true)
+
+
+def test_of_searches_ending_at_one_model_the_first_is_kept_whatever_the_rounding():
+    c0, c1, v1 = Term("coulomb", 0), Term("coulomb", 1), Term("viscous", 1)
+    ends = [([c0, c1], -1.0), ([v1], -1.5), ([c1, c0], -1.0 - 1e-15), ([v1], -1.5 - 1e-15)]
+    searches = [Search(f"s{k}", [], 0.0, terms, 0.0, objective) for k, (terms, objective) in enumerate(ends)]
+    assert kept_search(searches) == 1  # the lowest model; the later search of it lower only by rounding
+    assert kept_search(searches[:1] + searches[2:3]) == 0
+    with pytest.raises(ValueError):
+        kept_search([])
+
+
+def test_coulomb_data_every_search_ends_at_coulomb_and_the_report_shows_the_first_search_s_steps():
+    cfg = IdentificationConfig(candidates=["coulomb", "viscous", "offset"])
+    truth = {Term("coulomb", 0): 0.5, Term("coulomb", 1): 0.4}
+    selection = select_effects(dataset(truth, cfg), cfg, [], margin=0.05)
+    assert [s.start for s in selection.searches] == list(STARTS)
+    assert all(set(s.terms) == set(truth) for s in selection.searches)
+    assert selection.chosen == 0 and [step.term for step in selection.steps] != []
+    assert set(step.term for step in selection.steps) == set(truth)  # the declared-effects start adds both
