@@ -6,8 +6,8 @@ Iteration 1 (default) of a config, its seed, run
 - with ``--workers 1`` (every restart in the main process),
 - on a real Dask cluster (``dask scheduler`` and one ``dask worker`` process started here),
 and for each the digest of the stored base parameters (names and regrouping matrix K), cond(C) and
-cond(CL) after the iterations, and the kept restart's end value. The BLAS architecture OpenBLAS
-picked (threadpoolctl) is printed first: other processors round otherwise.
+cond(CL) after the iterations, and the kept restart's end value. The kernels the runs compute with
+(:func:`excite_cli.kernels.describe`) are printed first: other kernels round otherwise.
 
     .venv/bin/python bench/same_answer.py [CONFIG] [--iterations K]
 """
@@ -28,7 +28,8 @@ import time
 from pathlib import Path
 
 import h5py
-from threadpoolctl import threadpool_info
+
+from excite_cli.kernels import describe
 
 ROOT = Path(__file__).resolve().parent.parent
 BIN = Path(sys.executable).parent
@@ -57,9 +58,7 @@ def main() -> None:
     parser.add_argument("config", type=Path, nargs="?", default=ROOT / "configs" / "g1_arms.yaml")
     parser.add_argument("--iterations", type=int, default=1)
     args = parser.parse_args()
-    import numpy  # noqa: F401, loads OpenBLAS so that threadpoolctl sees it
-
-    print("BLAS:", ", ".join(f"{i['internal_api']} {i['version']} {i['architecture']}" for i in threadpool_info()))
+    print("kernels:", describe())
     base = {k: v for k, v in os.environ.items() if k not in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS")}
     print(f"{'run':<28} {'base digest':>13} {'cond(C)':>10} {'cond(CL)':>10} {'kept end value':>16} {'wall [s]':>9}")
     with tempfile.TemporaryDirectory() as folder:

@@ -67,7 +67,8 @@ def use_common_kernels() -> dict[str, str]:
 def describe() -> str:
     """The kernels this process computes with, for a result's record: e.g. ``OpenBLAS Haswell;
     NumPy without X86_V4 AVX512_ICL AVX512_SPR``."""
-    from threadpoolctl import threadpool_info  # here: it loads NumPy's and SciPy's libraries to look
+    import numpy  # noqa: F401  (loads OpenBLAS, which threadpoolctl sees only once loaded)
+    from threadpoolctl import threadpool_info
 
     blas = sorted({str(i.get("architecture")) for i in threadpool_info() if i.get("internal_api") == "openblas"})
     disabled = os.environ.get("NPY_DISABLE_CPU_FEATURES", "").strip()

@@ -62,3 +62,12 @@ def test_numpy_loaded_after_excite_computes_as_with_the_kernels_asked_for_by_han
     if "avx512f" in cpu_flags():
         assert native["blas"] != [CORETYPE] and (native["exp"], native["mm"]) != (excite["exp"], excite["mm"])
     assert _probe("excite", {"EXCITE_NATIVE_KERNELS": "1"}) == native  # the opt-out keeps them
+
+
+def test_describe_in_a_process_that_has_not_loaded_numpy_names_the_blas_kernels():
+    clean = {k: v for k, v in os.environ.items() if k not in ("OPENBLAS_CORETYPE", "NPY_DISABLE_CPU_FEATURES")}
+    code = "import excite_cli.kernels as k; print(k.describe())"
+    out = subprocess.run([sys.executable, "-c", code], env=clean, capture_output=True, text=True, check=True).stdout
+    assert out.startswith("OpenBLAS ") and "OpenBLAS none" not in out
+    if common_kernels({}, "x86_64", cpu_flags()):
+        assert out.startswith(f"OpenBLAS {CORETYPE}; NumPy without {ABOVE_AVX2}")
