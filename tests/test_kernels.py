@@ -26,10 +26,18 @@ print(json.dumps({"exp": np.exp(x).tobytes().hex(), "mm": (a @ a @ a).tobytes().
 """
 
 
+def _clean_environment() -> dict[str, str]:
+    """This process's environment without the kernel variables pytest's ``-p excite_cli.kernels`` set."""
+    return {k: v for k, v in os.environ.items() if k not in ("OPENBLAS_CORETYPE", "NPY_DISABLE_CPU_FEATURES")}
+
+
 def _probe(first: str, env: dict[str, str]) -> dict:
-    clean = {k: v for k, v in os.environ.items() if k not in ("OPENBLAS_CORETYPE", "NPY_DISABLE_CPU_FEATURES")}
     out = subprocess.run(
-        [sys.executable, "-c", PROBE, first], env={**clean, **env}, capture_output=True, text=True, check=True
+        [sys.executable, "-c", PROBE, first],
+        env={**_clean_environment(), **env},
+        capture_output=True,
+        text=True,
+        check=True,
     )
     return json.loads(out.stdout)
 
@@ -65,9 +73,10 @@ def test_numpy_loaded_after_excite_computes_as_with_the_kernels_asked_for_by_han
 
 
 def test_describe_in_a_process_that_has_not_loaded_numpy_names_the_blas_kernels():
-    clean = {k: v for k, v in os.environ.items() if k not in ("OPENBLAS_CORETYPE", "NPY_DISABLE_CPU_FEATURES")}
     code = "import excite_cli.kernels as k; print(k.describe())"
-    out = subprocess.run([sys.executable, "-c", code], env=clean, capture_output=True, text=True, check=True).stdout
+    out = subprocess.run(
+        [sys.executable, "-c", code], env=_clean_environment(), capture_output=True, text=True, check=True
+    ).stdout
     assert out.startswith("OpenBLAS ") and "OpenBLAS none" not in out
     if common_kernels({}, "x86_64", cpu_flags()):
         assert out.startswith(f"OpenBLAS {CORETYPE}; NumPy without {ABOVE_AVX2}")
