@@ -1,11 +1,11 @@
 """Start-up: `excite --help` and `--version` load the command line's frame (typer, rich) and nothing a
-command needs only once it runs: no numpy, scipy, pinocchio, pydantic, h5py, matplotlib or cvxpy."""
+command needs only once it runs: no numpy, scipy, pinocchio, pydantic, h5py, matplotlib, cvxpy or numba."""
 
 import json
 import subprocess
 import sys
 
-HEAVY = ("numpy", "scipy", "pinocchio", "pydantic", "h5py", "matplotlib", "cvxpy", "coal", "yaml")
+HEAVY = ("numpy", "scipy", "pinocchio", "pydantic", "h5py", "matplotlib", "cvxpy", "coal", "yaml", "numba")
 
 
 def test_importing_the_command_line_loads_no_study_module():

@@ -160,7 +160,8 @@ def segment_ends(
     kinematics: BatchKinematics, capsules: list[Capsule], Q: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Every capsule's segment in the world frame at each configuration of the active joints Q (T, n):
-    start and end points (3, T, C) [m] (coordinates first, see :func:`segment_closest_points`), with
+    start and end points (3, T, C) [m] (coordinates first, as
+    :func:`~excite_cli.collision.segments.segment_closest_points` takes them), with
     the joint placements they came from (:meth:`BatchKinematics.placements`: rotations (T, J, 3, 3),
     origins (T, J, 3))."""
     R, p = kinematics.placements(Q)
@@ -173,45 +174,3 @@ def segment_ends(
         R,
         p,
     )
-
-
-def segment_closest_points(
-    p1: np.ndarray, q1: np.ndarray, p2: np.ndarray, q2: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
-    """Closest points c1 on segment [p1, q1] and c2 on [p2, q2] [m], vectorized: every array has its
-    coordinates on the first axis, (3, ...) (contiguous coordinate planes are faster here).
-
-    Ericson, Real-Time Collision Detection, 2005, Sec. 5.1.9 (:func:`segment_parameters`).
-    The distance of two capsules is |c2 − c1| minus their radii, its normal (c2 − c1)/|c2 − c1|.
-    """
-    d1, d2 = q1 - p1, q2 - p2
-    s, t = segment_parameters(p1 - p2, d1, d2, _dot(d1, d1), _dot(d2, d2))
-    return p1 + s * d1, p2 + t * d2
-
-
-def segment_parameters(
-    r: np.ndarray, d1: np.ndarray, d2: np.ndarray, a: np.ndarray, e: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
-    """Where the closest points of two segments p1 + s·d1 and p2 + t·d2 lie, s, t in [0, 1], from
-    r = p1 − p2 and the directions d1, d2 (3, ...) [m] and their squared lengths a = |d1|², e = |d2|²
-    (broadcastable to (...)) [m²], which a caller pairing few segments many ways computes once per
-    segment (:class:`~excite_cli.constraints.self_collision.SelfCollision`: per capsule, not per pair).
-
-    Ericson, Real-Time Collision Detection, 2005, Sec. 5.1.9, degenerate (point) segments included.
-    """
-    f, c, b = _dot(d2, r), _dot(d1, r), _dot(d1, d2)
-    tiny = 1e-12
-    safe_a, safe_e = np.where(a > tiny, a, 1.0), np.where(e > tiny, e, 1.0)
-    denom = a * e - b * b
-    s = np.where(denom > tiny, np.clip((b * f - c * e) / np.where(denom > tiny, denom, 1.0), 0.0, 1.0), 0.0)
-    t = (b * s + f) / safe_e
-    s = np.where(t < 0.0, np.clip(-c / safe_a, 0.0, 1.0), np.where(t > 1.0, np.clip((b - c) / safe_a, 0.0, 1.0), s))
-    t = np.clip(t, 0.0, 1.0)
-    # degenerate segments: the first a point (s = 0), the second a point (t = 0), or both
-    s = np.where(a <= tiny, 0.0, np.where(e <= tiny, np.clip(-c / safe_a, 0.0, 1.0), s))
-    t = np.where(e <= tiny, 0.0, np.where(a <= tiny, np.clip(f / safe_e, 0.0, 1.0), t))
-    return s, t
-
-
-def _dot(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    return x[0] * y[0] + x[1] * y[1] + x[2] * y[2]

@@ -1,15 +1,14 @@
 """Self-collision between capsules (Eq. 53): the distance between each capsule pair stays above a
 safety margin over the constraint grid.
 
-In the optimizer, every (instant, pair) distance is computed at once in vectorized numpy: the joint
-placements at all grid instants (:class:`~excite_cli.dynamics.kinematics.BatchKinematics`), each capsule's
-segment, and the closest points of the two segments in closed form (``segment_parameters``);
-the capsule distance is d = |c₂ − c₁| − r₁ − r₂ with normal n = (c₂ − c₁)/|c₂ − c₁|. It varies as
-∂d = nᵀ(J_{c₂} − J_{c₁}) ∂q, J_c the velocity Jacobian of the closest point fixed to its body
-(``BatchKinematics.distance_rates``). Per pair, s_t = (margin − d_t) / L with L = ``LENGTH_SCALE``
-is aggregated by a log-sum-exp over the grid. coal (the reference, equal to the closed form to
-1e-15) gives the distance of the exact checks: the fine check asks coal at every sample the closed
-form puts within ``CONFIRM`` of the smallest distance.
+In the optimizer, the joint placements at all grid instants come at once
+(:class:`~excite_cli.dynamics.kinematics.BatchKinematics`), then each capsule's segment, and every
+(instant, pair) distance d = |c₂ − c₁| − r₁ − r₂ in one compiled loop (:mod:`excite_cli.collision.segments`,
+Ericson's closed form). Per pair, s_t = (margin − d_t) / L with L = ``LENGTH_SCALE`` is aggregated
+by a log-sum-exp over the grid; it varies as ∂d = nᵀ(J_{c₂} − J_{c₁}) ∂q, J_c the velocity Jacobian
+of the closest point fixed to its body. coal (the reference, equal to the closed form to 1e-15)
+gives the distance of the exact checks: the fine check asks coal at every sample the closed form
+puts within ``CONFIRM`` of the smallest distance.
 """
 
 from __future__ import annotations
@@ -17,9 +16,10 @@ from __future__ import annotations
 import coal
 import numpy as np
 
-from excite_cli.collision.capsules import Capsule, capsule_frames, segment_ends, segment_parameters
+import excite_cli.constraints.lse as lse
+from excite_cli.collision.capsules import Capsule, capsule_frames, segment_ends
+from excite_cli.collision.segments import pair_aggregates, pair_distances, pair_jacobian
 from excite_cli.constraints.constraint import Constraint, FineCheck
-from excite_cli.constraints.lse import ACCEPT_MARGIN, smooth_max, smooth_max_value
 from excite_cli.dynamics.kinematics import BatchKinematics
 from excite_cli.dynamics.robot import Robot
 from excite_cli.trajectory.fourier import FourierBasis
@@ -28,40 +28,6 @@ from excite_cli.trajectory.fourier import FourierBasis
 LENGTH_SCALE = 0.05
 #: The fine check asks coal for every sample screened within this of the smallest distance [m].
 CONFIRM = 1e-3
-#: Instants screened at a time: a fine grid's (3, T, P) arrays at once outgrow the processor's caches.
-BLOCK = 512
-
-
-def aggregated_distances(
-    kinematics: BatchKinematics,
-    basis: FourierBasis,
-    margin: float | np.ndarray,
-    d: np.ndarray,
-    points: np.ndarray,
-    normals: np.ndarray,
-    R: np.ndarray,
-    p: np.ndarray,
-    moves: np.ndarray,
-) -> tuple[np.ndarray, np.ndarray]:
-    """Per pair, s_t = (margin − d_t)/L aggregated over the grid instants by a log-sum-exp, and its
-    Jacobian in α: ∂g/∂q(t) = Σ (∂g/∂d) nᵀJ_x, with ∂g/∂d = −w/L folded into the normals.
-
-    Args:
-        kinematics, basis: the constraint's batched kinematics and grid basis (T instants).
-        margin: (P,) or scalar [m]; d: (T, P) distances [m].
-        points, normals: (3, T, P) the point x whose motion changes d and the unit normal n along
-            which it does (:meth:`BatchKinematics.distance_rates`); R, p: the joint placements.
-        moves: (P, n) the sign with which each active joint moves the pair's distance (0: not at all).
-
-    Returns:
-        g (P,) and its Jacobian (P, α.size), α flattened row-major.
-    """
-    P, n = moves.shape
-    m = basis.q.shape[1]
-    g, w = smooth_max((margin - d) / LENGTH_SCALE, axis=0)  # (P,), (T, P)
-    rates = kinematics.distance_rates(R, p, points, normals * (-w / LENGTH_SCALE))  # (T, P, n)
-    J = (basis.q.T @ rates.reshape(d.shape[0], P * n)).reshape(m, P, n) * moves
-    return g, J.transpose(1, 2, 0).reshape(P, n * m)
 
 
 class SelfCollision(Constraint):
@@ -77,7 +43,7 @@ class SelfCollision(Constraint):
 
     name = "self_collision"
     field = "constraints.self_collision"
-    grid_margin = ACCEPT_MARGIN
+    grid_margin = lse.ACCEPT_MARGIN
 
     def __init__(
         self, robot: Robot, basis: FourierBasis, capsules: list[Capsule], pairs: list[tuple[int, int]], margin: float
@@ -108,49 +74,41 @@ class SelfCollision(Constraint):
         return result
 
     def distances(self, Q: np.ndarray) -> np.ndarray:
-        """Distances (T, P) [m] of every kept capsule pair at the configurations Q (T, n) (closed form),
-        ``BLOCK`` instants at a time."""
-        if len(Q) <= BLOCK:
-            return self._closest(Q)[0]
-        return np.concatenate([self._closest_points(Q[k : k + BLOCK])[0] for k in range(0, len(Q), BLOCK)])
+        """Distances (T, P) [m] of every kept capsule pair at the configurations Q (T, n) (closed form)."""
+        start, end = self._ends(Q)[:2]
+        return pair_distances(start, end, self._first, self._second, self._radii)
 
-    def _closest(self, Q: np.ndarray) -> tuple[np.ndarray, ...]:
-        """At the configurations Q (T, n): distances d (T, P) [m], the closest points c₁ (3, T, P) of
-        each pair's first segment, the unit normals (3, T, P) from c₁ to c₂, and the joint placements
-        (:meth:`BatchKinematics.placements`)."""
+    def _ends(self, Q: np.ndarray) -> tuple[np.ndarray, ...]:
+        """At the configurations Q (T, n): every capsule's segment ends (3, T, C) [m] and the joint
+        placements (:func:`~excite_cli.collision.capsules.segment_ends`)."""
         key = Q.tobytes()  # the values and then the Jacobian at the same point: computed once
-        if getattr(self, "_last_closest", (None,))[0] != key:
-            self._last_closest = (key, self._closest_points(Q))
-        return self._last_closest[1]
+        if getattr(self, "_last_ends", (None,))[0] != key:
+            self._last_ends = (key, segment_ends(self.kinematics, self.capsules, Q))
+        return self._last_ends[1]
 
-    def _closest_points(self, Q: np.ndarray) -> tuple[np.ndarray, ...]:
-        """:meth:`_closest`, computed."""
-        start, end, R, p = segment_ends(self.kinematics, self.capsules, Q)
-        i, j = self._first, self._second
-        d = end - start  # per capsule, then per pair: (3, T, C) before (3, T, P)
-        squared = d[0] ** 2 + d[1] ** 2 + d[2] ** 2
-        p1, p2, d1, d2 = start[..., i], start[..., j], d[..., i], d[..., j]
-        s, t = segment_parameters(p1 - p2, d1, d2, squared[:, i], squared[:, j])
-        c1 = p1 + s * d1
-        gap = (p2 + t * d2) - c1
-        length = np.sqrt(gap[0] ** 2 + gap[1] ** 2 + gap[2] ** 2)
-        return length - self._radii[i] - self._radii[j], c1, gap / np.maximum(length, 1e-12), R, p
+    def _pairs(self) -> tuple:
+        """The pairs' arguments of the kernels: first and second capsules, radii, margins, L, β."""
+        margins = np.full(len(self.pairs), self.margin)
+        return self._first, self._second, self._radii, margins, LENGTH_SCALE, lse.SHARPNESS
 
     def evaluate(self, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """One aggregated value per pair (P,) and the Jacobian (P, α.size), see :meth:`Constraint.evaluate`."""
+        """One aggregated value per pair (P,) and the Jacobian (P, α.size), see :meth:`Constraint.evaluate`
+        (:func:`~excite_cli.collision.segments.pair_jacobian`)."""
         n, m = alpha.shape
-        P = len(self.pairs)
-        if not P:
+        if not self.pairs:
             return np.zeros(0), np.zeros((0, n * m))
-        return aggregated_distances(
-            self.kinematics, self.basis, self.margin, *self._closest(self.basis.q @ alpha.T), self._moves
+        start, end, R, p = self._ends(self.basis.q @ alpha.T)
+        axes, moments = self.kinematics.joint_axes(R, p)
+        g, J = pair_jacobian(
+            start, end, *self._pairs(), axes, moments, self.kinematics.revolute, self._moves, self.basis.q
         )
+        return g + lse.GRID_MARGIN, J.reshape(len(self.pairs), n * m)
 
     def values(self, alpha: np.ndarray) -> np.ndarray:
         """The aggregated values of :meth:`evaluate` (P,) without the Jacobian."""
         if not self.pairs:
             return np.zeros(0)
-        return smooth_max_value((self.margin - self._closest(self.basis.q @ alpha.T)[0]) / LENGTH_SCALE, axis=0)
+        return pair_aggregates(*self._ends(self.basis.q @ alpha.T)[:2], *self._pairs()) + lse.GRID_MARGIN
 
     track_units = {"min_capsule_distance": "m"}
 

@@ -4,8 +4,8 @@ the world frame: half-spaces (a floor, a table top), spheres, capsules and boxes
 Distances are closed forms over all (instant, capsule, shape) at once: to a half-space with unit
 normal n through point o, a segment's closest point is the end point of least height h = n·(x − o),
 d = h − r; to a sphere or a world capsule, the closest points of the two segments
-(:func:`segment_closest_points`, a sphere being a segment of length 0), d = |c₂ − c₁| − r₁ − r₂;
-to a box, coal's distance, nearest points and normal (negative inside).
+(:func:`~excite_cli.collision.segments.segment_closest_points`, a sphere being a segment of length 0),
+d = |c₂ − c₁| − r₁ − r₂; to a box, coal's distance, nearest points and normal (negative inside).
 d varies as ∂d = nᵀ J_x ∂q along the normal n from the world shape to the robot's point x
 (:meth:`BatchKinematics.distance_rates`); per (capsule, shape), s_t = (margin − d_t)/L is aggregated
 over the grid like the self-collision pairs. Capsules on links no active joint moves are left out:
@@ -20,11 +20,12 @@ import coal
 import numpy as np
 import pinocchio as pin
 
-from excite_cli.collision.capsules import Capsule, capsule_frames, segment_closest_points, segment_ends
+from excite_cli.collision.capsules import Capsule, capsule_frames, segment_ends
+from excite_cli.collision.segments import segment_closest_points
 from excite_cli.config import EnvironmentConfig
 from excite_cli.constraints.constraint import Constraint, FineCheck
-from excite_cli.constraints.lse import ACCEPT_MARGIN, smooth_max_value
-from excite_cli.constraints.self_collision import LENGTH_SCALE, aggregated_distances
+from excite_cli.constraints.lse import ACCEPT_MARGIN, smooth_max, smooth_max_value
+from excite_cli.constraints.self_collision import LENGTH_SCALE
 from excite_cli.dynamics.kinematics import BatchKinematics
 from excite_cli.dynamics.robot import Robot
 from excite_cli.trajectory.fourier import FourierBasis
@@ -105,6 +106,38 @@ def distance_bound(robot: Robot, capsule: Capsule, shape: WorldShape) -> float:
         closest = segment_closest_points(shape.start, shape.end, origin, origin)[0]
         away = float(np.linalg.norm(origin - closest)) - shape.radius
     return away - reach
+
+
+def aggregated_distances(
+    kinematics: BatchKinematics,
+    basis: FourierBasis,
+    margin: float | np.ndarray,
+    d: np.ndarray,
+    points: np.ndarray,
+    normals: np.ndarray,
+    R: np.ndarray,
+    p: np.ndarray,
+    moves: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Per pair, s_t = (margin − d_t)/L aggregated over the grid instants by a log-sum-exp, and its
+    Jacobian in α: ∂g/∂q(t) = Σ (∂g/∂d) nᵀJ_x, with ∂g/∂d = −w/L folded into the normals.
+
+    Args:
+        kinematics, basis: the constraint's batched kinematics and grid basis (T instants).
+        margin: (P,) or scalar [m]; d: (T, P) distances [m].
+        points, normals: (3, T, P) the point x whose motion changes d and the unit normal n along
+            which it does (:meth:`BatchKinematics.distance_rates`); R, p: the joint placements.
+        moves: (P, n) the sign with which each active joint moves the pair's distance (0: not at all).
+
+    Returns:
+        g (P,) and its Jacobian (P, α.size), α flattened row-major.
+    """
+    P, n = moves.shape
+    m = basis.q.shape[1]
+    g, w = smooth_max((margin - d) / LENGTH_SCALE, axis=0)  # (P,), (T, P)
+    rates = kinematics.distance_rates(R, p, points, normals * (-w / LENGTH_SCALE))  # (T, P, n)
+    J = (basis.q.T @ rates.reshape(d.shape[0], P * n)).reshape(m, P, n) * moves
+    return g, J.transpose(1, 2, 0).reshape(P, n * m)
 
 
 class WorldCollision(Constraint):

@@ -84,13 +84,19 @@ class BatchKinematics:
                 p[:, j] += (Rj @ self.axes[k]) * Q[:, k, None]
         return R, p
 
+    def joint_axes(self, R: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Each active joint's world axis a_k and moment a_k × o_k (o_k its origin) [m] at T instants,
+        (T, 3, n) each, from the joint placements (:meth:`placements`)."""
+        axes = np.einsum("tkij,kj->tik", R[:, self.joint_of], self.axes)
+        return axes, np.cross(axes, p[:, self.joint_of].transpose(0, 2, 1), axis=1)
+
     def distance_rates(self, R: np.ndarray, p: np.ndarray, points: np.ndarray, normals: np.ndarray) -> np.ndarray:
         """Rates (T, K, n) at which each active joint alone moves K world points along directions n.
 
         Args:
             R, p: joint placements at T instants (:meth:`placements`).
             points: (3, T, K) world positions x [m]; normals: (3, T, K) directions n (coordinates
-                first, as :func:`~excite_cli.collision.capsules.segment_closest_points` gives them).
+                first, as :func:`~excite_cli.collision.segments.segment_closest_points` gives them).
 
         Entry k is nᵀ(a_k × (x − o_k)) = a_k·(x × n) − (a_k × o_k)·n for a revolute active joint k
         (a_k its world axis, o_k its origin), nᵀa_k for a prismatic one: the velocity Jacobian of x,
@@ -99,8 +105,7 @@ class BatchKinematics:
         either point gives the same rates (x₂ × n = x₁ × n), so ∂d/∂q_k is the rate times
         ancestors[body₂, k] − ancestors[body₁, k].
         """
-        axes = np.einsum("tkij,kj->tik", R[:, self.joint_of], self.axes)  # (T, 3, n)
-        moments = np.cross(axes, p[:, self.joint_of].transpose(0, 2, 1), axis=1)  # a_k × o_k, (T, 3, n)
+        axes, moments = self.joint_axes(R, p)
         turning = np.concatenate([_cross(points, normals), -normals]).transpose(1, 2, 0) @ np.concatenate(
             [axes, moments], axis=1
         )

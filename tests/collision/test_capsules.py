@@ -7,8 +7,9 @@ import pytest
 import yaml
 from conftest import CONFIGS, robot_of
 
-from excite_cli.collision.capsules import fit_capsule, segment_closest_points
+from excite_cli.collision.capsules import fit_capsule
 from excite_cli.collision.geometry import link_points, links_with_geometry, world_points
+from excite_cli.collision.segments import segment_closest_points
 from excite_cli.config_file import load_problem
 
 

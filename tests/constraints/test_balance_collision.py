@@ -8,7 +8,8 @@ import pytest
 import yaml
 from conftest import CONFIGS, TESTS, write_config
 
-from excite_cli.collision.capsules import capsule_frames
+from excite_cli.collision.capsules import capsule_frames, segment_ends
+from excite_cli.collision.segments import segment_closest_points
 from excite_cli.config_file import load_problem
 from excite_cli.constraints.self_collision import SelfCollision
 from excite_cli.errors import ExciteError
@@ -63,7 +64,11 @@ def test_closed_form_distances_and_witness_points_equal_coal(robot, request):
     constraint = excitation.constraints[-1]
     assert isinstance(constraint, SelfCollision)
     Q = excitation.grid_basis.q @ _lively(excitation, 3).T
-    d, c1, normal, _, _ = constraint._closest(Q)
+    d = constraint.distances(Q)
+    start, end = segment_ends(constraint.kinematics, constraint.capsules, Q)[:2]
+    first, second = [i for i, _ in constraint.pairs], [j for _, j in constraint.pairs]
+    c1, c2 = segment_closest_points(start[..., first], end[..., first], start[..., second], end[..., second])
+    normal = (c2 - c1) / np.linalg.norm(c2 - c1, axis=0)
     alpha = _lively(excitation, 3)
     assert np.array_equal(constraint.values(alpha), constraint.evaluate(alpha)[0])  # values alone: the same g
     rotations, centres = capsule_frames(*constraint.kinematics.placements(Q), constraint.capsules)
