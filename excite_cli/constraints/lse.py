@@ -8,7 +8,6 @@ exact samples keep δ/2 (``ACCEPT_MARGIN``), which also covers the overshoot bet
 from __future__ import annotations
 
 import numpy as np
-from scipy.special import logsumexp, softmax
 
 #: β, in the normalized units of each constraint.
 SHARPNESS = 300.0
@@ -19,10 +18,30 @@ ACCEPT_MARGIN = GRID_MARGIN / 2.0
 
 
 def smooth_max(values: np.ndarray, axis: int | tuple[int, ...]) -> tuple[np.ndarray, np.ndarray]:
-    """Aggregate g over ``axis`` of ``values`` and the weights ∂g/∂values (shaped like ``values``)."""
-    return smooth_max_value(values, axis), softmax(SHARPNESS * values, axis=axis)
+    """Aggregate g over ``axis`` of ``values`` and the weights ∂g/∂values (shaped like ``values``).
+
+    g = (m + log Σ exp(β s − m))/β + δ with m the largest β s (the usual shift that keeps every
+    exponential ≤ 1), and the weights exp(β s − m)/Σ (the softmax), from the same exponentials.
+    """
+    peak, exponentials, total = _shifted(values, axis)
+    return _aggregate(peak, total, axis), exponentials / total
 
 
 def smooth_max_value(values: np.ndarray, axis: int | tuple[int, ...]) -> np.ndarray:
     """The aggregated g of :func:`smooth_max` alone (a line search's trial points need no weights)."""
-    return logsumexp(SHARPNESS * values, axis=axis) / SHARPNESS + GRID_MARGIN
+    peak, _, total = _shifted(values, axis)
+    return _aggregate(peak, total, axis)
+
+
+def _shifted(values: np.ndarray, axis: int | tuple[int, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """m = max β s over ``axis`` (0 where not finite), exp(β s − m) and their sum, dimensions kept."""
+    scaled = SHARPNESS * values
+    peak = np.max(scaled, axis=axis, keepdims=True)
+    peak[~np.isfinite(peak)] = 0.0
+    exponentials = np.exp(scaled - peak)
+    return peak, exponentials, np.sum(exponentials, axis=axis, keepdims=True)
+
+
+def _aggregate(peak: np.ndarray, total: np.ndarray, axis: int | tuple[int, ...]) -> np.ndarray:
+    with np.errstate(divide="ignore"):  # no sample at all: log 0 = −inf, no constraint
+        return np.squeeze(peak + np.log(total), axis=axis) / SHARPNESS + GRID_MARGIN

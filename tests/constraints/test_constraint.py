@@ -3,6 +3,7 @@ accepted point, and the log-sum-exp aggregation's bounds."""
 
 import numpy as np
 import pytest
+from scipy.special import logsumexp, softmax
 
 from excite_cli.constraints.constraint import Constraint, FineCheck, accepted, farthest_accepted
 from excite_cli.constraints.lse import ACCEPT_MARGIN, GRID_MARGIN, SHARPNESS, smooth_max, smooth_max_value
@@ -43,3 +44,13 @@ def test_smooth_max_never_underestimates_and_overshoots_by_at_most_log_count_ove
     np.testing.assert_allclose(weights.sum(axis=0), 1.0)
     assert np.array_equal(smooth_max_value(values, axis=0), g)  # the values-only path gives the same g
     assert ACCEPT_MARGIN == GRID_MARGIN / 2
+
+
+def test_smooth_max_is_scipys_log_sum_exp_and_softmax_over_any_axes():
+    values = np.random.default_rng(1).uniform(-3.0, 0.2, (2, 40, 5))
+    for axis in (1, (0, 1)):
+        g, weights = smooth_max(values, axis=axis)
+        np.testing.assert_allclose(g, logsumexp(SHARPNESS * values, axis=axis) / SHARPNESS + GRID_MARGIN, rtol=1e-14)
+        np.testing.assert_allclose(weights, softmax(SHARPNESS * values, axis=axis), rtol=1e-12, atol=1e-300)
+    nothing = np.full((4, 2), -np.inf)  # no sample at all: no constraint, and no NaN
+    assert np.all(smooth_max_value(nothing, axis=0) == -np.inf)
