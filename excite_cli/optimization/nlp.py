@@ -47,7 +47,7 @@ class Evaluations:
 
         def compute() -> float:
             alpha = self.boundary.to_alpha(z)
-            value = self.criterion.value(alpha)
+            value = self.criterion.value(alpha, from_gram=True)
             if (
                 value < (self.best_value if self.best_inside is not None else np.inf)
                 and self.constraint_values(z).max() <= 0.0

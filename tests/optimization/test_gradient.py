@@ -122,6 +122,9 @@ def test_gram_value_matches_the_svd_at_high_cond(panda_problem):
         exact = criterion.value(alpha)
         error = abs(criterion.value_and_gradient(alpha)[0] - exact) / exact
         assert error <= (largest or 1.0) and error <= np.finfo(float).eps * exact**2  # the Gram matrix squares cond
+        # the solver's value: from the Gram matrix where cond(C) ≤ 10³, else the SVD's exactly
+        solver = criterion.value(alpha, from_gram=True)
+        assert solver == exact if exact > 1e3 else 0 < abs(solver - exact) / exact <= 1e-10
     assert exact > 1e8  # the last point is far worse than any optimizer iterate
 
 
