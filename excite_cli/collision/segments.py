@@ -19,6 +19,8 @@ NumPy and OpenBLAS do under :mod:`excite_cli.kernels`.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
 
@@ -27,6 +29,25 @@ TINY = 1e-12
 #: Instants whose log-sum-exp weight is below this add nothing to a pair's Jacobian that double
 #: precision keeps (their sum over a grid stays below 1e-13 of the largest weight's part).
 WEIGHT_FLOOR = 1e-16
+
+
+class CapsulePairs(NamedTuple):
+    """The capsule pairs the loops below take, in the order of their compiled kernels' arguments.
+
+    Attributes:
+        first, second: (P,) int, the capsule indices of each pair.
+        radii: (C,) every capsule's radius [m].
+        margins: (P,) each pair's required clearance [m].
+        scale: L [m], the distances' normalization (s = (margin − d)/L).
+        sharpness: β of the log-sum-exp over the instants.
+    """
+
+    first: np.ndarray
+    second: np.ndarray
+    radii: np.ndarray
+    margins: np.ndarray
+    scale: float
+    sharpness: float
 
 
 @njit(cache=True, inline="always")
@@ -106,13 +127,11 @@ def _pair_distances(start, end, first, second, radii, d):
             d[t, k] = _pair(start, end, t, i, j)[6] - radii[i] - radii[j]
 
 
-def pair_distances(
-    start: np.ndarray, end: np.ndarray, first: np.ndarray, second: np.ndarray, radii: np.ndarray
-) -> np.ndarray:
-    """Distances d (T, P) [m] of the capsule pairs (first[k], second[k]) (P,) from their segments'
-    world ends start, end (3, T, C) [m] and radii (C,) [m]."""
-    d = np.empty((start.shape[1], first.size))
-    _pair_distances(start, end, first, second, radii, d)
+def pair_distances(start: np.ndarray, end: np.ndarray, pairs: CapsulePairs) -> np.ndarray:
+    """Distances d (T, P) [m] of the capsule ``pairs`` (P pairs) from their segments' world ends
+    start, end (3, T, C) [m]."""
+    d = np.empty((start.shape[1], pairs.first.size))
+    _pair_distances(start, end, pairs.first, pairs.second, pairs.radii, d)
     return d
 
 
@@ -143,25 +162,16 @@ def _pair_aggregates(start, end, first, second, radii, margins, scale, sharpness
         g[k] = (peak + np.log(_total(exponents, peak))) / sharpness
 
 
-def pair_aggregates(
-    start: np.ndarray,
-    end: np.ndarray,
-    first: np.ndarray,
-    second: np.ndarray,
-    radii: np.ndarray,
-    margins: np.ndarray,
-    scale: float,
-    sharpness: float,
-) -> np.ndarray:
+def pair_aggregates(start: np.ndarray, end: np.ndarray, pairs: CapsulePairs) -> np.ndarray:
     """Per pair k, the log-sum-exp over the instants t of s_t = (margins[k] − d_t)/scale:
-    g_k = (1/β) log Σ_t exp(β s_t) (P,), β = ``sharpness``, stable (shifted by the largest term).
+    g_k = (1/β) log Σ_t exp(β s_t) (P,), β = ``pairs.sharpness``, stable (shifted by the largest term).
 
     Args:
-        start, end: (3, T, C) the capsules' segment ends in the world [m]; radii: (C,) [m].
-        first, second: (P,) the pairs' capsule indices; margins: (P,) [m]; scale: L [m].
+        start, end: (3, T, C) the capsules' segment ends in the world [m].
+        pairs: the P pairs, their margins, L and β.
     """
-    g = np.empty(first.size)
-    _pair_aggregates(start, end, first, second, radii, margins, scale, sharpness, g)
+    g = np.empty(pairs.first.size)
+    _pair_aggregates(start, end, *pairs, g)
     return g
 
 
@@ -201,12 +211,7 @@ def _pair_jacobian(
 def pair_jacobian(
     start: np.ndarray,
     end: np.ndarray,
-    first: np.ndarray,
-    second: np.ndarray,
-    radii: np.ndarray,
-    margins: np.ndarray,
-    scale: float,
-    sharpness: float,
+    pairs: CapsulePairs,
     axes: np.ndarray,
     moments: np.ndarray,
     revolute: np.ndarray,
@@ -224,14 +229,12 @@ def pair_jacobian(
     capsule, −1 only the first, 0 both or neither; Eq. 53's gradient from the witness points).
 
     Args:
-        start ... sharpness: as :func:`pair_aggregates`.
+        start, end, pairs: as :func:`pair_aggregates`.
         axes, moments: (T, 3, n) each active joint's world axis a_q and a_q × o_q at every instant
             (:meth:`~excite_cli.dynamics.kinematics.BatchKinematics.joint_axes`); revolute: (n,) bool.
         moves: (P, n) the signs above; basis: (T, m) the Fourier basis of q at the instants.
     """
-    P, n, m = first.size, moves.shape[1], basis.shape[1]
+    P, n, m = pairs.first.size, moves.shape[1], basis.shape[1]
     g, J = np.empty(P), np.zeros((P, n, m))
-    _pair_jacobian(
-        start, end, first, second, radii, margins, scale, sharpness, axes, moments, revolute, moves, basis, g, J
-    )
+    _pair_jacobian(start, end, *pairs, axes, moments, revolute, moves, basis, g, J)
     return g, J

@@ -18,7 +18,7 @@ import numpy as np
 
 import excite_cli.constraints.lse as lse
 from excite_cli.collision.capsules import Capsule, capsule_frames, segment_ends
-from excite_cli.collision.segments import pair_aggregates, pair_distances, pair_jacobian
+from excite_cli.collision.segments import CapsulePairs, pair_aggregates, pair_distances, pair_jacobian
 from excite_cli.constraints.constraint import Constraint, FineCheck
 from excite_cli.dynamics.kinematics import BatchKinematics
 from excite_cli.dynamics.robot import Robot
@@ -50,14 +50,14 @@ class SelfCollision(Constraint):
     ):
         self.robot, self.basis, self.capsules, self.pairs, self.margin = robot, basis, capsules, pairs, margin
         self._shapes = [coal.Capsule(c.radius, float(np.linalg.norm(c.end - c.start))) for c in capsules]
-        self._first = np.array([i for i, _ in pairs], dtype=int)
-        self._second = np.array([j for _, j in pairs], dtype=int)
-        self._radii = np.array([c.radius for c in capsules])
-        self._joints = np.array([c.joint for c in capsules], dtype=int)
+        first, second = np.array([i for i, _ in pairs], dtype=int), np.array([j for _, j in pairs], dtype=int)
+        radii, margins = np.array([c.radius for c in capsules]), np.full(len(pairs), margin)
+        self._pairs = CapsulePairs(first, second, radii, margins, LENGTH_SCALE, lse.SHARPNESS)
+        joints = np.array([c.joint for c in capsules], dtype=int)
         self.kinematics = BatchKinematics(robot)
         ancestors = self.kinematics.ancestors
         # (P, n): +1 where an active joint moves only the second capsule, −1 only the first
-        self._moves = ancestors[self._joints[self._second]].astype(float) - ancestors[self._joints[self._first]]
+        self._moves = ancestors[joints[second]].astype(float) - ancestors[joints[first]]
 
     def _distance(self, rotations: np.ndarray, centres: np.ndarray, t: int, p: int) -> coal.DistanceResult:
         """coal's distance of pair p at instant t, from capsule placements (T, C, 3, 3), (T, C, 3)."""
@@ -76,7 +76,7 @@ class SelfCollision(Constraint):
     def distances(self, Q: np.ndarray) -> np.ndarray:
         """Distances (T, P) [m] of every kept capsule pair at the configurations Q (T, n) (closed form)."""
         start, end = self._ends(Q)[:2]
-        return pair_distances(start, end, self._first, self._second, self._radii)
+        return pair_distances(start, end, self._pairs)
 
     def _ends(self, Q: np.ndarray) -> tuple[np.ndarray, ...]:
         """At the configurations Q (T, n): every capsule's segment ends (3, T, C) [m] and the joint
@@ -85,11 +85,6 @@ class SelfCollision(Constraint):
         if getattr(self, "_last_ends", (None,))[0] != key:
             self._last_ends = (key, segment_ends(self.kinematics, self.capsules, Q))
         return self._last_ends[1]
-
-    def _pairs(self) -> tuple:
-        """The pairs' arguments of the kernels: first and second capsules, radii, margins, L, β."""
-        margins = np.full(len(self.pairs), self.margin)
-        return self._first, self._second, self._radii, margins, LENGTH_SCALE, lse.SHARPNESS
 
     def evaluate(self, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """One aggregated value per pair (P,) and the Jacobian (P, α.size), see :meth:`Constraint.evaluate`
@@ -100,7 +95,7 @@ class SelfCollision(Constraint):
         start, end, R, p = self._ends(self.basis.q @ alpha.T)
         axes, moments = self.kinematics.joint_axes(R, p)
         g, J = pair_jacobian(
-            start, end, *self._pairs(), axes, moments, self.kinematics.revolute, self._moves, self.basis.q
+            start, end, self._pairs, axes, moments, self.kinematics.revolute, self._moves, self.basis.q
         )
         return g + lse.GRID_MARGIN, J.reshape(len(self.pairs), n * m)
 
@@ -108,7 +103,7 @@ class SelfCollision(Constraint):
         """The aggregated values of :meth:`evaluate` (P,) without the Jacobian."""
         if not self.pairs:
             return np.zeros(0)
-        return pair_aggregates(*self._ends(self.basis.q @ alpha.T)[:2], *self._pairs()) + lse.GRID_MARGIN
+        return pair_aggregates(*self._ends(self.basis.q @ alpha.T)[:2], self._pairs) + lse.GRID_MARGIN
 
     track_units = {"min_capsule_distance": "m"}
 
