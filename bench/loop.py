@@ -108,10 +108,11 @@ def predicted_std(runs: list[tuple[np.ndarray, np.ndarray]], sigma: np.ndarray) 
     return np.sqrt(np.diag(np.linalg.inv((Y * w[:, None]).T @ (Y * w[:, None]))))
 
 
-def loop(config: Path, seed: int, design_criterion: tuple[str, str] | None = None, weight: float = 1.0) -> tuple:
-    """(a) and (b)'s errors of one seed, and the wall time; (b) designed with ``design_criterion``
-    (objective, scaling), default the config's, the effects' magnitudes in its frame divided by ``weight``."""
-    begin = time.perf_counter()
+def simulated_robot(config: Path, seed: int) -> tuple:
+    """The config's problem with optimizer seed ``seed``: its blind excitation (rigid body only), the
+    problem with the simulated robot's effects (Coulomb, viscous, armature on every joint, a motor
+    coupled to the last two joints), that problem's excitation (the identified model's columns: those
+    the base does not hold) and the true [β; c] (b+e,)."""
     problem = load_problem(config)
     problem.optimizer.seed = seed
     blind = build_excitation(problem)
@@ -121,26 +122,44 @@ def loop(config: Path, seed: int, design_criterion: tuple[str, str] | None = Non
         joints={"*": ["coulomb", "viscous", "armature"]},
         motors=[MotorConfig(joints=joints[-2:], transmission=[1.0, 1.0])],
     )
-    model = build_excitation(design)  # the identified model's columns (those the base does not hold)
+    model = build_excitation(design)
+    effort = model.robot.model.effortLimit[model.robot.v_idx]
+    magnitudes = model.effects.magnitudes(effort, model.limits.upper[1], model.limits.upper[2])
+    truth = np.concatenate([model.base.from_standard(model.robot.urdf_parameters()), magnitudes])
+    return blind, design, model, truth
+
+
+def blind_runs(blind, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """α of trajectory 1 and of (a)'s trajectory 2, iterations 1 and 2 of the blind sequence (n, 2N+1)."""
+    with Engine(blind, min(default_workers(), blind.problem.optimizer.restarts)) as engine:
+        first = run_sequence(blind, 1, seed, engine=engine)
+        second = run_sequence(blind, 2, seed, engine=engine, finished=first)[-1].alpha
+    return first[0].alpha, second
+
+
+def noise_levels(model, truth: np.ndarray) -> tuple[tuple[np.ndarray, np.ndarray], np.ndarray]:
+    """The unseen motion's columns and true torques, and each joint's noise σ_j (n,): ``NOISE`` of its
+    RMS torque there."""
+    unseen = measured(model, model.random_start(np.random.default_rng(UNSEEN_SEED)), truth)
+    return unseen, NOISE * np.sqrt((unseen[1] ** 2).mean(axis=0))
+
+
+def loop(config: Path, seed: int, design_criterion: tuple[str, str] | None = None, weight: float = 1.0) -> tuple:
+    """(a) and (b)'s errors of one seed, and the wall time; (b) designed with ``design_criterion``
+    (objective, scaling), default the config's, the effects' magnitudes in its frame divided by ``weight``."""
+    begin = time.perf_counter()
+    blind, design, model, truth = simulated_robot(config, seed)
     if design_criterion is not None:
         design.optimizer.objective, design.optimizer.scaling = design_criterion
     designer = build_excitation(design) if design_criterion is not None else model
     if weight != 1.0:
         emphasis = np.concatenate([np.ones(model.base.count), np.full(model.effects.count, 1.0 / weight)])
         designer = replace(designer, scaled_frame=designer.scaled_frame * emphasis)
-    effort = model.robot.model.effortLimit[model.robot.v_idx]
-    magnitudes = model.effects.magnitudes(effort, model.limits.upper[1], model.limits.upper[2])
-    truth = np.concatenate([model.base.from_standard(model.robot.urdf_parameters()), magnitudes])
-    workers = min(default_workers(), problem.optimizer.restarts)
-    with Engine(blind, workers) as engine:
-        first = run_sequence(blind, 1, seed, engine=engine)
-        blind_second = run_sequence(blind, 2, seed, engine=engine, finished=first)[-1].alpha
-    alpha1 = first[0].alpha
-    with Engine(designer, workers) as engine:
+    alpha1, blind_second = blind_runs(blind, seed)
+    with Engine(designer, min(default_workers(), design.optimizer.restarts)) as engine:
         earlier = [describe(designer, 1, alpha1, np.zeros((0, designer.columns)))]
         designed_second = run_sequence(designer, 2, seed, engine=engine, finished=earlier)[-1].alpha
-    unseen = measured(model, model.random_start(np.random.default_rng(UNSEEN_SEED)), truth)
-    sigma = NOISE * np.sqrt((unseen[1] ** 2).mean(axis=0))
+    unseen, sigma = noise_levels(model, truth)
     run1 = measured(model, alpha1, truth)
     rows = []
     for second in (blind_second, designed_second):
