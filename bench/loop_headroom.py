@@ -14,7 +14,8 @@ could reach at all:
   by 1/σ_j as bench/loop.py identifies;
 - SLSQP (SciPy) from run 1's coefficients, (a)'s and ``STARTS`` random starts; the best feasible end.
 
-This is the best a multi-start local search found, not a proven optimum. Printed per robot and seed:
+This is the best a multi-start local search found, not a proven optimum (searched with one BLAS thread:
+the searches' paths are chaotic in the last bits, and so the same with any thread setting). Printed per robot and seed:
 the effect coefficients' mean predicted relative standard deviation [%] with (a)'s second run (the
 rigid-body columns included, as bench/loop.py predicts it) and with the best second run found; and the
 last lines, one per robot: `headroom ROBOT: effects std blind X %, best second run for the effects
@@ -37,6 +38,7 @@ import time
 import numpy as np
 from loop import RATE, ROBOTS, blind_runs, measured, noise_levels, predicted_std, simulated_robot
 from scipy.optimize import minimize
+from threadpoolctl import threadpool_limits
 
 from excite_cli.trajectory.boundary import boundary_rows
 
@@ -128,7 +130,8 @@ def headroom(config, seed: int, starts: int, coefficients: bool = False) -> tupl
     b = model.base.count
     runs = [measured(model, alpha, truth) for alpha in (alpha1, blind_second)]
     blind_std = predicted_std(runs, sigma)[b:] / np.abs(truth[b:])
-    best = best_second_run(model, [alpha1, blind_second], sigma, np.abs(truth[b:]), seed, starts)
+    with threadpool_limits(1):  # the local searches' paths are chaotic: the same rounding with any BLAS threads
+        best = best_second_run(model, [alpha1, blind_second], sigma, np.abs(truth[b:]), seed, starts)
     for name, before, after in zip(model.effects.names, blind_std, best) if coefficients else ():
         print(f"    {name}: {before:.3%} / {after:.3%}")
     return float(np.mean(blind_std)), float(np.mean(best)), time.perf_counter() - begin
