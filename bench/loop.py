@@ -156,7 +156,9 @@ def loop(config: Path, seed: int, design_criterion: tuple[str, str] | None = Non
         emphasis = np.concatenate([np.ones(model.base.count), np.full(model.effects.count, 1.0 / weight)])
         designer = replace(designer, scaled_frame=designer.scaled_frame * emphasis)
     alpha1, blind_second = blind_runs(blind, seed)
-    with Engine(designer, min(default_workers(), design.optimizer.restarts)) as engine:
+    # pool workers build the excitation from the problem, which does not hold the emphasis: serial then
+    workers = 1 if weight != 1.0 else min(default_workers(), design.optimizer.restarts)
+    with Engine(designer, workers) as engine:
         earlier = [describe(designer, 1, alpha1, np.zeros((0, designer.columns)))]
         designed_second = run_sequence(designer, 2, seed, engine=engine, finished=earlier)[-1].alpha
     unseen, sigma = noise_levels(model, truth)
@@ -183,14 +185,14 @@ def main() -> None:
             a, b, wall = loop(ROBOTS[robot], seed, design, args.effects_weight)
             results.append((a, b))
             print(
-                f"  {robot} seed {seed}: effects {a[0]:.2%} / {b[0]:.2%}, base {a[1]:.3%} / {b[1]:.3%}, "
+                f"  {robot} seed {seed}: effects {a[0]:.3%} / {b[0]:.3%}, base {a[1]:.3%} / {b[1]:.3%}, "
                 f"unseen torque {a[2]:.3%} / {b[2]:.3%}, predicted effect std {a[3]:.3%} / {b[3]:.3%} "
                 f"(blind / designed), {wall:.0f} s",
                 flush=True,
             )
         mean = np.mean(np.array(results), axis=0)  # (2, 4)
         lines.append(
-            f"loop {robot}: effects error blind {mean[0, 0]:.2%}, designed {mean[1, 0]:.2%}; "
+            f"loop {robot}: effects error blind {mean[0, 0]:.3%}, designed {mean[1, 0]:.3%}; "
             f"base error blind {mean[0, 1]:.3%}, designed {mean[1, 1]:.3%}"
         )
     print("\n".join(lines))

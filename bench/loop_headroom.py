@@ -15,11 +15,17 @@ could reach at all:
 - SLSQP (SciPy) from run 1's coefficients, (a)'s and ``STARTS`` random starts; the best feasible end.
 
 This is the best a multi-start local search found, not a proven optimum (searched with one BLAS thread:
-the searches' paths are chaotic in the last bits, and so the same with any thread setting). Printed per robot and seed:
-the effect coefficients' mean predicted relative standard deviation [%] with (a)'s second run (the
-rigid-body columns included, as bench/loop.py predicts it) and with the best second run found; and the
-last lines, one per robot: `headroom ROBOT: effects std blind X %, best second run for the effects
-alone Y % (Z % lower)` (means over the seeds); ``--coefficients`` each coefficient's two.
+the searches' paths are chaotic in the last bits, and so the same with any thread setting). The groups'
+best motions together are one second run (each joint's coefficients from its group's best); identified
+as bench/loop.py identifies, with the base parameters beside the effects, it shows how much of the
+room the rigid-body columns leave.
+
+Printed per robot and seed: the effect coefficients' mean predicted relative standard deviation [%]
+with (a)'s second run (the rigid-body columns included, as bench/loop.py predicts it), with the best
+second run found for the effects alone, and with that run identified with the base parameters; the last
+lines, one per robot: `headroom ROBOT: effects std blind X %, best second run for the effects alone Y %
+(Z % lower), identified with the base parameters W % (V % lower)` (means over the seeds);
+``--coefficients`` each coefficient's first two.
 
     .venv/bin/python bench/loop_headroom.py [--robots G1 Panda] [--seeds 0 1 2] [--starts 12] [--coefficients]
 
@@ -60,10 +66,11 @@ def joint_groups(transmissions: np.ndarray) -> list[tuple[np.ndarray, np.ndarray
 
 def best_second_run(
     model, alphas: list[np.ndarray], sigma: np.ndarray, magnitudes: np.ndarray, seed: int, starts: int
-) -> np.ndarray:
+) -> tuple[np.ndarray, np.ndarray]:
     """(e,) each effect coefficient's relative standard deviation with the best second run found for its
-    group; ``alphas``: run 1's coefficients, then the other starts (n, 2N+1); ``starts`` random starts
-    more per group; ``magnitudes`` (e,) the true coefficients' sizes."""
+    group, and that run's coefficients (n, 2N+1) (each group's joints from its own best); ``alphas``:
+    run 1's coefficients, then the other starts (n, 2N+1); ``starts`` random starts more per group;
+    ``magnitudes`` (e,) the true coefficients' sizes."""
     duration = model.problem.trajectory.duration
     basis = model.trajectory.basis(np.arange(0.0, duration, 1.0 / RATE))
     ends = boundary_rows(model.trajectory, duration, model.problem.trajectory.boundary == "rest", False)
@@ -74,7 +81,7 @@ def best_second_run(
         Y = effects.columns(QD, QDD) * np.tile(1.0 / sigma, QD.shape[0])[:, None] * scale
         return Y.T @ Y
 
-    out = np.empty(model.effects.count)
+    out, combined = np.empty(model.effects.count), alphas[0].copy()
     rng = np.random.default_rng(seed)
     for joints, columns in joint_groups(model.effects.transmissions):
         keep = np.isin(np.arange(model.effects.count), columns)
@@ -117,12 +124,14 @@ def best_second_run(
             if feasible and end.fun < best:
                 best, best_x = end.fun, end.x
         out[columns] = deviations(best_x)
-    return out
+        combined[joints] = best_x.reshape(shape)
+    return out, combined
 
 
-def headroom(config, seed: int, starts: int, coefficients: bool = False) -> tuple[float, float, float]:
-    """Mean predicted relative std of the effects with (a)'s second run and with the best found, and the
-    wall time [s]; with ``coefficients`` each coefficient's two printed first."""
+def headroom(config, seed: int, starts: int, coefficients: bool = False) -> tuple[float, float, float, float]:
+    """Mean predicted relative std of the effects with (a)'s second run, with the best found for the
+    effects alone and with that run identified with the base parameters as bench/loop.py does, and the
+    wall time [s]; with ``coefficients`` each coefficient's first two printed first."""
     begin = time.perf_counter()
     blind, _, model, truth = simulated_robot(config, seed)
     alpha1, blind_second = blind_runs(blind, seed)
@@ -131,10 +140,12 @@ def headroom(config, seed: int, starts: int, coefficients: bool = False) -> tupl
     runs = [measured(model, alpha, truth) for alpha in (alpha1, blind_second)]
     blind_std = predicted_std(runs, sigma)[b:] / np.abs(truth[b:])
     with threadpool_limits(1):  # the local searches' paths are chaotic: the same rounding with any BLAS threads
-        best = best_second_run(model, [alpha1, blind_second], sigma, np.abs(truth[b:]), seed, starts)
+        best, second = best_second_run(model, [alpha1, blind_second], sigma, np.abs(truth[b:]), seed, starts)
+    with_base = predicted_std([runs[0], measured(model, second, truth)], sigma)[b:] / np.abs(truth[b:])
     for name, before, after in zip(model.effects.names, blind_std, best) if coefficients else ():
         print(f"    {name}: {before:.3%} / {after:.3%}")
-    return float(np.mean(blind_std)), float(np.mean(best)), time.perf_counter() - begin
+    means = (float(np.mean(blind_std)), float(np.mean(best)), float(np.mean(with_base)))
+    return *means, time.perf_counter() - begin
 
 
 def main() -> None:
@@ -148,16 +159,18 @@ def main() -> None:
     for robot in args.robots:
         results = []
         for seed in args.seeds:
-            blind_std, best, wall = headroom(ROBOTS[robot], seed, args.starts, args.coefficients)
-            results.append((blind_std, best))
+            *means, wall = headroom(ROBOTS[robot], seed, args.starts, args.coefficients)
+            results.append(means)
             print(
-                f"  {robot} seed {seed}: effects std blind {blind_std:.3%}, best found {best:.3%}, {wall:.0f} s",
+                f"  {robot} seed {seed}: effects std blind {means[0]:.3%}, best found {means[1]:.3%}, "
+                f"identified with the base parameters {means[2]:.3%}, {wall:.0f} s",
                 flush=True,
             )
-        blind_std, best = np.mean(results, axis=0)
+        blind_std, best, with_base = np.mean(results, axis=0)
         lines.append(
             f"headroom {robot}: effects std blind {blind_std:.3%}, best second run for the effects alone "
-            f"{best:.3%} ({1.0 - best / blind_std:.0%} lower)"
+            f"{best:.3%} ({1.0 - best / blind_std:.0%} lower), identified with the base parameters "
+            f"{with_base:.3%} ({1.0 - with_base / blind_std:.0%} lower)"
         )
     print("\n".join(lines))
 
