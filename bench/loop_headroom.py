@@ -25,7 +25,7 @@ with (a)'s second run (the rigid-body columns included, as bench/loop.py predict
 second run found for the effects alone, and with that run identified with the base parameters; the last
 lines, one per robot: `headroom ROBOT: effects std blind X %, best second run for the effects alone Y %
 (Z % lower), identified with the base parameters W % (V % lower)` (means over the seeds);
-``--coefficients`` each coefficient's first two.
+``--coefficients`` each coefficient's std with (a)'s second run and with the best found.
 
     .venv/bin/python bench/loop_headroom.py [--robots G1 Panda] [--seeds 0 1 2] [--starts 12] [--coefficients]
 
@@ -131,7 +131,8 @@ def best_second_run(
 def headroom(config, seed: int, starts: int, coefficients: bool = False) -> tuple[float, float, float, float]:
     """Mean predicted relative std of the effects with (a)'s second run, with the best found for the
     effects alone and with that run identified with the base parameters as bench/loop.py does, and the
-    wall time [s]; with ``coefficients`` each coefficient's first two printed first."""
+    wall time [s]; with ``coefficients`` each coefficient's std with (a)'s second run and with the best
+    found printed first."""
     begin = time.perf_counter()
     blind, _, model, truth = simulated_robot(config, seed)
     alpha1, blind_second = blind_runs(blind, seed)
