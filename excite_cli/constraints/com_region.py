@@ -11,12 +11,11 @@ from __future__ import annotations
 
 import numpy as np
 import pinocchio as pin
-from scipy.spatial import ConvexHull, QhullError
 
-from excite_cli.collision.geometry import world_points
 from excite_cli.config import ComConfig
 from excite_cli.constraints.constraint import Constraint, FineCheck
 from excite_cli.constraints.lse import ACCEPT_MARGIN, smooth_max
+from excite_cli.constraints.support import support_polygon
 from excite_cli.dynamics.robot import Robot
 from excite_cli.errors import ExciteError
 from excite_cli.trajectory.fourier import FourierBasis
@@ -27,23 +26,13 @@ SOLE_HEIGHT = 0.005
 
 def support_centre(robot: Robot, links: list[str]) -> np.ndarray:
     """Centre (x, y) [m] of the support area: the area centroid of the convex hull of the soles,
-    i.e. the collision-geometry points of ``links`` near their lowest height, at the home posture.
+    i.e. the collision-geometry points of ``links`` within ``SOLE_HEIGHT`` of their lowest height, at
+    the home posture (:func:`~excite_cli.constraints.support.support_polygon`).
 
     Raises:
         ExciteError: a link without collision geometry, or soles spanning no area.
     """
-    points = np.vstack([world_points(robot, link, robot.home) for link in links])
-    sole = points[points[:, 2] <= points[:, 2].min() + SOLE_HEIGHT, :2]
-    try:
-        hull = ConvexHull(sole)
-    except QhullError:  # degenerate input (collinear or coincident points)
-        raise ExciteError("constraints.com.support_links", "the soles of these links span no area") from None
-    v = sole[hull.vertices]
-    cross = v[:, 0] * np.roll(v[:, 1], -1) - np.roll(v[:, 0], -1) * v[:, 1]
-    area = cross.sum() / 2.0
-    return np.array(
-        [((v[:, 0] + np.roll(v[:, 0], -1)) * cross).sum(), ((v[:, 1] + np.roll(v[:, 1], -1)) * cross).sum()]
-    ) / (6.0 * area)
+    return support_polygon(robot, links, SOLE_HEIGHT, "constraints.com.support_links").centroid
 
 
 class ComRegion(Constraint):

@@ -1,0 +1,86 @@
+"""The support polygon of a standing robot: the convex hull of its soles' lowest collision points on
+the ground plane, which the centre-of-mass region (Eq. 52) is centred in and the zero-moment point
+keeps inside (Kajita et al., *Introduction to Humanoid Robotics*, 2014, ch. 3)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import ConvexHull, QhullError
+
+from excite_cli.collision.geometry import world_points
+from excite_cli.dynamics.robot import Robot
+from excite_cli.errors import ExciteError
+
+
+@dataclass(frozen=True)
+class SupportPolygon:
+    """A convex polygon on the ground plane z = ``height``.
+
+    Attributes:
+        vertices: (K, 2) corners [m], world x, y, counter-clockwise.
+        height: z [m] of the ground plane (the soles' lowest point).
+        normals: (K, 2) outward unit normal of edge k (from vertex k to k + 1).
+        offsets: (K,) n_kᵀv for any point v of edge k [m]: a point p is inside when n_kᵀp ≤ offsets_k.
+    """
+
+    vertices: np.ndarray
+    height: float
+    normals: np.ndarray
+    offsets: np.ndarray
+
+    @classmethod
+    def from_points(cls, points: np.ndarray, height: float) -> "SupportPolygon":
+        """The convex hull of ``points`` (m, 2) [m] on the plane z = ``height`` [m].
+
+        Raises:
+            QhullError: the points span no area.
+        """
+        v = points[ConvexHull(points).vertices]  # counter-clockwise in 2-D
+        edge = np.roll(v, -1, axis=0) - v
+        normals = np.stack([edge[:, 1], -edge[:, 0]], axis=1) / np.linalg.norm(edge, axis=1)[:, None]
+        for array in (v, normals):
+            array.flags.writeable = False
+        offsets = np.einsum("kx,kx->k", normals, v)
+        offsets.flags.writeable = False
+        return cls(v, float(height), normals, offsets)
+
+    @property
+    def centroid(self) -> np.ndarray:
+        """(2,) area centroid [m]."""
+        v = self.vertices
+        cross = v[:, 0] * np.roll(v[:, 1], -1) - np.roll(v[:, 0], -1) * v[:, 1]
+        area = cross.sum() / 2.0
+        return np.array(
+            [((v[:, 0] + np.roll(v[:, 0], -1)) * cross).sum(), ((v[:, 1] + np.roll(v[:, 1], -1)) * cross).sum()]
+        ) / (6.0 * area)
+
+    def shrunk(self, margin: float) -> np.ndarray:
+        """(K, 2) corners [m] of the polygon whose edges lie ``margin`` [m] inside these (each corner where
+        two neighbouring shifted edges meet; a margin wider than the polygon's inradius crosses them)."""
+        normals, offsets = self.normals, self.offsets - margin
+        before = np.roll(np.arange(len(offsets)), 1)
+        pairs = np.stack([normals[before], normals], axis=1)  # (K, 2, 2): edges k − 1 and k meet at corner k
+        return np.linalg.solve(pairs, np.stack([offsets[before], offsets], axis=1)[..., None])[..., 0]
+
+    def margins(self, points: np.ndarray) -> np.ndarray:
+        """(T,) signed distance [m] of each of ``points`` (T, 2) inside the polygon: the least
+        offsets_k − n_kᵀp over the edges (the distance to the nearest edge inside, ≤ 0 outside)."""
+        return (self.offsets - points @ self.normals.T).min(axis=1)
+
+
+def support_polygon(robot: Robot, links: list[str], height: float, field: str) -> SupportPolygon:
+    """The hull of the collision-geometry points of ``links`` within ``height`` [m] of their lowest
+    point, at the home posture (the robot standing on them).
+
+    Raises:
+        ExciteError: (``field``) a link without collision geometry, or soles spanning no area.
+    """
+    points = np.vstack([world_points(robot, link, robot.home, field) for link in links])
+    lowest = points[:, 2].min()
+    sole = points[points[:, 2] <= lowest + height, :2]
+    try:
+        return SupportPolygon.from_points(sole, lowest)
+    except (QhullError, ValueError):  # degenerate input (too few, collinear or coincident points)
+        raise ExciteError(field, "the soles of these links span no area") from None
