@@ -39,9 +39,7 @@ def main(
 def optimize(
     config: Path = typer.Argument(..., help="Problem YAML file (see docs/config-reference.md)."),
     output: Optional[Path] = typer.Option(None, "--output", "-o", help="HDF5 result file (overrides config 'output')."),
-    iterations: Optional[int] = typer.Option(
-        None, "--iterations", "-k", help="Sequential iterations (sequence.iterations)."
-    ),
+    iterations: Optional[int] = typer.Option(None, "--iterations", "-k", help="Iterations (sequence.iterations)."),
     seed: Optional[int] = typer.Option(None, "--seed", help="Seed of the random starts (optimizer.seed)."),
     workers: Optional[int] = WORKERS,
     scheduler: Optional[str] = SCHEDULER,
@@ -207,11 +205,12 @@ def export(
     rate: float = typer.Option(1000.0, "--rate", help="Controller rate (Hz)."),
     periods: int = typer.Option(1, "--periods", help="Periods to play."),
     fmt: str = typer.Option("csv", "--format", help=f"File format: {' or '.join(FORMATS)}."),
+    speed: float = typer.Option(1.0, "--speed", help="Times the optimized speed (0.5: half as fast)."),
     force: bool = FORCE,
     output: Optional[Path] = typer.Option(None, "--output", "-o", help="File to write (default: beside the result)."),
 ) -> None:
     """Write a trajectory as a robot plays it: home → P periods → home, at the controller's rate, with torques."""
-    exported, target = workflows.run_export(result, iteration, rate, periods, fmt, output, force)
+    exported, target = workflows.run_export(result, iteration, rate, periods, fmt, output, force, speed)
     say(console.tables.export_lines(exported, rate, target, fmt))
 
 

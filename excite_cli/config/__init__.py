@@ -22,6 +22,7 @@ from excite_cli.config.constraints import (
     EnvironmentConfig,
     SelfCollisionConfig,
     WorldShapeConfig,
+    ZmpConfig,
 )
 from excite_cli.config.effects import EffectsConfig, MotorConfig
 from excite_cli.config.problem import (
@@ -59,6 +60,7 @@ __all__ = [
     "SequenceConfig",
     "TrajectoryConfig",
     "WorldShapeConfig",
+    "ZmpConfig",
     "effective_yaml",
     "resolve_path",
 ]

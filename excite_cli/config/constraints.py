@@ -1,5 +1,6 @@
 """The optional constraint sections of an ``optimize`` config: the centre-of-mass region (Eq. 52),
-self-collision capsules (Eq. 53) and the world around the robot."""
+the zero-moment point (balance under acceleration), self-collision capsules (Eq. 53) and the world
+around the robot."""
 
 from __future__ import annotations
 
@@ -30,6 +31,17 @@ class ComConfig(Section):
         if bool(self.support_links) == (self.centre is not None):
             raise ValueError("give exactly one of support_links or centre [x, y] [m]")
         return self
+
+
+class ZmpConfig(Section):
+    """Zero-moment point (ZMP) of a standing robot whose feet stay flat: inside the soles' support
+    polygon shrunk by ``margin`` [m], with the ground pushing up (F_z > 0). Needs
+    ``robot.floating_base: true``."""
+
+    support_links: list[str] = Field(min_length=1)
+    """The links whose lowest collision points touch the ground (the soles' contact points)."""
+    margin: float = Field(0.02, ge=0.0)
+    """Distance [m] the ZMP keeps from every edge of the support polygon."""
 
 
 class CapsuleConfig(Section):
@@ -120,6 +132,8 @@ class ConstraintsConfig(Section):
 
     com: Optional[ComConfig] = None
     """The centre-of-mass region (Eq. 52), or none."""
+    zmp: Optional[ZmpConfig] = None
+    """The zero-moment point inside the support polygon, or none."""
     self_collision: Optional[SelfCollisionConfig] = None
     """Self-collision between capsules (Eq. 53), or none."""
     environment: Optional[EnvironmentConfig] = None

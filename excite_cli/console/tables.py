@@ -20,6 +20,13 @@ from excite_cli.workflows.compare import Comparison
 from excite_cli.workflows.init import InitRun
 from excite_cli.workflows.verify_gradient import Verification
 
+#: Fine-check figures Table I shows where the run has them: key, column, scale, decimals, caption.
+FINE_FIGURES = (
+    ("com_max_excursion_m", "CoM [cm]", 100.0, 2, ""),
+    ("zmp_min_margin_m", "ZMP [mm]", 1000.0, 1, "; ZMP: the zero-moment point's least distance inside the soles"),
+    ("min_capsule_distance_m", "dist [cm]", 100.0, 2, ""),
+)
+
 
 def titled_table(title: str, columns: Sequence[str], rows: Sequence[Sequence[str]], caption: str = "") -> Table:
     """A table whose text is shown as written (brackets such as ``[Nm]`` or ``tau0[run.csv]`` are
@@ -42,11 +49,7 @@ def iterations(
     ``optimizer.objective`` and ``scaling`` optimized, first-order optimality, active constraints,
     solver iterations, stop reason) and, with measured prior data, the coefficients the new
     trajectories determine better (``improved``: name, predicted std before and after)."""
-    extra = [
-        (key, label)
-        for key, label in (("com_max_excursion_m", "CoM [cm]"), ("min_capsule_distance_m", "dist [cm]"))
-        if results and key in results[0].checks
-    ]
+    extra = [figure for figure in FINE_FIGURES if results and figure[0] in results[0].checks]
     rows = []
     for r in results:
         ok = float(r.checks.get("transition_max_violation", -np.inf)) <= 0.0
@@ -63,7 +66,7 @@ def iterations(
                 f"{r.scaled_cond_stacked:.4g}",
                 f"{r.excitation_stacked:.3g}",
                 f"{r.max_violation:+.1e}",
-                *[f"{100 * float(r.checks[key]):.2f}" for key, _ in extra],
+                *[f"{scale * float(r.checks[key]):.{digits}f}" for key, _, scale, digits, _ in extra],
                 moves,
                 "-" if np.isnan(r.max_correlation) else f"{r.max_correlation:.2f}",
                 f"{r.wall_time_s:.0f}",
@@ -79,7 +82,7 @@ def iterations(
             "cond(CL)",
             "ē(C) [Nm]",
             "max viol.",
-            *[label for _, label in extra],
+            *[label for _, label, _, _, _ in extra],
             "in/out [s]",
             "corr.",
             "time [s]",
@@ -91,7 +94,7 @@ def iterations(
         "(geometric mean of the singular values) of the URDF-scaled regressor, which do not depend on the "
         "choice of base columns; in/out: quintic transitions from and to the home posture at "
         "rest (checked on the fine grid); corr.: largest correlation of the motion with an earlier iteration's "
-        "(1: the same motion again); stop: why the kept restart ended",
+        "(1: the same motion again); stop: why the kept restart ended" + "".join(f[4] for f in extra),
     )
     convergence = _restarts(results, optimizer or OptimizerConfig())
     tables = [table, convergence] if convergence.row_count else [table]
@@ -221,9 +224,12 @@ def verification(v: Verification, tolerance: float) -> list[Table | str]:
 def export_lines(e: Export, rate: float, target: Path, fmt: str) -> list[str]:
     """The segments of an exported motion, its constraint check, the file written and, for a ROS 2
     bag, how to play it and record the run."""
+    faster = f", played at {e.speed:g} × the optimized speed" if e.speed != 1.0 else ""
     lines = [f"{name:>15}: {start:8.3f} s → {start + duration:8.3f} s" for name, start, duration in e.segments] + [
-        f"{e.time.size} samples at {rate:g} Hz; every constraint holds: largest normalized violation "
+        f"{e.time.size} samples at {rate:g} Hz{faster}; every constraint holds: largest normalized violation "
         f"{e.max_violation:+.2e} (≤ 0 satisfied), closest: {e.worst}",
+        *[f"predicted (feet flat, legs rigid): {p}" for p in e.predictions],
+        *[f"warning: {w}" for w in e.warnings],
         f"wrote {target}",
     ]
     if fmt == "rosbag2":

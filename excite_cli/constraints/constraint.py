@@ -39,6 +39,8 @@ class Constraint(ABC):
         track_units: the unit of each series :meth:`track` returns, by name.
         needs_motion: whether only a moving trajectory can satisfy it (standing still at the home
             posture and the random starts need not; the solver moves into it).
+        advisory: whether it predicts what the robot's own control decides (the zero-moment point, which
+            the stance's compliance moves): the optimizer keeps it, ``export`` warns instead of refusing.
     """
 
     name: str
@@ -47,6 +49,7 @@ class Constraint(ABC):
     grid_margin: float = 0.0
     track_units: dict[str, str] = {}
     needs_motion: bool = False
+    advisory: bool = False
 
     @abstractmethod
     def evaluate(self, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -81,6 +84,10 @@ class Constraint(ABC):
     def accepts(self, alpha: np.ndarray) -> bool:
         """Whether α satisfies the constraint on the grid, exactly, with ``grid_margin`` to spare."""
         return self.check(alpha, self.basis).max_violation <= -self.grid_margin
+
+    def in_words(self) -> str:
+        """What its rows hold, in words (``check``); default: its config field."""
+        return self.field
 
     def track(self, alpha: np.ndarray, basis: FourierBasis) -> dict[str, np.ndarray]:
         """Named time series worth plotting and storing, on ``basis``'s instants (default: none)."""

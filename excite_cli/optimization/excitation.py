@@ -19,6 +19,7 @@ from excite_cli.constraints.joint_limits import joint_limit_bounds
 from excite_cli.constraints.lse import GRID_MARGIN
 from excite_cli.constraints.torque_limits import TorqueLimits, TorqueUse, torque_limit, torque_use_fraction
 from excite_cli.constraints.world_collision import WorldCollision, world_shapes
+from excite_cli.constraints.zmp import zmp_from_config
 from excite_cli.criteria import criterion_record
 from excite_cli.dynamics.base_parameters import BaseParameters, compute_base_parameters
 from excite_cli.dynamics.effect_columns import EffectColumns
@@ -177,7 +178,7 @@ def build_excitation(problem: Problem, base: BaseParameters | None = None, check
             constraint violated at the home posture (with ``check_home``).
     """
     ccfg = problem.constraints
-    collision = bool(ccfg.self_collision or ccfg.environment or (ccfg.com and ccfg.com.support_links))
+    collision = bool(ccfg.self_collision or ccfg.environment or ccfg.zmp or (ccfg.com and ccfg.com.support_links))
     robot = load_robot(problem.robot, problem.folder, collision)
     base = base or compute_base_parameters(robot)
     effects = design_effects(problem, robot, base)
@@ -204,6 +205,8 @@ def build_excitation(problem: Problem, base: BaseParameters | None = None, check
         constraints.append(TorqueUse(robot, grid_basis, limit, fraction))
     if ccfg.com is not None:
         constraints.append(com_region_from_config(ccfg.com, robot, grid_basis))
+    if ccfg.zmp is not None:
+        constraints.append(zmp_from_config(ccfg.zmp, robot, grid_basis))
     if ccfg.self_collision is not None:
         capsules = capsules_from_config(ccfg.self_collision, robot)
         pairs = capsule_pairs(ccfg.self_collision, robot, capsules)

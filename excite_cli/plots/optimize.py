@@ -14,7 +14,9 @@ import numpy as np  # noqa: E402
 from matplotlib.collections import LineCollection, PolyCollection  # noqa: E402
 
 from excite_cli.constraints import ComRegion, SelfCollision  # noqa: E402
+from excite_cli.constraints.support import SupportPolygon  # noqa: E402
 from excite_cli.constraints.world_collision import WorldCollision, WorldShape, world_shapes  # noqa: E402
+from excite_cli.constraints.zmp import ZeroMomentPoint  # noqa: E402
 from excite_cli.optimization.excitation import Excitation  # noqa: E402
 from excite_cli.optimization.sequence import IterationResult  # noqa: E402
 from excite_cli.plots.figure import save_figure  # noqa: E402
@@ -27,6 +29,7 @@ def plot_result(target: Path, excitation: Excitation, results: Sequence[Iteratio
     ``_cond.png``, ``_postures.png`` and, with balance or collision constraints, ``_constraints.png``)."""
     stem = target.with_suffix("")
     com = next((c for c in excitation.constraints if isinstance(c, ComRegion)), None)
+    zmp = next((c for c in excitation.constraints if isinstance(c, ZeroMomentPoint)), None)
     collision = next((c for c in excitation.constraints if isinstance(c, SelfCollision)), None)
     world = next((c for c in excitation.constraints if isinstance(c, WorldCollision)), None)
     capsules = collision.capsules if collision else world.capsules if world else []
@@ -58,6 +61,8 @@ def plot_result(target: Path, excitation: Excitation, results: Sequence[Iteratio
                 radius=com.radius if com else None,
                 polygon=com.polygon if com else None,
                 margin=collision.margin if collision else None,
+                support=zmp.polygon if zmp else None,
+                zmp_margin=zmp.margin if zmp else 0.0,
             )
         )
     return plots
@@ -192,17 +197,20 @@ def plot_constraint_tracks(
     radius: float | None = None,
     polygon=None,
     margin: float | None = None,
+    support: SupportPolygon | None = None,
+    zmp_margin: float = 0.0,
 ) -> Path:
     """Per iteration, for the constraints the run has: the CoM ground track against its region
-    (Eq. 52), the smallest capsule distance over time against the margin (Eq. 53) and the smallest
-    distance to the world, in cm, and each joint's torque as a fraction of its limit; written to
-    ``path`` (PNG).
+    (Eq. 52), the zero-moment point's track in the support polygon, the smallest capsule distance over
+    time against the margin (Eq. 53) and the smallest distance to the world, in cm, and each joint's
+    torque as a fraction of its limit; written to ``path`` (PNG).
 
     Args:
         centre: (2,) region centre [m]; radius [m] or polygon (K, 2) relative to it [m].
         margin: capsule safety margin [m].
+        support: the support polygon the ZMP keeps ``zmp_margin`` [m] inside.
     """
-    names = ("com_xy", "min_capsule_distance", "min_world_distance", "torque_use")
+    names = ("com_xy", "zmp_xy", "min_capsule_distance", "min_world_distance", "torque_use")
     kinds = [k for k in names if any(k in r.tracks for r in results)]
     fig, axes = plt.subplots(len(kinds), len(results), figsize=(4.2 * len(results), 3.7 * len(kinds)), squeeze=False)
     for col, r in enumerate(results):
@@ -219,6 +227,14 @@ def plot_constraint_tracks(
                 if polygon is not None:
                     ax.add_patch(plt.Polygon(polygon * 100, fill=False, color="r", label="region"))
                 ax.set(aspect="equal", xlabel="x − centre [cm]", ylabel="y − centre [cm]")
+            elif kind == "zmp_xy" and support is not None:
+                ax.plot(*(r.tracks["zmp_xy"] * 100).T, linewidth=0.8, label="ZMP track")
+                ax.add_patch(plt.Polygon(support.vertices * 100, fill=False, color="k", label="support polygon"))
+                inner = support.shrunk(zmp_margin) * 100
+                ax.add_patch(
+                    plt.Polygon(inner, fill=False, color="r", linestyle="--", label=f"{zmp_margin * 1000:g} mm in")
+                )
+                ax.set(aspect="equal", xlabel="x [cm]", ylabel="y [cm]")
             elif kind == "min_capsule_distance":
                 ax.plot(r.time, r.tracks[kind] * 100, linewidth=0.8, label="smallest distance")
                 if margin is not None:

@@ -93,7 +93,7 @@ def _what(constraint, joints: int) -> str:
         return f"one per capsule and world shape ({len(pairs)})"
     if constraint.name == "joint_limits":
         return f"position, velocity, acceleration × lower, upper × {joints} joints"
-    return constraint.field
+    return constraint.in_words()
 
 
 def plan_optimize(problem: Problem) -> Plan:

@@ -1,0 +1,185 @@
+"""Balance under acceleration: the zero-moment point (ZMP) of a robot standing on flat feet stays inside
+its support polygon shrunk by a margin, and the ground pushes up.
+
+With the feet fixed to the ground, the ground supplies the wrench that the floating base's first six
+rows of inverse dynamics ask for with the base at rest (RNEA with v_base = a_base = 0): a force f and
+a moment n_O about the world origin, in the world frame (the base is held at the identity). The ZMP
+on the ground plane z = h is where the horizontal moment of that wrench vanishes (Kajita et al.,
+*Introduction to Humanoid Robotics*, 2014, ch. 3; Sardain & Bessonnet, IEEE T-SMC 2004):
+
+    p_x = (h f_x − n_O,y) / f_z,    p_y = (h f_y + n_O,x) / f_z,
+
+equal to the centre of pressure while both feet are flat. Unlike the centre-of-mass region (Eq. 52)
+it moves with the arms' accelerations, which is what tips a standing humanoid. Per instant t and
+polygon edge k (outward normal n_k, offset b_k), s_t,k = (n_kᵀp_t − b_k + margin) / L, aggregated by
+a log-sum-exp over the grid into one inequality, and s_t = −f_z,t / (m g) into another (F_z > 0).
+
+The Jacobian in α comes from pinocchio's RNEA derivatives (Carpentier & Mansard 2018), their base
+rows: with q_j(t) = B(t) α_j (Eq. 50), ∂w_t/∂α_j = ∂w/∂q_j B(t) + ∂w/∂q̇_j Ḃ(t) + M_bj B̈(t) (the
+normal force's weights spread over every instant, so every instant gets one derivative pass, which
+gives the wrench too).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+from excite_cli.config import ZmpConfig
+from excite_cli.constraints.constraint import Constraint, FineCheck
+from excite_cli.constraints.lse import ACCEPT_MARGIN, smooth_max, smooth_max_value
+from excite_cli.constraints.self_collision import LENGTH_SCALE
+from excite_cli.constraints.support import SupportPolygon, support_polygon
+from excite_cli.dynamics.robot import Robot
+from excite_cli.errors import ExciteError
+from excite_cli.trajectory.fourier import FourierBasis
+
+#: The soles' contact points: collision points within this height of the lowest [m] (a sphere's
+#: bottom, a box's lower face), the polygon the centre of pressure can reach.
+CONTACT_HEIGHT = 0.001
+#: Standard gravity [m/s²], which pinocchio's models carry (the F_z > 0 inequality is normalized by m g).
+GRAVITY = 9.81
+
+
+def has_floating_base(robot: Robot) -> bool:
+    """Whether the robot's model starts with a free-flyer joint (``robot.floating_base: true``)."""
+    return robot.model.njoints > 1 and robot.model.joints[1].shortname() == "JointModelFreeFlyer"
+
+
+def zero_moment_point(wrench: np.ndarray, height: float) -> np.ndarray:
+    """(T, 2) ZMP [m] on the plane z = ``height`` [m] of ground wrenches ``wrench`` (T, 6): force
+    f [N] then moment n_O [N·m] about the world origin, in the world frame (Kajita et al. 2014, ch. 3)."""
+    f, n = wrench[:, :3], wrench[:, 3:]
+    return np.stack([height * f[:, 0] - n[:, 1], height * f[:, 1] + n[:, 0]], axis=1) / f[:, 2:3]
+
+
+class ZeroMomentPoint(Constraint):
+    """The ZMP inside the support polygon shrunk by ``margin`` and F_z > 0, on the constraint grid:
+    two aggregated inequalities.
+
+    Args:
+        robot: a floating-base robot (its URDF inertias give the ground wrench).
+        basis: Fourier basis on the constraint grid.
+        polygon: the support polygon and the ground plane.
+        margin: distance [m] the ZMP keeps from every edge.
+
+    Raises:
+        ExciteError: a robot without a floating base; a margin that leaves no polygon.
+    """
+
+    name = "zmp"
+    field = "constraints.zmp"
+    grid_margin = ACCEPT_MARGIN
+    track_units = {"zmp_xy": "m"}
+    advisory = True
+
+    def __init__(self, robot: Robot, basis: FourierBasis, polygon: SupportPolygon, margin: float):
+        if not has_floating_base(robot):
+            raise ExciteError(
+                "constraints.zmp", "needs robot.floating_base: true (the ground wrench is the floating base's)"
+            )
+        room = float(polygon.margins(polygon.centroid[None])[0])
+        if margin >= room:
+            raise ExciteError(
+                "constraints.zmp.margin",
+                f"{margin:g} m leaves no support polygon (its centre is {room:.3g} m from the nearest edge)",
+                margin,
+                f"less than {room:.3g} m",
+            )
+        self.robot, self.basis, self.polygon, self.margin = robot, basis, polygon, float(margin)
+        self.data = robot.model.createData()
+        self._orders = (basis.q, basis.qd, basis.qdd)
+        self._weight = GRAVITY * sum(inertia.mass for inertia in robot.model.inertias)
+
+    def in_words(self) -> str:
+        """The rows, in words (for ``check``)."""
+        home = self.check_samples(np.zeros(1), self.robot.home[None], *np.zeros((2, 1, self.robot.n_joints)))
+        return (
+            f"ZMP inside the support polygon less {1000 * self.margin:g} mm "
+            f"(standing at home: {1000 * float(home.details['zmp_min_margin_m']):.1f} mm inside); F_z > 0"
+        )
+
+    def wrenches(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
+        """(T, 6) ground wrench [N, N·m] (force, moment about the world origin, world frame) at the
+        samples q, q̇, q̈ (T, n) of the active joints, base at rest."""
+        r = self.robot
+        return np.array([pin.rnea(r.model, self.data, *state)[:6] for state in zip(*self._states(q, qd, qdd))])
+
+    def _states(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The full model's (q, v, a) (T, nq), (T, nv), (T, nv) of the active joints' samples (T, n):
+        :meth:`Robot.state` at every sample at once."""
+        r = self.robot
+        full_q = np.tile(r.q_reference, (len(q), 1))
+        full_v, full_a = np.zeros((2, len(q), r.model.nv))
+        full_q[:, r.q_idx], full_v[:, r.v_idx], full_a[:, r.v_idx] = q, qd, qdd
+        return full_q, full_v, full_a
+
+    def _normalized(self, wrench: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The ZMP (T, 2) [m], s of the edges (T, K) and s of the normal force (T,), normalized."""
+        p = zero_moment_point(wrench, self.polygon.height)
+        edges = (p @ self.polygon.normals.T - self.polygon.offsets + self.margin) / LENGTH_SCALE
+        return p, edges, -wrench[:, 2] / self._weight
+
+    def values(self, alpha: np.ndarray) -> np.ndarray:
+        """The two values of :meth:`evaluate` from RNEA alone, without the derivatives."""
+        _, edges, force = self._normalized(self.wrenches(*(B @ alpha.T for B in self._orders)))
+        return np.array([smooth_max_value(edges, (0, 1)), smooth_max_value(force, 0)])
+
+    def evaluate(self, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The two aggregated values (ZMP, normal force) and their Jacobian (2, α.size)."""
+        r, d = self.robot, self.data
+        T = self.basis.q.shape[0]
+        rows = np.empty((4, T, 6, r.model.nv))  # the base rows of τ (in column 0), ∂τ/∂q, ∂τ/∂q̇ and M
+        for t, state in enumerate(zip(*self._states(*(B @ alpha.T for B in self._orders)))):
+            pin.computeRNEADerivatives(r.model, d, *state)
+            rows[0, t, :, 0], rows[1, t], rows[2, t], rows[3, t] = d.tau[:6], d.dtau_dq[:6], d.dtau_dv[:6], d.M[:6]
+        wrench = rows[0, :, :, 0]
+        p, edges, force = self._normalized(wrench)
+        g_edges, w_edges = smooth_max(edges, (0, 1))
+        g_force, w_force = smooth_max(force, 0)
+        fz, h = wrench[:, 2], self.polygon.height
+        dp = np.zeros((T, 2, 6))  # ∂p/∂w: p_x = (h f_x − n_y)/f_z, p_y = (h f_y + n_x)/f_z
+        dp[:, 0, 0], dp[:, 0, 4], dp[:, 0, 2] = h / fz, -1.0 / fz, -p[:, 0] / fz
+        dp[:, 1, 1], dp[:, 1, 3], dp[:, 1, 2] = h / fz, 1.0 / fz, -p[:, 1] / fz
+        dg = np.zeros((2, T, 6))  # ∂g/∂w_t of both rows
+        dg[0] = np.einsum("tk,kx,txw->tw", w_edges, self.polygon.normals / LENGTH_SCALE, dp)
+        dg[1, :, 2] = -w_force / self._weight
+        jacobian = sum(  # the active joints' columns (M: its upper triangle, which holds the base rows)
+            np.einsum("rtw,twj->rjt", dg, D[..., r.v_idx]) @ B for D, B in zip(rows[1:], self._orders)
+        )
+        return np.array([g_edges, g_force]), jacobian.reshape(2, -1)
+
+    def check_samples(self, time: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> FineCheck:
+        """The smallest distance [m] of the ZMP inside the support polygon, when and where it is, the
+        smallest normal force as a fraction of the weight, and the normalized violation."""
+        wrench = self.wrenches(q, qd, qdd)
+        p, _, force = self._normalized(wrench)
+        inside = self.polygon.margins(p)
+        t = int(np.argmin(inside))
+        violation = max(float((self.margin - inside.min()) / LENGTH_SCALE), float(force.max()))
+        return FineCheck(
+            max_violation=violation,
+            details={
+                "zmp_min_margin_m": float(inside[t]),
+                "zmp_min_margin_time_s": float(time[t]),
+                "zmp_min_normal_force_ratio": float(-force.max()),
+            },
+            where=(
+                f"ZMP {1000 * inside[t]:.1f} mm inside the support polygon at t = {time[t]:.2f} s "
+                f"(x {p[t, 0]:.3f}, y {p[t, 1]:.3f} m)"
+            ),
+        )
+
+    def track(self, alpha: np.ndarray, basis: FourierBasis) -> dict[str, np.ndarray]:
+        """``zmp_xy``: (T, 2) the ZMP on the ground plane [m] on ``basis``'s instants."""
+        return {"zmp_xy": zero_moment_point(self.wrenches(*basis.evaluate(alpha)), self.polygon.height)}
+
+
+def zmp_from_config(cfg: ZmpConfig, robot: Robot, basis: FourierBasis) -> ZeroMomentPoint:
+    """The :class:`ZeroMomentPoint` of ``constraints.zmp`` (support polygon from the soles' contact points).
+
+    Raises:
+        ExciteError: see :class:`ZeroMomentPoint` and :func:`~excite_cli.constraints.support.support_polygon`.
+    """
+    polygon = support_polygon(robot, cfg.support_links, CONTACT_HEIGHT, "constraints.zmp.support_links")
+    return ZeroMomentPoint(robot, basis, polygon, cfg.margin)
