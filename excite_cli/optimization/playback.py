@@ -141,11 +141,15 @@ class Playback:
         return float(sum(s.duration for s in self.segments))
 
     def sample(
-        self, rate: float, only: Sequence[str] | None = None
+        self, rate: float, only: Sequence[str] | None = None, speed: float = 1.0
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """time (S,) [s] = k / ``rate`` [Hz] up to the first instant at or after the end (held at the
         final state there), and q, q̇, q̈ (S, n); with ``only``, just the samples of segments with
-        those names."""
+        those names. At ``speed`` s ≠ 1 the motion is played s times faster: q_s(t) = q(s t), so
+        q̇ scales by s and q̈ by s² (what the joints, the torques and the zero-moment point see)."""
+        if speed != 1.0:
+            time, q, qd, qdd = self.sample(rate / speed, only)
+            return np.round(time * rate / speed) / rate, q, speed * qd, speed**2 * qdd
         count = int(np.ceil(self.duration * rate - 1e-6)) + 1
         time = np.arange(count) / rate
         starts = np.cumsum([0.0] + [s.duration for s in self.segments])

@@ -3,8 +3,10 @@
 The file holds time [s], q [rad], q̇ [rad/s], q̈ [rad/s²] of the active joints and the feed-forward
 torque τ = RNEA(q, q̇, q̈) [Nm] of the URDF model (base held fixed, locked joints at their values):
 a quintic transition from the home posture at rest, P periods of the trajectory, a transition back
-(:mod:`excite_cli.optimization.playback`). Every constraint of the problem is checked again on the exported
-samples; a file that violates one is not written.
+(:mod:`excite_cli.optimization.playback`), at the optimized speed or ``speed`` times faster. Every
+constraint of the problem is checked again on the exported samples; a file that violates one is not
+written, except for predictions the robot's own control decides (the zero-moment point,
+:attr:`~excite_cli.constraints.constraint.Constraint.advisory`), which are reported and warned about.
 """
 
 from __future__ import annotations
@@ -27,6 +29,8 @@ from excite_cli.storage.rosbag import check_goal_size, write_rosbag
 MAX_RATE = 100_000.0
 #: Most periods accepted.
 MAX_PERIODS = 1000
+#: Fastest and slowest playback accepted (times the optimized speed).
+MAX_SPEED, MIN_SPEED = 10.0, 0.01
 #: Most samples in one file (about 1.3 GB of CSV with 7 joints).
 MAX_SAMPLES = 20_000_000
 
@@ -42,6 +46,9 @@ class Export:
         segments: (name, start [s], duration [s]) of the transitions and periods, in order.
         max_violation: largest normalized constraint violation on the samples (≤ 0: satisfied).
         worst: the constraint and place of ``max_violation``, in words.
+        speed: times the optimized speed the motion is played (q̇ scales by it, q̈ by its square).
+        predictions: what the advisory constraints (the zero-moment point) predict on the samples, in words.
+        warnings: the advisory constraints the samples violate, in words.
     """
 
     joint_names: list[str]
@@ -56,19 +63,27 @@ class Export:
     segments: list[tuple[str, float, float]]
     max_violation: float
     worst: str
+    speed: float = 1.0
+    predictions: tuple[str, ...] = ()
+    warnings: tuple[str, ...] = ()
 
 
-def export_trajectory(result: Path, iteration: int | None = None, rate: float = 1000.0, periods: int = 1) -> Export:
+def export_trajectory(
+    result: Path, iteration: int | None = None, rate: float = 1000.0, periods: int = 1, speed: float = 1.0
+) -> Export:
     """Sample iteration ``iteration`` (default: the last) of an ``optimize`` result at ``rate`` [Hz]
-    with the transitions from and to the home posture, and its feed-forward torques.
+    with the transitions from and to the home posture, played ``speed`` times as fast as optimized,
+    and its feed-forward torques.
 
     Raises:
-        ExciteError: not an excite result, an iteration it does not have, a rate or period count out
-            of range or together more than ``MAX_SAMPLES`` samples, or samples that violate a
-            constraint (the message names it).
+        ExciteError: not an excite result, an iteration it does not have, a rate, speed or period count
+            out of range or together more than ``MAX_SAMPLES`` samples, or samples that violate a
+            constraint that is not advisory (the message names it).
     """
     if not (np.isfinite(rate) and 0.0 < rate <= MAX_RATE):
         raise ExciteError("rate", f"{rate:g} Hz is out of range", rate, f"(0, {MAX_RATE:g}] Hz")
+    if not (np.isfinite(speed) and MIN_SPEED <= speed <= MAX_SPEED):
+        raise ExciteError("speed", f"{speed:g} is out of range", speed, f"{MIN_SPEED:g} to {MAX_SPEED:g}")
     if not 1 <= periods <= MAX_PERIODS:
         raise ExciteError("periods", f"{periods} is out of range", periods, f"1 to {MAX_PERIODS}")
     # a copy whose regressor rows are the joints' torques, the feed-forward a robot plays
@@ -87,28 +102,36 @@ def export_trajectory(result: Path, iteration: int | None = None, rate: float = 
             f"{result}: iteration {k} has α of shape {alpha.shape}, its config needs "
             f"{(excitation.robot.n_joints, excitation.trajectory.n_coefficients)}",
         )
-    if rate <= excitation.trajectory.nyquist_rate:
+    nyquist = speed * excitation.trajectory.nyquist_rate
+    if rate <= nyquist:
+        played = f" played at speed {speed:g}" if speed != 1.0 else ""
         raise ExciteError(
             "rate",
-            f"{rate:g} Hz cannot represent the trajectory (its highest harmonic needs more than "
-            f"{excitation.trajectory.nyquist_rate:.3g} Hz)",
+            f"{rate:g} Hz cannot represent the trajectory{played} (its highest harmonic needs more than "
+            f"{nyquist:.3g} Hz)",
             rate,
-            f"more than {excitation.trajectory.nyquist_rate:.3g} Hz",
+            f"more than {nyquist:.3g} Hz",
         )
     try:
         playback = plan_playback(excitation, alpha, periods)
     except ExciteError as exc:  # a stored α the optimizer cannot have written (edited, corrupt)
         raise ExciteError("result", f"{result}: iteration {k}: {exc.field}: {exc.problem}") from None
-    if playback.duration * rate > MAX_SAMPLES:
+    duration = playback.duration / speed
+    if duration * rate > MAX_SAMPLES:
         raise ExciteError(
             "rate",
-            f"{playback.duration:.0f} s at {rate:g} Hz is {playback.duration * rate:.3g} samples; "
+            f"{duration:.0f} s at {rate:g} Hz is {duration * rate:.3g} samples; "
             f"at most {MAX_SAMPLES:.0e} fit in one file (lower the rate or the periods)",
         )
-    time, q, qd, qdd = playback.sample(rate)
-    violation, worst = check_motion(excitation.constraints, time, q, qd, qdd)
+    time, q, qd, qdd = playback.sample(rate, speed=speed)
+    binding = [c for c in excitation.constraints if not c.advisory]
+    violation, worst = check_motion(binding, time, q, qd, qdd)
+    played = f" at speed {speed:g}" if speed != 1.0 else ""
     if violation > 0.0:
-        raise ExciteError("result", f"{result}: iteration {k} played at {rate:g} Hz violates {worst}; no file written")
+        raise ExciteError(
+            "result", f"{result}: iteration {k} played{played} at {rate:g} Hz violates {worst}; no file written"
+        )
+    advisory = [(c, c.check_samples(time, q, qd, qdd)) for c in excitation.constraints if c.advisory]
     robot = excitation.robot
     tau = np.array([robot.torques(*x) for x in zip(q, qd, qdd)])
     starts = np.cumsum([0.0] + [s.duration for s in playback.segments])
@@ -122,9 +145,16 @@ def export_trajectory(result: Path, iteration: int | None = None, rate: float = 
         rate=rate,
         iteration=k,
         periods=periods,
-        segments=[(s.name, float(t0), s.duration) for s, t0 in zip(playback.segments, starts)],
+        segments=[(s.name, float(t0) / speed, s.duration / speed) for s, t0 in zip(playback.segments, starts)],
         max_violation=violation,
         worst=worst,
+        speed=speed,
+        predictions=tuple(f"{c.field}: {check.where}" for c, check in advisory),
+        warnings=tuple(
+            f"{c.field}: played{played}, the {check.where}, less than the margin the config asks: the robot may tip"
+            for c, check in advisory
+            if check.max_violation > 0.0
+        ),
     )
 
 

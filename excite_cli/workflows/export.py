@@ -19,6 +19,7 @@ def run_export(
     fmt: str = "csv",
     output: Path | None = None,
     force: bool = False,
+    speed: float = 1.0,
 ) -> tuple[Export, Path]:
     """:func:`export_trajectory` written by :func:`write_export` to ``output`` (default
     ``<result>_iteration<K>_<rate>Hz.<ending>``, the ending of :data:`FORMATS`, beside the result; a
@@ -32,7 +33,8 @@ def run_export(
     check = check_bag_target if fmt == "rosbag2" else check_target
     if output is not None:
         check(output, "output", force)
-    export = export_trajectory(result, iteration, rate, periods)
+    export = export_trajectory(result, iteration, rate, periods, speed)
     ending = f".{FORMATS[fmt]}" if FORMATS[fmt] else ""
-    target = output or result.with_name(f"{result.stem}_iteration{export.iteration}_{rate:g}Hz{ending}")
+    faster = f"_speed{speed:g}" if speed != 1.0 else ""
+    target = output or result.with_name(f"{result.stem}_iteration{export.iteration}_{rate:g}Hz{faster}{ending}")
     return export, write_export(check(target, "output", force), export, fmt)

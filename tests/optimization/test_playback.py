@@ -15,6 +15,7 @@ from excite_cli.constraints import JointLimits
 from excite_cli.constraints.lse import GRID_MARGIN
 from excite_cli.dynamics.urdf_source import example_robot_data_root
 from excite_cli.optimization.playback import RESOLUTION, Transition, plan_transition
+from excite_cli.storage.export import export_trajectory
 from excite_cli.storage.rosbag import TOPIC
 
 runner = CliRunner()
@@ -108,6 +109,24 @@ def test_export_at_1khz_plays_from_home_to_home_with_rnea_torques(panda_runs, tm
     assert "every constraint holds" in run.output
 
 
+def test_export_at_half_speed_plays_the_same_path_in_twice_the_time(panda_runs):
+    """q_s(t) = q(t/2): the slow file's sample 2k is the fast one's k, with q̇ halved, q̈ quartered and the
+    torques RNEA's of those."""
+    fast = export_trajectory(panda_runs["rest"], rate=200.0)
+    slow = export_trajectory(panda_runs["rest"], rate=200.0, speed=0.5)
+    count = min(len(fast.time), (len(slow.time) + 1) // 2)
+    np.testing.assert_allclose(slow.time[: 2 * count : 2], 2 * fast.time[:count], atol=1e-12)
+    np.testing.assert_allclose(slow.q[: 2 * count : 2], fast.q[:count], atol=1e-12)
+    np.testing.assert_allclose(slow.qd[: 2 * count : 2], 0.5 * fast.qd[:count], atol=1e-12)
+    np.testing.assert_allclose(slow.qdd[: 2 * count : 2], 0.25 * fast.qdd[:count], atol=1e-12)
+    assert slow.speed == 0.5 and slow.segments[-1][1] == pytest.approx(2 * fast.segments[-1][1])
+    full = pin.buildModelFromUrdf(str(example_robot_data_root() / PANDA_URDF))
+    data, k = full.createData(), len(slow.time) // 3
+    expected = pin.rnea(full, data, *(np.r_[x[k], 0.0, 0.0] for x in (slow.q, slow.qd, slow.qdd)))[:7]
+    np.testing.assert_allclose(slow.tau[k], expected, rtol=1e-8, atol=1e-8)
+    assert slow.predictions == () and slow.warnings == ()  # a fixed-base arm: nothing to tip
+
+
 def test_export_npz_has_the_same_samples(panda_runs, tmp_path):
     run = runner.invoke(
         app,
@@ -173,6 +192,8 @@ def _csv(path):
         (["-k", "9"], "--iteration"),
         (["--rate", "0"], "--rate"),
         (["--periods", "0"], "--periods"),
+        (["--speed", "0"], "--speed"),
+        (["--speed", "3"], "joint_limits"),
         (["--rate", "100000", "--periods", "1000"], "samples"),
     ],
 )

@@ -1,16 +1,23 @@
 """The played file: CSV, NPZ, a ROS 2 goal and a ROS 2 bag written from the same samples and read back."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 import yaml
 from rosbags.typesys import Stores, get_typestore
 
+from excite_cli.config_file import load_problem, with_overrides
 from excite_cli.errors import ExciteError
-from excite_cli.storage.export import Export, columns, write_export
+from excite_cli.optimization.excitation import build_excitation
+from excite_cli.optimization.sequence import describe
+from excite_cli.storage.export import Export, columns, export_trajectory, write_export
 from excite_cli.storage.formats import FORMATS
+from excite_cli.storage.results import write_result
 from excite_cli.storage.rosbag import MSGTYPE
 
 JOINTS = ["a", "b"]
+CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 
 
 @pytest.fixture
@@ -87,3 +94,19 @@ def test_every_format_the_help_lists_is_written_with_its_ending(export, tmp_path
     written = path / "metadata.yaml" if fmt == "rosbag2" else path  # a bag is a folder
     assert written.is_file() and path.suffix == (f".{FORMATS[fmt]}" if FORMATS[fmt] else "")
     assert written.stat().st_size > 0
+
+
+def test_a_zmp_closer_to_the_edge_than_its_margin_is_a_warning_not_a_refusal(tmp_path):
+    """The G1's ZMP is a prediction its stance decides (the constraint is advisory): a motion the
+    optimizer's margin of 2 cm accepts, stored under a margin of 8.4 cm (standing still: 8.47 cm), exports with a warning."""
+    problem = load_problem(CONFIGS / "g1_arms.yaml")
+    alpha = build_excitation(problem).random_start(np.random.default_rng(2))
+    strict = build_excitation(with_overrides(problem, {"constraints.zmp.margin": 0.084}))
+    result = describe(strict, 1, alpha, np.zeros((0, strict.columns)))
+    target = tmp_path / "g1.h5"
+    write_result(target, strict, [result], 0, {"method": "optimized"})
+    played = export_trajectory(target, rate=100.0)
+    margin = result.checks["zmp_min_margin_m"]
+    assert 0.0 < margin < 0.084 and played.max_violation <= 0.0
+    assert len(played.warnings) == 1 and "the robot may tip" in played.warnings[0]
+    assert played.predictions[0].startswith("constraints.zmp: ZMP ")
