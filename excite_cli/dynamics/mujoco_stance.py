@@ -1,0 +1,239 @@
+"""A standing robot in MuJoCo playing a trajectory: the independent check of the zero-moment point.
+
+MuJoCo compiles the URDF itself (its own inertias, integrator and soft contacts); the robot gets a free
+joint at its root, the collision geometry of the support links (spheres, boxes, capsules: its soles) as
+its only contacts, and a floor under their lowest point. The joints the problem does not move are held
+at their locked values, welded (rigid, as excite's model holds them) or by a PD controller (the
+stance's compliance); each moving joint gets the feed-forward torque plus a PD on the tracking error
+(MuJoCo's position actuators, whose damping its ``implicitfast`` integrator takes implicitly). The
+centre of pressure comes from the floor's contact forces (``mj_contactForce``), the support polygon
+from MuJoCo's contact points standing still (MuJoCo documentation: Computation, Contact; Programming,
+Simulation).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from excite_cli.constraints.support import SupportPolygon
+from excite_cli.errors import ExciteError
+from excite_cli.identification.reporting.mjcf_out import import_mujoco
+
+#: Simulation step [s]; the played samples come at its rate.
+TIMESTEP = 0.0005
+#: Seconds standing still at the first sample before the motion starts.
+SETTLE = 2.0
+#: PD gains of the moving joints' tracking [Nm/rad, Nm·s/rad] (beside the feed-forward torque).
+TRACKING_GAINS = (200.0, 10.0)
+#: A robot whose root drops more than this below its standing height has fallen [m].
+FALL_DROP = 0.05
+#: Geometry MuJoCo keeps as the soles' contacts (a URDF's meshes are visual or collision hulls).
+CONTACT_GEOMS = ("sphere", "box", "capsule", "cylinder", "ellipsoid")
+
+
+@dataclass(frozen=True)
+class Stance:
+    """How the joints that do not move are held at their locked values.
+
+    Attributes:
+        stiffness: PD stiffness [Nm/rad], or None: welded (rigid).
+        damping: PD damping [Nm·s/rad].
+    """
+
+    stiffness: float | None = None
+    damping: float = 0.0
+
+    def __str__(self) -> str:
+        if self.stiffness is None:
+            return "welded"
+        return f"PD {self.stiffness:g} Nm/rad, {self.damping:g} Nm·s/rad"
+
+
+@dataclass(frozen=True)
+class StandingRun:
+    """What MuJoCo measured while the robot played the samples.
+
+    Attributes:
+        time: (S,) [s] from the start of the motion.
+        cop: (S, 2) centre of pressure [m], world x, y (NaN while no foot touches).
+        polygon: the support polygon of MuJoCo's contact points standing still.
+        tilt_deg: (S,) the largest tilt of a support link from its standing orientation [deg].
+        drop: (S,) how far the root is below its standing height [m].
+        tracking: (S,) the largest tracking error of a moving joint [rad].
+    """
+
+    time: np.ndarray
+    cop: np.ndarray
+    polygon: SupportPolygon
+    tilt_deg: np.ndarray
+    drop: np.ndarray
+    tracking: np.ndarray
+
+    @property
+    def margin(self) -> np.ndarray:
+        """(S,) the centre of pressure's distance inside the support polygon [m] (−inf with no contact)."""
+        inside = self.polygon.margins(np.nan_to_num(self.cop, nan=np.inf))
+        return np.where(np.isnan(self.cop).any(axis=1), -np.inf, inside)
+
+    @property
+    def fell(self) -> bool:
+        """Whether the root dropped more than ``FALL_DROP`` below its standing height."""
+        return bool(self.drop.max() > FALL_DROP)
+
+
+def standing_model(urdf: Path, active: list[str], locked: dict[str, float], support_links: list[str], stance: Stance):
+    """MuJoCo's model of the robot of ``urdf`` standing on the contact geometry of ``support_links``.
+
+    Args:
+        urdf: the robot's URDF.
+        active: the joints that move (tracked by PD on top of the feed-forward torque).
+        locked: {joint: value [rad]} of the held joints (0 for those not named).
+        support_links: the links whose collision geometry touches the floor.
+        stance: how the other joints are held.
+
+    Returns:
+        The compiled ``mujoco.MjModel``: the root's free joint first, then the joints of the URDF less
+        the welded ones, an actuator per remaining joint named after it.
+
+    Raises:
+        ExciteError: MuJoCo is missing or cannot read the URDF; no contact geometry on the support links.
+    """
+    mujoco = import_mujoco()
+    try:
+        spec = mujoco.MjSpec.from_file(str(urdf))
+    except ValueError as exc:
+        raise ExciteError("robot.urdf", f"MuJoCo cannot read {urdf}: {exc}") from None
+    spec.compiler.inertiafromgeom = mujoco.mjtInertiaFromGeom.mjINERTIAFROMGEOM_FALSE
+    kinds = {getattr(mujoco.mjtGeom, f"mjGEOM_{k.upper()}") for k in CONTACT_GEOMS}
+    for geom in list(spec.geoms):
+        if geom.parent.name not in support_links or geom.type not in kinds:
+            spec.delete(geom)
+    for mesh in list(spec.meshes):
+        spec.delete(mesh)
+    if not spec.geoms:
+        raise ExciteError("constraints.zmp.support_links", "MuJoCo finds no sphere, box or capsule on these links")
+    spec.option.timestep = TIMESTEP
+    spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    for joint in list(spec.joints):
+        joint.actfrclimited = mujoco.mjtLimited.mjLIMITED_FALSE  # the PD of a held joint is not a motor
+        value = locked.get(joint.name, 0.0)
+        if joint.name in active:
+            gains = TRACKING_GAINS
+        elif stance.stiffness is None:
+            _weld(mujoco, spec, joint, value)
+            continue
+        else:
+            gains = (stance.stiffness, stance.damping)
+        actuator = spec.add_actuator(name=joint.name, target=joint.name, trntype=mujoco.mjtTrn.mjTRN_JOINT)
+        actuator.gainprm[0] = gains[0]
+        actuator.biastype = mujoco.mjtBias.mjBIAS_AFFINE
+        actuator.biasprm[:3] = [0.0, -gains[0], -gains[1]]
+    spec.worldbody.first_body().add_freejoint()
+    model = spec.compile()
+    data = mujoco.MjData(model)
+    _pose(model, data, {name: locked.get(name, 0.0) for name in _joint_names(model)})
+    mujoco.mj_forward(model, data)
+    lowest = min(data.geom_xpos[g, 2] - _depth(mujoco, model, data, g) for g in range(model.ngeom))
+    spec.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_PLANE, size=[5.0, 5.0, 0.1], pos=[0.0, 0.0, lowest])
+    return spec.compile()
+
+
+def _weld(mujoco, spec, joint, value: float) -> None:
+    """Remove a hinge joint, turning its child body by ``value`` [rad] about its axis."""
+    body = joint.parent
+    if value:
+        turn, quat = np.zeros(4), np.zeros(4)
+        mujoco.mju_axisAngle2Quat(turn, np.asarray(joint.axis, float), value)
+        mujoco.mju_mulQuat(quat, np.asarray(body.quat, float), turn)
+        body.quat = quat
+    spec.delete(joint)
+
+
+def _joint_names(model) -> list[str]:
+    """The names of the model's joints after the free joint."""
+    return [model.joint(j).name for j in range(1, model.njnt)]
+
+
+def _pose(model, data, values: dict[str, float]) -> None:
+    """The root at the world origin, at rest, and the named joints at their values [rad]."""
+    data.qpos[:] = 0.0
+    data.qpos[3] = 1.0  # the free joint's unit quaternion
+    for name, value in values.items():
+        data.qpos[model.jnt_qposadr[model.joint(name).id]] = value
+
+
+def _depth(mujoco, model, data, geom: int) -> float:
+    """How far below its centre a contact geom reaches [m]: a sphere's radius, a box's half-extent in
+    z, else its bounding sphere's radius."""
+    size, rotation = model.geom_size[geom], data.geom_xmat[geom].reshape(3, 3)
+    if model.geom_type[geom] == mujoco.mjtGeom.mjGEOM_SPHERE:
+        return float(size[0])
+    if model.geom_type[geom] == mujoco.mjtGeom.mjGEOM_BOX:
+        return float(np.abs(rotation[2]) @ size)
+    return float(model.geom_rbound[geom])
+
+
+def play_standing(
+    model,
+    active: list[str],
+    locked: dict[str, float],
+    q: np.ndarray,
+    qd: np.ndarray,
+    tau: np.ndarray,
+) -> StandingRun:
+    """Stand ``SETTLE`` seconds at the first sample, then play the samples, one per ``TIMESTEP``.
+
+    Args:
+        model: :func:`standing_model`'s.
+        active: the moving joints, the columns of q, q̇, τ.
+        locked: {joint: value [rad]} the held joints' set points.
+        q, qd, tau: (S, n) positions [rad], velocities [rad/s] and feed-forward torques [Nm].
+
+    Returns:
+        What MuJoCo measured at each sample.
+    """
+    mujoco = import_mujoco()
+    data = mujoco.MjData(model)
+    names = _joint_names(model)
+    _pose(model, data, {name: locked.get(name, 0.0) for name in names} | dict(zip(active, q[0])))
+    qpos = np.array([model.jnt_qposadr[model.joint(name).id] for name in active])
+    dofs = np.array([model.jnt_dofadr[model.joint(name).id] for name in active])
+    moved = np.array([model.actuator(name).id for name in active])
+    data.ctrl[:] = [locked.get(model.actuator(a).name, 0.0) for a in range(model.nu)]
+    damping = TRACKING_GAINS[1]
+    supports = sorted({int(model.geom_bodyid[g]) for g in range(model.ngeom) if model.geom_bodyid[g] > 0})
+
+    def step(k: int) -> None:
+        data.ctrl[moved] = q[k]
+        data.qfrc_applied[dofs] = tau[k] + damping * qd[k]  # the PD's damping acts on the error q̇_ref − q̇
+        mujoco.mj_step(model, data)
+
+    for _ in range(int(round(SETTLE / model.opt.timestep))):
+        step(0)
+    standing_height = float(data.qpos[2])
+    upright = [data.xmat[b].reshape(3, 3)[:, 2].copy() for b in supports]
+    polygon = SupportPolygon.from_points(np.array([data.contact[i].pos[:2] for i in range(data.ncon)]), 0.0)
+    count = len(q)
+    cop, tilt, drop, tracking = np.full((count, 2), np.nan), np.zeros(count), np.zeros(count), np.zeros(count)
+    force = np.zeros(6)
+    for k in range(count):
+        step(k)
+        pressure, total = np.zeros(2), 0.0
+        for i in range(data.ncon):
+            contact = data.contact[i]
+            mujoco.mj_contactForce(model, data, i, force)
+            up = abs((contact.frame.reshape(3, 3).T @ force[:3])[2])  # friction lies in the floor's plane
+            pressure += up * contact.pos[:2]
+            total += up
+        if total > 0:
+            cop[k] = pressure / total
+        tilt[k] = max(
+            np.degrees(np.arccos(np.clip(data.xmat[b].reshape(3, 3)[:, 2] @ z, -1.0, 1.0)))
+            for b, z in zip(supports, upright)
+        )
+        drop[k] = standing_height - data.qpos[2]
+        tracking[k] = np.abs(data.qpos[qpos] - q[k]).max()
+    return StandingRun(np.arange(count) * model.opt.timestep, cop, polygon, tilt, drop, tracking)
