@@ -12,12 +12,11 @@ on the ground plane z = h is where the horizontal moment of that wrench vanishes
 equal to the centre of pressure while both feet are flat. Unlike the centre-of-mass region (Eq. 52)
 it moves with the arms' accelerations, which is what tips a standing humanoid. Per instant t and
 polygon edge k (outward normal n_k, offset b_k), s_t,k = (n_kᵀp_t − b_k + margin) / L, aggregated by
-a log-sum-exp over the grid into one inequality, and s_t = −f_z,t / (m g) into another (F_z > 0).
+a log-sum-exp over the grid into one inequality, and s_t = −f_z,t / (0.1 m g) into another (F_z > 0).
 
 The Jacobian in α comes from pinocchio's RNEA derivatives (Carpentier & Mansard 2018), their base
-rows: with q_j(t) = B(t) α_j (Eq. 50), ∂w_t/∂α_j = ∂w/∂q_j B(t) + ∂w/∂q̇_j Ḃ(t) + M_bj B̈(t) (the
-normal force's weights spread over every instant, so every instant gets one derivative pass, which
-gives the wrench too).
+rows: with q_j(t) = B(t) α_j (Eq. 50), ∂w_t/∂α_j = ∂w/∂q_j B(t) + ∂w/∂q̇_j Ḃ(t) + M_bj B̈(t), at the
+instants whose aggregation weight is not negligible.
 """
 
 from __future__ import annotations
@@ -37,8 +36,14 @@ from excite_cli.trajectory.fourier import FourierBasis
 #: The soles' contact points: collision points within this height of the lowest [m] (a sphere's
 #: bottom, a box's lower face), the polygon the centre of pressure can reach.
 CONTACT_HEIGHT = 0.001
-#: Standard gravity [m/s²], which pinocchio's models carry (the F_z > 0 inequality is normalized by m g).
+#: Standard gravity [m/s²], which pinocchio's models carry.
 GRAVITY = 9.81
+#: The normal force's row is normalized by this fraction of the weight m g: −F_z / (0.1 m g) ≤ 0, so
+#: that its aggregation weights gather on the few instants of least F_z, as the edges' do.
+FORCE_SCALE = 0.1
+#: Instants whose aggregation weights are all below this get no RNEA derivatives (their share of the
+#: Jacobian is below rounding).
+NEGLIGIBLE_WEIGHT = 1e-16
 
 
 def has_floating_base(robot: Robot) -> bool:
@@ -118,7 +123,7 @@ class ZeroMomentPoint(Constraint):
         """The ZMP (T, 2) [m], s of the edges (T, K) and s of the normal force (T,), normalized."""
         p = zero_moment_point(wrench, self.polygon.height)
         edges = (p @ self.polygon.normals.T - self.polygon.offsets + self.margin) / LENGTH_SCALE
-        return p, edges, -wrench[:, 2] / self._weight
+        return p, edges, -wrench[:, 2] / (FORCE_SCALE * self._weight)
 
     def values(self, alpha: np.ndarray) -> np.ndarray:
         """The two values of :meth:`evaluate` from RNEA alone, without the derivatives."""
@@ -128,24 +133,26 @@ class ZeroMomentPoint(Constraint):
     def evaluate(self, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The two aggregated values (ZMP, normal force) and their Jacobian (2, α.size)."""
         r, d = self.robot, self.data
-        T = self.basis.q.shape[0]
-        rows = np.empty((4, T, 6, r.model.nv))  # the base rows of τ (in column 0), ∂τ/∂q, ∂τ/∂q̇ and M
-        for t, state in enumerate(zip(*self._states(*(B @ alpha.T for B in self._orders)))):
-            pin.computeRNEADerivatives(r.model, d, *state)
-            rows[0, t, :, 0], rows[1, t], rows[2, t], rows[3, t] = d.tau[:6], d.dtau_dq[:6], d.dtau_dv[:6], d.M[:6]
-        wrench = rows[0, :, :, 0]
+        states = self._states(*(B @ alpha.T for B in self._orders))
+        wrench = np.array([pin.rnea(r.model, d, *state)[:6] for state in zip(*states)])
         p, edges, force = self._normalized(wrench)
         g_edges, w_edges = smooth_max(edges, (0, 1))
         g_force, w_force = smooth_max(force, 0)
-        fz, h = wrench[:, 2], self.polygon.height
+        fz, h, T = wrench[:, 2], self.polygon.height, len(wrench)
         dp = np.zeros((T, 2, 6))  # ∂p/∂w: p_x = (h f_x − n_y)/f_z, p_y = (h f_y + n_x)/f_z
         dp[:, 0, 0], dp[:, 0, 4], dp[:, 0, 2] = h / fz, -1.0 / fz, -p[:, 0] / fz
         dp[:, 1, 1], dp[:, 1, 3], dp[:, 1, 2] = h / fz, 1.0 / fz, -p[:, 1] / fz
         dg = np.zeros((2, T, 6))  # ∂g/∂w_t of both rows
         dg[0] = np.einsum("tk,kx,txw->tw", w_edges, self.polygon.normals / LENGTH_SCALE, dp)
-        dg[1, :, 2] = -w_force / self._weight
-        jacobian = sum(  # the active joints' columns (M: its upper triangle, which holds the base rows)
-            np.einsum("rtw,twj->rjt", dg, D[..., r.v_idx]) @ B for D, B in zip(rows[1:], self._orders)
+        dg[1, :, 2] = -w_force / (FORCE_SCALE * self._weight)
+        instants = np.flatnonzero(np.abs(dg).max(axis=(0, 2)) > NEGLIGIBLE_WEIGHT)
+        rows = np.empty((3, instants.size, 6, r.model.nv))  # ∂w/∂q, ∂w/∂q̇ and M's base rows
+        for i, t in enumerate(instants):
+            pin.computeRNEADerivatives(r.model, d, states[0][t], states[1][t], states[2][t])
+            rows[0, i], rows[1, i], rows[2, i] = d.dtau_dq[:6], d.dtau_dv[:6], d.M[:6]  # M: its upper triangle
+        jacobian = sum(  # the active joints' columns
+            np.einsum("rtw,twj->rjt", dg[:, instants], D[..., r.v_idx]) @ B[instants]
+            for D, B in zip(rows, self._orders)
         )
         return np.array([g_edges, g_force]), jacobian.reshape(2, -1)
 
@@ -162,7 +169,7 @@ class ZeroMomentPoint(Constraint):
             details={
                 "zmp_min_margin_m": float(inside[t]),
                 "zmp_min_margin_time_s": float(time[t]),
-                "zmp_min_normal_force_ratio": float(-force.max()),
+                "zmp_min_normal_force_ratio": float(-force.max() * FORCE_SCALE),
             },
             where=(
                 f"ZMP {1000 * inside[t]:.1f} mm inside the support polygon at t = {time[t]:.2f} s "
