@@ -98,7 +98,8 @@ def test_every_format_the_help_lists_is_written_with_its_ending(export, tmp_path
 
 def test_a_zmp_closer_to_the_edge_than_its_margin_is_a_warning_not_a_refusal(tmp_path):
     """The G1's ZMP is a prediction its stance decides (the constraint is advisory): a motion the
-    optimizer's margin of 2 cm accepts, stored under a margin of 8.4 cm (standing still: 8.47 cm), exports with a warning."""
+    optimizer's margin of 2 cm accepts, stored under a margin of 8.4 cm (standing still: 8.47 cm),
+    exports with a warning."""
     problem = load_problem(CONFIGS / "g1_arms.yaml")
     alpha = build_excitation(problem).random_start(np.random.default_rng(2))
     strict = build_excitation(with_overrides(problem, {"constraints.zmp.margin": 0.084}))
