@@ -20,7 +20,7 @@ import numpy as np
 
 from excite_cli.constraints.support import SupportPolygon
 from excite_cli.errors import ExciteError
-from excite_cli.identification.reporting.mjcf_out import import_mujoco
+from excite_cli.identification.reporting.mjcf_out import import_mujoco, urdf_spec, weld_joints
 
 #: Simulation step [s]; the played samples come at its rate.
 TIMESTEP = 0.0005
@@ -101,12 +101,7 @@ def standing_model(urdf: Path, active: list[str], locked: dict[str, float], supp
     Raises:
         ExciteError: MuJoCo is missing or cannot read the URDF; no contact geometry on the support links.
     """
-    mujoco = import_mujoco()
-    try:
-        spec = mujoco.MjSpec.from_file(str(urdf))
-    except ValueError as exc:
-        raise ExciteError("robot.urdf", f"MuJoCo cannot read {urdf}: {exc}") from None
-    spec.compiler.inertiafromgeom = mujoco.mjtInertiaFromGeom.mjINERTIAFROMGEOM_FALSE
+    mujoco, spec = urdf_spec(urdf)
     kinds = {getattr(mujoco.mjtGeom, f"mjGEOM_{k.upper()}") for k in CONTACT_GEOMS}
     for geom in list(spec.geoms):
         if geom.parent.name not in support_links or geom.type not in kinds:
@@ -117,16 +112,11 @@ def standing_model(urdf: Path, active: list[str], locked: dict[str, float], supp
         raise ExciteError("constraints.zmp.support_links", "MuJoCo finds no sphere, box or capsule on these links")
     spec.option.timestep = TIMESTEP
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    if stance.stiffness is None:
+        weld_joints(mujoco, spec, active, locked, [])
     for joint in list(spec.joints):
         joint.actfrclimited = mujoco.mjtLimited.mjLIMITED_FALSE  # the PD of a held joint is not a motor
-        value = locked.get(joint.name, 0.0)
-        if joint.name in active:
-            gains = TRACKING_GAINS
-        elif stance.stiffness is None:
-            _weld(mujoco, spec, joint, value)
-            continue
-        else:
-            gains = (stance.stiffness, stance.damping)
+        gains = TRACKING_GAINS if joint.name in active else (stance.stiffness, stance.damping)
         actuator = spec.add_actuator(name=joint.name, target=joint.name, trntype=mujoco.mjtTrn.mjTRN_JOINT)
         actuator.gainprm[0] = gains[0]
         actuator.biastype = mujoco.mjtBias.mjBIAS_AFFINE
@@ -139,17 +129,6 @@ def standing_model(urdf: Path, active: list[str], locked: dict[str, float], supp
     lowest = min(data.geom_xpos[g, 2] - _depth(mujoco, model, data, g) for g in range(model.ngeom))
     spec.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_PLANE, size=[5.0, 5.0, 0.1], pos=[0.0, 0.0, lowest])
     return spec.compile()
-
-
-def _weld(mujoco, spec, joint, value: float) -> None:
-    """Remove a hinge joint, turning its child body by ``value`` [rad] about its axis."""
-    body = joint.parent
-    if value:
-        turn, quat = np.zeros(4), np.zeros(4)
-        mujoco.mju_axisAngle2Quat(turn, np.asarray(joint.axis, float), value)
-        mujoco.mju_mulQuat(quat, np.asarray(body.quat, float), turn)
-        body.quat = quat
-    spec.delete(joint)
 
 
 def _joint_names(model) -> list[str]:

@@ -98,10 +98,27 @@ def _resolve_meshes(spec, urdf: Path, package_dirs: list[str], notes: list[str])
         notes.append(f"collision mesh {name} left out ({why})")
 
 
-def _weld(mujoco, spec, robot: Robot, locked: dict[str, float], notes: list[str]) -> None:
-    """Remove every joint that is not active (and the equality constraints on it, a URDF <mimic>),
-    turning its child body by the joint's locked value (0 unless ``robot.locked_joints`` says)."""
-    welded = [j for j in spec.joints if j.name not in robot.joint_names]
+def urdf_spec(urdf: Path):
+    """The ``mujoco`` module and MuJoCo's spec (``MjSpec``) of the URDF at ``urdf``, its bodies keeping
+    the URDF's inertias (not MuJoCo's from the geometry).
+
+    Raises:
+        ExciteError: MuJoCo is missing or cannot read the URDF.
+    """
+    mujoco = import_mujoco()
+    try:
+        spec = mujoco.MjSpec.from_file(str(urdf))
+    except ValueError as exc:
+        raise ExciteError("robot.urdf", f"MuJoCo cannot read {urdf}: {exc}") from None
+    spec.compiler.inertiafromgeom = mujoco.mjtInertiaFromGeom.mjINERTIAFROMGEOM_FALSE
+    return mujoco, spec
+
+
+def weld_joints(mujoco, spec, active: list[str], locked: dict[str, float], notes: list[str]) -> None:
+    """Remove every joint of ``spec`` not in ``active`` (and the equality constraints on it, a URDF
+    <mimic>), turning its child body by the joint's locked value [rad or m] (0 unless ``locked`` says);
+    the free joint of a floating root is kept. What was welded is added to ``notes``."""
+    welded = [j for j in spec.joints if j.name not in active and j.type != mujoco.mjtJoint.mjJNT_FREE]
     names = {j.name for j in welded}
     for equality in [e for e in spec.equalities if e.name1 in names or e.name2 in names]:
         spec.delete(equality)
@@ -214,15 +231,10 @@ def write_mjcf(
         ExciteError: MuJoCo is missing, cannot read the URDF or refuses the model; the file cannot be
             written.
     """
-    mujoco = import_mujoco()
-    try:
-        spec = mujoco.MjSpec.from_file(str(urdf))
-    except ValueError as exc:
-        raise ExciteError("robot.urdf", f"MuJoCo cannot read {urdf}: {exc}") from None
-    spec.compiler.inertiafromgeom = mujoco.mjtInertiaFromGeom.mjINERTIAFROMGEOM_FALSE
+    mujoco, spec = urdf_spec(urdf)
     model = MjcfModel(Path(target), list(robot.joint_names))
     _resolve_meshes(spec, urdf, package_dirs, model.notes)
-    _weld(mujoco, spec, robot, locked, model.notes)
+    weld_joints(mujoco, spec, robot.joint_names, locked, model.notes)
     _inertias(spec, robot, standard, model.notes)
     _joint_fields(spec, robot, effects, model)
     _motors(mujoco, spec, robot)
