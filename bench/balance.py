@@ -12,7 +12,9 @@ One line per stance, seed, iteration and speed:
 tilt T deg, stands|falls` — MuJoCo's smallest distance of the centre of pressure (from the contact
 forces) inside the polygon of its contact points, excite's predicted smallest ZMP margin on the same
 samples, the RMS distance between the two points, the largest tilt of a foot, and whether the root
-dropped more than 5 cm. A summary line per stance and speed follows.
+dropped more than 5 cm. A summary line per stance and speed follows, then the PD stance's sway
+frequencies: the root pushed (60 N for 50 ms) fore-aft and sideways while standing at home, the
+peak of its centre of mass's free motion over 5.9 s.
 
     .venv/bin/python bench/balance.py [--config configs/g1_arms.yaml] [--seeds 0 1 2] [--result R.h5]
 
@@ -26,6 +28,7 @@ import excite_cli  # noqa: F401  (before NumPy: the kernels of the command line,
 # isort: split
 
 import argparse
+import copy
 import tempfile
 from pathlib import Path
 
@@ -35,6 +38,7 @@ from excite_cli.config_file import load_problem
 from excite_cli.constraints.zmp import zero_moment_point
 from excite_cli.dynamics.mujoco_stance import TIMESTEP, Stance, play_standing, standing_model
 from excite_cli.dynamics.urdf_source import resolve_urdf
+from excite_cli.identification.reporting.mjcf_out import import_mujoco
 from excite_cli.optimization.excitation import build_excitation
 from excite_cli.optimization.playback import plan_playback
 from excite_cli.storage.results import read_alphas
@@ -55,6 +59,26 @@ def results(config: Path, seeds: list[int], given: Path | None, folder: Path) ->
         run_optimize(problem, target, force=True)
         found[seed] = dict(read_alphas(target))
         print(f"  optimized seed {seed}", flush=True)
+    return found
+
+
+def sway(model, joints: list[str], home: np.ndarray, locked: dict[str, float]) -> list[float]:
+    """The frequencies [Hz] (fore-aft, sideways) at which the standing robot's centre of mass swings
+    freely after a push of the root: 60 N for 50 ms after 2 s standing at ``home``."""
+    mujoco = import_mujoco()
+    settled = mujoco.MjData(model)
+    play_standing(model, joints, locked, home[None], 0 * home[None], 0 * home[None], settled)
+    found = []
+    for axis in (0, 1):
+        data = copy.copy(settled)
+        track = []
+        for k in range(12_000):
+            data.xfrc_applied[1, axis] = 60.0 if k < 100 else 0.0
+            mujoco.mj_step(model, data)
+            track.append(data.subtree_com[1, axis])
+        swing = np.array(track[200:]) - np.mean(track[200:])
+        spectrum = np.abs(np.fft.rfft(swing))[1:]
+        found.append(float(np.fft.rfftfreq(swing.size, TIMESTEP)[1:][np.argmax(spectrum)]))
     return found
 
 
@@ -95,6 +119,8 @@ def main() -> None:
                         f"{1000 * gap:.1f} mm), tilt {run.tilt_deg.max():.2f} deg, {'falls' if run.fell else 'stands'}",
                         flush=True,
                     )
+    fore_aft, sideways = sway(models[1], joints, excitation.home, locked)
+    print(f"sway [{stances[1]}]: fore-aft {fore_aft:.2f} Hz, sideways {sideways:.2f} Hz")
     for (stance, speed), rows in summary.items():
         margins, gaps, fell = zip(*rows)
         print(

@@ -162,6 +162,7 @@ def play_standing(
     q: np.ndarray,
     qd: np.ndarray,
     tau: np.ndarray,
+    data=None,
 ) -> StandingRun:
     """Stand ``SETTLE`` seconds at the first sample, then play the samples, one per ``TIMESTEP``.
 
@@ -170,12 +171,13 @@ def play_standing(
         active: the moving joints, the columns of q, q̇, τ.
         locked: {joint: value [rad]} the held joints' set points.
         q, qd, tau: (S, n) positions [rad], velocities [rad/s] and feed-forward torques [Nm].
+        data: the ``mujoco.MjData`` to play in (default: a new one); it holds the last state afterwards.
 
     Returns:
         What MuJoCo measured at each sample.
     """
     mujoco = import_mujoco()
-    data = mujoco.MjData(model)
+    data = mujoco.MjData(model) if data is None else data
     names = _joint_names(model)
     _pose(model, data, {name: locked.get(name, 0.0) for name in names} | dict(zip(active, q[0])))
     qpos = np.array([model.jnt_qposadr[model.joint(name).id] for name in active])
