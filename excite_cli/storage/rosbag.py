@@ -19,6 +19,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+import yaml
 from rosbags.rosbag2 import Writer, WriterError
 from rosbags.typesys import Stores, get_typestore
 
@@ -54,20 +55,39 @@ def check_goal_size(text: str) -> None:
         )
 
 
+def is_rosbag2_folder(folder: Path) -> bool:
+    """Whether ``folder`` is a ROS 2 bag and nothing else: its ``metadata.yaml`` parses as rosbag2's
+    (``rosbag2_bagfile_information`` with ``relative_file_paths``, the rosbag2 metadata format) and the
+    folder holds no file or folder but that metadata and the files it lists (what excite, or ``ros2 bag
+    record``, wrote there). A folder holding anything else is a user's, however its files are named."""
+    try:
+        info = yaml.safe_load((folder / "metadata.yaml").read_text(encoding="utf-8"))["rosbag2_bagfile_information"]
+        listed = {str(name) for name in info["relative_file_paths"]}
+    except (OSError, UnicodeDecodeError, yaml.YAMLError, KeyError, TypeError):
+        return False
+    return {entry.name for entry in folder.iterdir()} <= listed | {"metadata.yaml"}
+
+
 def check_bag_target(folder: Path, field: str, force: bool) -> Path:
-    """``folder`` may receive a bag: it does not exist, or with ``force`` it is a ROS 2 bag (a folder
-    with ``metadata.yaml``), which is replaced; never another folder or a file.
+    """``folder`` may receive a bag: it does not exist, or with ``force`` it is a ROS 2 bag and nothing
+    else (:func:`is_rosbag2_folder`), which is replaced; never another folder or a file.
 
     Raises:
         OutputExists: it exists, without ``force``.
-        ExciteError: it is a file, a folder that is not a bag, or cannot be written
+        ExciteError: it is a file, a folder that is not only a bag, or cannot be written
             (:func:`~excite_cli.storage.paths.check_target`).
     """
     folder = Path(folder)
     if folder.exists() and not force:
         raise OutputExists(field, folder)
-    if folder.exists() and not (folder.is_dir() and (folder / "metadata.yaml").is_file()):
-        raise ExciteError(field, f"{folder} exists and is not a ROS 2 bag folder; not replaced", folder, "a new folder")
+    if folder.exists() and not (folder.is_dir() and is_rosbag2_folder(folder)):
+        raise ExciteError(
+            field,
+            f"{folder} exists and is not only a ROS 2 bag (a rosbag2 metadata.yaml and the files it lists); "
+            "not replaced",
+            folder,
+            "a new folder",
+        )
     check_target(folder / "metadata.yaml", field, force=True)  # its folder (or the nearest one there is) writable
     return folder
 

@@ -1,5 +1,5 @@
 """The exported motion as a ROS 2 bag: read back with rosbags as ros2 bag play reads it, written
-whole or not at all, replacing only a bag."""
+whole or not at all, replacing only a folder that holds a bag and nothing else."""
 
 import numpy as np
 import pytest
@@ -59,8 +59,31 @@ def test_force_replaces_a_bag_and_never_another_folder(tmp_path):
     assert len(_read(bag)) == 1
     (tmp_path / "notes").mkdir()
     (tmp_path / "notes" / "keep.txt").write_text("mine")
-    with pytest.raises(ExciteError, match="is not a ROS 2 bag folder; not replaced"):
+    with pytest.raises(ExciteError, match="is not only a ROS 2 bag .*; not replaced"):
         check_bag_target(tmp_path / "notes", "output", force=True)
+
+
+@pytest.mark.parametrize("kind", ["dataset", "bag with notes", "bag metadata without its list"])
+def test_force_never_replaces_a_folder_that_holds_more_than_a_bag(tmp_path, kind):
+    """A dataset's own metadata.yaml (title, author, licence) beside its files, a bag a user added notes
+    to, a metadata.yaml that does not list the bag's files: refused with force, nothing touched."""
+    folder = tmp_path / "site"
+    if kind == "dataset":
+        folder.mkdir()
+        (folder / "metadata.yaml").write_text("title: my data\nauthor: me\nlicence: CC-BY\n")
+        (folder / "data.csv").write_text("t,q\n0,1\n")
+    else:
+        _bag(folder)
+        if kind == "bag metadata without its list":
+            text = (folder / "metadata.yaml").read_text().replace("relative_file_paths", "files")
+            (folder / "metadata.yaml").write_text(text)
+    if kind != "bag metadata without its list":
+        (folder / "notes.txt").write_text("mine")
+    before = {p.name: p.read_bytes() for p in folder.iterdir()}
+    with pytest.raises(ExciteError, match="not only a ROS 2 bag") as error:
+        check_bag_target(folder, "output", force=True)
+    assert error.value.field == "output"
+    assert {p.name: p.read_bytes() for p in folder.iterdir()} == before
 
 
 def test_a_recorded_run_reads_back_through_identify_s_bag_reader(tmp_path):

@@ -10,6 +10,7 @@ from conftest import CONFIGS, JOINTS, robot_of, write_config
 
 from excite_cli import workflows
 from excite_cli.config_file import load_problem
+from excite_cli.errors import ExciteError
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.simulation_config import SimulationConfig
 from excite_cli.workflows.compare import run_compare_random
@@ -45,6 +46,26 @@ def test_export_plays_the_last_iteration_at_the_rate_from_home_to_home(smoke):
     np.testing.assert_allclose(np.diff(played.time), 1 / 200.0)
     np.testing.assert_allclose(played.q[[0, -1]], np.tile(run.excitation.home, (2, 1)), atol=1e-12)
     assert path.exists() and played.iteration == len(run.results) and played.max_violation <= 0
+
+
+@pytest.mark.parametrize("writer", ["export", "simulate"])
+def test_a_bag_writer_with_force_leaves_a_user_s_folder_whole(smoke, writer):
+    """`export --format rosbag2 --force` and `simulate --force` with `recording: rosbag2` over a folder
+    that holds a dataset's own metadata.yaml and notes: refused in one line, every file kept."""
+    folder, _, run = smoke
+    site = folder / f"site_{writer}"
+    target = site / "run_1" if writer == "simulate" else site
+    target.mkdir(parents=True)
+    (target / "metadata.yaml").write_text("title: my data\nauthor: me\n")
+    (target / "notes.txt").write_text("mine")
+    with pytest.raises(ExciteError, match="not only a ROS 2 bag"):
+        if writer == "export":
+            run_export(run.target, rate=200.0, fmt="rosbag2", output=site, force=True)
+        else:
+            sim = SimulationConfig(sample_rate=100, periods=1, recording="rosbag2", effects={"coulomb": {"*": 0.5}})
+            simulate_runs(run.target, sim, site, force=True)
+    assert sorted(p.name for p in target.iterdir()) == ["metadata.yaml", "notes.txt"]
+    assert (target / "notes.txt").read_text() == "mine"
 
 
 def test_view_writes_one_scene(smoke):
