@@ -52,7 +52,8 @@ def read_report_model(path: Path) -> ReportModel:
     ``joint_names`` and the attribute ``coulomb_velocity_rad_s``).
 
     Raises:
-        FileNotFound, ExciteError: (``effects.model``) no readable file, or not an identify report.
+        FileNotFound, ExciteError: (``effects.model``) no readable file, not an identify report, an
+            effects table without its fields, a Coulomb velocity scale that is not positive.
     """
     with open_h5(path, "effects.model") as f:
         if "identification/effects" not in f:
@@ -61,6 +62,16 @@ def read_report_model(path: Path) -> ReportModel:
         rows, coupling = g["effects"][()], g["effect_coupling"][()]
         names = read_strings(g, "joint_names")
         velocity = float(g.attrs.get("coulomb_velocity_rad_s", 0.01))
+    missing = [name for name in ("effect", "joint") if name not in (rows.dtype.names or ())]
+    if missing:
+        raise ExciteError("effects.model", f"{path}: /identification/effects has no field '{missing[0]}' (damaged?)")
+    if not (np.isfinite(velocity) and velocity > 0):
+        raise ExciteError(
+            "effects.model",
+            f"{path}: its Coulomb velocity scale coulomb_velocity_rad_s is {velocity:g}",
+            velocity,
+            "a positive number of rad/s",
+        )
     joints: dict[str, list[str]] = {}
     motors: list[tuple[list[str], list[float]]] = []
     left_out: list[str] = []
@@ -148,14 +159,33 @@ class MeasuredPrior:
 def read_measured_prior(path: Path) -> MeasuredPrior | None:
     """The weighing of ``sequence.prior`` when it is an identify report (``/identification/rms_after``,
     ``/identification/joint_names``, ``/regressor`` attribute ``sample_rate_Hz``); None for anything else
-    (an optimize result, a plain regressor file, or no file: whoever reads the rows says what is wrong)."""
+    (an optimize result, a plain regressor file, or no file: whoever reads the rows says what is wrong).
+
+    Raises:
+        ExciteError: (``sequence.prior``) a report whose errors or sample rate no weighing can use
+            (not finite, negative, all zero, not one per joint; a rate that is not positive).
+    """
     if not path.is_file():
         return None
     with open_h5(path, "sequence.prior") as f:
         if "identification/rms_after" not in f or "sample_rate_Hz" not in f["regressor"].attrs:
             return None
         joints = read_strings(f["identification"], "joint_names")
-        return MeasuredPrior(joints, f["identification/rms_after"][()], float(f["regressor"].attrs["sample_rate_Hz"]))
+        sigma, rate = (
+            np.asarray(f["identification/rms_after"][()], dtype=float),
+            float(f["regressor"].attrs["sample_rate_Hz"]),
+        )
+    if sigma.shape != (len(joints),) or not np.all(np.isfinite(sigma)) or np.any(sigma < 0) or not np.any(sigma > 0):
+        raise ExciteError(
+            "sequence.prior",
+            f"{path}: /identification/rms_after must hold each of its {len(joints)} joints' error, finite, not "
+            "negative and not all zero (damaged?)",
+        )
+    if not (np.isfinite(rate) and rate > 0):
+        raise ExciteError(
+            "sequence.prior", f"{path}: its sample rate sample_rate_Hz is {rate:g}", rate, "a positive rate [Hz]"
+        )
+    return MeasuredPrior(joints, sigma, rate)
 
 
 @dataclass

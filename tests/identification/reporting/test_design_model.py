@@ -218,3 +218,51 @@ def test_a_coupled_motor_and_an_offset_are_named_and_placed_as_a_design_has_them
     np.testing.assert_array_equal(rows.effects[0][:, 0], [1.0, 0.0] * 3)
     np.testing.assert_array_equal(rows.effects[0][0::2, 1:], cols)
     np.testing.assert_array_equal(rows.effects[0][1::2, 1:], -2.0 * cols)
+
+
+def _damaged(report_file, tmp_path, edit):
+    """A copy of the report with ``edit(h5py.File)`` applied."""
+    path = tmp_path / "damaged.h5"
+    path.write_bytes(report_file.read_bytes())
+    with h5py.File(path, "a") as f:
+        edit(f)
+    return path
+
+
+def _replace(f, name, value):
+    del f[name]
+    f[name] = value
+
+
+@pytest.mark.parametrize(
+    "edit, message",
+    [
+        (lambda f: _replace(f, "identification/rms_after", np.zeros(7)), "rms_after must hold"),
+        (lambda f: _replace(f, "identification/rms_after", np.full(7, np.nan)), "rms_after must hold"),
+        (lambda f: _replace(f, "identification/rms_after", np.ones(3)), "rms_after must hold"),
+        (lambda f: f["regressor"].attrs.__setitem__("sample_rate_Hz", 0.0), "sample_rate_Hz is 0"),
+    ],
+)
+def test_a_damaged_report_as_prior_is_refused_in_one_line(report_file, tmp_path, edit, message):
+    """What a report's weighing divides by: errors of its joints and its rate (issue 62: rms_after all
+    zero ended in LinAlgError, a rate of 0 in ZeroDivisionError)."""
+    with pytest.raises(ExciteError, match=message) as error:
+        read_measured_prior(_damaged(report_file, tmp_path, edit))
+    assert error.value.field == "sequence.prior"
+
+
+def test_a_damaged_report_as_model_is_refused_in_one_line(report_file, tmp_path):
+    """An effects table without its effect field, a Coulomb velocity scale of NaN (issue 62: a ValueError
+    from numpy; the Coulomb columns dropped with a false warning)."""
+    with h5py.File(report_file) as f:
+        rows = f["identification/effects"][()]
+    renamed = rows.astype([("kind" if n == "effect" else n, rows.dtype[n]) for n in rows.dtype.names])
+    no_field = _damaged(report_file, tmp_path, lambda f: _replace(f, "identification/effects", renamed))
+    with pytest.raises(ExciteError, match="has no field 'effect'"):
+        read_report_model(no_field)
+    nan = _damaged(
+        report_file, tmp_path, lambda f: f["identification"].attrs.__setitem__("coulomb_velocity_rad_s", np.nan)
+    )
+    with pytest.raises(ExciteError, match="coulomb_velocity_rad_s is nan") as error:
+        read_report_model(nan)
+    assert error.value.field == "effects.model"
