@@ -104,8 +104,9 @@ def atomic_folder(path: Path, field: str = "output") -> Iterator[Path]:
     (the inner folder has the target's own name, for writers that name their files after their
     folder, as rosbag2 does), which is moved onto ``path`` when the block ends without error (a folder
     already there is replaced: the caller has checked that it may be) and removed otherwise, with any
-    folder made for it (:func:`new_folders`); one a killed run left is removed first, with a warning
-    (:func:`remove_stale`).
+    folder made for it (:func:`new_folders`); the folder it replaces is only set aside until the new
+    one is in place (and put back if that fails); one a killed run left is removed first, with a
+    warning (:func:`remove_stale`).
 
     Raises:
         CannotWrite: the folder cannot be written (``OSError`` in the block or in the move).
@@ -118,9 +119,14 @@ def atomic_folder(path: Path, field: str = "output") -> Iterator[Path]:
             try:
                 staging.mkdir()
                 yield staging / path.name
-                if path.exists():
-                    shutil.rmtree(path)
-                os.replace(staging / path.name, path)
+                if path.exists():  # set aside, not removed, until the new folder is in its place
+                    os.replace(path, staging / ".replaced")
+                try:
+                    os.replace(staging / path.name, path)
+                except OSError:
+                    if (staging / ".replaced").exists():
+                        os.replace(staging / ".replaced", path)
+                    raise
             finally:
                 shutil.rmtree(staging, ignore_errors=True)
     except OSError as exc:

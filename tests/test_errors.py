@@ -1,6 +1,9 @@
 """Errors carry the field at fault, the offending value and what is expected; the library names
 arguments and config fields, the command line words them as its own options."""
 
+import os
+from pathlib import Path
+
 import pytest
 import yaml
 from conftest import UR5, write_config
@@ -67,6 +70,29 @@ def test_an_atomic_folder_is_whole_or_absent_and_replaces_the_one_there(tmp_path
         with atomic_folder(target) as staging:
             staging.mkdir()
     assert [p.name for p in target.parent.iterdir()] == ["bag"]
+
+
+def test_an_atomic_folder_that_cannot_take_its_place_puts_back_the_one_it_replaced(tmp_path, monkeypatch):
+    """The replaced folder is set aside, not removed, until the new one is in place (issue 62: --force
+    never removes what it replaces before the new one is complete)."""
+    target = tmp_path / "bag"
+    target.mkdir()
+    (target / "bag.db3").write_text("earlier")
+    moves, replace = [], os.replace
+
+    def failing(source, destination):
+        moves.append(Path(destination).name)
+        if len(moves) == 2:  # the new folder onto the target
+            raise OSError(18, "Invalid cross-device link")
+        replace(source, destination)
+
+    monkeypatch.setattr(os, "replace", failing)
+    with pytest.raises(CannotWrite, match="cross-device"):
+        with atomic_folder(target) as staging:
+            staging.mkdir()
+            (staging / "bag.db3").write_text("new")
+    monkeypatch.setattr(os, "replace", replace)
+    assert (target / "bag.db3").read_text() == "earlier" and [p.name for p in tmp_path.iterdir()] == ["bag"]
 
 
 def test_a_file_that_is_not_hdf5_is_named_with_the_field_that_gave_it(tmp_path):

@@ -15,6 +15,7 @@ per sample on :data:`JOINT_STATES`, stamped with its time (from :data:`START`), 
 
 from __future__ import annotations
 
+import sqlite3
 import time
 from pathlib import Path
 
@@ -119,7 +120,8 @@ def _write_bag(folder: Path, topic: str, msgtype: str, messages) -> Path:
     :func:`check_bag_target`).
 
     Raises:
-        CannotWrite: the bag cannot be written (a full disk, permissions).
+        CannotWrite: the bag cannot be written (a full disk, permissions), whatever the writer or its
+            storage raises; nothing is left of it and a bag it was to replace is kept.
     """
     typestore = get_typestore(Stores.ROS2_HUMBLE)
     try:
@@ -127,7 +129,7 @@ def _write_bag(folder: Path, topic: str, msgtype: str, messages) -> Path:
             connection = writer.add_connection(topic, msgtype, typestore=typestore)
             for ns, message in messages(typestore.types):
                 writer.write(connection, ns, typestore.serialize_cdr(message, msgtype))
-    except WriterError as exc:
+    except (WriterError, sqlite3.Error) as exc:  # rosbags' own, and its SQLite storage's (a full disk at close)
         raise CannotWrite("output", folder, exc) from None
     return Path(folder)
 

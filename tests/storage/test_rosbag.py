@@ -6,7 +6,7 @@ import pytest
 from rosbags.highlevel import AnyReader
 from rosbags.typesys import Stores, get_typestore
 
-from excite_cli.errors import ExciteError, OutputExists
+from excite_cli.errors import CannotWrite, ExciteError, OutputExists
 from excite_cli.identification.measured.bags import read_bag
 from excite_cli.storage.rosbag import (
     JOINT_STATES,
@@ -95,3 +95,28 @@ def test_a_recorded_run_reads_back_through_identify_s_bag_reader(tmp_path):
     np.testing.assert_array_equal(table.column("position/elbow", "q", bag), Q[:, 1])
     np.testing.assert_array_equal(table.column("effort/shoulder", "tau", bag), MOTION[3][:, 0])
     assert "velocity/elbow" not in table.names  # left empty, as many drivers publish it
+
+
+def test_a_full_disk_under_the_bag_writer_is_one_error_and_keeps_the_bag_it_would_replace(tmp_path, monkeypatch):
+    """rosbags' SQLite storage raises sqlite3.OperationalError when the disk fills at close (issue 62: a
+    108-line traceback): one CannotWrite, nothing of the new bag left, the earlier bag whole."""
+    import sqlite3
+
+    import excite_cli.storage.rosbag as rosbag
+
+    bag = _bag(tmp_path / "bag")
+    before = {p.name: p.read_bytes() for p in bag.iterdir()}
+
+    class FullDisk(rosbag.Writer):
+        def close(self):
+            super().close()
+            raise sqlite3.OperationalError("database or disk is full")
+
+    monkeypatch.setattr(rosbag, "Writer", FullDisk)
+    with pytest.raises(CannotWrite, match="disk is full"):
+        check_bag_target(bag, "output", force=True)
+        _bag(bag)
+    with pytest.raises(CannotWrite):
+        _bag(tmp_path / "new")
+    assert {p.name: p.read_bytes() for p in bag.iterdir()} == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bag"]
