@@ -155,6 +155,8 @@ class OptimizerConfig(Section):
     def _address(cls, value: Optional[str]) -> Optional[str]:
         if value is not None and not SCHEDULER_ADDRESS.match(value):
             raise ValueError("expected a Dask scheduler address host:port, e.g. tcp://10.0.0.5:8786")
+        if value is not None and not 1 <= int(value.rpartition(":")[2]) <= 65535:
+            raise ValueError(f"port {value.rpartition(':')[2]} is out of range; expected 1 to 65535")
         return value
 
 

@@ -1,11 +1,15 @@
 """Restarts and random draws in parallel: a process pool and a Dask cluster give the serial run's
 trajectories and candidates, bit for bit, for the same seed; each restart draws its own start."""
 
+import contextlib
 import os
 import re
 import signal
+import socket
+import struct
 import subprocess
 import sys
+import threading
 import time
 from contextlib import contextmanager
 from pathlib import Path
@@ -16,8 +20,10 @@ import numpy as np
 import pytest
 import yaml
 from conftest import TESTS, tcp_server, write_config
+from pydantic import ValidationError
 
 import excite_cli.optimization.engine as engine_module
+from excite_cli.config import OptimizerConfig
 from excite_cli.config_file import load_problem
 from excite_cli.errors import ExciteError
 from excite_cli.optimization.engine import Engine
@@ -97,9 +103,12 @@ def test_unreachable_scheduler_is_named(excitation, monkeypatch):
     "first_bytes, expected",
     [
         (b"HTTP/1.1 400 Bad Request\r\n\r\n", "its first bytes are no Dask handshake"),
-        (b"", "it said nothing for 0.5 s"),
+        (b"", "its first message did not come whole within 0.5 s"),
+        (bytes(8), "its first bytes are no Dask handshake"),
+        (struct.pack("Q", 16) + b"garbage, garbage", "its first bytes are no Dask handshake"),
+        (struct.pack("Q", 64) + b"a part of it", "its first message did not come whole within 0.5 s"),
     ],
-    ids=["a-web-server", "a-silent-server"],
+    ids=["a-web-server", "a-silent-server", "zero-bytes", "framed-garbage", "a-short-message"],
 )
 def test_a_server_that_is_no_dask_scheduler_is_refused_before_dask_reads_from_it(first_bytes, expected):
     """Dask's client would allocate what a web server's first bytes say (3 EiB): the handshake is
@@ -109,6 +118,35 @@ def test_a_server_that_is_no_dask_scheduler_is_refused_before_dask_reads_from_it
         with pytest.raises(ExciteError, match=f"is not a Dask scheduler: {expected}"):
             engine_module.check_scheduler(address, timeout=0.5)
         assert time.monotonic() - started < 5
+
+
+def test_a_server_that_trickles_bytes_is_cut_off_at_the_bound():
+    """A message of 100 bytes announced, then one byte every 0.1 s: no single read times out, the bound is
+    on the whole message (a trickle of a byte every 5 s was refused only after 37 s)."""
+    listener = socket.create_server(("127.0.0.1", 0))
+    stop = threading.Event()
+
+    def serve() -> None:
+        connection, _ = listener.accept()
+        with connection, contextlib.suppress(OSError):
+            connection.sendall(struct.pack("Q", 100))
+            while not stop.wait(0.1):
+                connection.sendall(b"\x01")
+
+    threading.Thread(target=serve, daemon=True).start()
+    started = time.monotonic()
+    try:
+        with pytest.raises(ExciteError, match="did not come whole within 1 s"):
+            engine_module.check_scheduler(f"tcp://127.0.0.1:{listener.getsockname()[1]}", timeout=1.0)
+    finally:
+        stop.set()
+        listener.close()
+    assert time.monotonic() - started < 3
+
+
+def test_a_port_out_of_range_is_refused_naming_the_field():
+    with pytest.raises(ValidationError, match="port 96543 is out of range"):
+        OptimizerConfig(scheduler="tcp://10.0.0.5:96543")
 
 
 def test_a_dask_scheduler_passes_the_handshake():
