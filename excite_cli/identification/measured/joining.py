@@ -13,13 +13,25 @@ from excite_cli.errors import ExciteError, ExciteWarning
 from excite_cli.identification.measured.files import Table
 
 
-def _in_time_order(path: Path, table: Table, time: int | str) -> tuple[np.ndarray, Table]:
-    """The stamps of ``table`` (T,) [s] and the table, its rows sorted by them.
+def _in_time_order(path: Path, table: Table, time: int | str, drop: bool) -> tuple[np.ndarray, Table]:
+    """The stamps of ``table`` (T,) [s] and the table, its rows sorted by them; with ``drop``, rows whose
+    stamp is not a number left out and counted in ``Table.dropped``.
 
     Raises:
-        ExciteError: a stamp that two rows share (naming the file and their lines).
+        ExciteError: a stamp that is not a number (without ``drop``), or one that two rows share (naming
+            the file and their lines).
     """
     stamps = table.column(time, "time", path)
+    bad = ~np.isfinite(stamps)
+    if bad.any() and not drop:
+        raise ExciteError(
+            "data",
+            f"{path.name}: NaN or missing time stamp at line {table.lines[np.flatnonzero(bad)[0]]} "
+            "(data.bad_rows: drop leaves such rows out)",
+        )
+    if bad.any():
+        table = Table(table.names, table.values[~bad], table.dropped + int(bad.sum()), table.lines[~bad], table.unread)
+        stamps = stamps[~bad]
     order = np.argsort(stamps, kind="stable")
     stamps = stamps[order]
     repeated = np.flatnonzero(np.diff(stamps) == 0)
@@ -33,18 +45,21 @@ def _in_time_order(path: Path, table: Table, time: int | str) -> tuple[np.ndarra
     return stamps, Table(table.names, table.values[order], table.dropped, table.lines[order], table.unread)
 
 
-def join_tables(tables: list[tuple[Path, Table]], time: int | str | None, rate: float | None = None) -> Table:
+def join_tables(
+    tables: list[tuple[Path, Table]], time: int | str | None, rate: float | None = None, drop: bool = False
+) -> Table:
     """One table of the files of one run (positions, velocities and efforts recorded apart): the rows
     whose ``time`` column holds the same stamp in every file, in time order (each file's rows sorted
     by their stamps first), or, without a time column, the rows of the same index, up to the
     shortest file. A file whose rows reach beyond the others' is cut, with a warning naming it and
-    the seconds lost (``rate`` [Hz]: the sample rate of files without a time column). The columns are
+    the seconds lost (``rate`` [Hz]: the sample rate of files without a time column); a row whose stamp
+    is not a number is refused, or with ``drop`` (``data.bad_rows: drop``) left out and counted. The columns are
     named ``<file stem>/<column>`` (e.g. ``effort/panda_joint1``), after a first column ``time`` of
     the common stamps; by position they count from 0 over the files in order, after that column.
 
     Raises:
-        ExciteError: a file with two rows at one stamp; files that share fewer than half of their
-            time stamps.
+        ExciteError: a file with two rows at one stamp or (without ``drop``) a stamp that is not a
+            number; files that share fewer than half of their time stamps.
     """
     if time is None:
         count = min(t.values.shape[0] for _, t in tables)
@@ -52,7 +67,7 @@ def join_tables(tables: list[tuple[Path, Table]], time: int | str | None, rate: 
         stamps = np.arange(count, dtype=float)
         lost = {path: (t.values.shape[0] - count) / (rate or 1.0) for path, t in tables}
     else:
-        ordered = [(path, *_in_time_order(path, t, time)) for path, t in tables]
+        ordered = [(path, *_in_time_order(path, t, time, drop)) for path, t in tables]
         tables = [(path, t) for path, _, t in ordered]
         stamps = ordered[0][1]
         for _, other, _ in ordered[1:]:

@@ -213,7 +213,7 @@ def load_run(run: RunConfig, data: DataConfig, joints: list[str], folder: Path |
         if data.columns is None:
             raise ExciteError("data.columns", "is required for a run of several files")
         table, cols = (
-            join_tables([(p, read_table(p, drop)) for p in paths], data.columns.time, data.sample_rate),
+            join_tables([(p, read_table(p, drop)) for p in paths], data.columns.time, data.sample_rate, drop),
             data.columns,
         )
         cols = cols if cols.time is None else cols.model_copy(update={"time": "time"})

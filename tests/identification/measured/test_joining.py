@@ -55,3 +55,14 @@ def test_files_without_time_are_paired_row_by_row_and_the_cut_is_said_in_seconds
 def test_files_of_one_recording_join_without_a_warning(recwarn):
     join_tables([(Path("q.csv"), _table(TIME, TIME, "q")), (Path("tau.csv"), _table(TIME, TIME, "tau"))], "time")
     assert not [w for w in recwarn if issubclass(w.category, ExciteWarning)]
+
+
+def test_a_stamp_that_is_no_number_is_refused_or_dropped_and_counted():
+    """Issue 62: a NaN stamp in one file of a several-file run was left out silently ("dropped 0")."""
+    stamps = TIME.copy()
+    stamps[40] = np.nan
+    tables = [(Path("q.csv"), _table(TIME, TIME, "q")), (Path("tau.csv"), _table(stamps, TIME, "tau"))]
+    with pytest.raises(ExciteError, match=r"tau.csv: NaN or missing time stamp at line 42 \(data.bad_rows: drop"):
+        join_tables(tables, "time")
+    joined = join_tables(tables, "time", drop=True)  # q.csv's row at 0.40 s then has no partner
+    assert joined.dropped == 1 and joined.values.shape[0] == TIME.size - 1
