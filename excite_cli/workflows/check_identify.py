@@ -87,17 +87,30 @@ def plan_identify(problem: IdentifyProblem) -> IdentifyPlan:
     )
 
 
+#: Sections only an optimize config has: beside ``data`` they say the file mixes both kinds.
+OPTIMIZE_ONLY = ("trajectory", "limits", "constraints", "optimizer", "sequence", "random_baseline")
+
+
 def plan_check(path: Path, overrides: dict[str, object]) -> Plan | IdentifyPlan:
     """``check``'s plan of the config at ``path``: :func:`plan_identify` for an identify config (one
     with a ``data`` section), else :func:`~excite_cli.workflows.check.plan_optimize` with the command
     line's ``overrides`` (optimize fields).
 
     Raises:
-        ExciteError: an unreadable config; overrides given for an identify config; see both plans.
+        ExciteError: an unreadable config; a data section beside optimize sections (``data``); overrides
+            given for an identify config; see both plans.
     """
     value, _ = read_yaml(Path(path))
     if not (isinstance(value, dict) and "data" in value):
         return plan_optimize(load_config(path, overrides))
+    stray = [name for name in OPTIMIZE_ONLY if name in value]
+    if stray:
+        raise ExciteError(
+            "data",
+            f"{Path(path).name} has a data section, which makes it an identify config, beside the optimize "
+            f"section(s) {', '.join(stray)}",
+            expected="one kind of config: an optimize config without data, or an identify config without those",
+        )
     given = [name.split(".")[-1] for name, v in overrides.items() if v is not None]  # the option's own name
     if given:
         raise ExciteError(given[0], "applies to an optimize config; this is an identify config (it has a data section)")

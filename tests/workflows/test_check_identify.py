@@ -54,3 +54,12 @@ def test_check_refuses_what_identify_would_refuse(identify_config, tmp_path):
     (identify_config.parent / "bad.yaml").write_text(yaml.safe_dump(config))
     assert_refused(tmp_path, ["check", str(identify_config.parent / "bad.yaml")], "no column 'tau_elbow'")
     assert_refused(tmp_path, ["check", str(identify_config), "-k", "2"], "--iterations: applies to an optimize config")
+
+
+def test_a_config_with_data_beside_optimize_sections_is_named_as_both(identify_config, tmp_path):
+    """Issue 62: an optimize config with a stray data section was read as an identify config and
+    refused on its limits section."""
+    config = yaml.safe_load(identify_config.read_text())
+    config["limits"], config["trajectory"] = {"position_margin": 0.1}, {"harmonics": 3}
+    (identify_config.parent / "both.yaml").write_text(yaml.safe_dump(config))
+    assert_refused(tmp_path, ["check", str(identify_config.parent / "both.yaml")], "beside the optimize section(s)")

@@ -162,13 +162,23 @@ def read_measured_prior(path: Path) -> MeasuredPrior | None:
     (an optimize result, a plain regressor file, or no file: whoever reads the rows says what is wrong).
 
     Raises:
-        ExciteError: (``sequence.prior``) a report whose errors or sample rate no weighing can use
-            (not finite, negative, all zero, not one per joint; a rate that is not positive).
+        ExciteError: (``sequence.prior``) a report of an earlier version without what weighs its rows, or
+            whose errors or sample rate no weighing can use (not finite, negative, all zero, not one per
+            joint; a rate that is not positive).
     """
     if not path.is_file():
         return None
     with open_h5(path, "sequence.prior") as f:
-        if "identification/rms_after" not in f or "sample_rate_Hz" not in f["regressor"].attrs:
+        weighed = "identification/rms_after" in f and "regressor" in f and "sample_rate_Hz" in f["regressor"].attrs
+        if not weighed and "identification" in f:
+            raise ExciteError(
+                "sequence.prior",
+                f"{path} is an identify report of an earlier excite: without /identification/rms_after and the "
+                "regressor's sample_rate_Hz its rows cannot be weighed as its measurements were",
+                path,
+                "a report of this version (identify its runs again)",
+            )
+        if not weighed:
             return None
         joints = read_strings(f["identification"], "joint_names")
         sigma, rate = (

@@ -241,11 +241,14 @@ def _replace(f, name, value):
         (lambda f: _replace(f, "identification/rms_after", np.full(7, np.nan)), "rms_after must hold"),
         (lambda f: _replace(f, "identification/rms_after", np.ones(3)), "rms_after must hold"),
         (lambda f: f["regressor"].attrs.__setitem__("sample_rate_Hz", 0.0), "sample_rate_Hz is 0"),
+        (lambda f: f["identification/rms_after"].parent.pop("rms_after"), "report of an earlier excite"),
+        (lambda f: f["regressor"].attrs.__delitem__("sample_rate_Hz"), "report of an earlier excite"),
     ],
 )
 def test_a_damaged_report_as_prior_is_refused_in_one_line(report_file, tmp_path, edit, message):
     """What a report's weighing divides by: errors of its joints and its rate (issue 62: rms_after all
-    zero ended in LinAlgError, a rate of 0 in ZeroDivisionError)."""
+    zero ended in LinAlgError, a rate of 0 in ZeroDivisionError, a report of the previous release's
+    format was used unweighted in silence)."""
     with pytest.raises(ExciteError, match=message) as error:
         read_measured_prior(_damaged(report_file, tmp_path, edit))
     assert error.value.field == "sequence.prior"
