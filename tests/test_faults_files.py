@@ -224,6 +224,9 @@ def test_a_simulation_beyond_its_bounds_is_refused_by_name(pendulum_run, tmp_pat
 IDENTIFY_FIELDS = [
     ("zero-torque-constant", {"data": {"torque_constants": [0.0]}}, "data.torque_constants"),
     ("infinite-torque-constant", {"data": {"torque_constants": [float("inf")]}}, "data.torque_constants"),
+    # issue 62: 1e-300 Nm/A ended in 'the SDP ended infeasible', a ratio of 1e300 in numpy overflow warnings
+    ("tiny-torque-constant", {"data": {"torque_constants": [1e-300]}}, "another unit?"),
+    ("huge-gear-ratio", {"data": {"transmission": {"gear_ratios": [1e300]}}}, "another unit?"),
     ("time-true", {"data": {"columns": {"time": True, "q": ["q_hinge"], "tau": ["tau_hinge"]}}}, "data.columns.time"),
     ("zero-sign", {"data": {"signs": [0.0]}}, "every sign must be 1 or -1"),
     ("blocks", {"data": {"validation_blocks": 10**9}}, "data.validation_blocks"),

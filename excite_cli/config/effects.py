@@ -3,6 +3,7 @@ trajectory is designed for (its effect columns stand beside the base regressor's
 
 from __future__ import annotations
 
+import math
 from typing import Literal, Optional
 
 from pydantic import Field, PositiveFloat, field_validator
@@ -12,6 +13,10 @@ from excite_cli.config.base import Section
 #: The effects a joint's columns can hold: linear in their coefficients and in the motion, so the
 #: optimizer can excite them (Coulomb through a smooth sign).
 JointEffect = Literal["coulomb", "viscous", "armature", "offset"]
+
+
+#: Largest transmission ratio or gear ratio taken as a ratio [1]: beyond it the number is in another unit.
+MAX_RATIO = 1e6
 
 
 class MotorConfig(Section):
@@ -28,6 +33,15 @@ class MotorConfig(Section):
     def _nonzero(cls, value: list[float]) -> list[float]:
         if not any(value):
             raise ValueError("a transmission row of zeros moves no joint")
+        if not all(math.isfinite(n) and abs(n) <= MAX_RATIO for n in value):
+            raise ValueError(f"every n_k must be a finite number of at most {MAX_RATIO:g} in size (another unit?)")
+        return value
+
+    @field_validator("joints")
+    @classmethod
+    def _distinct(cls, value: list[str]) -> list[str]:
+        if len(set(value)) != len(value):
+            raise ValueError("a joint is named twice; give each joint once with its n_k")
         return value
 
 

@@ -12,6 +12,7 @@ from pydantic import Field, NonNegativeFloat, PositiveFloat, field_validator, mo
 from pydantic.json_schema import SkipJsonSchema
 
 from excite_cli.config import Problem, RobotConfig, Section
+from excite_cli.config.effects import MAX_RATIO
 from excite_cli.identification.effects import EFFECT_NAMES, SHAPE_GRID
 
 Effect = Literal[EFFECT_NAMES]
@@ -134,6 +135,10 @@ class TransmissionConfig(Section):
     def _nonzero_ratios(cls, values):
         if any(v == 0.0 or not np.isfinite(v) for v in values):
             raise ValueError("every gear ratio must be a finite number other than 0")
+        if any(not 1.0 / MAX_RATIO <= abs(v) <= MAX_RATIO for v in values):
+            raise ValueError(
+                f"every gear ratio must lie within {1 / MAX_RATIO:g} to {MAX_RATIO:g} in size (another unit?)"
+            )
         return values
 
     @model_validator(mode="after")
@@ -197,6 +202,11 @@ class DataConfig(Section):
             raise ValueError(
                 "every torque constant must be a finite number other than 0 Nm/A (the vendor's gain from "
                 "current to joint torque; negative where the vendor's is)"
+            )
+        if values is not None and any(not 1.0 / MAX_RATIO <= abs(v) <= MAX_RATIO for v in values):
+            raise ValueError(
+                f"every torque constant must lie within {1 / MAX_RATIO:g} to {MAX_RATIO:g} Nm/A in size (no "
+                "motor's is outside: another unit?)"
             )
         return values
 

@@ -22,6 +22,8 @@ def test_joints_take_the_designable_effects_and_motors_a_transmission_row():
         ({"coulomb_velocity": 0.0}, "coulomb_velocity"),
         ({"motors": [{"joints": ["a"], "transmission": [0.0]}]}, "transmission"),
         ({"motors": [{"joints": [], "transmission": []}]}, "joints"),
+        ({"motors": [{"joints": ["a", "b"], "transmission": [1.0, 1e300]}]}, "another unit"),  # issue 62
+        ({"motors": [{"joints": ["a", "a"], "transmission": [1.0, -1.0]}]}, "named twice"),  # issue 62
         ({"friction": ["coulomb"]}, "friction"),
     ],
 )
