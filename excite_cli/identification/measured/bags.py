@@ -10,6 +10,7 @@ do not carry every wanted joint (another publisher on the same topic, e.g. a gri
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 from typing import Sequence
 
@@ -17,7 +18,7 @@ import numpy as np
 from rosbags.highlevel import AnyReader, AnyReaderError
 from rosbags.typesys import Stores, get_typestore
 
-from excite_cli.errors import ExciteError
+from excite_cli.errors import ExciteError, ExciteWarning
 from excite_cli.identification.measured.files import Table
 from excite_cli.inputs import input_file
 
@@ -39,13 +40,14 @@ def _bag_paths(path: Path) -> list[Path]:
 
 def _rows(reader: AnyReader, connections: list, joints: Sequence[str]) -> tuple[list[np.ndarray], int]:
     """(1 + 3n,) rows [time, position, velocity, effort] of the messages carrying every joint (NaN
-    where a message leaves a field empty), and the number of messages skipped."""
+    where a message leaves a field empty), and the number of messages skipped that carry some of the
+    joints but not all (those that carry none are another publisher's: a gripper's)."""
     rows, skipped, n = [], 0, len(joints)
     for connection, recorded_ns, raw in reader.messages(connections=connections):
         message = reader.deserialize(raw, connection.msgtype)
         names = list(message.name)
         if not set(joints) <= set(names):
-            skipped += 1
+            skipped += bool(set(joints) & set(names))
             continue
         order = [names.index(j) for j in joints]
         stamp = message.header.stamp.sec + 1e-9 * message.header.stamp.nanosec
@@ -63,6 +65,10 @@ def read_bag(path: Path, topic: str, joints: Sequence[str]) -> Table:
     Args:
         topic: the ``sensor_msgs/JointState`` topic (``data.topic``).
         joints: (n,) the active joints' names, as in the URDF.
+
+    Messages that carry some of the active joints but not all are left out, counted in ``Table.dropped``
+    and named in an :class:`~excite_cli.errors.ExciteWarning` (those that carry none are another
+    publisher's, a gripper's, and are passed over).
 
     Raises:
         ExciteError: not a readable bag (a FIFO or device: :func:`~excite_cli.inputs.input_file`), no such topic or not
@@ -94,10 +100,16 @@ def read_bag(path: Path, topic: str, joints: Sequence[str]) -> Table:
             f"({', '.join(joints)}; {skipped} message(s) without some)",
             path,
         )
+    if skipped:
+        warnings.warn(
+            f"{path.name}: {skipped} of {skipped + len(rows)} messages on {topic} carry only some of the active "
+            "joints and are left out (counted as dropped; a driver that publishes them in several messages?)",
+            ExciteWarning,
+        )
     values = np.vstack(rows)
     names = ["time"] + [f"{field}/{joint}" for field in FIELDS for joint in joints]
     filled = [k for k in range(len(names)) if not np.all(np.isnan(values[:, k]))]
-    return Table([names[k] for k in filled], values[:, filled], 0, np.arange(1, values.shape[0] + 1))
+    return Table([names[k] for k in filled], values[:, filled], skipped, np.arange(1, values.shape[0] + 1))
 
 
 def bag_columns(joints: Sequence[str], table: Table) -> dict[str, list[str]]:

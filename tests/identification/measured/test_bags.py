@@ -16,7 +16,7 @@ from typer.testing import CliRunner
 
 from excite_cli.cli import app
 from excite_cli.config_file import load_problem
-from excite_cli.errors import ExciteError
+from excite_cli.errors import ExciteError, ExciteWarning
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.measured.bags import is_bag, read_bag
 from excite_cli.identification.measured.measurements import load_run
@@ -136,3 +136,23 @@ def test_a_bag_without_the_topic_or_a_file_without_columns_is_named(simulated):
     with pytest.raises(ExciteError) as caught:
         load_run(problem.data.runs[0], problem.data, problem.robot.active_joints, problem.folder)
     assert caught.value.field == "data.columns"
+
+
+def test_messages_with_only_some_of_the_joints_are_counted_and_named(simulated, tmp_path):
+    """Issue 62: a bag where every other message lacks a joint lost them without a count (then its run
+    was refused for a rate half the recording's). A gripper's messages (none of the joints) are passed
+    over without a word, as in the other bags here."""
+    _, table = simulated
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    path = tmp_path / "partial"
+    with Ros2Writer(path, version=9) as writer:
+        connection = writer.add_connection("/joint_states", MSGTYPE, typestore=store)
+        for k, (ns, message) in enumerate(_messages(table[:200], Stores.ROS2_HUMBLE, seq=False)):
+            if k % 2 and len(message.name) == 7:  # every other arm message loses its first joint
+                message.name, message.position, message.effort = (
+                    x[1:] for x in (message.name, message.position, message.effort)
+                )
+            writer.write(connection, ns, store.serialize_cdr(message, MSGTYPE))
+    with pytest.warns(ExciteWarning, match=r"partial: 100 of 200 messages on /joint_states carry only some"):
+        read = read_bag(path, "/joint_states", JOINTS)
+    assert read.dropped == 100 and read.values.shape[0] == 100
