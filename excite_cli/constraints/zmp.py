@@ -107,8 +107,12 @@ class ZeroMomentPoint(Constraint):
     def wrenches(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
         """(T, 6) ground wrench [N, N·m] (force, moment about the world origin, world frame) at the
         samples q, q̇, q̈ (T, n) of the active joints, base at rest."""
+        return self._wrenches(self._states(q, qd, qdd))
+
+    def _wrenches(self, states: tuple[np.ndarray, np.ndarray, np.ndarray]) -> np.ndarray:
+        """(T, 6) ground wrench of the full model's states (:meth:`_states`): RNEA's base rows."""
         r = self.robot
-        return np.array([pin.rnea(r.model, self.data, *state)[:6] for state in zip(*self._states(q, qd, qdd))])
+        return np.array([pin.rnea(r.model, self.data, *state)[:6] for state in zip(*states)])
 
     def _states(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The full model's (q, v, a) (T, nq), (T, nv), (T, nv) of the active joints' samples (T, n):
@@ -134,7 +138,7 @@ class ZeroMomentPoint(Constraint):
         """The two aggregated values (ZMP, normal force) and their Jacobian (2, α.size)."""
         r, d = self.robot, self.data
         states = self._states(*(B @ alpha.T for B in self._orders))
-        wrench = np.array([pin.rnea(r.model, d, *state)[:6] for state in zip(*states)])
+        wrench = self._wrenches(states)
         p, edges, force = self._normalized(wrench)
         g_edges, w_edges = smooth_max(edges, (0, 1))
         g_force, w_force = smooth_max(force, 0)
