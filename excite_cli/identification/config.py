@@ -133,11 +133,9 @@ class TransmissionConfig(Section):
     @field_validator("gear_ratios")
     @classmethod
     def _nonzero_ratios(cls, values):
-        if any(v == 0.0 or not np.isfinite(v) for v in values):
-            raise ValueError("every gear ratio must be a finite number other than 0")
-        if any(not 1.0 / MAX_RATIO <= abs(v) <= MAX_RATIO for v in values):
+        if any(not (np.isfinite(v) and 1.0 / MAX_RATIO <= abs(v) <= MAX_RATIO) for v in values):
             raise ValueError(
-                f"every gear ratio must lie within {1 / MAX_RATIO:g} to {MAX_RATIO:g} in size (another unit?)"
+                f"every gear ratio must be finite, {1 / MAX_RATIO:g} to {MAX_RATIO:g} in size (another unit?)"
             )
         return values
 

@@ -23,6 +23,7 @@ from conftest import TESTS, tcp_server, write_config
 from pydantic import ValidationError
 
 import excite_cli.optimization.engine as engine_module
+import excite_cli.optimization.scheduler as scheduler_module
 from excite_cli.config import OptimizerConfig
 from excite_cli.config_file import load_problem
 from excite_cli.errors import ExciteError
@@ -116,7 +117,7 @@ def test_a_server_that_is_no_dask_scheduler_is_refused_before_dask_reads_from_it
     with tcp_server(first_bytes) as address:
         started = time.monotonic()
         with pytest.raises(ExciteError, match=f"is not a Dask scheduler: {expected}"):
-            engine_module.check_scheduler(address, timeout=0.5)
+            scheduler_module.check_scheduler(address, timeout=0.5)
         assert time.monotonic() - started < 5
 
 
@@ -137,7 +138,7 @@ def test_a_server_that_trickles_bytes_is_cut_off_at_the_bound():
     started = time.monotonic()
     try:
         with pytest.raises(ExciteError, match="did not come whole within 1 s"):
-            engine_module.check_scheduler(f"tcp://127.0.0.1:{listener.getsockname()[1]}", timeout=1.0)
+            scheduler_module.check_scheduler(f"tcp://127.0.0.1:{listener.getsockname()[1]}", timeout=1.0)
     finally:
         stop.set()
         listener.close()
@@ -152,7 +153,7 @@ def test_a_port_out_of_range_is_refused_naming_the_field():
 def test_a_dask_scheduler_passes_the_handshake():
     distributed = pytest.importorskip("dask.distributed")
     with distributed.LocalCluster(n_workers=0, processes=False, protocol="tcp://", dashboard_address=None) as cluster:
-        engine_module.check_scheduler(cluster.scheduler_address, timeout=5)
+        scheduler_module.check_scheduler(cluster.scheduler_address, timeout=5)
 
 
 def test_workers_optimize_in_the_main_process_base(excitation):
