@@ -12,6 +12,9 @@ import numpy as np
 from excite_cli.errors import ExciteError, ExciteWarning
 from excite_cli.identification.measured.files import Table
 
+#: Fewest rows a file of a several-file run may have: fewer are no recording (a header and a stray line).
+FEWEST_ROWS = 10
+
 
 def _in_time_order(path: Path, table: Table, time: int | str, drop: bool) -> tuple[np.ndarray, Table]:
     """The stamps of ``table`` (T,) [s] and the table, its rows sorted by them; with ``drop``, rows whose
@@ -58,9 +61,19 @@ def join_tables(
     the common stamps; by position they count from 0 over the files in order, after that column.
 
     Raises:
-        ExciteError: a file with two rows at one stamp or (without ``drop``) a stamp that is not a
-            number; files that share fewer than half of their time stamps.
+        ExciteError: a file with fewer than ``FEWEST_ROWS`` rows (naming it), a file with two
+            rows at one stamp or (without ``drop``) a stamp that is not a number; files that share fewer
+            than half of their time stamps.
     """
+    sizes = {path: t.values.shape[0] for path, t in tables}
+    longest, shortest = max(sizes, key=sizes.get), min(sizes, key=sizes.get)
+    if sizes[shortest] < FEWEST_ROWS:
+        raise ExciteError(
+            "data.runs.file",
+            f"{shortest.name} has {sizes[shortest]} row(s) where {longest.name} has {sizes[longest]}; expected "
+            f"at least {FEWEST_ROWS} in every file of one recording (a run of several files pairs their rows)",
+            shortest,
+        )
     if time is None:
         count = min(t.values.shape[0] for _, t in tables)
         rows = [np.arange(count) for _ in tables]

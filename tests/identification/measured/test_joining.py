@@ -66,3 +66,11 @@ def test_a_stamp_that_is_no_number_is_refused_or_dropped_and_counted():
         join_tables(tables, "time")
     joined = join_tables(tables, "time", drop=True)  # q.csv's row at 0.40 s then has no partner
     assert joined.dropped == 1 and joined.values.shape[0] == TIME.size - 1
+
+
+def test_a_file_of_one_row_is_the_one_named():
+    """Issue 62: a one-row file in a several-file run was blamed on another file (its 2001 rows)."""
+    tables = [(Path("q.csv"), _table(TIME, TIME, "q")), (Path("tau.csv"), _table(TIME[:1], TIME[:1], "tau"))]
+    with pytest.raises(ExciteError, match=r"tau.csv has 1 row\(s\) where q.csv has 100") as error:
+        join_tables(tables, "time")
+    assert error.value.value == Path("tau.csv")
