@@ -99,38 +99,64 @@ def atomic_path(path: Path, field: str = "output") -> Iterator[Path]:
 
 
 @contextmanager
-def atomic_folder(path: Path, field: str = "output") -> Iterator[Path]:
-    """A folder written whole or not at all: the block fills ``.<name>.partial/<name>`` beside ``path``
-    (the inner folder has the target's own name, for writers that name their files after their
-    folder, as rosbag2 does), which is moved onto ``path`` when the block ends without error (a folder
-    already there is replaced: the caller has checked that it may be) and removed otherwise, with any
-    folder made for it (:func:`new_folders`); the folder it replaces is only set aside until the new
-    one is in place (and put back if that fails); one a killed run left is removed first, with a
-    warning (:func:`remove_stale`).
+def atomic_folders(paths: Sequence[Path], field: str = "output") -> Iterator[list[Path]]:
+    """Folders written whole or not at all, as a set: the block fills ``.<name>.partial/<name>`` beside
+    each path (the inner folder has the target's own name, for writers that name their files after
+    their folder, as rosbag2 does); when it ends without error each is moved onto its path (a folder
+    already there is replaced: the caller has checked that it may be), else all are removed, with any
+    folder made for them (:func:`new_folders`). A folder a new one replaces is only set aside until
+    every new one is in place, and all are put back if a move fails; one a killed run left is removed
+    first, with a warning (:func:`remove_stale`).
 
     Raises:
-        CannotWrite: the folder cannot be written (``OSError`` in the block or in the move).
+        CannotWrite: a folder cannot be written (``OSError`` in the block or in a move).
     """
-    path = Path(path)
-    staging = partial_path(path)
-    remove_stale(staging)
+    paths = [Path(p) for p in paths]
+    stagings = [partial_path(p) for p in paths]
+    for staging in stagings:
+        remove_stale(staging)
     try:
-        with new_folders([path], field):
+        with new_folders(paths, field):
             try:
-                staging.mkdir()
-                yield staging / path.name
-                if path.exists():  # set aside, not removed, until the new folder is in its place
-                    os.replace(path, staging / ".replaced")
-                try:
-                    os.replace(staging / path.name, path)
-                except OSError:
-                    if (staging / ".replaced").exists():
-                        os.replace(staging / ".replaced", path)
-                    raise
+                for staging in stagings:
+                    staging.mkdir()
+                yield [staging / path.name for staging, path in zip(stagings, paths)]
+                _swap_in(paths, stagings)
             finally:
-                shutil.rmtree(staging, ignore_errors=True)
+                for staging in stagings:
+                    shutil.rmtree(staging, ignore_errors=True)
     except OSError as exc:
-        raise CannotWrite(field, path, exc.strerror or exc) from None
+        raise CannotWrite(field, paths[0], exc.strerror or exc) from None
+
+
+def _swap_in(paths: list[Path], stagings: list[Path]) -> None:
+    """Each finished ``<staging>/<name>`` onto its path, the folder there set aside in the staging
+    first; when a move fails, the new folders moved so far go back and every set-aside folder returns."""
+    done = []
+    try:
+        for path, staging in zip(paths, stagings):
+            done.append((path, staging))
+            if path.exists():
+                os.replace(path, staging / ".replaced")
+            os.replace(staging / path.name, path)
+    except OSError:
+        for path, staging in reversed(done):
+            if not (staging / path.name).exists() and path.exists():  # a new folder in place: out again
+                os.replace(path, staging / path.name)
+            if (staging / ".replaced").exists():
+                os.replace(staging / ".replaced", path)
+        raise
+
+
+@contextmanager
+def atomic_folder(path: Path, field: str = "output") -> Iterator[Path]:
+    """One folder written through :func:`atomic_folders`: ``.<name>.partial/<name>`` beside ``path``.
+
+    Raises:
+        CannotWrite: the folder cannot be written.
+    """
+    with atomic_folders([path], field) as (staging,):
+        yield staging
 
 
 def atomic_bytes(path: Path, data: bytes | memoryview, field: str = "output") -> Path:

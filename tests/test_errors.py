@@ -8,7 +8,7 @@ import pytest
 import yaml
 from conftest import UR5, write_config
 
-from excite_cli.atomic import atomic_folder, atomic_path
+from excite_cli.atomic import atomic_folder, atomic_folders, atomic_path
 from excite_cli.config_file import load_problem
 from excite_cli.errors import CannotWrite, ExciteError, ExciteWarning, FileNotFound, OutputExists
 from excite_cli.h5 import open_h5
@@ -93,6 +93,32 @@ def test_an_atomic_folder_that_cannot_take_its_place_puts_back_the_one_it_replac
             (staging / "bag.db3").write_text("new")
     monkeypatch.setattr(os, "replace", replace)
     assert (target / "bag.db3").read_text() == "earlier" and [p.name for p in tmp_path.iterdir()] == ["bag"]
+
+
+def test_a_set_of_atomic_folders_that_cannot_all_take_their_place_puts_every_earlier_one_back(tmp_path, monkeypatch):
+    """The second of two folders cannot be moved in: the first new one goes out again and both earlier
+    ones return."""
+    targets = [tmp_path / "run_1", tmp_path / "run_2"]
+    for target in targets:
+        target.mkdir()
+        (target / "bag.db3").write_text(f"earlier {target.name}")
+    moves, replace = [], os.replace
+
+    def failing(source, destination):
+        moves.append(Path(destination).name)
+        if moves == [".replaced", "run_1", ".replaced", "run_2"]:  # the second new folder onto its target
+            raise OSError(18, "Invalid cross-device link")
+        replace(source, destination)
+
+    monkeypatch.setattr(os, "replace", failing)
+    with pytest.raises(CannotWrite, match="cross-device"):
+        with atomic_folders(targets) as stagings:
+            for staging in stagings:
+                staging.mkdir()
+                (staging / "bag.db3").write_text("new")
+    monkeypatch.setattr(os, "replace", replace)
+    assert [(t / "bag.db3").read_text() for t in targets] == ["earlier run_1", "earlier run_2"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run_1", "run_2"]
 
 
 def test_a_file_that_is_not_hdf5_is_named_with_the_field_that_gave_it(tmp_path):

@@ -18,13 +18,14 @@ from __future__ import annotations
 import sqlite3
 import time
 from pathlib import Path
+from typing import Sequence
 
 import numpy as np
 import yaml
 from rosbags.rosbag2 import Writer, WriterError
 from rosbags.typesys import Stores, get_typestore
 
-from excite_cli.atomic import atomic_folder
+from excite_cli.atomic import atomic_folder, atomic_folders
 from excite_cli.errors import CannotWrite, ExciteError, OutputExists
 from excite_cli.storage.paths import check_target
 
@@ -123,15 +124,25 @@ def _write_bag(folder: Path, topic: str, msgtype: str, messages) -> Path:
         CannotWrite: the bag cannot be written (a full disk, permissions), whatever the writer or its
             storage raises; nothing is left of it and a bag it was to replace is kept.
     """
+    with atomic_folder(folder) as staging:
+        _fill_bag(staging, folder, topic, msgtype, messages)
+    return Path(folder)
+
+
+def _fill_bag(staging: Path, folder: Path, topic: str, msgtype: str, messages) -> None:
+    """The bag of :func:`_write_bag` written at ``staging`` (which does not exist yet) for ``folder``.
+
+    Raises:
+        CannotWrite: (naming ``folder``) what rosbags' writer or its SQLite storage raises.
+    """
     typestore = get_typestore(Stores.ROS2_HUMBLE)
     try:
-        with atomic_folder(folder) as staging, Writer(staging, version=8) as writer:
+        with Writer(staging, version=8) as writer:
             connection = writer.add_connection(topic, msgtype, typestore=typestore)
             for ns, message in messages(typestore.types):
                 writer.write(connection, ns, typestore.serialize_cdr(message, msgtype))
     except (WriterError, sqlite3.Error) as exc:  # rosbags' own, and its SQLite storage's (a full disk at close)
         raise CannotWrite("output", folder, exc) from None
-    return Path(folder)
 
 
 def write_rosbag(
@@ -146,23 +157,33 @@ def write_rosbag(
     return _write_bag(folder, topic, MSGTYPE, lambda types: [(time.time_ns(), _message(types, joints, time_s, motion))])
 
 
-def write_joint_states(folder: Path, joints: list[str], time_s: np.ndarray, q: np.ndarray, tau: np.ndarray) -> Path:
-    """Write a run (``time_s`` (T,) [s] from 0, ``q``, ``tau`` (T, n) [rad, Nm] of ``joints``) as the
-    recorded bag of the module docstring at ``folder`` (:func:`_write_bag`).
+def write_joint_states(
+    folders: Sequence[Path], joints: list[str], runs: Sequence[tuple[np.ndarray, np.ndarray, np.ndarray]]
+) -> list[Path]:
+    """Write runs (each ``time_s`` (T,) [s] from 0, ``q``, ``tau`` (T, n) [rad, Nm] of ``joints``) as the
+    recorded bags of the module docstring at ``folders``, one a run, all or none
+    (:func:`~excite_cli.atomic.atomic_folders`: the bags they replace are kept until every new one is
+    written).
 
     Raises:
-        CannotWrite: the bag cannot be written.
+        CannotWrite: a bag cannot be written; none is, and the earlier ones stay.
     """
 
-    def messages(types):
-        Time, Header, JointState = (
-            types[t] for t in ("builtin_interfaces/msg/Time", "std_msgs/msg/Header", "sensor_msgs/msg/JointState")
-        )
-        for k, ns in enumerate(START + np.round(time_s * 1e9).astype(np.int64)):
-            header = Header(stamp=Time(sec=int(ns // 10**9), nanosec=int(ns % 10**9)), frame_id="")
-            yield (
-                int(ns),
-                JointState(header=header, name=list(joints), position=q[k], velocity=np.zeros(0), effort=tau[k]),
+    def messages(time_s: np.ndarray, q: np.ndarray, tau: np.ndarray):
+        def each(types):
+            Time, Header, JointState = (
+                types[t] for t in ("builtin_interfaces/msg/Time", "std_msgs/msg/Header", "sensor_msgs/msg/JointState")
             )
+            for k, ns in enumerate(START + np.round(time_s * 1e9).astype(np.int64)):
+                header = Header(stamp=Time(sec=int(ns // 10**9), nanosec=int(ns % 10**9)), frame_id="")
+                yield (
+                    int(ns),
+                    JointState(header=header, name=list(joints), position=q[k], velocity=np.zeros(0), effort=tau[k]),
+                )
 
-    return _write_bag(folder, JOINT_STATES, "sensor_msgs/msg/JointState", messages)
+        return each
+
+    with atomic_folders(folders, "output_dir") as stagings:
+        for staging, folder, run in zip(stagings, folders, runs):
+            _fill_bag(staging, folder, JOINT_STATES, "sensor_msgs/msg/JointState", messages(*run))
+    return [Path(f) for f in folders]

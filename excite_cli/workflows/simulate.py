@@ -13,7 +13,6 @@ controller records instead: motor angles m and motor torques τ_m = R⁻ᵀ τ, 
 
 from __future__ import annotations
 
-import shutil
 from pathlib import Path
 
 import numpy as np
@@ -143,22 +142,10 @@ def simulate_runs(
             raise ExciteError("effects", "a value makes non-finite torques (NaN or inf in the effects file?)")
     written = [out_dir / name for name in names]
     if bags:
-        return _write_bags(written, robot.joint_names, list(tables.values()))
+        n = robot.n_joints
+        runs = [(table[:, 0], table[:, 1 : 1 + n], table[:, 1 + n :]) for table in tables.values()]
+        return write_joint_states(written, robot.joint_names, runs)
     with atomic_paths(written, "output_dir") as tmps:
         for tmp, table in zip(tmps, tables.values()):
             np.savetxt(tmp, table, delimiter=",", header=",".join(header), comments="", fmt="%.10g")
     return written
-
-
-def _write_bags(folders: list[Path], joints: list[str], tables: list[np.ndarray]) -> list[Path]:
-    """Each table (time, q, τ columns) as a recorded bag in its folder; all or none (the bags of this
-    call are removed when one cannot be written)."""
-    n, done = len(joints), []
-    try:
-        for folder, table in zip(folders, tables):
-            done.append(write_joint_states(folder, joints, table[:, 0], table[:, 1 : 1 + n], table[:, 1 + n :]))
-    except BaseException:
-        for folder in done:
-            shutil.rmtree(folder, ignore_errors=True)
-        raise
-    return done

@@ -89,7 +89,7 @@ def test_force_never_replaces_a_folder_that_holds_more_than_a_bag(tmp_path, kind
 def test_a_recorded_run_reads_back_through_identify_s_bag_reader(tmp_path):
     """What ``simulate`` writes with ``recording: rosbag2``: one JointState per sample on /joint_states,
     stamped from START; identify's reader gives back the samples and their times."""
-    bag = write_joint_states(tmp_path / "run_1", JOINTS, TIME, Q, MOTION[3])
+    [bag] = write_joint_states([tmp_path / "run_1"], JOINTS, [(TIME, Q, MOTION[3])])
     table = read_bag(bag, JOINT_STATES, JOINTS[::-1])  # joints matched by name, in any order
     np.testing.assert_allclose(table.column("time", "time", bag) - START / 1e9, TIME, atol=1e-6)
     np.testing.assert_array_equal(table.column("position/elbow", "q", bag), Q[:, 1])
@@ -120,3 +120,29 @@ def test_a_full_disk_under_the_bag_writer_is_one_error_and_keeps_the_bag_it_woul
         _bag(tmp_path / "new")
     assert {p.name: p.read_bytes() for p in bag.iterdir()} == before
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bag"]
+
+
+def test_a_set_of_recorded_bags_replaces_the_earlier_set_whole_or_not_at_all(tmp_path, monkeypatch):
+    """simulate --force over earlier bags (issue 62: a failure at run_2 lost run_1): when the disk fills
+    at the second bag, both earlier bags stay as they were and nothing new is left."""
+    import sqlite3
+
+    import excite_cli.storage.rosbag as rosbag
+
+    folders = [tmp_path / "bags" / f"run_{k}" for k in (1, 2)]
+    write_joint_states(folders, JOINTS, [(TIME, Q, MOTION[3]), (TIME, 2 * Q, MOTION[3])])
+    before = {f: {p.name: p.read_bytes() for p in f.iterdir()} for f in folders}
+    opened = []
+
+    class FullDiskAtTheSecond(rosbag.Writer):
+        def close(self):
+            super().close()
+            opened.append(self)
+            if len(opened) == 2:
+                raise sqlite3.OperationalError("database or disk is full")
+
+    monkeypatch.setattr(rosbag, "Writer", FullDiskAtTheSecond)
+    with pytest.raises(CannotWrite, match="run_2.*disk is full"):
+        write_joint_states(folders, JOINTS, [(TIME, 3 * Q, MOTION[3]), (TIME, 4 * Q, MOTION[3])])
+    assert {f: {p.name: p.read_bytes() for p in f.iterdir()} for f in folders} == before
+    assert sorted(p.name for p in (tmp_path / "bags").iterdir()) == ["run_1", "run_2"]
