@@ -82,6 +82,14 @@ def sway(model, joints: list[str], home: np.ndarray, locked: dict[str, float]) -
     return found
 
 
+def setup(config: Path):
+    """The problem of ``config``, its excitation, its ZMP constraint, its URDF and locked joints."""
+    problem = load_problem(config)
+    excitation = build_excitation(problem)
+    zmp = next(c for c in excitation.constraints if c.name == "zmp")
+    return problem, excitation, zmp, resolve_urdf(problem.robot, problem.folder)[0], dict(problem.robot.locked_joints)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--config", type=Path, default=ROOT / "configs" / "g1_arms.yaml")
@@ -91,10 +99,7 @@ def main() -> None:
     parser.add_argument("--damping", type=float, default=40.0, help="PD stance [Nm·s/rad]")
     parser.add_argument("--result", type=Path, help="play this result's iterations instead of optimizing")
     args = parser.parse_args()
-    problem = load_problem(args.config)
-    excitation = build_excitation(problem)
-    zmp = next(c for c in excitation.constraints if c.name == "zmp")
-    urdf, locked = resolve_urdf(problem.robot, problem.folder)[0], dict(problem.robot.locked_joints)
+    problem, excitation, zmp, urdf, locked = setup(args.config)
     joints, robot = excitation.robot.joint_names, excitation.robot
     stances = [Stance(), Stance(args.stiffness, args.damping)]
     models = [standing_model(urdf, joints, locked, problem.constraints.zmp.support_links, s) for s in stances]

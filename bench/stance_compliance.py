@@ -28,14 +28,11 @@ from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
-from balance import sway
+from balance import setup, sway
 from scipy.linalg import null_space
 
-from excite_cli.config_file import load_problem
 from excite_cli.constraints.zmp import zero_moment_point
 from excite_cli.dynamics.mujoco_stance import TIMESTEP, Stance, play_standing, standing_model
-from excite_cli.dynamics.urdf_source import resolve_urdf
-from excite_cli.optimization.excitation import build_excitation
 from excite_cli.optimization.playback import plan_playback
 from excite_cli.storage.results import read_alphas
 
@@ -140,10 +137,7 @@ def main() -> None:
     parser.add_argument("--stiffness", type=float, default=1000.0, help="PD stance [Nm/rad]")
     parser.add_argument("--damping", type=float, default=40.0, help="PD stance [Nm·s/rad]")
     args = parser.parse_args()
-    problem = load_problem(args.config)
-    excitation = build_excitation(problem)
-    zmp = next(c for c in excitation.constraints if c.name == "zmp")
-    urdf, locked = resolve_urdf(problem.robot, problem.folder)[0], dict(problem.robot.locked_joints)
+    problem, excitation, zmp, urdf, locked = setup(args.config)
     joints, robot = excitation.robot.joint_names, excitation.robot
     stance = CompliantStance(urdf, excitation, args.stiffness, args.damping)
     print(f"model sway frequencies: {' '.join(f'{f:.2f}' for f in stance.frequencies()[:3])} Hz")
