@@ -80,8 +80,7 @@ class ComRegion(Constraint):
     def _com(self, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(T, 2) ground projections [m] and (T, 2, n) their Jacobians."""
         r, data = self.robot, self._data
-        configurations = np.tile(r.q_reference, (len(Q), 1))
-        configurations[:, r.q_idx] = Q
+        configurations = r.states(Q, np.zeros_like(Q), np.zeros_like(Q))[0]
         P, J = np.empty((len(Q), 3)), np.empty((len(Q), 3, r.model.nv))
         for t, q in enumerate(configurations):  # Robot.com's pinocchio calls, without its per-call set-up
             J[t] = pin.jacobianCenterOfMass(r.model, data, q, False)

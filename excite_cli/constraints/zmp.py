@@ -107,21 +107,12 @@ class ZeroMomentPoint(Constraint):
     def wrenches(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
         """(T, 6) ground wrench [N, N·m] (force, moment about the world origin, world frame) at the
         samples q, q̇, q̈ (T, n) of the active joints, base at rest."""
-        return self._wrenches(self._states(q, qd, qdd))
+        return self._wrenches(self.robot.states(q, qd, qdd))
 
     def _wrenches(self, states: tuple[np.ndarray, np.ndarray, np.ndarray]) -> np.ndarray:
-        """(T, 6) ground wrench of the full model's states (:meth:`_states`): RNEA's base rows."""
+        """(T, 6) ground wrench of the full model's states (:meth:`Robot.states`): RNEA's base rows."""
         r = self.robot
         return np.array([pin.rnea(r.model, self.data, *state)[:6] for state in zip(*states)])
-
-    def _states(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The full model's (q, v, a) (T, nq), (T, nv), (T, nv) of the active joints' samples (T, n):
-        :meth:`Robot.state` at every sample at once."""
-        r = self.robot
-        full_q = np.tile(r.q_reference, (len(q), 1))
-        full_v, full_a = np.zeros((2, len(q), r.model.nv))
-        full_q[:, r.q_idx], full_v[:, r.v_idx], full_a[:, r.v_idx] = q, qd, qdd
-        return full_q, full_v, full_a
 
     def _normalized(self, wrench: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The ZMP (T, 2) [m], s of the edges (T, K) and s of the normal force (T,), normalized."""
@@ -137,7 +128,7 @@ class ZeroMomentPoint(Constraint):
     def evaluate(self, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The two aggregated values (ZMP, normal force) and their Jacobian (2, α.size)."""
         r, d = self.robot, self.data
-        states = self._states(*(B @ alpha.T for B in self._orders))
+        states = self.robot.states(*(B @ alpha.T for B in self._orders))
         wrench = self._wrenches(states)
         p, edges, force = self._normalized(wrench)
         g_edges, w_edges = smooth_max(edges, (0, 1))

@@ -107,6 +107,14 @@ class Robot:
         af[self.v_idx] = qdd
         return qf, vf, af
 
+    def states(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`state` of T samples at once: the full model's (q, v, a) (T, nq), (T, nv), (T, nv) from
+        the active joints' (T, n) values."""
+        full_q = np.tile(self.q_reference, (len(q), 1))
+        full_v, full_a = np.zeros((2, len(q), self.model.nv))
+        full_q[:, self.q_idx], full_v[:, self.v_idx], full_a[:, self.v_idx] = q, qd, qdd
+        return full_q, full_v, full_a
+
     def regressor(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, data: pin.Data | None = None) -> np.ndarray:
         """Torque regressor Y(q, q̇, q̈) of Eq. 1, rows ``row_idx``: (n_rows, p).
 

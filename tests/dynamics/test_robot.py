@@ -47,3 +47,10 @@ def test_an_unknown_joint_is_named_with_the_nearest_one():
     cfg = load_problem(CONFIGS / "smoke.yaml").robot
     with pytest.raises(ExciteError, match="panda_joint77"):
         load_robot(cfg.model_copy(update={"active_joints": ["panda_joint1", "panda_joint77"]}))
+
+
+def test_states_of_many_samples_are_each_sample_s_state():
+    robot = load_robot(load_problem(CONFIGS / "g1_arms.yaml").robot)
+    samples = np.random.default_rng(4).standard_normal((3, 5, robot.n_joints))
+    for batch, single in zip(robot.states(*samples), zip(*(robot.state(*x) for x in zip(*samples)))):
+        np.testing.assert_array_equal(batch, np.array(single))
