@@ -165,7 +165,7 @@ class DataConfig(Section):
     runs: list[RunConfig] = Field(min_length=1)
     """The measured runs."""
     columns: Optional[ColumnsConfig] = None
-    """The columns of the files (ROS bags: matched by joint name)."""
+    """The columns of the files (ROS bags: matched by joint name; where every run is a bag, these name its columns)."""
     topic: str = "/joint_states"
     """The sensor_msgs/JointState topic of ROS bags."""
     angle_unit: Literal["rad", "deg"] = "rad"

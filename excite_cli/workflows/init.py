@@ -64,10 +64,11 @@ def _identify_config(
 ) -> None:
     """The identify config of the robot: its joints, and the data section of ``runs`` (files as the
     user named them, written relative to ``target``'s folder; default a CSV ``runs/run_1.csv``): ROS
-    bags need no columns (joints matched by name), other files the columns ``excite simulate`` writes."""
+    bags need no columns (joints matched by name), other files the columns ``excite simulate`` writes
+    (which, among bags, are the files' only)."""
     active, held = joint_choice(urdf, joints, draft)
     files = [os.path.relpath(Path(r).resolve(), target.resolve().parent) for r in runs] or ["runs/run_1.csv"]
-    bags = bool(runs) and all(is_bag(Path(r)) for r in runs)
+    bags = [r for r in runs if is_bag(Path(r))]
     draft.config = {
         "robot": {**robot, "active_joints": active, "locked_joints": held},
         "data": {"runs": [{"file": f, "role": "blocks"} for f in files]},
@@ -82,6 +83,7 @@ def _identify_config(
     )
     if bags:
         draft.assumptions["data.topic"] = "/joint_states: the bags' sensor_msgs/JointState, joints matched by name"
+    if runs and len(bags) == len(runs):
         return
     draft.config["data"]["columns"] = {
         "time": "time",
@@ -91,6 +93,7 @@ def _identify_config(
     draft.assumptions["data.columns"] = (
         "FILL IN: the column names of your files (these are the ones `excite simulate` writes); "
         "add qd (and qdd) if you record them, factors for units other than rad and Nm"
+        + ("; the bags' joints are matched by name" if bags else "")
     )
 
 
@@ -99,10 +102,17 @@ def _existing(runs: list[str]) -> list[str]:
 
     Raises:
         FileNotFound: a run that does not exist.
+        ExciteError: a folder that is not a ROS 2 bag (a folder of CSV files: each file is a run).
     """
     for run in runs:
         if not Path(run).exists():
             raise FileNotFound("runs", run, "measured run (a data file or a ROS 2 bag folder)")
+        if Path(run).is_dir() and not is_bag(Path(run)):
+            raise ExciteError(
+                "runs",
+                f"{run} is a folder, not a data file or a ROS 2 bag (no metadata.yaml in it)",
+                expected="each data file named as a run of its own",
+            )
     return runs
 
 

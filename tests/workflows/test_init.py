@@ -105,6 +105,21 @@ def test_recorded_bags_get_a_config_without_columns_that_identifies_the_friction
     with h5py.File(tmp_path / "report.h5") as f:
         found = {(r["effect"].decode(), r["joint"].decode()): r["value"] for r in f["identification/effects"][()]}
     assert found[("viscous", "hinge")] == pytest.approx(0.2, rel=0.05)
+    # a bag and a CSV file in one config: the columns are the file's, the bag's joints matched by name
+    friction = {"effects": {"viscous": {"*": 0.2}}}
+    (tmp_path / "effects.yaml").write_text(yaml.safe_dump({**effects, **friction, "recording": "csv", "seed": 3}))
+    assert runner.invoke(app, ["simulate", "out.h5", "effects.yaml", "-o", "csvs"]).exit_code == 0
+    argv[-3:] = ["bags/run_1", "--runs", "csvs/run_1.csv", "-o", "mixed.yaml"]
+    assert runner.invoke(app, argv).exit_code == 0
+    mixed = load_problem(tmp_path / "mixed.yaml", IdentifyProblem).data
+    assert [r.file for r in mixed.runs] == ["bags/run_1", "csvs/run_1.csv"] and mixed.columns.q == ["q_hinge"]
+    result = runner.invoke(app, ["check", "mixed.yaml"])
+    assert result.exit_code == 0, result.output
+    result = runner.invoke(app, ["identify", "mixed.yaml", "-o", "mixed.h5"])
+    assert result.exit_code == 0, result.output
+    with h5py.File(tmp_path / "mixed.h5") as f:
+        found = {(r["effect"].decode(), r["joint"].decode()): r["value"] for r in f["identification/effects"][()]}
+    assert found[("viscous", "hinge")] == pytest.approx(0.2, rel=0.05)
 
 
 @pytest.mark.parametrize(
@@ -115,6 +130,11 @@ def test_recorded_bags_get_a_config_without_columns_that_identifies_the_friction
             "--runs: are the measured runs of an identify config; expected kind identify",
         ),
         (["init", UR3, "--kind", "identify", "--runs", "none.csv"], "none.csv"),
+        (
+            ["init", UR3, "--kind", "identify", "--runs", "csvs"],
+            "runs: csvs is a folder, not a data file or a ROS 2 bag (no metadata.yaml in it); "
+            "expected each data file named as a run of its own",
+        ),
         (["init", UR3, "--joints", "elbow_joint,nope"], "'nope' is not a 1-DoF joint of ur3_robot.urdf"),
         (["init", "nothing/here.urdf"], "URDF (a file, or a path inside example-robot-data's robots folder) not found"),
         (["init", UR3, "--kind", "simulate"], "'simulate' is not a config kind"),
@@ -124,6 +144,8 @@ def test_recorded_bags_get_a_config_without_columns_that_identifies_the_friction
 def test_bad_init_input_is_one_line_and_writes_nothing(tmp_path, monkeypatch, argv, expected):
     monkeypatch.chdir(tmp_path)
     (tmp_path / "taken.yaml").write_text("keep: me\n")
+    (tmp_path / "csvs").mkdir()
+    (tmp_path / "csvs" / "run_1.csv").write_text("time,q_elbow_joint\n0,0\n")
     assert_refused(tmp_path, argv, expected)
     assert (tmp_path / "taken.yaml").read_text() == "keep: me\n"
 

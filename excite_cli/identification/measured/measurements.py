@@ -187,6 +187,12 @@ def check_joint_lists(data: DataConfig, n: int) -> None:
             )
 
 
+def _columns_are_the_bags(data: DataConfig, folder: Path | None) -> bool:
+    """Whether ``data.columns`` describe the bags: given, and every run a ROS bag. Where data files
+    are among the runs, the columns are theirs and a bag's joints are matched by name."""
+    return data.columns is not None and all(is_bag(resolve_path(r.files[0], folder)) for r in data.runs)
+
+
 def load_run(run: RunConfig, data: DataConfig, joints: list[str], folder: Path | None = None) -> Run:
     """Read, convert and validate one run (CSV with or without header, NPZ, MAT or HDF5, see
     :mod:`excite_cli.identification.measured.files`; a ROS bag, see :mod:`excite_cli.identification.measured.bags`).
@@ -219,7 +225,7 @@ def load_run(run: RunConfig, data: DataConfig, joints: list[str], folder: Path |
         cols = cols if cols.time is None else cols.model_copy(update={"time": "time"})
     elif is_bag(path):
         table = read_bag(path, data.topic, joints)
-        cols = data.columns or ColumnsConfig(**bag_columns(joints, table))
+        cols = data.columns if _columns_are_the_bags(data, folder) else ColumnsConfig(**bag_columns(joints, table))
     elif path.is_dir():
         raise ExciteError("data.runs", f"{path} is a folder, not a data file or a ROS 2 bag", path)
     elif data.columns is None:
