@@ -16,6 +16,7 @@ import pytest
 import scipy.io
 import yaml
 from conftest import assert_refused, pendulum_config, tcp_server
+from numpy.lib import recfunctions as rf
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
@@ -529,13 +530,65 @@ def test_a_damaged_report_is_one_line(pendulum_run, tmp_path):
     assert_refused(tmp_path, argv, "is damaged or not an excite file")
 
 
-def test_a_report_whose_cutoff_is_not_a_number_is_one_line(pendulum_run, tmp_path):
-    folder = _copy(pendulum_run, tmp_path / "run")
+def _replace(f, name, change):
+    values = f[name][()]
+    del f[name]
+    f[name] = change(values)
+
+
+def _nan_values(rows):
+    assert len(rows), "the report has effects to damage"
+    for field in ("value", "value_consistent"):
+        rows[field] = np.nan
+    return rows
+
+
+REPORT_DAMAGE = {
+    "cutoff": (lambda f: f["identification"].attrs.__setitem__("cutoff_Hz", np.nan), "cutoff_Hz is nan"),
+    "base-short": (
+        lambda f: _replace(f, "identification/base_parameters", lambda b: b[:1]),
+        "/identification/base_parameters has shape 1; expected",
+    ),
+    "base-nan": (
+        lambda f: _replace(f, "identification/base_parameters", lambda b: b * np.nan),
+        "/identification/base_parameters holds NaN or infinite values",
+    ),
+    "effect-values-nan": (
+        lambda f: _replace(f, "identification/effects", _nan_values),
+        "/identification/effects holds NaN or infinite values",
+    ),
+    "no-effect-field": (
+        lambda f: _replace(f, "identification/effects", lambda r: rf.drop_fields(r, "effect", usemask=False)),
+        "/identification/effects has no field 'effect'",
+    ),
+    "coupling-shape": (
+        lambda f: _replace(f, "identification/effect_coupling", lambda c: np.zeros((len(c) + 1, 3))),
+        "/identification/effect_coupling has shape",
+    ),
+    "range-nan": (
+        lambda f: _replace(f, "identification/fit_q_range", lambda r: r * np.nan),
+        "/identification/fit_q_range holds NaN",
+    ),
+}
+
+
+@pytest.fixture(scope="module")
+def pendulum_report(pendulum_run, tmp_path_factory):
+    folder = _copy(pendulum_run, tmp_path_factory.mktemp("report") / "run")
     assert runner.invoke(app, ["identify", str(folder / "id.yaml"), "-o", str(folder / "report.h5")]).exit_code == 0
+    return folder
+
+
+@pytest.mark.parametrize("damage", list(REPORT_DAMAGE))
+def test_a_report_with_a_field_damaged_is_one_line_naming_it(pendulum_report, tmp_path, damage):
+    """``validate`` reads every field of the model it uses checked: shape from the report's own joints
+    and base parameters, finite values (a NaN effect value printed a table of nan before)."""
+    folder = _copy(pendulum_report, tmp_path / "run")
+    change, expected = REPORT_DAMAGE[damage]
     with h5py.File(folder / "report.h5", "a") as f:
-        f["identification"].attrs["cutoff_Hz"] = np.nan
+        change(f)
     argv = ["validate", str(folder / "report.h5"), str(folder / "id.yaml")]
-    assert_refused(folder, argv, "cutoff_Hz is nan")
+    assert_refused(folder, argv, expected)
 
 
 # --- two runs, one output ----------------------------------------------------------------------------

@@ -68,11 +68,12 @@ class IdentifiedModel:
 
 
 def read_model(path: Path) -> IdentifiedModel:
-    """The model of the ``identify`` report at ``path``.
+    """The model of the ``identify`` report at ``path``, every field it uses checked.
 
     Raises:
-        ExciteError: missing or unreadable file, not an identify report, or a cut-off or Coulomb
-            velocity that is not a positive number.
+        ExciteError: missing or unreadable file, not an identify report, a field missing or of
+            another shape than its joints and base parameters give, a value that is not finite, or a
+            cut-off or Coulomb velocity that is not a positive number (the field named).
     """
     with open_h5(path, "report") as f:
         if "identification" not in f or "effects" not in f["identification"]:
@@ -82,32 +83,62 @@ def read_model(path: Path) -> IdentifiedModel:
             value = float(g.attrs.get(name, 0.01))
             if not (np.isfinite(value) and value > 0.0):  # checked like the config field it came from
                 raise ExciteError("report", f"{path}: /identification {name} is {value:g}", value, f"> 0 {unit}")
+        joints, names = read_strings(g, "joint_names"), read_strings(g, "base_parameter_names")
         rows = g["effects"][()]
+        for field in ("effect", "joint", "value"):
+            if rows.dtype.names is None or field not in rows.dtype.names:
+                raise ExciteError("report", f"{path}: /identification/effects has no field '{field}' (damaged?)")
         consistent = bool(g["physically_consistent"][()]) if "physically_consistent" in g else False
-        values = rows["value_consistent"] if consistent else rows["value"]
+        values = rows["value_consistent"] if consistent and "value_consistent" in rows.dtype.names else rows["value"]
         shapes = rows["shape"] if "shape" in rows.dtype.names else np.full(len(rows), np.nan)
-        coupling = g["effect_coupling"][()] if "effect_coupling" in g else np.zeros((len(rows), 1))
+        coupling = (
+            _checked(g, "effect_coupling", (len(rows), len(joints)), path)
+            if "effect_coupling" in g
+            else np.zeros((len(rows), 1))
+        )
         terms: list[tuple[str, str, float | None, tuple[float, ...] | None]] = []
-        effects, joints = (
+        effects, joint_of = (
             [v.decode() if isinstance(v, bytes) else str(v) for v in rows[c]] for c in ("effect", "joint")
         )
-        for effect, joint, shape, weights in zip(effects, joints, shapes, coupling):
+        for effect, joint, shape, weights in zip(effects, joint_of, shapes, coupling):
             coupled = tuple(float(w) for w in weights) if np.any(weights) else None
             term = (effect, joint, None if np.isnan(shape) else float(shape), coupled)
             if term not in terms:
                 terms.append(term)
         return IdentifiedModel(
-            read_strings(g, "joint_names"),
-            read_strings(g, "base_parameter_names"),
-            g["base_parameters"][()],
-            g["base_parameters_rigid_only"][()],
+            joints,
+            names,
+            _checked(g, "base_parameters", (len(names),), path),
+            _checked(g, "base_parameters_rigid_only", (len(names),), path),
             terms,
-            np.asarray(values, dtype=float),
+            _finite(np.asarray(values, dtype=float), "effects", path),
             max(1, len(g["offset_runs"][()])) if "offset_runs" in g else 1,
             float(g.attrs["cutoff_Hz"]),
             float(g.attrs.get("coulomb_velocity_rad_s", 0.01)),
-            g["fit_q_range"][()] if "fit_q_range" in g else None,
+            _checked(g, "fit_q_range", (len(joints), 2), path) if "fit_q_range" in g else None,
         )
+
+
+def _checked(group, name: str, shape: tuple[int, ...], path: Path) -> np.ndarray:
+    """The report's dataset /identification/``name`` as floats of ``shape``, every value finite.
+
+    Raises:
+        ExciteError: missing, of another shape, or not finite (the dataset named).
+    """
+    if name not in group:
+        raise ExciteError("report", f"{path}: /identification/{name} is missing (damaged?)")
+    values = np.asarray(group[name][()], dtype=float)
+    if values.shape != shape:
+        found, wanted = ("x".join(map(str, s)) or "scalar" for s in (values.shape, shape))
+        raise ExciteError("report", f"{path}: /identification/{name} has shape {found}", expected=wanted)
+    return _finite(values, name, path)
+
+
+def _finite(values: np.ndarray, name: str, path: Path) -> np.ndarray:
+    """``values``, refused where one is NaN or infinite (the dataset named)."""
+    if not np.all(np.isfinite(values)):
+        raise ExciteError("report", f"{path}: /identification/{name} holds NaN or infinite values (damaged?)")
+    return values
 
 
 def validate_model(report: Path, problem: IdentifyProblem) -> list[RunError]:
