@@ -4,14 +4,14 @@ PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 CONFIG ?= configs/g1_arms.yaml
 
-.PHONY: install ipopt optimize test lint smoke view-check docs docs-serve figure-plots guide bench clean
+.PHONY: install ipopt optimize test lint smoke bare view-check docs docs-serve figure-plots guide bench clean
 
 install: $(STAMP)
 
 $(STAMP): pyproject.toml constraints.txt
 	python3 -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -c constraints.txt -e ".[test,mujoco,docs]"
+	$(PY) -m pip install --quiet -c constraints.txt -e ".[test,mujoco,docs,cluster,view]"
 	$(MAKE) --no-print-directory ipopt
 	touch $(STAMP)
 
@@ -44,6 +44,16 @@ smoke: $(STAMP)
 	$(VENV)/bin/excite init ur_description/urdf/ur3_robot.urdf --output results/smoke_ur3.yaml --force
 	$(VENV)/bin/excite check results/smoke_ur3.yaml
 
+# `pip install .` without extras (a user's own environment): the command line optimizes a shipped
+# config; the extras (cluster, view, mujoco, ipopt) are only needed by the options that say so
+bare:
+	rm -rf .venv-bare
+	python3 -m venv .venv-bare
+	.venv-bare/bin/python -m pip install --quiet --upgrade pip
+	.venv-bare/bin/python -m pip install --quiet -c constraints.txt .
+	cd /tmp && $(CURDIR)/.venv-bare/bin/excite optimize $(CURDIR)/configs/smoke.yaml --output $(CURDIR)/results/bare.h5 --force
+	rm -rf .venv-bare
+
 # `excite view` opened in headless Chromium: the screenshot must show the robot (bench/view_check.py).
 # A browser is ~300 MB and needs root to install, so it is not part of `make test`; Debian's chromium
 # is installed here when missing (as root with apt-get, as for IPOPT), else the check says it skipped.
@@ -54,11 +64,11 @@ view-check: $(STAMP)
 
 # the documentation site (mkdocs-material) in site/, warnings as errors
 docs: $(STAMP)
-	NO_MKDOCS_2_WARNING=1 $(VENV)/bin/mkdocs build --strict --quiet
+	$(VENV)/bin/mkdocs build --strict --quiet
 
 # the site served at http://127.0.0.1:8000, with search (which browsers block on pages opened from disk)
 docs-serve: $(STAMP)
-	NO_MKDOCS_2_WARNING=1 $(VENV)/bin/mkdocs serve
+	$(VENV)/bin/mkdocs serve
 
 # the plots of docs/figures.md, drawn from its tables into docs/images
 figure-plots: $(STAMP)
@@ -72,4 +82,4 @@ bench: $(STAMP)
 	$(PY) bench/bench_g1_arms.py
 
 clean:
-	rm -rf $(VENV) results
+	rm -rf $(VENV) .venv-bare results

@@ -187,6 +187,22 @@ def test_a_scheduler_that_is_a_web_server_is_one_line(tmp_path):
         assert_refused(tmp_path, argv, f"--scheduler: the server at {address} is not a Dask scheduler")
 
 
+def test_a_scheduler_without_the_cluster_extra_is_one_line(tmp_path, monkeypatch):
+    """distributed is the ``cluster`` extra: a plain ``pip install`` runs locally, and a scheduler
+    asked for without it is one line, before anything is computed or written."""
+    import excite_cli.optimization.scheduler as scheduler_module
+
+    real = scheduler_module.find_spec
+    monkeypatch.setattr(scheduler_module, "find_spec", lambda name: None if name == "distributed" else real(name))
+    argv = ["optimize", str(pendulum_config(tmp_path)), "--scheduler", "tcp://127.0.0.1:8786"]
+    assert_refused(
+        tmp_path,
+        argv,
+        "--scheduler: needs Dask's distributed package, which is not installed; "
+        "expected the cluster extra: pip install 'excite[cluster]'",
+    )
+
+
 @pytest.mark.parametrize(
     "command, option",
     [

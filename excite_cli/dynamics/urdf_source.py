@@ -20,32 +20,42 @@ def example_robot_data_root() -> Path:
     Raises:
         ExciteError: the package is not installed.
     """
+    share = installed_share()
+    if share is None:
+        raise ExciteError("robot.source", "example-robot-data is not installed (run `make install`)")
+    return share
+
+
+def installed_share() -> Path | None:
+    """example-robot-data's ``share`` folder, or None where the package is not installed."""
     try:
         dist = metadata.distribution("example-robot-data")
     except metadata.PackageNotFoundError:
-        raise ExciteError("robot.source", "example-robot-data is not installed (run `make install`)") from None
+        return None
     return Path(dist.locate_file("cmeel.prefix/share")).resolve()
 
 
 def resolve_urdf(cfg: RobotConfig, folder: Path | None = None) -> tuple[Path, list[str]]:
     """The URDF file named by ``robot.urdf`` and the package folders its meshes are found in: the
-    URDF's folder and the one above it, example-robot-data's, and those
-    :func:`~excite_cli.dynamics.urdf_meshes.package_folders` adds.
+    URDF's folder and the one above it, example-robot-data's (where installed: a URDF of one's own
+    needs nothing of it), and those :func:`~excite_cli.dynamics.urdf_meshes.package_folders` adds.
 
     Args:
         cfg: the ``robot`` section.
         folder: the config file's folder, which a relative ``urdf`` with ``source: file`` is in.
 
     Raises:
-        ExciteError: the file does not exist, is a folder, a FIFO or a device (:func:`~excite_cli.inputs.input_file`).
+        ExciteError: the file does not exist, is a folder, a FIFO or a device (:func:`~excite_cli.inputs.input_file`),
+            or ``source: example-robot-data`` without that package installed.
     """
-    share = example_robot_data_root()
     if cfg.source == "example-robot-data":
+        share = example_robot_data_root()
         path = share / "example-robot-data" / "robots" / cfg.urdf
         dirs = [str(share)]
     else:
         path = resolve_path(cfg.urdf, folder)
-        dirs = [str(path.parent), str(path.parent.parent), str(share)]
+        share = installed_share()
+        dirs = [str(path.parent), str(path.parent.parent)] + ([str(share)] if share is not None else [])
     path = input_file(path, "robot.urdf", "URDF")
     return path, package_folders(path, dirs)
 

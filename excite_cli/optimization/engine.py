@@ -112,9 +112,9 @@ class Engine:
         self._limits = threadpool_limits(limits=1)
         keep_freed_memory()
         if self.scheduler:
+            check_scheduler(self.scheduler)
             from dask.distributed import Client
 
-            check_scheduler(self.scheduler)
             try:
                 self._client = Client(self.scheduler, timeout=f"{CONNECT_TIMEOUT:g}s")
             except (OSError, TimeoutError, ValueError) as exc:

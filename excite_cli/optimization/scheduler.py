@@ -7,6 +7,7 @@ import contextlib
 import socket
 import struct
 import time
+from importlib.util import find_spec
 
 from excite_cli.errors import ExciteError
 
@@ -15,6 +16,20 @@ CONNECT_TIMEOUT = 10.0
 #: Largest first message a Dask scheduler may announce on a new connection (its handshake, a few
 #: hundred bytes) [bytes].
 HANDSHAKE_BYTES = 1 << 20
+
+
+def require_distributed() -> None:
+    """That Dask's ``distributed`` is installed (the ``cluster`` extra: only a run on a scheduler needs it).
+
+    Raises:
+        ExciteError: (``optimizer.scheduler``) it is not.
+    """
+    if find_spec("distributed") is None:
+        raise ExciteError(
+            "optimizer.scheduler",
+            "needs Dask's distributed package, which is not installed",
+            expected="the cluster extra: pip install 'excite[cluster]' (make install has it)",
+        )
 
 
 def check_scheduler(address: str, timeout: float = CONNECT_TIMEOUT) -> None:
@@ -28,10 +43,12 @@ def check_scheduler(address: str, timeout: float = CONNECT_TIMEOUT) -> None:
     and decoded by distributed itself. ``tls://`` and in-process addresses are left to Dask.
 
     Raises:
-        ExciteError: (``optimizer.scheduler``) nothing listens there, the server's first message is not
+        ExciteError: (``optimizer.scheduler``) distributed is not installed (:func:`require_distributed`),
+            nothing listens there, the server's first message is not
             whole within ``timeout`` [s], announces more than :data:`HANDSHAKE_BYTES`, or is no Dask
             handshake.
     """
+    require_distributed()
     scheme, _, rest = address.rpartition("://")
     if scheme not in ("", "tcp"):
         return

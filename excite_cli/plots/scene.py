@@ -15,6 +15,7 @@ import pinocchio as pin
 from excite_cli.atomic import atomic_bytes
 from excite_cli.constraints.world_collision import WorldShape
 from excite_cli.dynamics.robot import Robot
+from excite_cli.errors import ExciteError
 
 #: Side [m] and thickness of the slab that draws a half-space.
 SLAB = (3.0, 0.01)
@@ -25,10 +26,16 @@ def write_scene(path: Path, robot: Robot, q: np.ndarray, rate: float, shapes: li
     collision meshes, beside ``shapes``.
 
     Raises:
+        ExciteError: meshcat (the ``view`` extra) is not installed.
         CannotWrite: the file cannot be written.
     """
-    import meshcat  # 0.7 s to import: only when a scene is written, not at every command's start
-    from meshcat.animation import Animation
+    try:  # 0.7 s to import: only when a scene is written, not at every command's start
+        import meshcat
+        from meshcat.animation import Animation
+    except ImportError:
+        raise ExciteError(
+            "view", "needs meshcat, which is not installed", expected="the view extra: pip install 'excite[view]'"
+        ) from None
     from pinocchio.visualize import MeshcatVisualizer
 
     with contextlib.redirect_stdout(io.StringIO()):  # the server prints its URL

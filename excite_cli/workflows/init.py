@@ -15,7 +15,7 @@ from excite_cli.atomic import atomic_path
 from excite_cli.config import RobotConfig
 from excite_cli.drafting.starting_config import StartingConfig, draft_config, joint_choice, validated
 from excite_cli.dynamics.urdf_checks import check_urdf
-from excite_cli.dynamics.urdf_source import example_robot_data_root, resolve_urdf
+from excite_cli.dynamics.urdf_source import installed_share, resolve_urdf
 from excite_cli.errors import ExciteError, FileNotFound
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.measured.bags import is_bag
@@ -54,7 +54,8 @@ def robot_source(urdf: str, target: Path) -> dict:
     path = Path(urdf)
     if path.is_file():
         return {"urdf": os.path.relpath(path.resolve(), Path(target).resolve().parent), "source": "file"}
-    if (example_robot_data_root() / "example-robot-data" / "robots" / urdf).is_file():
+    share = installed_share()
+    if share is not None and (share / "example-robot-data" / "robots" / urdf).is_file():
         return {"urdf": urdf, "source": "example-robot-data"}
     raise FileNotFound("urdf", urdf, "URDF (a file, or a path inside example-robot-data's robots folder)")
 

@@ -7,12 +7,14 @@ import re
 
 import numpy as np
 import pinocchio as pin
+import pytest
 import umsgpack
 from conftest import CONFIGS, robot_of
 
 from excite_cli.config import EnvironmentConfig
 from excite_cli.config_file import load_problem
 from excite_cli.constraints.world_collision import world_shapes
+from excite_cli.errors import ExciteError
 from excite_cli.plots.scene import write_scene
 
 
@@ -41,3 +43,14 @@ def test_a_scene_animates_every_mesh_at_its_placement_beside_the_world(tmp_path)
         pin.updateGeometryPlacements(robot.model, data, robot.collision_model, placements)
         expected = placements.oMg[names.index("panda_hand_0")].translation
         np.testing.assert_allclose(track[".position"][k]["value"], expected, atol=1e-9)
+
+
+def test_without_the_view_extra_a_scene_is_one_line_and_no_file(tmp_path, monkeypatch):
+    """meshcat is the ``view`` extra: without it, writing a scene says which extra, and writes nothing."""
+    import sys
+
+    monkeypatch.setitem(sys.modules, "meshcat", None)  # import meshcat now raises ImportError
+    robot = robot_of(load_problem(CONFIGS / "smoke.yaml"), collision=True)
+    with pytest.raises(ExciteError, match=r"needs meshcat, which is not installed") as raised:
+        write_scene(tmp_path / "scene.html", robot, robot.home[None, :], 10.0, [])
+    assert "pip install 'excite[view]'" in raised.value.describe() and not (tmp_path / "scene.html").exists()
