@@ -141,8 +141,8 @@ class OptimizerConfig(Section):
     """Solver iterations of each screened start."""
     polish_rounds: int = Field(3, ge=0, le=100)
     """Runs of max_iterations the kept restart continues by, each from a fresh quasi-Newton matrix, until converged."""
-    time_budget: float = Field(300.0, gt=0.0, le=604_800.0)
-    """Wall time [s] an iteration may spend: its solver runs stop there; if all fail, more starts run until then."""
+    time_budget: float = Field(1800.0, gt=0.0, le=604_800.0)
+    """Wall time [s] an iteration may spend, a safety net: its solver runs stop there (stop: time budget)."""
     workers: Optional[int] = Field(None, ge=1, le=MAX_WORKERS)
     """Local processes the restarts run in (default: the machine's cores)."""
     scheduler: Optional[str] = None

@@ -28,13 +28,15 @@ IMPROVEMENT_WINDOW = 10
 #: A decrease of the objective over that window larger than this (relative to max(1, |f|)) is progress.
 IMPROVEMENT = 1e-3
 
-#: The stop reasons a restart can end with (``INFEASIBLE``: no end point met a constraint that needs motion).
-CONVERGED, STILL_IMPROVING, STALLED, SOLVER_FAILED, INFEASIBLE = (
+#: The stop reasons a restart can end with (``INFEASIBLE``: no end point met a constraint that needs
+#: motion; ``TIME_BUDGET``: ``optimizer.time_budget`` ran out first, a result that depends on the machine).
+CONVERGED, STILL_IMPROVING, STALLED, SOLVER_FAILED, INFEASIBLE, TIME_BUDGET = (
     "converged",
     "iteration limit, still improving",
     "stalled",
     "solver failed",
     "infeasible",
+    "time budget",
 )
 
 
@@ -69,15 +71,25 @@ def kkt_optimality(gradient: np.ndarray, values: np.ndarray, jacobian: np.ndarra
     )
 
 
-def stop_reason(optimality: Optimality, history: Sequence[float], limit: bool, failed: bool, tolerance: float) -> str:
+def stop_reason(
+    optimality: Optimality,
+    history: Sequence[float],
+    limit: bool,
+    failed: bool,
+    tolerance: float,
+    out_of_time: bool = False,
+) -> str:
     """Why a restart ended, honestly: ``converged`` when its end point meets the KKT ``tolerance``
-    (whatever the solver said); else ``solver failed`` (line search or subproblem), ``iteration
-    limit, still improving`` (the objective ``history`` (one value per iteration) still fell by more
-    than ``IMPROVEMENT`` over its last ``IMPROVEMENT_WINDOW`` iterations or tenth), or ``stalled``."""
+    (whatever the solver said); else ``solver failed`` (line search or subproblem), ``time budget``
+    (``out_of_time``: the iteration's wall-time budget stopped it), ``iteration limit, still
+    improving`` (the objective ``history`` (one value per iteration) still fell by more than
+    ``IMPROVEMENT`` over its last ``IMPROVEMENT_WINDOW`` iterations or tenth), or ``stalled``."""
     if optimality.residual <= tolerance:
         return CONVERGED
     if failed:
         return SOLVER_FAILED
+    if out_of_time:
+        return TIME_BUDGET
     window = max(IMPROVEMENT_WINDOW, len(history) // 10)
     if limit and len(history) > window:
         before, recent = history[-window - 1], min(history[-window:])

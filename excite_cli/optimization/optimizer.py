@@ -187,16 +187,16 @@ def optimize_restart(
         if progress is not None:
             progress(index, len(history), history[-1][0])
 
+    deadline = begin + (np.inf if time_limit is None else time_limit)
     run = solve(
         options.method,
         problem,
         boundary.to_variables(start),
         max_iterations or options.max_iterations,
         options.tolerance,
-        _until_done(
-            problem, on_iterate, options.optimality_tolerance, begin + (np.inf if time_limit is None else time_limit)
-        ),
+        _until_done(problem, on_iterate, options.optimality_tolerance, deadline),
     )
+    out_of_time = time.perf_counter() > deadline
     if len(history) < run.iterations:  # a solver that ends inside an iteration calls back no more: its last iterate
         on_iterate(run.z)
     ends = [("start", start)]
@@ -218,7 +218,8 @@ def optimize_restart(
         alpha = start + farthest_accepted(constraints, start, alpha, BISECTIONS, fine_basis) * (alpha - start)
         value = criterion.value(alpha)
     optimality = problem.optimality(alpha)
-    stop = stop_reason(optimality, [f for f, _ in history], run.limit, run.failed, options.optimality_tolerance)
+    history_values = [f for f, _ in history]
+    stop = stop_reason(optimality, history_values, run.limit, run.failed, options.optimality_tolerance, out_of_time)
     stop = stop if scored else INFEASIBLE
     return RestartResult(
         index,

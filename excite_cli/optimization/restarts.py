@@ -11,7 +11,7 @@ import numpy as np
 
 from excite_cli.optimization.engine import Engine
 from excite_cli.optimization.excitation import Excitation
-from excite_cli.optimization.optimality import CONVERGED
+from excite_cli.optimization.optimality import CONVERGED, TIME_BUDGET
 from excite_cli.optimization.optimizer import ProgressHook, RestartResult, optimize_restart
 
 
@@ -129,7 +129,8 @@ def polish(
         hook: progress, the polished restart's iterations counted on from where it stopped.
 
     Returns:
-        ``runs`` with the polished restart in its place, its iterations and history joined.
+        ``runs`` with the polished restart in its place, its iterations and history joined; its stop
+        is ``time budget`` when the deadline came before it converged.
     """
     opts, runs = excitation.problem.optimizer, list(runs)
     at = next(i for i, r in enumerate(runs) if r.index == kept)
@@ -143,6 +144,8 @@ def polish(
         if not more.succeeded or more.objective > current.objective:
             break
         runs[at] = _joined(current, more)
+    if opts.polish_rounds and runs[at].stop != CONVERGED and _left(deadline) <= 0.0:
+        runs[at] = replace(runs[at], stop=TIME_BUDGET)  # not polished to the end: the budget decided
     return runs
 
 

@@ -24,6 +24,7 @@ from excite_cli.optimization.optimality import (
     SOLVER_FAILED,
     STALLED,
     STILL_IMPROVING,
+    TIME_BUDGET,
     Optimality,
     kkt_optimality,
     stop_reason,
@@ -59,6 +60,8 @@ def test_stop_reasons():
         stop_reason(far, falling, limit=False, failed=False, tolerance=1e-3) == STALLED
     )  # the solver's own test, not KKT
     assert stop_reason(far, falling, limit=False, failed=True, tolerance=1e-3) == SOLVER_FAILED
+    assert stop_reason(far, falling, limit=True, failed=False, tolerance=1e-3, out_of_time=True) == TIME_BUDGET
+    assert stop_reason(near, falling, limit=True, failed=False, tolerance=1e-3, out_of_time=True) == CONVERGED
 
 
 def _small_problem(tmp_path, objective, iterations=2):
@@ -131,14 +134,14 @@ def test_a_restart_stops_where_it_meets_the_kkt_tolerance_or_its_time_limit(tmp_
     assert result.iterations < 300
     assert _fd_kkt(excitation, prior, result.alpha) <= 1.01 * problem.optimizer.optimality_tolerance
     hurried = RestartTask(1, 0, 1, prior, time_limit=0.0)(excitation)
-    assert hurried.iterations <= 2 and hurried.stop != CONVERGED and hurried.succeeded
+    assert hurried.iterations <= 2 and hurried.stop == TIME_BUDGET and hurried.succeeded
 
 
 def test_the_kept_restart_continues_from_a_fresh_matrix_until_it_converges(tmp_path):
     """A restart stopped at 15 iterations short of the tolerance, polished in rounds of 15: each round
     starts at the end point of the one before (iterations and history joined), none ends higher, and
     the last converges, its KKT residual recomputed by central differences. A converged restart, or
-    polish_rounds 0, is left as it is."""
+    polish_rounds 0, is left as it is; one the deadline leaves unpolished says "time budget"."""
     from excite_cli.optimization.engine import Engine
     from excite_cli.optimization.restarts import RestartTask, polish
 
@@ -153,6 +156,8 @@ def test_the_kept_restart_continues_from_a_fresh_matrix_until_it_converges(tmp_p
     with Engine(excitation) as serial:
         polished = polish(excitation, serial, 1, 1, prior, [first], 0, deadline)[0]
         assert polish(excitation, serial, 1, 1, prior, [polished], 0, deadline)[0] is polished
+        late = polish(excitation, serial, 1, 1, prior, [first], 0, time.perf_counter() - 1.0)[0]
+        assert late.stop == TIME_BUDGET and late.iterations == 15  # not polished: the budget decided
         opts.polish_rounds = 0
         assert polish(excitation, serial, 1, 1, prior, [first], 0, deadline)[0] is first
     assert polished.stop == CONVERGED and polished.objective < first.objective
