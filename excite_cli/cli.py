@@ -76,7 +76,7 @@ def optimize(
 
 @command()
 def init(
-    urdf: str = typer.Argument(..., help="URDF file, or a path in example-robot-data (ur_description/urdf/ur10.urdf)."),
+    urdf: str = typer.Argument(..., help="URDF file or example-robot-data path (ur_description/urdf/ur3_robot.urdf)."),
     joints: Optional[list[str]] = JOINTS,
     kind: str = typer.Option("optimize", "--kind", help="Config kind: optimize or identify."),
     runs: Optional[list[str]] = RUNS,

@@ -39,6 +39,16 @@ JOINTS = typer.Option(
 RUNS = typer.Option(None, "--runs", help="identify: measured runs (CSV, NPZ, MAT, HDF5, ROS bag), repeatable.")
 
 
+#: One command line per command that its ``--help`` shows as the example, run as written from the
+#: repository's folder (a test runs each).
+EXAMPLES = {
+    "init": "excite init ur_description/urdf/ur10_robot.urdf --output ur10.yaml",
+    "check": "excite check configs/panda.yaml",
+    "schema": "excite schema --output-dir schema",
+    "verify-gradient": "excite verify-gradient configs/smoke.yaml --objective log_det",
+}
+
+
 def command(name: Optional[str] = None) -> Callable:
     """A command of ``app``: ExciteError → one line, exit 2 (no traceback; 1 for a run that found no
     solution, :class:`~excite_cli.errors.NoSolution`); Ctrl-C or SIGTERM → what was kept, exit 130 or 143."""
@@ -60,7 +70,8 @@ def command(name: Optional[str] = None) -> Callable:
                 err.print("terminated" if isinstance(exc, Terminated) else "interrupted", highlight=False)
                 raise typer.Exit(exit_status(exc)) from None
 
-        return app.command(name)(guarded)
+        example = EXAMPLES.get(name or function.__name__.replace("_", "-"))
+        return app.command(name, epilog=f"Example: {example}" if example else None)(guarded)
 
     return register
 
