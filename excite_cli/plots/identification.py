@@ -81,7 +81,8 @@ def plot_ladder(path: Path, report: Report) -> Path:
         2, 1, figsize=(max(6.0, 0.42 * len(labels) + 2.5), 7.5), gridspec_kw={"height_ratios": [3, 2]}
     )
     x = np.arange(len(labels))
-    top.bar(x, val, color=["0.55"] + ["C0"] * (len(labels) - 1), label="validation (never seen by fit or selection)")
+    top.bar(x[:1], val[:1], color="0.55", label="rigid body (URDF), validation")
+    top.bar(x[1:], val[1:], color="C0", label="after each step, validation (never seen by fit or selection)")
     top.plot(
         x,
         cv,

@@ -12,6 +12,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.collections import LineCollection, PolyCollection  # noqa: E402
+from matplotlib.lines import Line2D  # noqa: E402
+from matplotlib.patches import Patch  # noqa: E402
 
 from excite_cli.constraints import ComRegion, SelfCollision  # noqa: E402
 from excite_cli.constraints.support import SupportPolygon  # noqa: E402
@@ -63,6 +65,7 @@ def plot_result(target: Path, excitation: Excitation, results: Sequence[Iteratio
                 margin=collision.margin if collision else None,
                 support=zmp.polygon if zmp else None,
                 zmp_margin=zmp.margin if zmp else 0.0,
+                joints=excitation.robot.joint_names,
             )
         )
     return plots
@@ -176,10 +179,23 @@ def plot_postures(
                 for shape in shapes:
                     draw_shape(ax, shape, axis, sign)
                 ax.set_aspect("equal")
-                ax.set_xticks([])
-                ax.set_yticks([])
+                ax.tick_params(labelsize=5, labelleft=c == 0, labelbottom=True)
+                ax.set_xlabel(("y" if axis == 1 else "x") + " [m]", fontsize=6)
+                if c == 0:
+                    ax.set_ylabel("z [m]", fontsize=6)
                 ax.set_title(f"iteration {r.index}, {view}, t = {t:.1f} s", fontsize=7)
-    fig.tight_layout()
+    fig.legend(
+        handles=[
+            Line2D([], [], color="k", marker="o", markersize=2, linewidth=1.2, label="links (joint to joint)"),
+            Patch(facecolor="tab:blue", alpha=0.15, label="collision capsules"),
+            Line2D([], [], color="0.8", linewidth=1.0, label="home posture"),
+        ]
+        + ([Patch(facecolor="0.8", label="world shapes")] if shapes else []),
+        loc="lower center",
+        ncol=4,
+        fontsize=7,
+    )
+    fig.tight_layout(rect=(0, 0.03, 1, 1))
     return save_figure(fig, path, 100)
 
 
@@ -199,6 +215,7 @@ def plot_constraint_tracks(
     margin: float | None = None,
     support: SupportPolygon | None = None,
     zmp_margin: float = 0.0,
+    joints: Sequence[str] = (),
 ) -> Path:
     """Per iteration, for the constraints the run has: the CoM ground track against its region
     (Eq. 52), the zero-moment point's track in the support polygon, the smallest capsule distance over
@@ -209,6 +226,7 @@ def plot_constraint_tracks(
         centre: (2,) region centre [m]; radius [m] or polygon (K, 2) relative to it [m].
         margin: capsule safety margin [m].
         support: the support polygon the ZMP keeps ``zmp_margin`` [m] inside.
+        joints: (n,) the active joints' names, for the torque panel's legend.
     """
     names = ("com_xy", "zmp_xy", "min_capsule_distance", "min_world_distance", "torque_use")
     kinds = [k for k in names if any(k in r.tracks for r in results)]
@@ -244,9 +262,15 @@ def plot_constraint_tracks(
                 ax.plot(r.time, r.tracks[kind] * 100, linewidth=0.8, label="smallest distance to the world")
                 ax.set(xlabel="time [s]", ylabel="distance to the world [cm]")
             elif kind == "torque_use":
-                ax.plot(r.time, r.tracks[kind], linewidth=0.7)
+                use = r.tracks[kind]
+                names = list(joints) or [f"joint {j + 1}" for j in range(use.shape[1])]
+                for j, colour in enumerate(_joint_colours(use.shape[1])):
+                    ax.plot(r.time, use[:, j], linewidth=0.7, color=colour, label=names[j])
                 ax.axhline(1.0, color="r", linestyle="--", label="limit")
                 ax.set(xlabel="time [s]", ylabel="|τ| / τ_max per joint")
+                if col == len(results) - 1:  # the joints named once, beside the last iteration
+                    ax.legend(fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+                continue
             ax.legend(fontsize=7)
     fig.tight_layout()
     return save_figure(fig, path, 110)
