@@ -1,6 +1,8 @@
 """The identify report: its effect values in order with their coefficient names, its HDF5 file read
 back, and the identified URDF that pinocchio loads with the consistent fit's torques."""
 
+from dataclasses import replace
+
 import h5py
 import numpy as np
 import pinocchio as pin
@@ -56,3 +58,14 @@ def test_the_identified_urdf_loads_and_reproduces_the_consistent_torques(simulat
         return robot.regressor(q, qd, qdd) @ base.composition_matrix @ phi
 
     assert urdf_deviation(problem.robot, robot, identified, target, samples=20) < 1e-6
+
+
+def test_a_model_without_effect_columns_writes_an_empty_effect_regressor(simulated_identification, tmp_path):
+    """A chosen model that the design holds no column of (no effects, or only asymmetric ones) gave h5py
+    zero-width chunks: a traceback after the whole fit, and no report."""
+    problem, report, robot, base, regressor = simulated_identification
+    rows = rows_copy(regressor)
+    rows = replace(rows, effects=[part[:, :0] for part in rows.effects], effect_names=[])
+    write_identification(tmp_path / "report.h5", report, robot, base, problem, rows)
+    with h5py.File(tmp_path / "report.h5") as f:
+        assert f["effect_regressor"].shape == (f["regressor"].shape[0], 0)
