@@ -112,7 +112,8 @@ def write_parts(group: h5py.Group, name: str, parts: list[np.ndarray], columns: 
     file (built in memory by :func:`atomic_h5`) grows by as much."""
     total = sum(part.shape[0] for part in parts)
     # a dataset without rows or without columns (a model with no effect columns) has no chunks to compress
-    options = {"compression": "gzip", "shuffle": True, "chunks": (min(total, 4096), columns)} if total and columns else {}
+    chunked = total > 0 and columns > 0
+    options = {"compression": "gzip", "shuffle": True, "chunks": (min(total, 4096), columns)} if chunked else {}
     data = group.create_dataset(name, shape=(total, columns), dtype="f8", **options)
     at = 0
     while parts:
