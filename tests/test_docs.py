@@ -125,3 +125,19 @@ def test_the_built_site_has_no_raw_table_pipes_or_list_dashes(tmp_path):
     assert raw == []
     assert RAW_LIST.search("<p>it assumed:\n- joints</p>") and not RAW_LIST.search("<p>a - b</p><ul><li>x</li></ul>")
     assert RAW_TABLE.search("<p>| a | b |\n| 1 | 2 |</p>") and not RAW_TABLE.search("<td>a</td><td>b | c</td>")
+
+
+#: What a development log says and a page of current results does not.
+DEVELOPMENT_LOG = re.compile(
+    r"\b(before this work|the earlier version|the code (of today|before)|re-measured|\d{4}-\d{2}-\d{2})\b", re.I
+)
+
+
+def test_the_figures_page_holds_current_results_only():
+    """History (before/after, earlier versions, dated rows) is on the measurement history page; every
+    plot on the figures page has a caption (an italic paragraph below it)."""
+    page = (ROOT / "docs" / "figures.md").read_text()
+    assert [m.group() for m in DEVELOPMENT_LOG.finditer(page)] == []
+    assert DEVELOPMENT_LOG.search("re-measured with the code of today (2026-11-25)")
+    images = re.findall(r"^!\[.*\]\(images/.*\)\n\n(.*)$", page, flags=re.M)
+    assert len(images) == page.count("](images/") and all(line.startswith("*") for line in images)
