@@ -206,12 +206,13 @@ def export(
     periods: int = typer.Option(1, "--periods", help="Periods to play."),
     fmt: str = typer.Option("csv", "--format", help=f"File format: {' or '.join(FORMATS)}."),
     speed: float = typer.Option(1.0, "--speed", help="Times the optimized speed (0.5: half as fast)."),
+    effort: bool = console.app.EFFORT,
     force: bool = FORCE,
     output: Optional[Path] = typer.Option(None, "--output", "-o", help="File to write (default: beside the result)."),
 ) -> None:
     """Write a trajectory as a robot plays it: home → P periods → home, at the controller's rate, with torques."""
-    exported, target = workflows.run_export(result, iteration, rate, periods, fmt, output, force, speed)
-    say(console.tables.export_lines(exported, rate, target, fmt))
+    exported, target = workflows.run_export(result, iteration, rate, periods, fmt, output, force, speed, effort)
+    say(console.export_lines.export_lines(exported, rate, target, fmt, effort))
 
 
 @command()

@@ -36,6 +36,12 @@ MODEL = typer.Option(None, "--model", help="Identify report whose effects to des
 JOINTS = typer.Option(
     None, "--joints", help="Active joints, repeatable or comma-separated (default: every revolute joint)."
 )
+EFFORT = typer.Option(
+    False,
+    "--effort",
+    help="ros2/rosbag2: the feed-forward torque as the points' effort, for an effort-controlled "
+    "joint_trajectory_controller (ros2_controllers 4.22 on, Jazzy); others refuse any effort.",
+)
 RUNS = typer.Option(None, "--runs", help="identify: measured runs (CSV, NPZ, MAT, HDF5, ROS bag), repeatable.")
 
 

@@ -3,7 +3,6 @@ from what the library returns."""
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Sequence
 
 import numpy as np
@@ -13,8 +12,6 @@ from rich.table import Table
 from excite_cli.config import OptimizerConfig
 from excite_cli.criteria import CRITERIA
 from excite_cli.optimization.sequence import IterationResult
-from excite_cli.storage.export import Export
-from excite_cli.storage.rosbag import TOPIC
 from excite_cli.workflows.check import Plan
 from excite_cli.workflows.compare import Comparison
 from excite_cli.workflows.init import InitRun
@@ -219,26 +216,6 @@ def verification(v: Verification, tolerance: float) -> list[Table | str]:
     )
     verdict = "PASS" if v.worst <= tolerance else "FAIL"
     return [gradients, jacobians, f"{verdict}: largest relative error {v.worst:.2e} (tolerance {tolerance:.0e})"]
-
-
-def export_lines(e: Export, rate: float, target: Path, fmt: str) -> list[str]:
-    """The segments of an exported motion, its constraint check, the file written and, for a ROS 2
-    bag, how to play it and record the run."""
-    faster = f", played at {e.speed:g} × the optimized speed" if e.speed != 1.0 else ""
-    lines = [f"{name:>15}: {start:8.3f} s → {start + duration:8.3f} s" for name, start, duration in e.segments] + [
-        f"{e.time.size} samples at {rate:g} Hz{faster}; every constraint holds: largest normalized violation "
-        f"{e.max_violation:+.2e} (≤ 0 satisfied), closest: {e.worst}",
-        *[f"predicted (feet flat, legs rigid): {p}" for p in e.predictions],
-        *[f"warning: {w}" for w in e.warnings],
-        f"wrote {target}",
-    ]
-    if fmt == "rosbag2":
-        lines += [
-            f"play it: ros2 bag play {target}  (another controller: --remap {TOPIC}:=/<controller>/joint_trajectory)",
-            f"record the run meanwhile: ros2 bag record /joint_states -o {target.name}_run_1  "
-            "(excite identify reads that bag folder as a data.runs file)",
-        ]
-    return lines
 
 
 def plan(p: Plan) -> list[Table | str]:

@@ -21,9 +21,10 @@ from excite_cli.config_file import with_overrides
 from excite_cli.errors import ExciteError
 from excite_cli.optimization.excitation import build_excitation
 from excite_cli.optimization.playback import check_motion, plan_playback
-from excite_cli.storage.formats import FORMATS
+from excite_cli.storage.formats import ROS_FORMATS, check_format
 from excite_cli.storage.results import problem_of_result, read_alphas
 from excite_cli.storage.rosbag import check_goal_size, write_rosbag
+from excite_cli.storage.trajectory_controller import controller_refusals
 
 #: Highest export rate accepted [Hz] (memory grows with rate × duration).
 MAX_RATE = 100_000.0
@@ -168,22 +169,27 @@ def columns(joint_names: list[str]) -> list[str]:
     ]
 
 
-def write_export(path: Path, export: Export, fmt: str = "csv") -> Path:
+def write_export(path: Path, export: Export, fmt: str = "csv", effort: bool = False) -> Path:
     """Write ``export`` as CSV (``#`` comment lines, then one header row of :func:`columns`), NPZ
     (arrays ``time``, ``q``, ``qd``, ``qdd``, ``tau``, ``joint_names``, ``columns``), a ROS 2
     FollowJointTrajectory goal (:func:`ros2_goal`) or a ROS 2 bag folder
-    (:func:`~excite_cli.storage.rosbag.write_rosbag`), atomically.
+    (:func:`~excite_cli.storage.rosbag.write_rosbag`), atomically. The ROS 2 formats carry τ as the
+    points' effort only with ``effort`` (for an effort-controlled joint_trajectory_controller), and
+    are checked against that controller's rules first (:mod:`~excite_cli.storage.trajectory_controller`).
 
     Raises:
-        ExciteError: an unknown format, a goal longer than one command-line argument holds
+        ExciteError: an unknown format, ``effort`` for a data file (which always holds τ), a trajectory
+            the controller would refuse, a goal longer than one command-line argument holds
             (:func:`~excite_cli.storage.rosbag.check_goal_size`), or a file that cannot be written.
     """
-    if fmt not in FORMATS:
-        raise ExciteError("format", f"must be one of {', '.join(FORMATS)} (got {fmt!r})")
+    check_format(fmt, effort)
     path = Path(path)
+    if fmt in ROS_FORMATS:
+        _check_controller_accepts(export, effort)
     if fmt == "rosbag2":
-        return write_rosbag(path, export.joint_names, export.time, (export.q, export.qd, export.qdd, export.tau))
-    goal = ros2_goal(export) if fmt == "ros2" else ""
+        motion = (export.q, export.qd, export.qdd, export.tau)
+        return write_rosbag(path, export.joint_names, export.time, motion, effort=effort)
+    goal = ros2_goal(export, effort) if fmt == "ros2" else ""
     if goal:
         check_goal_size(goal)
     with atomic_path(path, "output") as tmp:
@@ -219,12 +225,31 @@ def _write_csv(path: Path, export: Export) -> None:
         np.savetxt(f, table, delimiter=",", header=",".join(columns(export.joint_names)), comments="", fmt="%.10g")
 
 
-def ros2_goal(export: Export) -> str:
+def _check_controller_accepts(export: Export, effort: bool) -> None:
+    """That the joint_trajectory_controller accepts the trajectory ``export`` writes.
+
+    Raises:
+        ExciteError: its first refusal, in the controller's words.
+    """
+    refusals = controller_refusals(
+        export.joint_names,
+        np.round(export.time * 1e9).astype(np.int64),
+        export.q,
+        export.qd,
+        export.qdd,
+        export.tau if effort else None,
+        effort_interface=effort,
+    )
+    if refusals:
+        raise ExciteError("format", f"joint_trajectory_controller would refuse the trajectory: {refusals[0]}")
+
+
+def ros2_goal(export: Export, effort: bool = False) -> str:
     """``export`` as the YAML of a ``control_msgs/action/FollowJointTrajectory`` goal: its
     ``trajectory`` (``trajectory_msgs/msg/JointTrajectory``) with the URDF's joint names and one
     point per sample (``positions`` [rad], ``velocities`` [rad/s], ``accelerations`` [rad/s²],
-    ``effort`` [Nm]: the feed-forward torque, ``time_from_start`` as sec and nanosec), e.g. for
-    ``ros2 action send_goal /<controller>/follow_joint_trajectory
+    ``time_from_start`` as sec and nanosec; ``effort`` [Nm], the feed-forward torque, with ``effort``),
+    e.g. for ``ros2 action send_goal /<controller>/follow_joint_trajectory
     control_msgs/action/FollowJointTrajectory "$(cat FILE)"`` (at most 128 KiB: one argument)."""
 
     def numbers(row: np.ndarray) -> str:
@@ -238,9 +263,10 @@ def ros2_goal(export: Export) -> str:
         "  points:",
     ]
     for k, ns in enumerate(nanoseconds):
+        torque = f"effort: {numbers(export.tau[k])}, " if effort else ""
         lines.append(
             f"  - {{positions: {numbers(export.q[k])}, velocities: {numbers(export.qd[k])}, "
-            f"accelerations: {numbers(export.qdd[k])}, effort: {numbers(export.tau[k])}, "
+            f"accelerations: {numbers(export.qdd[k])}, {torque}"
             f"time_from_start: {{sec: {ns // 10**9}, nanosec: {ns % 10**9}}}}}"
         )
     return "\n".join(lines) + "\n"

@@ -3,8 +3,9 @@
 
 An exported motion: one ``trajectory_msgs/msg/JointTrajectory``
 on a joint trajectory controller's command topic, with one point per sample (positions [rad],
-velocities [rad/s], accelerations [rad/s²], effort [Nm]: the feed-forward torque, time_from_start)
-and a header stamp of 0 (start on arrival). ``ros2 bag play BAG`` publishes it; ``--remap`` sends it
+velocities [rad/s], accelerations [rad/s²], time_from_start; effort [Nm], the feed-forward torque,
+only when asked: see :mod:`excite_cli.storage.trajectory_controller`) and a header stamp of 0 (start
+on arrival). ``ros2 bag play BAG`` publishes it; ``--remap`` sends it
 to another controller. A goal for ``ros2 action send_goal`` is one command-line argument, which Linux
 caps at 128 KiB (``MAX_ARG_STRLEN``): longer goals are refused in favour of the bag.
 
@@ -32,6 +33,12 @@ from excite_cli.storage.paths import check_target
 #: The topic a ros2_control joint trajectory controller named ``joint_trajectory_controller`` listens on.
 TOPIC = "/joint_trajectory_controller/joint_trajectory"
 MSGTYPE = "trajectory_msgs/msg/JointTrajectory"
+#: ``ros2 bag play --delay`` [s]: the bag holds one message, published the instant the player starts,
+#: before discovery has matched the controller's subscription; the delay lets it match first.
+PLAY_DELAY_S = 2.0
+#: ``ros2 bag play --wait-for-all-acked`` [ms] (rosbag2 since Humble): the player waits until the
+#: controller has acknowledged the message (reliable QoS) before it ends.
+ACKED_WAIT_MS = 5000
 #: The joint-state topic robots publish and ``ros2 bag record`` records.
 JOINT_STATES = "/joint_states"
 #: Stamp of a simulated run's first sample [ns] (2026-01-01, Unix time: a recording's clock).
@@ -94,19 +101,22 @@ def check_bag_target(folder: Path, field: str, force: bool) -> Path:
     return folder
 
 
-def _message(types: dict, joints: list[str], time_s: np.ndarray, motion: tuple[np.ndarray, ...]) -> object:
-    """The JointTrajectory of one point per instant of ``time_s`` (S,) [s]: ``motion`` q, q̇, q̈, τ (S, n)
-    (``types``: a typestore's message classes)."""
+def _message(
+    types: dict, joints: list[str], time_s: np.ndarray, motion: tuple[np.ndarray, ...], effort: bool
+) -> object:
+    """The JointTrajectory of one point per instant of ``time_s`` (S,) [s]: ``motion`` q, q̇, q̈, τ (S, n),
+    τ as effort only with ``effort`` (``types``: a typestore's message classes)."""
     Time, Duration = (types[f"builtin_interfaces/msg/{t}"] for t in ("Time", "Duration"))
     Header, Point = types["std_msgs/msg/Header"], types["trajectory_msgs/msg/JointTrajectoryPoint"]
     q, qd, qdd, tau = motion
     nanoseconds = np.round(time_s * 1e9).astype(np.int64)
+    none = np.zeros(0)
     points = [
         Point(
             positions=q[k],
             velocities=qd[k],
             accelerations=qdd[k],
-            effort=tau[k],
+            effort=tau[k] if effort else none,
             time_from_start=Duration(sec=int(ns // 10**9), nanosec=int(ns % 10**9)),
         )
         for k, ns in enumerate(nanoseconds)
@@ -146,15 +156,23 @@ def _fill_bag(staging: Path, folder: Path, topic: str, msgtype: str, messages) -
 
 
 def write_rosbag(
-    folder: Path, joints: list[str], time_s: np.ndarray, motion: tuple[np.ndarray, ...], topic: str = TOPIC
+    folder: Path,
+    joints: list[str],
+    time_s: np.ndarray,
+    motion: tuple[np.ndarray, ...],
+    topic: str = TOPIC,
+    effort: bool = False,
 ) -> Path:
     """Write a played motion (``time_s`` (S,) [s] from 0; ``motion`` q, q̇, q̈, τ (S, n) [rad, rad/s,
-    rad/s², Nm] of ``joints``) as the trajectory bag of the module docstring at ``folder`` (:func:`_write_bag`).
+    rad/s², Nm] of ``joints``) as the trajectory bag of the module docstring at ``folder``
+    (:func:`_write_bag`), τ as the points' effort only with ``effort``.
 
     Raises:
         CannotWrite: the bag cannot be written.
     """
-    return _write_bag(folder, topic, MSGTYPE, lambda types: [(time.time_ns(), _message(types, joints, time_s, motion))])
+    return _write_bag(
+        folder, topic, MSGTYPE, lambda types: [(time.time_ns(), _message(types, joints, time_s, motion, effort))]
+    )
 
 
 def write_joint_states(

@@ -160,12 +160,21 @@ def test_a_ros2_goal_longer_than_one_command_line_argument_is_refused_naming_the
 
 def test_a_rosbag2_export_plays_the_samples_of_the_csv(panda_runs, tmp_path):
     """Read back with rosbags as ``ros2 bag play`` would: one JointTrajectory on the controller's topic
-    whose points are the CSV's rows (positions, effort = feed-forward torque, time_from_start)."""
+    whose points are the CSV's rows (positions, time_from_start; with ``--effort``, effort = the
+    feed-forward torque, else no effort), and the printed play command waits for the controller."""
     argv = ["export", str(panda_runs["rest"]), "-k", "1", "--rate", "50"]
     assert runner.invoke(app, [*argv, "-o", str(tmp_path / "play.csv")]).exit_code == 0
+    plain = runner.invoke(app, [*argv, "--format", "rosbag2", "-o", str(tmp_path / "plain")], env={"COLUMNS": "400"})
+    assert plain.exit_code == 0, plain.output
+    assert f"ros2 bag play {tmp_path / 'plain'} --delay 2 --wait-for-all-acked 5000" in plain.output
+    assert "positions, velocities and accelerations: what every joint_trajectory_controller accepts" in plain.output
+    with AnyReader([tmp_path / "plain"], default_typestore=get_typestore(Stores.ROS2_HUMBLE)) as reader:
+        [plain_message] = [reader.deserialize(raw, c.msgtype) for c, _, raw in reader.messages()]
+    assert all(len(p.effort) == 0 for p in plain_message.points)  # no effort unless asked
+    argv += ["--effort"]
     result = runner.invoke(app, [*argv, "--format", "rosbag2", "-o", str(tmp_path / "bag")], env={"COLUMNS": "400"})
     assert result.exit_code == 0, result.output
-    assert f"ros2 bag play {tmp_path / 'bag'}" in result.output
+    assert f"ros2 bag play {tmp_path / 'bag'}" in result.output and "effort-controlled" in result.output
     time, q, _, _, tau = _csv(tmp_path / "play.csv")
     with AnyReader([tmp_path / "bag"], default_typestore=get_typestore(Stores.ROS2_HUMBLE)) as reader:
         assert [(c.topic, c.msgtype) for c in reader.connections] == [(TOPIC, "trajectory_msgs/msg/JointTrajectory")]

@@ -1,5 +1,6 @@
 """The played file: CSV, NPZ, a ROS 2 goal and a ROS 2 bag written from the same samples and read back."""
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -20,11 +21,19 @@ JOINTS = ["a", "b"]
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 
 
+def _at_rest_at_the_end(q: np.ndarray) -> np.ndarray:
+    """Velocities 2q but zero at the last sample, as every exported motion ends (home, at rest)."""
+    qd = 2 * q
+    qd[-1] = 0.0
+    return qd
+
+
 @pytest.fixture
 def export():
     t = np.arange(5) / 100.0
     q = np.column_stack([np.sin(t), np.cos(t)])
-    return Export(JOINTS, t, q, 2 * q, 3 * q, 4 * q, 100.0, 2, 1, [("trajectory", 0.0, 0.05)], -0.01, "none")
+    qd = _at_rest_at_the_end(q)
+    return Export(JOINTS, t, q, qd, 3 * q, 4 * q, 100.0, 2, 1, [("trajectory", 0.0, 0.05)], -0.01, "none")
 
 
 def test_csv_and_npz_hold_the_same_samples_under_their_column_names(export, tmp_path):
@@ -50,15 +59,22 @@ def test_csv_and_npz_hold_the_same_samples_under_their_column_names(export, tmp_
     assert archive["joint_names"].tolist() == JOINTS
 
 
-def test_a_ros2_goal_has_one_point_per_sample_with_its_time_and_builds_the_ros_message(export, tmp_path):
+@pytest.mark.parametrize("effort", [False, True])
+def test_a_ros2_goal_has_one_point_per_sample_with_its_time_and_builds_the_ros_message(export, tmp_path, effort):
     """The YAML goal's fields are trajectory_msgs/JointTrajectory(Point)'s as ROS 2 defines them
-    (rosbags' Humble message store): they build such a message, which serializes to CDR."""
-    goal = yaml.safe_load(write_export(tmp_path / "m.yaml", export, "ros2").read_text())
+    (rosbags' Humble message store): they build such a message, which serializes to CDR. Effort only
+    when asked."""
+    goal = yaml.safe_load(write_export(tmp_path / "m.yaml", export, "ros2", effort).read_text())
     trajectory = goal["trajectory"]
     assert trajectory["joint_names"] == JOINTS and len(trajectory["points"]) == 5
     last = trajectory["points"][-1]
     assert last["time_from_start"] == {"sec": 0, "nanosec": 40_000_000}
-    np.testing.assert_allclose(last["effort"], export.tau[-1])
+    if effort:
+        np.testing.assert_allclose(last["effort"], export.tau[-1])
+    else:
+        assert all("effort" not in point for point in trajectory["points"])
+        for point in trajectory["points"]:
+            point["effort"] = []
     store = get_typestore(Stores.ROS2_HUMBLE)
     types = store.types
     points = [
@@ -76,7 +92,7 @@ def test_a_ros2_goal_has_one_point_per_sample_with_its_time_and_builds_the_ros_m
 def test_a_goal_longer_than_one_command_line_argument_is_refused_and_not_written(tmp_path):
     t = np.arange(5000) / 1000.0
     q = np.column_stack([np.sin(t), np.cos(t)])
-    long = Export(JOINTS, t, q, q, q, q, 1000.0, 1, 1, [("trajectory", 0.0, 5.0)], -0.01, "none")
+    long = Export(JOINTS, t, q, _at_rest_at_the_end(q), q, q, 1000.0, 1, 1, [("trajectory", 0.0, 5.0)], -0.01, "none")
     with pytest.raises(ExciteError, match="more than the 128 KiB one command-line argument holds"):
         write_export(tmp_path / "m.yaml", long, "ros2")
     assert list(tmp_path.iterdir()) == []
@@ -85,6 +101,18 @@ def test_a_goal_longer_than_one_command_line_argument_is_refused_and_not_written
 def test_an_unknown_format_writes_nothing(export, tmp_path):
     with pytest.raises(ExciteError, match="format"):
         write_export(tmp_path / "m.xml", export, "xml")
+    with pytest.raises(ExciteError, match="effort: is for the ROS 2 formats; a csv file holds τ always"):
+        write_export(tmp_path / "m.csv", export, "csv", effort=True)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_trajectory_the_controller_would_refuse_is_not_written(export, tmp_path):
+    """A motion that does not end at rest (which every export does) would be refused by the
+    joint_trajectory_controller: excite says so and writes nothing, in both ROS 2 formats."""
+    moving = replace(export, qd=2 * export.q)
+    for fmt, name in (("ros2", "m.yaml"), ("rosbag2", "bag")):
+        with pytest.raises(ExciteError, match="Velocity of last trajectory point of joint b is not zero"):
+            write_export(tmp_path / name, moving, fmt)
     assert list(tmp_path.iterdir()) == []
 
 

@@ -27,8 +27,8 @@ Q = np.column_stack([np.sin(TIME), np.cos(TIME)])
 MOTION = (Q, 2 * Q, 3 * Q, 4 * Q)
 
 
-def _bag(folder):
-    return write_rosbag(folder, JOINTS, TIME, MOTION)
+def _bag(folder, effort=False):
+    return write_rosbag(folder, JOINTS, TIME, MOTION, effort=effort)
 
 
 def _read(bag):
@@ -36,15 +36,19 @@ def _read(bag):
         return [(c.topic, c.msgtype, reader.deserialize(raw, c.msgtype)) for c, _, raw in reader.messages()]
 
 
-def test_the_bag_holds_one_joint_trajectory_with_every_sample(tmp_path):
-    [(topic, msgtype, message)] = _read(_bag(tmp_path / "bag"))
+@pytest.mark.parametrize("effort", [False, True])
+def test_the_bag_holds_one_joint_trajectory_with_every_sample(tmp_path, effort):
+    [(topic, msgtype, message)] = _read(_bag(tmp_path / "bag", effort))
     assert (topic, msgtype) == (TOPIC, MSGTYPE)
     assert list(message.joint_names) == JOINTS
     assert (message.header.stamp.sec, message.header.stamp.nanosec) == (0, 0)  # start on arrival
     np.testing.assert_array_equal([p.positions for p in message.points], MOTION[0])
     np.testing.assert_array_equal([p.velocities for p in message.points], MOTION[1])
     np.testing.assert_array_equal([p.accelerations for p in message.points], MOTION[2])
-    np.testing.assert_array_equal([p.effort for p in message.points], MOTION[3])
+    if effort:  # the feed-forward torque, asked for (an effort-controlled controller)
+        np.testing.assert_array_equal([p.effort for p in message.points], MOTION[3])
+    else:  # what every joint_trajectory_controller accepts
+        assert all(len(p.effort) == 0 for p in message.points)
     assert [(p.time_from_start.sec, p.time_from_start.nanosec) for p in message.points][-1] == (0, 60_000_000)
     assert sorted(p.name for p in (tmp_path / "bag").iterdir()) == ["bag.db3", "metadata.yaml"]
     assert [p.name for p in tmp_path.iterdir()] == ["bag"]  # nothing left beside it

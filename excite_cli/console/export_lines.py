@@ -1,0 +1,38 @@
+"""What ``export`` prints: the played motion's segments and checks, the file written and, for the
+ROS 2 formats, how the controller gets it."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from excite_cli.storage.export import Export
+from excite_cli.storage.rosbag import ACKED_WAIT_MS, PLAY_DELAY_S, TOPIC
+
+
+def export_lines(e: Export, rate: float, target: Path, fmt: str, effort: bool = False) -> list[str]:
+    """The segments of an exported motion, its constraint check, the file written and, for a ROS 2
+    bag, how to play it and record the run; for the ROS 2 formats, whether the points carry ``effort``."""
+    faster = f", played at {e.speed:g} × the optimized speed" if e.speed != 1.0 else ""
+    lines = [f"{name:>15}: {start:8.3f} s → {start + duration:8.3f} s" for name, start, duration in e.segments] + [
+        f"{e.time.size} samples at {rate:g} Hz{faster}; every constraint holds: largest normalized violation "
+        f"{e.max_violation:+.2e} (≤ 0 satisfied), closest: {e.worst}",
+        *[f"predicted (feet flat, legs rigid): {p}" for p in e.predictions],
+        *[f"warning: {w}" for w in e.warnings],
+        f"wrote {target}",
+    ]
+    if fmt == "rosbag2":
+        lines += [
+            f"play it: ros2 bag play {target} --delay {PLAY_DELAY_S:g} --wait-for-all-acked {ACKED_WAIT_MS}  "
+            f"(the controller's subscription matched first, the message acknowledged before the player ends; "
+            f"another controller: --remap {TOPIC}:=/<controller>/joint_trajectory)",
+            f"record the run meanwhile: ros2 bag record /joint_states -o {target.name}_run_1  "
+            "(excite identify reads that bag folder as a data.runs file)",
+        ]
+    if fmt in ("ros2", "rosbag2"):
+        lines.append(
+            "effort: the feed-forward torque, for an effort-controlled joint_trajectory_controller (Jazzy on)"
+            if effort
+            else "positions, velocities and accelerations: what every joint_trajectory_controller accepts "
+            "(--effort adds the feed-forward torque, for an effort-controlled one)"
+        )
+    return lines
