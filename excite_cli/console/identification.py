@@ -29,13 +29,24 @@ def plan(p: IdentifyPlan) -> list[Table | str]:
     """What ``check`` found in an identify config: the robot, the runs as read, what would be fitted."""
     cfg = p.problem.identification
     rows = [
-        (r.label, r.role, str(r.samples), f"{r.seconds:.2f}", f"{r.rate:.4g}", ", ".join(r.signals), str(r.dropped))
+        (
+            r.label,
+            r.role,
+            str(r.samples),
+            f"{r.seconds:.2f}",
+            f"{r.rate:.4g}",
+            ", ".join(r.signals),
+            str(r.dropped),
+            "; ".join(f"{g.length:.3g} s after {g.start:.3f} s" for g in r.gaps) or "none",
+        )
         for r in p.runs
     ]
     return [
         f"robot: {len(p.joints)} active joints ({', '.join(p.joints)}), {p.base_parameters} base parameters",
         titled_table(
-            "Runs, read as identify reads them", ("run", "role", "samples", "s", "Hz", "signals", "dropped"), rows
+            "Runs, read as identify reads them",
+            ("run", "role", "samples", "s", "Hz", "signals", "dropped", "gaps (cut there)"),
+            rows,
         ),
         f"fit: {cfg.method}, {cfg.fit}; declared effects: {', '.join(p.declared) or 'none'}; "
         f"{p.candidates} candidate terms the search may add",

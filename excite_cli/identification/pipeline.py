@@ -23,6 +23,7 @@ from excite_cli.identification.fitting.dataset import Dataset, build_datasets, f
 from excite_cli.identification.fitting.least_squares import joint_weights, least_squares, predict, torque_errors
 from excite_cli.identification.fitting.normal import NormalEquations, excited_rank
 from excite_cli.identification.fitting.plausibility import implausible
+from excite_cli.identification.measured.gaps import split_at_gaps
 from excite_cli.identification.measured.measurements import (
     check_against_limits,
     in_sample_validation,
@@ -108,20 +109,14 @@ def prepare_data(problem: IdentifyProblem, robot: Robot, base: BaseParameters, t
             fit runs that do not excite every base parameter.
     """
     cfg = problem.identification
-    payloads = [
-        payload_parameters(robot, r.payload, f"data.runs[{k}].payload") if r.payload else None
-        for k, r in enumerate(problem.data.runs)
-    ]
-    runs = [
-        check_against_limits(
-            load_run(r, problem.data, robot.joint_names, problem.folder),
-            robot.joint_names,
-            robot.lower,
-            robot.upper,
-            robot.velocity_limit,
-        )
-        for r in problem.data.runs
-    ]  # a list only: the runs are released one by one as they are preprocessed
+    runs, payloads = [], []  # a list only: the runs are released one by one as they are preprocessed
+    for k, r in enumerate(problem.data.runs):
+        payload = payload_parameters(robot, r.payload, f"data.runs[{k}].payload") if r.payload else None
+        run = load_run(r, problem.data, robot.joint_names, problem.folder)
+        check_against_limits(run, robot.joint_names, robot.lower, robot.upper, robot.velocity_limit)
+        pieces = split_at_gaps(run)  # a recording's gaps are never interpolated across
+        runs += pieces
+        payloads += [payload] * len(pieces)
     silent = silent_channels(runs)
     cutoff, source = choose_cutoff(runs, problem.preprocessing)
     dropped = [(r.name, r.dropped) for r in runs if r.dropped]

@@ -25,6 +25,7 @@ from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.effects import Term
 from excite_cli.identification.fitting.dataset import build_datasets
 from excite_cli.identification.fitting.least_squares import predict, torque_errors
+from excite_cli.identification.measured.gaps import split_at_gaps
 from excite_cli.identification.measured.measurements import load_run
 from excite_cli.identification.measured.payload import payload_parameters
 from excite_cli.identification.measured.preprocessing import preprocess
@@ -163,16 +164,12 @@ def validate_model(report: Path, problem: IdentifyProblem) -> list[RunError]:
     needed = terms + [Term("coulomb", j) for j in range(robot.n_joints)]
     errors = []
     for k, run in enumerate(problem.data.runs):
+        pieces = split_at_gaps(  # a gap is never interpolated across, as in identify
+            load_run(run.model_copy(update={"role": "validation"}), problem.data, robot.joint_names, problem.folder)
+        )
+        samples = [preprocess(piece, problem.preprocessing, model.cutoff) for piece in pieces]
         payload = [payload_parameters(robot, run.payload, f"data.runs[{k}].payload") if run.payload else None]
-        samples = [
-            preprocess(
-                load_run(
-                    run.model_copy(update={"role": "validation"}), problem.data, robot.joint_names, problem.folder
-                ),
-                problem.preprocessing,
-                model.cutoff,
-            )
-        ]
+        payload *= len(samples)
         _, data, _ = build_datasets(
             robot,
             base,

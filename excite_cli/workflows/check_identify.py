@@ -17,6 +17,7 @@ from excite_cli.dynamics.robot import load_robot
 from excite_cli.errors import ExciteError
 from excite_cli.identification.choice.selection import candidate_terms, motor_couplings
 from excite_cli.identification.config import IdentifyProblem
+from excite_cli.identification.measured.gaps import Gap, find_gaps
 from excite_cli.identification.measured.measurements import check_against_limits, load_run
 from excite_cli.identification.pipeline import declared_terms
 from excite_cli.workflows.check import Plan, plan_optimize
@@ -25,8 +26,9 @@ from excite_cli.workflows.check import Plan, plan_optimize
 @dataclass(frozen=True)
 class RunSummary:
     """One measured run as ``identify`` reads it: its label (file and crop), role, samples, duration
-    [s], median sample rate [Hz], the signals found (``q``, ``qd`` or ``qdd`` when recorded, ``tau``)
-    and the rows left out (``data.bad_rows: drop``)."""
+    [s], median sample rate [Hz], the signals found (``q``, ``qd`` or ``qdd`` when recorded, ``tau``),
+    the rows left out (``data.bad_rows: drop``) and its gaps (where identify cuts the run, never
+    interpolating across: :func:`~excite_cli.identification.measured.gaps.find_gaps`)."""
 
     label: str
     role: str
@@ -35,6 +37,7 @@ class RunSummary:
     rate: float
     signals: tuple[str, ...]
     dropped: int
+    gaps: tuple[Gap, ...] = ()
 
 
 @dataclass
@@ -71,9 +74,10 @@ def plan_identify(problem: IdentifyProblem) -> IdentifyPlan:
         signals = ("q",) + tuple(s for s in ("qd", "qdd") if getattr(run, s) is not None) + ("tau",)
         steps = np.diff(run.time)
         rate = float(1.0 / np.median(steps)) if steps.size else float("nan")
+        seconds = float(run.time[-1] - run.time[0])
         runs.append(
             RunSummary(
-                config.label, run.role, run.time.size, float(run.time[-1] - run.time[0]), rate, signals, run.dropped
+                config.label, run.role, run.time.size, seconds, rate, signals, run.dropped, tuple(find_gaps(run.time))
             )
         )
     return IdentifyPlan(

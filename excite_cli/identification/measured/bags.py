@@ -38,24 +38,54 @@ def _bag_paths(path: Path) -> list[Path]:
     return [path]
 
 
+#: Messages that each carry part of the active joints are one sample when their stamps differ by at most
+#: this [s] (a driver that publishes an arm's joints in several JointState messages, stamped together).
+MERGE_TOLERANCE_S = 0.001
+
+
 def _rows(reader: AnyReader, connections: list, joints: Sequence[str]) -> tuple[list[np.ndarray], int]:
-    """(1 + 3n,) rows [time, position, velocity, effort] of the messages carrying every joint (NaN
-    where a message leaves a field empty), and the number of messages skipped that carry some of the
-    joints but not all (those that carry none are another publisher's: a gripper's)."""
-    rows, skipped, n = [], 0, len(joints)
+    """(1 + 3n,) rows [time, position, velocity, effort] of the samples carrying every joint (NaN where
+    a message leaves a field empty), in recorded order, and the number of messages left out: those
+    that carry some of the joints and no message within :data:`MERGE_TOLERANCE_S` completes (those
+    that carry none are another publisher's: a gripper's). Messages that together carry every joint
+    once, stamped within the tolerance, are merged into one sample, joints by name."""
+    rows, skipped = [], 0
+    wanted = set(joints)
+    pending: list[tuple[float, dict[str, list[float]], int]] = []  # (stamp, joint → values, messages)
     for connection, recorded_ns, raw in reader.messages(connections=connections):
         message = reader.deserialize(raw, connection.msgtype)
         names = list(message.name)
-        if not set(joints) <= set(names):
-            skipped += bool(set(joints) & set(names))
+        carried = wanted & set(names)
+        if not carried:
             continue
-        order = [names.index(j) for j in joints]
         stamp = message.header.stamp.sec + 1e-9 * message.header.stamp.nanosec
-        row = [stamp if stamp > 0 else 1e-9 * recorded_ns]
+        stamp = stamp if stamp > 0 else 1e-9 * recorded_ns
+        values = {}
         for name in FIELDS:
-            values = np.asarray(getattr(message, name), dtype=float)
-            row += list(values[order]) if values.size == len(names) else [np.nan] * n
+            field = np.asarray(getattr(message, name), dtype=float)
+            for j in carried:
+                values.setdefault(j, []).append(field[names.index(j)] if field.size == len(names) else np.nan)
+        if carried != wanted:  # part of a sample: merged with the parts stamped with it
+            stale = [p for p in pending if p[0] < stamp - 10 * MERGE_TOLERANCE_S]
+            skipped += sum(p[2] for p in stale)
+            pending = [p for p in pending if p not in stale]
+            match = next(
+                (p for p in pending if abs(p[0] - stamp) <= MERGE_TOLERANCE_S and not carried & p[1].keys()), None
+            )
+            if match is None:
+                pending.append((stamp, values, 1))
+                continue
+            pending.remove(match)
+            values, count = {**match[1], **values}, match[2] + 1
+            if values.keys() != wanted:
+                pending.append((match[0], values, count))
+                continue
+            stamp = match[0]
+        row = [stamp] + [values[j][f] for f in range(len(FIELDS)) for j in joints]
         rows.append(np.array(row))
+    skipped += sum(p[2] for p in pending)
+    if any(np.diff([r[0] for r in rows]) < 0):  # merged parts can complete out of recorded order
+        rows.sort(key=lambda r: r[0])
     return rows, skipped
 
 
@@ -66,9 +96,11 @@ def read_bag(path: Path, topic: str, joints: Sequence[str]) -> Table:
         topic: the ``sensor_msgs/JointState`` topic (``data.topic``).
         joints: (n,) the active joints' names, as in the URDF.
 
-    Messages that carry some of the active joints but not all are left out, counted in ``Table.dropped``
-    and named in an :class:`~excite_cli.errors.ExciteWarning` (those that carry none are another
-    publisher's, a gripper's, and are passed over).
+    Messages that carry some of the active joints but not all are merged, by joint name, with those
+    stamped within :data:`MERGE_TOLERANCE_S` of them that carry the others (a driver publishing an
+    arm in several messages); the parts no message completes are left out, counted in
+    ``Table.dropped`` and named in an :class:`~excite_cli.errors.ExciteWarning` (messages that carry
+    none of the joints are another publisher's, a gripper's, and are passed over).
 
     Raises:
         ExciteError: not a readable bag (a FIFO or device: :func:`~excite_cli.inputs.input_file`), no such topic or not
@@ -103,7 +135,8 @@ def read_bag(path: Path, topic: str, joints: Sequence[str]) -> Table:
     if skipped:
         warnings.warn(
             f"{path.name}: {skipped} of {skipped + len(rows)} messages on {topic} carry only some of the active "
-            "joints and are left out (counted as dropped; a driver that publishes them in several messages?)",
+            f"joints, and no message stamped within {MERGE_TOLERANCE_S * 1e3:g} ms carries the others: left out "
+            "(counted as dropped)",
             ExciteWarning,
         )
     values = np.vstack(rows)

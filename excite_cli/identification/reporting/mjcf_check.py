@@ -29,6 +29,7 @@ from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.effects import effect_columns
 from excite_cli.identification.fitting.dataset import fit_instants
 from excite_cli.identification.fitting.least_squares import predict, torque_errors
+from excite_cli.identification.measured.gaps import split_at_gaps
 from excite_cli.identification.measured.measurements import load_run
 from excite_cli.identification.measured.preprocessing import preprocess
 from excite_cli.identification.reporting.mjcf_out import MjcfModel, import_mujoco
@@ -141,11 +142,15 @@ def check_mjcf(
     )
     measured, validation = report.validation.tau.reshape(-1, n), report.validation
     predicted = np.empty_like(measured)
-    for k, cfg in enumerate(problem.data.runs):
+    pieces = [  # the runs as identify fitted them: cut at their gaps (said there already)
+        piece
+        for cfg in problem.data.runs
+        for piece in split_at_gaps(load_run(cfg, problem.data, robot.joint_names, problem.folder), quiet=True)
+    ]
+    for k, run in enumerate(pieces):
         rows = np.flatnonzero(validation.run == k)
         if rows.size == 0:
             continue
-        run = load_run(cfg, problem.data, robot.joint_names, problem.folder)
         s = preprocess(run, problem.preprocessing, report.cutoff)
         kept = s.filter.kept(s.time.size)
         held_out = ~fit_instants(s.role, kept, problem.data.validation_blocks)

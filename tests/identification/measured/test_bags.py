@@ -156,3 +156,33 @@ def test_messages_with_only_some_of_the_joints_are_counted_and_named(simulated, 
     with pytest.warns(ExciteWarning, match=r"partial: 100 of 200 messages on /joint_states carry only some"):
         read = read_bag(path, "/joint_states", JOINTS)
     assert read.dropped == 100 and read.values.shape[0] == 100
+
+
+def test_a_driver_that_publishes_the_arm_in_two_messages_reads_as_one(simulated, tmp_path):
+    """Each sample as two JointState messages, joints 1-4 and 5-7 (the second stamped 0.3 ms later, in
+    reversed order some of the time): the same samples as the whole messages, nothing dropped."""
+    _, table = simulated
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    types = store.types
+    Time, Header, JointState = (types[t] for t in ("builtin_interfaces/msg/Time", "std_msgs/msg/Header", MSGTYPE))
+    path = tmp_path / "split"
+    with Ros2Writer(path, version=9) as writer:
+        connection = writer.add_connection("/joint_states", MSGTYPE, typestore=store)
+        for k, row in enumerate(table[:300]):
+            ns = T0 * 10**9 + int(round(row[0] * 1e9))
+            parts = [(range(0, 4), ns), (range(4, 7), ns + 300_000)]
+            for part, stamp in parts[::-1] if k % 3 == 0 else parts:
+                header = Header(stamp=Time(sec=stamp // 10**9, nanosec=stamp % 10**9), frame_id="")
+                message = JointState(
+                    header=header,
+                    name=[JOINTS[j] for j in part],
+                    position=row[1:8][list(part)],
+                    velocity=np.zeros(0),
+                    effort=row[8:15][list(part)],
+                )
+                writer.write(connection, stamp, store.serialize_cdr(message, MSGTYPE))
+    whole = read_bag(write_bag(tmp_path / "whole", table[:300], "ros2"), "/joint_states", JOINTS)
+    read = read_bag(path, "/joint_states", JOINTS)
+    assert read.dropped == 0 and read.names == whole.names
+    np.testing.assert_allclose(read.values[:, 1:], whole.values[:, 1:], rtol=0, atol=0)
+    np.testing.assert_allclose(read.values[:, 0], whole.values[:, 0], atol=4e-4)
