@@ -15,17 +15,23 @@ not move would refuse valid work. Per active joint: the limits are numbers and l
 the joint it follows may, but the follower is then held still while its leader moves, so it must be
 listed in ``robot.locked_joints`` (held on purpose, as the Panda's second finger when the first is
 active): otherwise the model would silently differ from the robot.
+
+The file is a URDF at all (:func:`check_format`): a vendor's ``.xacro`` as shipped parsed as a URDF
+with every joint fixed, and an MJCF as two raw urdfdom lines. Links an active joint moves that have
+no mass (ROS-Industrial's KUKA iiwa has no ``<inertial>`` anywhere) are said in a warning: the
+regressor does not need their inertias, but the feed-forward torque and the torque limits do.
 """
 
 from __future__ import annotations
 
 import math
+import warnings
 from pathlib import Path
 from xml.etree import ElementTree
 
 import numpy as np
 
-from excite_cli.errors import ExciteError
+from excite_cli.errors import ExciteError, ExciteWarning
 
 #: Relative tolerance of the principal-moment checks (CAD exports round their inertias).
 TOLERANCE = 1e-6
@@ -34,6 +40,33 @@ TOLERANCE = 1e-6
 MAX_LINKS = 1000
 INERTIA = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
 LIMITS = ("lower", "upper", "effort", "velocity")
+#: The namespace xacro's macros are written in.
+XACRO = "{http://www.ros.org/wiki/xacro}"
+
+
+def check_format(root: ElementTree.Element, path: Path) -> None:
+    """That the XML at ``path`` (its ``root`` element) is a URDF, not a xacro file to expand first or
+    an MJCF.
+
+    Raises:
+        ExciteError: (``robot.urdf``) a xacro file (its ending or xacro elements), an MJCF (root
+            ``<mujoco>``), or another root element than ``<robot>``, naming the next step.
+    """
+    if path.name.endswith(".xacro") or any(e.tag.startswith(XACRO) for e in root.iter()):
+        raise ExciteError(
+            "robot.urdf",
+            f"{path.name} is a xacro file: its macros are not expanded",
+            expected=f"the URDF it expands to: xacro {path.name} > robot.urdf (pip install xacro, or "
+            f"ros2 run xacro xacro {path.name}), then robot.urdf: robot.urdf",
+        )
+    if root.tag == "mujoco":
+        raise ExciteError(
+            "robot.urdf",
+            f"{path.name} is an MJCF (MuJoCo) model; excite reads URDF",
+            expected="the robot's URDF (its vendor's description package ships one)",
+        )
+    if root.tag != "robot":
+        raise ExciteError("robot.urdf", f"{path.name} is not a URDF: its root element is <{root.tag}>, not <robot>")
 
 
 def _number(element: ElementTree.Element, attribute: str, what: str) -> float:
@@ -123,6 +156,37 @@ def check_joints(root: ElementTree.Element, active: list[str], locked: list[str]
             )
 
 
+def _warn_massless(root: ElementTree.Element, active: list[str], children: dict[str, list[str]], path: Path) -> None:
+    """An :class:`~excite_cli.errors.ExciteWarning` naming the ``active`` joints of the URDF at ``path``
+    (its ``root``; ``children``: link → child links) that move no mass at all: their torque is 0
+    whatever the motion (a frame with no mass is common; a whole arm without is a URDF without
+    inertias)."""
+    masses = {}
+    for link in root.findall("link"):
+        mass = link.find("inertial/mass")
+        masses[link.get("name")] = 0.0 if mass is None else _number(mass, "value", f"link '{link.get('name')}': mass")
+    idle = []
+    for joint in root.findall("joint"):
+        child = joint.find("child")
+        if joint.get("name") not in active or child is None:
+            continue
+        subtree, total = [child.get("link")], 0.0
+        while subtree:
+            link = subtree.pop()
+            total += masses.get(link, 0.0)
+            subtree += children.get(link, [])
+        if not total > 0.0:
+            idle.append(joint.get("name"))
+    if idle:
+        warnings.warn(
+            f"{path.name} gives no mass to anything {', '.join(idle)} move(s): their torque is 0 whatever the "
+            "motion (no <inertial> in the URDF?); the trajectory still excites them, but the feed-forward torque "
+            "export writes and the torque limits are 0 there",
+            ExciteWarning,
+            stacklevel=3,
+        )
+
+
 def check_tree(links: list[str], parents: dict[str, list[str]], children: dict[str, list[str]]) -> None:
     """The links and joints of a URDF form one tree of at most :data:`MAX_LINKS` links: no link is the
     child of two joints (a closed kinematic chain, which a URDF cannot describe and pinocchio
@@ -192,6 +256,7 @@ def check_urdf(path: Path, active: list[str], physical: bool = True, locked: lis
         root = ElementTree.parse(path).getroot()
     except (ElementTree.ParseError, OSError) as exc:
         raise ExciteError("robot.urdf", f"cannot read {path}: {exc}") from None
+    check_format(root, path)
     children: dict[str, list[str]] = {}
     parents: dict[str, list[str]] = {}
     moved: list[str] = []
@@ -208,6 +273,7 @@ def check_urdf(path: Path, active: list[str], physical: bool = True, locked: lis
         below.add(link)
         moved += [c for c in children.get(link, []) if c not in below]
     problems = [p for link in root.findall("link") if (p := check_inertial(link, link.get("name") in below))]
+    _warn_massless(root, active, children, path)
     if problems and physical:
         raise ExciteError(
             "robot.urdf", problems[0], None, "moments ≥ 0 with the two smaller summing to at least the largest"

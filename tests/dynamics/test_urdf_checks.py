@@ -1,10 +1,12 @@
 """A robot that can be: bodies and joints a model cannot have are refused by name, before pinocchio."""
 
+import warnings
+
 import pytest
 from conftest import GOOD, PENDULUM
 
 from excite_cli.dynamics.urdf_checks import MAX_LINKS, check_urdf
-from excite_cli.errors import ExciteError
+from excite_cli.errors import ExciteError, ExciteWarning
 
 
 def _urdf(tmp_path, **fields):
@@ -91,3 +93,43 @@ def test_a_mimic_joint_held_while_its_leader_moves_is_refused_unless_locked_on_p
     check_urdf(path, ["hinge"], locked=["tip_joint"])  # held on purpose
     with pytest.raises(ExciteError, match="a coupling the model does not represent"):
         check_urdf(path, ["hinge", "tip_joint"])  # the follower itself may not be active
+
+
+@pytest.mark.parametrize(
+    "name, text, expected",
+    [
+        (
+            "arm.urdf.xacro",
+            '<robot name="arm" xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:include filename="x.xacro"/></robot>',
+            "arm.urdf.xacro is a xacro file: its macros are not expanded; expected the URDF it expands to: "
+            "xacro arm.urdf.xacro > robot.urdf",
+        ),
+        (
+            "arm.urdf",  # a vendor's xacro saved under a URDF name: its macros give it away
+            '<robot name="arm" xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:arm prefix=""/></robot>',
+            "arm.urdf is a xacro file",
+        ),
+        (
+            "fr3.xml",
+            '<mujoco model="fr3"><worldbody/></mujoco>',
+            "fr3.xml is an MJCF (MuJoCo) model; excite reads URDF",
+        ),
+        ("scene.sdf", '<sdf version="1.6"><model name="m"/></sdf>', "its root element is <sdf>, not <robot>"),
+    ],
+)
+def test_a_file_that_is_no_urdf_says_what_it_is_and_the_next_step(tmp_path, name, text, expected):
+    (tmp_path / name).write_text(text)
+    with pytest.raises(ExciteError) as raised:
+        check_urdf(tmp_path / name, [])
+    assert expected in raised.value.describe()
+
+
+def test_a_joint_that_moves_no_mass_is_a_warning(tmp_path):
+    """A URDF without inertias (ROS-Industrial's iiwa): the torques export would write are all 0."""
+    massless = PENDULUM.format(**{**GOOD, "mimic": "", "mass": "0", "tip_mass": "0"})
+    (tmp_path / "robot.urdf").write_text(massless)
+    with pytest.warns(ExciteWarning, match="robot.urdf gives no mass to anything hinge move"):
+        check_urdf(tmp_path / "robot.urdf", ["hinge"])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        check_urdf(_urdf(tmp_path), ["hinge"])  # a massless frame beside bodies with mass is no warning

@@ -139,6 +139,10 @@ def test_recorded_bags_get_a_config_without_columns_that_identifies_the_friction
         (["init", "nothing/here.urdf"], "URDF (a file, or a path inside example-robot-data's robots folder) not found"),
         (["init", UR3, "--kind", "simulate"], "'simulate' is not a config kind"),
         (["init", UR3, "-o", "taken.yaml"], "taken.yaml exists"),
+        (
+            ["init", "arm.urdf.xacro"],
+            "urdf: arm.urdf.xacro is a xacro file: its macros are not expanded; expected the URDF it expands to",
+        ),
     ],
 )
 def test_bad_init_input_is_one_line_and_writes_nothing(tmp_path, monkeypatch, argv, expected):
@@ -146,6 +150,7 @@ def test_bad_init_input_is_one_line_and_writes_nothing(tmp_path, monkeypatch, ar
     (tmp_path / "taken.yaml").write_text("keep: me\n")
     (tmp_path / "csvs").mkdir()
     (tmp_path / "csvs" / "run_1.csv").write_text("time,q_elbow_joint\n0,0\n")
+    (tmp_path / "arm.urdf.xacro").write_text('<robot name="arm" xmlns:xacro="http://www.ros.org/wiki/xacro"/>\n')
     assert_refused(tmp_path, argv, expected)
     assert (tmp_path / "taken.yaml").read_text() == "keep: me\n"
 
