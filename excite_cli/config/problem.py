@@ -35,6 +35,8 @@ class RobotConfig(Section):
     """URDF file (relative to the config file), or with `source: example-robot-data` a path in its robots folder."""
     source: Literal["file", "example-robot-data"] = "file"
     """Where `urdf` is found: `file` or `example-robot-data`."""
+    package_dirs: list[str] = Field(default_factory=list)
+    """Folders (relative to the config file) that hold the packages the URDF's `package://` meshes name."""
     floating_base: bool = False
     """Load with a free-flyer root joint, held fixed at the identity pose (humanoids)."""
     active_joints: list[str] = Field(min_length=1)

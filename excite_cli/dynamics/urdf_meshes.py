@@ -58,11 +58,12 @@ def mesh_path(name: str, urdf: Path, package_dirs: list[str]) -> Path | None:
 
 
 def check_meshes(urdf: Path, package_dirs: list[str], kind: str = "collision") -> None:
-    """Every ``<mesh>`` under a ``<kind>`` element of ``urdf`` that is found is a regular, readable
-    file of at most :data:`MAX_MESH_BYTES`.
+    """Every ``<mesh>`` under a ``<kind>`` element of ``urdf`` is found in ``package_dirs`` (or where its
+    path points) and is a regular, readable file of at most :data:`MAX_MESH_BYTES`.
 
     Raises:
-        ExciteError: (``robot.urdf``) naming the link and the mesh.
+        ExciteError: (``robot.urdf``) naming the link and the mesh, and for a mesh not found, every
+            folder looked in.
     """
     try:
         root = ElementTree.parse(urdf).getroot()
@@ -72,9 +73,18 @@ def check_meshes(urdf: Path, package_dirs: list[str], kind: str = "collision") -
         for mesh in (m for element in link.iter(kind) for m in element.iter("mesh")):
             name = mesh.get("filename", "")
             path = mesh_path(name, urdf, package_dirs)
-            if path is None:
-                continue
             what = f"link '{link.get('name')}': {kind} mesh {name}"
+            if path is None:
+                package = name[len("package://") :].split("/")[0] if name.startswith("package://") else ""
+                raise ExciteError(
+                    "robot.urdf",
+                    f"{what} is not found; looked in {', '.join(package_dirs) or 'no folder'} "
+                    "(robot.package_dirs, beside the URDF, example-robot-data, ROS_PACKAGE_PATH)",
+                    name,
+                    f"robot.package_dirs: the folder that holds the package '{package}'"
+                    if package
+                    else "the mesh beside the URDF, where its path points",
+                )
             try:
                 input_file(path, "robot.urdf", "mesh file")
             except ExciteError as exc:

@@ -36,9 +36,10 @@ def installed_share() -> Path | None:
 
 
 def resolve_urdf(cfg: RobotConfig, folder: Path | None = None) -> tuple[Path, list[str]]:
-    """The URDF file named by ``robot.urdf`` and the package folders its meshes are found in: the
-    URDF's folder and the one above it, example-robot-data's (where installed: a URDF of one's own
-    needs nothing of it), and those :func:`~excite_cli.dynamics.urdf_meshes.package_folders` adds.
+    """The URDF file named by ``robot.urdf`` and the package folders its meshes are found in:
+    ``robot.package_dirs``, the URDF's folder and the one above it, example-robot-data's (where
+    installed: a URDF of one's own needs nothing of it), and those
+    :func:`~excite_cli.dynamics.urdf_meshes.package_folders` adds.
 
     Args:
         cfg: the ``robot`` section.
@@ -56,6 +57,7 @@ def resolve_urdf(cfg: RobotConfig, folder: Path | None = None) -> tuple[Path, li
         path = resolve_path(cfg.urdf, folder)
         share = installed_share()
         dirs = [str(path.parent), str(path.parent.parent)] + ([str(share)] if share is not None else [])
+    dirs = [str(resolve_path(d, folder)) for d in cfg.package_dirs] + dirs  # the user's folders first
     path = input_file(path, "robot.urdf", "URDF")
     return path, package_folders(path, dirs)
 

@@ -95,3 +95,25 @@ def test_every_arm_example_robot_data_ships_loads_its_meshes_given_as_a_file(arm
     path, folders = resolve_urdf(RobotConfig.model_construct(urdf=str(urdf), source="file"), tmp_path)
     geometry = collision_geometry(pin.buildModelFromUrdf(str(path)), path, folders)
     assert geometry.ngeoms > 0
+
+
+def test_a_mesh_of_a_package_installed_elsewhere_is_named_with_where_excite_looked(tmp_path, monkeypatch):
+    """An expanded vendor URDF whose ``package://`` meshes are not installed as a ROS package: the
+    refusal names the mesh and every folder looked in; ``robot.package_dirs`` names where it is."""
+    monkeypatch.delenv("ROS_PACKAGE_PATH", raising=False)
+    urdf = _robot(tmp_path, "package://vendor_description/meshes/arm.stl")
+    cfg = RobotConfig(urdf="my_robot/urdf/robot.urdf", active_joints=["j"])
+    path, folders = resolve_urdf(cfg, tmp_path)
+    with pytest.raises(ExciteError) as refused:
+        check_meshes(path, folders)
+    said = refused.value.describe()
+    assert "link 'arm': collision mesh package://vendor_description/meshes/arm.stl is not found; looked in" in said
+    assert (
+        str(urdf.parent) in said
+        and "robot.package_dirs: the folder that holds the package 'vendor_description'" in said
+    )
+    (tmp_path / "downloads" / "vendor_description" / "meshes").mkdir(parents=True)
+    (tmp_path / "downloads" / "vendor_description" / "meshes" / "arm.stl").write_text(BOX)
+    given = RobotConfig(urdf="my_robot/urdf/robot.urdf", active_joints=["j"], package_dirs=["downloads"])
+    path, folders = resolve_urdf(given, tmp_path)
+    assert collision_geometry(pin.buildModelFromUrdf(str(path)), path, folders).ngeoms == 1
