@@ -84,7 +84,8 @@ class Prepared:
     runs with fit instants, the cut-off [Hz] and its source, rows dropped per run, decimated rate [Hz],
     the fit data's q range per joint (n, 2) [rad] that guards the position-dependent effects (None
     with ``identification.position_guard`` off or no position effect among the terms), the joints
-    whose torque channel carries no signal (n,) and why, in words (one line per such joint)."""
+    whose torque channel carries no signal (n,) and why, in words (one line per such joint). A run
+    cut at its gaps is preprocessed piece by piece and stays one run in the datasets."""
 
     fit: Dataset
     validation: Dataset
@@ -109,7 +110,7 @@ def prepare_data(problem: IdentifyProblem, robot: Robot, base: BaseParameters, t
             fit runs that do not excite every base parameter.
     """
     cfg = problem.identification
-    runs, payloads = [], []  # a list only: the runs are released one by one as they are preprocessed
+    runs, payloads, sources = [], [], []  # lists only: the runs are released as they are preprocessed
     for k, r in enumerate(problem.data.runs):
         payload = payload_parameters(robot, r.payload, f"data.runs[{k}].payload") if r.payload else None
         run = load_run(r, problem.data, robot.joint_names, problem.folder)
@@ -117,6 +118,7 @@ def prepare_data(problem: IdentifyProblem, robot: Robot, base: BaseParameters, t
         pieces = split_at_gaps(run)  # a recording's gaps are never interpolated across
         runs += pieces
         payloads += [payload] * len(pieces)
+        sources += [k] * len(pieces)
     silent = silent_channels(runs)
     cutoff, source = choose_cutoff(runs, problem.preprocessing)
     dropped = [(r.name, r.dropped) for r in runs if r.dropped]
@@ -134,6 +136,7 @@ def prepare_data(problem: IdentifyProblem, robot: Robot, base: BaseParameters, t
         problem.data.validation_blocks,
         payloads,
         q_range=q_range,
+        sources=sources,
     )
     silent, silence = dead_channels(robot, base, silent, (fit, val))
     rigid_only = NormalEquations(fit, [])

@@ -164,6 +164,7 @@ def build_datasets(
     split: bool = True,
     offset_runs: int | None = None,
     q_range: np.ndarray | None = None,
+    sources: list[int] | None = None,
 ) -> tuple[Dataset, Dataset, list[int]]:
     """The fit and validation datasets: regressor, the effect columns of ``terms`` and torques of the
     samples, each low-passed by its run's filter in parallel and decimated (so the filtered τ still
@@ -176,7 +177,9 @@ def build_datasets(
     :func:`~excite_cli.identification.measured.payload.payload_parameters`) or None; its torque Y π is
     filtered and decimated with the regressor and taken out of τ. ``q_range``: (n, 2) [rad], the
     fit data's q range per joint (see :func:`fit_position_range`) that guards the position-dependent
-    effects, or None (no guard).
+    effects, or None (no guard). ``sources``: per sample, the run it is part of (the pieces of a
+    recording cut at its gaps are one run: one offset, one index in ``Dataset.run``); default each
+    sample its own run.
 
     Returns:
         fit, validation and the indices of the runs with fit instants (the offsets' columns).
@@ -189,7 +192,8 @@ def build_datasets(
     sizes = {True: sum(int(m.sum()) for m in masks), False: sum(int((~m).sum()) for m in masks)}
     if split and (not sizes[True] or not sizes[False]):
         raise ExciteError("data.runs", "need data for fitting and for validation (roles fit/validation, or blocks)")
-    fitted = [k for k, m in enumerate(masks) if m.any()] if split else []
+    sources = list(range(len(samples))) if sources is None else list(sources)
+    fitted = sorted({sources[k] for k, m in enumerate(masks) if m.any()}) if split else []
     offsets = len(fitted) if split else max(offset_runs or 1, 1)
     terms = list(dict.fromkeys(t for t in terms if not t.kind.two_stage))
     width = {t: offsets if t.kind.per_run else len(t.kind.coefficients) for t in terms}
@@ -212,7 +216,7 @@ def build_datasets(
         time = s.time[s.filter.trim : s.time.size - s.filter.trim : s.filter.step]
         for side in (True, False):
             out[side]["tau"][where[side]], out[side]["time"][where[side]] = tau[rows[side]], time[rows[side]]
-            out[side]["run"][where[side]] = index
+            out[side]["run"][where[side]] = sources[index]
         for start, Y, load in _regressor_chunks(
             robot, base.composition_matrix, s, payloads[index] if payloads else None
         ):
@@ -224,7 +228,7 @@ def build_datasets(
                 if load is not None:
                     out[side]["tau"][first : first + count] -= load[part == side]
         for t, columns in _run_columns(
-            s, index, terms, fitted, offsets, coulomb_velocity, q_range
+            s, sources[index], terms, fitted, offsets, coulomb_velocity, q_range
         ):  # releases the run's signals
             for side in (True, False):
                 out[side]["blocks"][t][where[side]] = columns[rows[side]]

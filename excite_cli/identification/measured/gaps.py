@@ -5,9 +5,12 @@ differentiates it. Across a gap (a logger that stalled, messages lost for a seco
 a straight line of positions and torques, whose q̇ and q̈ the filter then spreads over its edges: a
 0.5 s gap in a simulated 500 Hz run made the friction estimates about 10 times worse, a 2 s gap gave
 the wrong friction model, and nothing was said. So a run is cut at every gap longer than
-:data:`GAP_PERIODS` median sample periods (a dropped message or the jitter of a timestamp is shorter)
-into pieces that are preprocessed and fitted as runs of their own, each gap named in a warning; a
-piece too short to filter (under :data:`MIN_PIECE_S`) is left out, and said so.
+:data:`GAP_PERIODS` median sample periods and :data:`MIN_GAP_S` (a dropped message, the jitter of a
+timestamp or a logger's 9 ms hiccup in a 1 kHz recording is shorter, and interpolation bridges it
+well below any cut-off excite uses) into pieces that are resampled, filtered and differentiated
+each on its own and stay one run of the fit (one sensor offset, one cross-validation group), each
+gap named in a warning; a piece too short to filter (under :data:`MIN_PIECE_S`: the 5 Hz
+filter's edges take 1.2 s) is left out, and said so.
 """
 
 from __future__ import annotations
@@ -20,10 +23,13 @@ import numpy as np
 from excite_cli.errors import ExciteWarning
 from excite_cli.identification.measured.measurements import Run
 
-#: A step between two samples longer than this many median sample periods is a gap.
+#: A step between two samples longer than this many median sample periods, and than MIN_GAP_S, is a gap.
 GAP_PERIODS = 5.0
+#: The shortest gap [s]: over a shorter step, the resampling's linear interpolation of an exciting
+#: motion (its band below about 1 Hz) errs by less than 0.3 % of its amplitude, (π f Δt)²/8.
+MIN_GAP_S = 0.05
 #: Pieces between gaps shorter than this [s] are left out (too short to filter and differentiate).
-MIN_PIECE_S = 1.0
+MIN_PIECE_S = 2.0
 
 
 @dataclass(frozen=True)
@@ -38,11 +44,11 @@ class Gap:
 
 def find_gaps(time: np.ndarray) -> list[Gap]:
     """The gaps of a run's time stamps (T,) [s], strictly increasing: steps longer than
-    :data:`GAP_PERIODS` × their median."""
+    :data:`GAP_PERIODS` × their median and than :data:`MIN_GAP_S`."""
     steps = np.diff(time)
     if steps.size == 0:
         return []
-    at = np.flatnonzero(steps > GAP_PERIODS * np.median(steps))
+    at = np.flatnonzero(steps > max(GAP_PERIODS * np.median(steps), MIN_GAP_S))
     return [Gap(float(time[k]), float(steps[k]), int(k + 1)) for k in at]
 
 
@@ -84,8 +90,8 @@ def split_at_gaps(run: Run, quiet: bool = False) -> list[Run]:
     said = "; ".join(f"{g.length:.3f} s after {g.start:.3f} s" for g in gaps)
     left = f"; left out, too short to filter (under {MIN_PIECE_S:g} s): {', '.join(short)}" if short else ""
     warnings.warn(
-        f"{run.name}: {len(gaps)} gap(s) in the recording ({said}): cut there into {len(pieces)} piece(s) "
-        f"identified as runs of their own, never interpolated across{left}",
+        f"{run.name}: {len(gaps)} gap(s) in the recording ({said}): cut there into {len(pieces)} piece(s), "
+        f"each filtered on its own and never interpolated across{left}",
         ExciteWarning,
         stacklevel=2,
     )

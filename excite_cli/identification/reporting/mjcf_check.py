@@ -142,22 +142,20 @@ def check_mjcf(
     )
     measured, validation = report.validation.tau.reshape(-1, n), report.validation
     predicted = np.empty_like(measured)
-    pieces = [  # the runs as identify fitted them: cut at their gaps (said there already)
-        piece
-        for cfg in problem.data.runs
-        for piece in split_at_gaps(load_run(cfg, problem.data, robot.joint_names, problem.folder), quiet=True)
-    ]
-    for k, run in enumerate(pieces):
+    for k, cfg in enumerate(problem.data.runs):
         rows = np.flatnonzero(validation.run == k)
         if rows.size == 0:
             continue
-        s = preprocess(run, problem.preprocessing, report.cutoff)
-        kept = s.filter.kept(s.time.size)
-        held_out = ~fit_instants(s.role, kept, problem.data.validation_blocks)
-        filtered = np.empty((kept, n))
-        for start, chunk in s.filter.chunks(lambda lo, hi: replay.torques(*s.states(lo, hi)), s.time.size):
-            filtered[start : start + chunk.shape[0]] = chunk
-        predicted[rows] = filtered[held_out]
+        parts = []  # the run as identify fitted it: piece by piece where it was cut at its gaps (said there)
+        for run in split_at_gaps(load_run(cfg, problem.data, robot.joint_names, problem.folder), quiet=True):
+            s = preprocess(run, problem.preprocessing, report.cutoff)
+            kept = s.filter.kept(s.time.size)
+            held_out = ~fit_instants(s.role, kept, problem.data.validation_blocks)
+            filtered = np.empty((kept, n))
+            for start, chunk in s.filter.chunks(lambda lo, hi: replay.torques(*s.states(lo, hi)), s.time.size):
+                filtered[start : start + chunk.shape[0]] = chunk
+            parts.append(filtered[held_out])
+        predicted[rows] = np.concatenate(parts)
     terms, values = _split(report)
     written = {t for t, _ in model.written}
     kept_terms = [t for t in terms if t in written]
