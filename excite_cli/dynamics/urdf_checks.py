@@ -16,7 +16,7 @@ the joint it follows may, but the follower is then held still while its leader m
 listed in ``robot.locked_joints`` (held on purpose, as the Panda's second finger when the first is
 active): otherwise the model would silently differ from the robot.
 
-The file is a URDF at all (:func:`check_format`): a vendor's ``.xacro`` as shipped parsed as a URDF
+The file is a URDF at all (:func:`check_is_urdf`): a vendor's ``.xacro`` as shipped parsed as a URDF
 with every joint fixed, and an MJCF as two raw urdfdom lines. Links an active joint moves that have
 no mass (ROS-Industrial's KUKA iiwa has no ``<inertial>`` anywhere) are said in a warning: the
 regressor does not need their inertias, but the feed-forward torque and the torque limits do.
@@ -44,7 +44,7 @@ LIMITS = ("lower", "upper", "effort", "velocity")
 XACRO = "{http://www.ros.org/wiki/xacro}"
 
 
-def check_format(root: ElementTree.Element, path: Path) -> None:
+def check_is_urdf(root: ElementTree.Element, path: Path) -> None:
     """That the XML at ``path`` (its ``root`` element) is a URDF, not a xacro file to expand first or
     an MJCF.
 
@@ -256,7 +256,7 @@ def check_urdf(path: Path, active: list[str], physical: bool = True, locked: lis
         root = ElementTree.parse(path).getroot()
     except (ElementTree.ParseError, OSError) as exc:
         raise ExciteError("robot.urdf", f"cannot read {path}: {exc}") from None
-    check_format(root, path)
+    check_is_urdf(root, path)
     children: dict[str, list[str]] = {}
     parents: dict[str, list[str]] = {}
     moved: list[str] = []
