@@ -34,7 +34,8 @@ def home_posture(excitation: Excitation, Q: np.ndarray, rng: np.random.Generator
     least ``HOME_CLEARANCE`` and nothing is violated (a torque limit: the steps go on).
 
     Raises:
-        ExciteError: no such posture within ``HOME_ROUNDS`` rounds.
+        ExciteError: no such posture within ``HOME_ROUNDS`` rounds, naming what binds at the best
+            posture found (the constraint and where: a capsule pair, a joint's torque).
     """
     centre, half = excitation.limits.centre[0], 0.95 * excitation.limits.half[0]
     scores = clearance(excitation, Q)
@@ -54,12 +55,15 @@ def home_posture(excitation: Excitation, Q: np.ndarray, rng: np.random.Generator
             else:
                 scale = max(0.7 * scale, 0.02)
     joints = excitation.robot.joint_names
+    violated = violated_at_rest(excitation, best)  # what binds at the best posture found
+    binding = (
+        f"{violated[0]} fails: {violated[1]}" if violated else f"capsules {score * 100:.2f} cm beyond their margins"
+    )
     raise ExciteError(
         "robot.home_posture",
         f"no posture found where every constraint holds at rest in {HOME_ROUNDS} rounds"
         + (f" (best clearance {score * 100:.1f} cm)" if np.isfinite(score) else "")
-        + f" with the {len(joints)} active joints {', '.join(joints)}: capsules that overlap at most postures, "
-        "or torque limits gravity exceeds?",
+        + f" with the {len(joints)} active joints {', '.join(joints)}; at the best posture found, {binding}",
         None,
-        "the joints to move named (the joints option), e.g. one arm's",
+        "the joints to move named (the joints option), e.g. one arm's, or that constraint's field loosened",
     )

@@ -19,7 +19,8 @@ def test_no_home_posture_names_the_joints_it_chose_and_what_to_give(tmp_path):
     )
     with pytest.raises(
         ExciteError,
-        match=f"in {HOME_ROUNDS} rounds with the 2 active joints hinge, tip_joint: .*the joints to move named",
+        match=f"in {HOME_ROUNDS} rounds with the 2 active joints hinge, tip_joint; .*the joints to move named",
     ) as caught:
         draft_config({"urdf": "weak.urdf", "source": "file"}, urdf, [str(tmp_path)], None, tmp_path / "weak.yaml")
     assert "clearance" not in str(caught.value)  # no capsule: no clearance to speak of
+    assert "at the best posture found, limits.torque fails:" in str(caught.value)  # what binds, not a guess
