@@ -142,7 +142,8 @@ def check_against_limits(
 
 def in_sample_validation(runs: list[RunConfig], folder: Path | None) -> list[str]:
     """Warnings, one per validation run that is a fit run's recording over overlapping times (the
-    same files, crops that overlap): its "validation" error is in-sample."""
+    same files, crops that overlap by more than an instant: crops that touch, fit [0.1, 5.3] s and
+    validation [5.3, 7.5] s, are apart): its "validation" error is in-sample."""
 
     def span(run: RunConfig) -> tuple[float, float]:
         return run.crop if run.crop is not None else (-np.inf, np.inf)
@@ -153,7 +154,7 @@ def in_sample_validation(runs: list[RunConfig], folder: Path | None) -> list[str
     out = []
     for v in (r for r in runs if r.role == "validation"):
         for f in (r for r in runs if r.role == "fit" and files(r) == files(v)):
-            if span(f)[0] <= span(v)[1] and span(v)[0] <= span(f)[1]:
+            if span(f)[0] < span(v)[1] and span(v)[0] < span(f)[1]:  # crops that only touch share no motion
                 out.append(
                     f"{v.label}: the validation run is the fit run {f.label} over the same times, so its error "
                     "is in-sample (crop them apart, or validate on another recording)"

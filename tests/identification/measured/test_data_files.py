@@ -166,3 +166,5 @@ def test_a_validation_run_that_is_a_fit_run_over_the_same_times_is_warned_about(
     assert in_sample_validation(apart, tmp_path) == []  # crops apart, or another recording
     overlap = runs(("a.csv", "fit", (0.0, 10.0)), ("a.csv", "validation", (5.0, 20.0)))
     assert len(in_sample_validation(overlap, tmp_path)) == 1
+    touching = runs(("a.csv", "fit", (0.1, 5.3)), ("a.csv", "validation", (5.3, 7.5)))
+    assert in_sample_validation(touching, tmp_path) == []  # one shared instant is no shared motion
