@@ -24,7 +24,7 @@ from excite_cli.optimization.playback import check_motion, plan_playback
 from excite_cli.storage.formats import ROS_FORMATS, check_format
 from excite_cli.storage.results import problem_of_result, read_alphas
 from excite_cli.storage.rosbag import check_goal_size, write_rosbag
-from excite_cli.storage.trajectory_controller import controller_refusals
+from excite_cli.storage.trajectory_controller import controller_refusals, time_from_start_ns
 
 #: Highest export rate accepted [Hz] (memory grows with rate × duration).
 MAX_RATE = 100_000.0
@@ -233,7 +233,7 @@ def _check_controller_accepts(export: Export, effort: bool) -> None:
     """
     refusals = controller_refusals(
         export.joint_names,
-        np.round(export.time * 1e9).astype(np.int64),
+        time_from_start_ns(export.time),
         export.q,
         export.qd,
         export.qdd,
@@ -255,7 +255,7 @@ def ros2_goal(export: Export, effort: bool = False) -> str:
     def numbers(row: np.ndarray) -> str:
         return "[" + ", ".join(f"{x:.10g}" for x in row) + "]"
 
-    nanoseconds = np.round(export.time * 1e9).astype(np.int64)
+    nanoseconds = time_from_start_ns(export.time)
     lines = [
         f"# excite export: iteration {export.iteration}, {export.rate:g} Hz, {export.periods} period(s)",
         "trajectory:",

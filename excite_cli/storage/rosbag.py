@@ -29,6 +29,7 @@ from rosbags.typesys import Stores, get_typestore
 from excite_cli.atomic import atomic_folder, atomic_folders
 from excite_cli.errors import CannotWrite, ExciteError, OutputExists
 from excite_cli.storage.paths import check_target
+from excite_cli.storage.trajectory_controller import time_from_start_ns
 
 #: The topic a ros2_control joint trajectory controller named ``joint_trajectory_controller`` listens on.
 TOPIC = "/joint_trajectory_controller/joint_trajectory"
@@ -109,7 +110,7 @@ def _message(
     Time, Duration = (types[f"builtin_interfaces/msg/{t}"] for t in ("Time", "Duration"))
     Header, Point = types["std_msgs/msg/Header"], types["trajectory_msgs/msg/JointTrajectoryPoint"]
     q, qd, qdd, tau = motion
-    nanoseconds = np.round(time_s * 1e9).astype(np.int64)
+    nanoseconds = time_from_start_ns(time_s)
     none = np.zeros(0)
     points = [
         Point(

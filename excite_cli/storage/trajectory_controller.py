@@ -33,6 +33,12 @@ import numpy as np
 AT_REST = float(np.finfo(np.float32).eps)
 
 
+def time_from_start_ns(time_s: np.ndarray) -> np.ndarray:
+    """(S,) int64 [ns]: each point's ``time_from_start`` as the messages carry it, from ``time_s`` (S,)
+    [s] rounded to the nanosecond (the writers and :func:`controller_refusals` use the same)."""
+    return np.round(np.asarray(time_s) * 1e9).astype(np.int64)
+
+
 def controller_refusals(
     joint_names: Sequence[str],
     time_ns: np.ndarray,
