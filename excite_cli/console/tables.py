@@ -223,7 +223,10 @@ def plan(p: Plan) -> list[Table | str]:
     e, cfg = p.excitation, p.excitation.problem
     t = cfg.trajectory
     grid, fine = e.grid_basis.q.shape[0], e.fine_basis.q.shape[0]
-    rows = [(c.name, str(c.rows), f"{c.smallest_row:.2g} – {c.largest_row:.2g}", c.what) for c in p.constraints]
+    rows = [
+        (c.name, str(c.rows), f"{c.smallest_row:.2g} – {c.largest_row:.2g}" if c.rows else "–", c.what)
+        for c in p.constraints
+    ]
     caption = (
         f"each row aggregated over the {grid}-instant constraint grid ({t.constraint_period:g} s); "
         f"the fine check: {fine} instants; row norms: of the Jacobian rows at the first random start, in "
@@ -261,6 +264,8 @@ def initialized(run: InitRun) -> list[Table | str]:
     lines += [f"  {name}: {why}" for name, why in draft.assumptions.items()]
     lines += [f"  excluded pair {a} – {b}: {why}" for a, b, why in draft.excluded]
     lines += [f"  mounting plane ignores {link}: {why}" for link, why in draft.ignored]
+    if draft.problem:
+        return [*lines, f"next: fix what it marks FIX FIRST, then excite check {run.target}"]
     if run.plan is None:
         filled = not any("FILL IN" in why for why in draft.assumptions.values())
         return [*lines, f"{'next' if filled else 'fill in what it marks FILL IN, then'}: excite identify {run.target}"]

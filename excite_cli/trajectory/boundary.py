@@ -83,6 +83,6 @@ class BoundaryConditions:
     def chain(self, gradient: np.ndarray) -> np.ndarray:
         """Gradients in the variables (k, n·r) of gradients in α (k, n·(2N+1)) (or (n·(2N+1),) → (n·r,))."""
         g = np.asarray(gradient)
-        n, m, _ = self.bases.shape
+        n, m, r = self.bases.shape
         out = np.einsum("kjm,jmr->kjr", g.reshape(-1, n, m) * self.scale, self.bases)
-        return out.reshape(g.shape[:-1] + (-1,)) if g.ndim > 1 else out.ravel()
+        return out.reshape(g.shape[:-1] + (n * r,)) if g.ndim > 1 else out.ravel()  # k may be 0 (no rows)

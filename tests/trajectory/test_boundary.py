@@ -78,6 +78,9 @@ def test_chained_gradient_matches_finite_differences_in_the_coordinates():
         ]
     )
     assert np.linalg.norm(analytic - numeric) / np.linalg.norm(numeric) < 1e-6
+    # a constraint without rows (self-collision on a robot with one capsule: no pair) chains to none
+    rows = boundary.chain(np.zeros((0, grad.size)))
+    assert rows.shape == (0, z.size)
 
 
 def test_random_starts_are_at_rest_and_feasible():
