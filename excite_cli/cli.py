@@ -1,6 +1,5 @@
 """Command line: parses options, calls one library function per command, prints what it returns."""
 
-from importlib import metadata
 from pathlib import Path
 from typing import Optional
 
@@ -8,7 +7,7 @@ import typer
 from rich.markup import escape
 
 from excite_cli import console, workflows
-from excite_cli.console.app import FORCE, JOINTS, MODEL, PRIOR, RUNS, SCHEDULER, WORKERS, app, command, err, out, say
+from excite_cli.console.app import FORCE, JOINTS, MODEL, PRIOR, RUNS, SCHEDULER, WORKERS, app, command, err, say
 from excite_cli.console.progress import Bars
 from excite_cli.criteria import NAMES as OBJECTIVES
 from excite_cli.storage.formats import FORMATS
@@ -21,15 +20,9 @@ def _load(path: Path, overrides: Optional[dict] = None, kind: str = "optimize"):
     return load_config(path, overrides, kind)
 
 
-def _version(show: bool) -> None:
-    if show:
-        out.print(f"excite {metadata.version('excite')}")
-        raise typer.Exit()
-
-
 @app.callback()
 def main(
-    version: bool = typer.Option(False, "--version", callback=_version, is_eager=True, help="Print the version."),
+    version: bool = console.app.VERSION,
     quiet: bool = console.app.QUIET,
 ) -> None:
     """Persistently exciting trajectories for robot dynamic identification (Ayusawa et al. 2017)."""
@@ -76,16 +69,19 @@ def optimize(
 
 @command()
 def init(
-    urdf: str = typer.Argument(..., help="URDF file or example-robot-data path (ur_description/urdf/ur3_robot.urdf)."),
+    urdf: str = console.app.ROBOT_FILE,
     joints: Optional[list[str]] = JOINTS,
     kind: str = typer.Option("optimize", "--kind", help="Config kind: optimize or identify."),
     runs: Optional[list[str]] = RUNS,
-    output: Optional[Path] = typer.Option(None, "--output", "-o", help="Config file (default: <URDF name>.yaml)."),
+    output: Optional[Path] = typer.Option(None, "--output", "-o", help="Config file (default: <file name>.yaml)."),
     force: bool = FORCE,
+    collision: bool = console.app.COLLISION,
+    package_dir: Optional[list[str]] = console.app.PACKAGE_DIRS,
 ) -> None:
-    """A starting config for your robot from its URDF: joints, limits, capsules, mounting plane, home posture."""
+    """A starting config for your robot from its URDF or MJCF: joints, limits, capsules, mounting plane, home."""
     with console.app.busy.status("fitting capsules and searching postures ..."):
-        run = workflows.run_init(urdf, output or Path(f"{Path(urdf).stem}.yaml"), joints, kind, force, runs)
+        target = output or Path(f"{Path(urdf).stem}.yaml")
+        run = workflows.run_init(urdf, target, joints, kind, force, runs, collision, package_dir)
     say(console.tables.initialized(run))
 
 

@@ -217,3 +217,58 @@ def tcp_server(first_bytes: bytes) -> Iterator[str]:
 def rows_copy(rows):
     """A copy of an identification's prior rows (``PriorRows``) whose parts the report file may empty."""
     return replace(rows, regressor=[part.copy() for part in rows.regressor], effects=[p.copy() for p in rows.effects])
+
+
+def panda_mjcf(folder: Path, frames: bool = False) -> Path:
+    """example-robot-data's Panda as MJCF, written by MuJoCo from the URDF (its inertias, its collision
+    meshes by absolute path, the fingers' mimic as a joint equality), as ``folder/panda.xml``; with
+    ``frames``, MuJoCo's fixed links as ``<frame>`` elements (what ``MjSpec.to_xml`` writes by default)."""
+    import mujoco
+
+    from excite_cli.dynamics.urdf_source import example_robot_data_root
+
+    share = example_robot_data_root()
+    text = (share / "example-robot-data/robots/panda_description/urdf/panda.urdf").read_text()
+    compiler = '<mujoco><compiler fusestatic="false" discardvisual="true"/></mujoco>' if not frames else ""
+    urdf = folder / "panda_for_mujoco.urdf"
+    urdf.write_text(text.replace("package://", f"{share}/").replace("</robot>", f"{compiler}</robot>"))
+    spec = mujoco.MjSpec.from_file(str(urdf))
+    spec.compiler.inertiafromgeom = mujoco.mjtInertiaFromGeom.mjINERTIAFROMGEOM_FALSE
+    spec.compile()
+    (folder / "panda.xml").write_text(spec.to_xml())
+    urdf.unlink()
+    return folder / "panda.xml"
+
+
+CHAIN_INERTIAL = (
+    '<inertial><mass value="0.5"/><inertia ixx="1e-3" ixy="0" ixz="0" iyy="1e-3" iyz="0" izz="1e-3"/></inertial>'
+)
+
+
+def chain_urdf(arm: list[str], gripper: bool = True) -> str:
+    """An arm of revolute (or continuous) joints ``arm`` (joint types) on a base, and a gripper as Kinova's
+    Gen3 lite has one: a fixed gripper base, a right finger on a revolute joint, a left finger whose joint
+    mimics it, each with a tip joint that mimics it too."""
+    links, joints = ['<link name="base_link"/>'], []
+
+    def joint(name: str, kind: str, parent: str, child: str, mimic: str = "") -> None:
+        links.append(f'<link name="{child}">{CHAIN_INERTIAL}</link>')
+        limit = '<limit lower="-2" upper="2" effort="10" velocity="1"/>' if kind != "fixed" else ""
+        follows = f'<mimic joint="{mimic}"/>' if mimic else ""
+        joints.append(
+            f'<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
+            f'<origin xyz="0 0 0.1"/><axis xyz="0 {k % 2} {1 - k % 2}"/>{limit}{follows}</joint>'
+        )
+
+    for k, kind in enumerate(arm, start=1):
+        joint(f"joint_{k}", kind, "base_link" if k == 1 else f"link_{k - 1}", f"link_{k}")
+    if gripper:
+        k = len(arm) + 1
+        joint("gripper_base_joint", "fixed", f"link_{len(arm)}", "gripper_base_link")
+        joint("right_finger_bottom_joint", "revolute", "gripper_base_link", "right_prox_link")
+        joint("right_finger_tip_joint", "revolute", "right_prox_link", "right_dist_link", "right_finger_bottom_joint")
+        joint(
+            "left_finger_bottom_joint", "revolute", "gripper_base_link", "left_prox_link", "right_finger_bottom_joint"
+        )
+        joint("left_finger_tip_joint", "revolute", "left_prox_link", "left_dist_link", "right_finger_bottom_joint")
+    return f'<robot name="arm">{"".join(links)}{"".join(joints)}</robot>'

@@ -242,7 +242,7 @@ def test_an_active_mimic_joint_is_refused_by_name(tmp_path, command):
 
 
 def _hostile_urdf(folder: Path, case: str) -> Path:
-    """A URDF of ``case``: no joint, only fixed joints, only a continuous one, a joint type urdfdom does
+    """A URDF of ``case``: no joint, only fixed joints, a joint type urdfdom does
     not know, a collision mesh that is not a mesh, a FIFO, or too large (sparse), a chain longer than
     pinocchio's parser holds."""
     inertia = '<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/>'
@@ -264,7 +264,6 @@ def _hostile_urdf(folder: Path, case: str) -> Path:
     body = {
         "no-joint": link.format("base", ""),
         "fixed-only": two_links("fixed"),
-        "continuous-only": two_links("continuous"),
         "not-a-mesh": two_links("revolute", "file:///etc/passwd"),
         "fifo": two_links("revolute", "fifo.stl"),
         "huge-mesh": two_links("revolute", "huge.stl"),
@@ -282,7 +281,6 @@ def _hostile_urdf(folder: Path, case: str) -> Path:
 HOSTILE = [
     ("no-joint", "no-joint.urdf has no revolute joint for excite to move (its joints are all fixed)"),
     ("fixed-only", "fixed-only.urdf has no revolute joint for excite to move (its joints are all fixed)"),
-    ("continuous-only", "continuous-only.urdf has no revolute joint for excite to move (continuous: j1)"),
     ("long-chain", "the URDF has 4001 links; expected at most 1000"),
     ("unknown-joint-type", "does not contain a valid URDF model"),  # pinocchio's ValueError was a traceback
 ]

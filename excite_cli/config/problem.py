@@ -29,10 +29,10 @@ from excite_cli.criteria import NAMES
 
 
 class RobotConfig(Section):
-    """URDF, floating or fixed base, active and locked joints, home posture."""
+    """URDF or MJCF, floating or fixed base, active and locked joints, joint ranges, home posture."""
 
     urdf: str
-    """URDF file (relative to the config file), or with `source: example-robot-data` a path in its robots folder."""
+    """URDF or MJCF file (relative to the config file), or with `source: example-robot-data` a path in its robots."""
     source: Literal["file", "example-robot-data"] = "file"
     """Where `urdf` is found: `file` or `example-robot-data`."""
     package_dirs: list[str] = Field(default_factory=list)
@@ -43,6 +43,8 @@ class RobotConfig(Section):
     """The n joints that move; their torques are the regressor rows."""
     locked_joints: dict[str, float] = Field(default_factory=dict)
     """Values of held joints [rad or m]; every joint not active is held, at 0 unless given."""
+    joint_ranges: dict[str, tuple[float, float]] = Field(default_factory=dict)
+    """{joint: [lower, upper]} [rad or m]: a range for joints the file gives none (continuous), or narrower than its."""
     home_posture: dict[str, float] = Field(default_factory=dict)
     """Posture the starts oscillate about [rad] (0 where not given), clipped into the limits."""
     base_wrench_rows: bool = False

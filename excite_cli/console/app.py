@@ -2,6 +2,7 @@
 guard every command runs in (one line and exit 2 for bad input, what was kept on Ctrl-C or SIGTERM)."""
 
 import functools
+from importlib import metadata
 from typing import Callable, Optional
 
 import typer
@@ -23,6 +24,13 @@ def _quiet(value: bool) -> bool:
     return value
 
 
+def _version(show: bool) -> None:
+    if show:
+        out.print(f"excite {metadata.version('excite')}")
+        raise typer.Exit()
+
+
+VERSION = typer.Option(False, "--version", callback=_version, is_eager=True, help="Print the version.")
 QUIET = typer.Option(
     False, "--quiet", "-q", callback=_quiet, help="Print only errors, warnings and nothing under way (for scripts)."
 )
@@ -34,7 +42,7 @@ SCHEDULER = typer.Option(None, "--scheduler", help="Dask scheduler, e.g. tcp://h
 PRIOR = typer.Option(None, "--prior", help="Earlier result or identify report stacked first (sequence.prior).")
 MODEL = typer.Option(None, "--model", help="Identify report whose effects to design for too (effects.model).")
 JOINTS = typer.Option(
-    None, "--joints", help="Active joints, repeatable or comma-separated (default: every revolute joint)."
+    None, "--joints", help="Active joints, repeatable or comma-separated (default: the arm's revolute joints)."
 )
 EFFORT = typer.Option(
     False,
@@ -43,6 +51,21 @@ EFFORT = typer.Option(
     "joint_trajectory_controller (ros2_controllers 4.22 on, Jazzy); others refuse any effort.",
 )
 RUNS = typer.Option(None, "--runs", help="identify: measured runs (CSV, NPZ, MAT, HDF5, ROS bag), repeatable.")
+ROBOT_FILE = typer.Argument(
+    ..., help="URDF or MJCF file, or an example-robot-data path (ur_description/urdf/ur3_robot.urdf)."
+)
+PACKAGE_DIRS = typer.Option(
+    None, "--package-dir", help="Folder holding the packages of package:// meshes (robot.package_dirs), repeatable."
+)
+COLLISION = typer.Option(
+    True, "--collision/--no-collision", help="Fit capsules and a mounting plane to the collision meshes."
+)
+PACKAGE_DIRS = typer.Option(
+    None, "--package-dir", help="Folder holding the packages of package:// meshes (robot.package_dirs), repeatable."
+)
+COLLISION = typer.Option(
+    True, "--collision/--no-collision", help="Fit capsules and a mounting plane to the collision meshes."
+)
 
 
 #: One command line per command that its ``--help`` shows as the example, run as written from the

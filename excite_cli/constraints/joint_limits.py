@@ -163,9 +163,10 @@ def per_joint(
         out[:] = value
     for name, v in zip(robot.joint_names, out):
         if not np.isfinite(v) or v < 0 or (v == 0 and not zero_allowed):
-            source = "the URDF has none" if value is None else f"got {v:g}"
+            source = "the robot's file has none" if value is None else f"got {v:g}"
             kind = "non-negative finite margin" if zero_allowed else "positive finite limit"
-            raise ExciteError(field, f"joint '{name}' needs a {kind} ({source})")
+            expected = f"{field}: {{{name}: value}}"
+            raise ExciteError(field, f"joint '{name}' needs a {kind} ({source})", expected=expected)
     return out
 
 
@@ -206,7 +207,12 @@ def joint_limit_bounds(cfg: LimitsConfig, robot: Robot) -> tuple[np.ndarray, np.
     lower, upper = robot.lower + margin, robot.upper - margin
     for name, lo, hi, m in zip(robot.joint_names, lower, upper, margin):
         if not (np.isfinite(lo) and np.isfinite(hi)):
-            raise ExciteError("limits", f"joint '{name}' has no finite position limits in the URDF")
+            raise ExciteError(
+                "robot.joint_ranges",
+                f"joint '{name}' has no range in the robot's file (continuous, or an MJCF joint without range)",
+                name,
+                f"robot.joint_ranges: {{{name}: [lower, upper]}}, the range [rad or m] it may move in",
+            )
         if hi <= lo:
             raise ExciteError(field, f"{m:g} rad leaves no range for joint '{name}'")
     velocity = per_joint("limits.velocity", cfg.velocity, robot.velocity_limit, robot)

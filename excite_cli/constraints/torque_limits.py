@@ -171,8 +171,20 @@ def torque_limit(value: PerJoint | str, robot: Robot) -> np.ndarray:
     of those, or {joint: Nm} (the others from the URDF).
 
     Raises:
-        ExciteError: an unknown joint, or a joint left without a positive finite limit.
+        ExciteError: an unknown joint, a joint left without a positive finite limit, or an active joint
+            that moves no mass (a URDF without ``<inertial>``: its torque is 0 whatever the motion).
     """
+    data = robot.model.createData()
+    pin.computeSubtreeMasses(robot.model, data)
+    idle = [n for n in robot.joint_names if not data.mass[robot.model.getJointId(n)] > 0.0]
+    if idle:
+        raise ExciteError(
+            "limits.torque",
+            f"{', '.join(idle)} move(s) no mass in the robot's file: the torque is 0 whatever the motion, so a "
+            "torque limit would check nothing",
+            None,
+            "the robot's inertias (<inertial> on its links), or no limits.torque",
+        )
     urdf = robot.model.effortLimit[robot.v_idx].astype(float)
     if isinstance(value, dict):
         return per_joint("limits.torque", value, urdf, robot)

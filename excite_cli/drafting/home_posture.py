@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from excite_cli.errors import ExciteError
 from excite_cli.optimization.excitation import Excitation, violated_at_rest
 
 #: Rounds of random steps, steps per round, clearance sought beyond the margins [m].
@@ -27,15 +26,16 @@ def clearance(excitation: Excitation, Q: np.ndarray) -> np.ndarray:
     return out
 
 
-def home_posture(excitation: Excitation, Q: np.ndarray, rng: np.random.Generator) -> tuple[np.ndarray, str]:
+def home_posture(excitation: Excitation, Q: np.ndarray, rng: np.random.Generator) -> tuple[np.ndarray, str, bool]:
     """A posture standing still at which every constraint holds (joint, torque and collision limits):
     from the middle of the joint ranges (the most room to move), else from the clearest of the random
     postures Q, random steps that increase the smallest clearance (:func:`clearance`) until it is at
     least ``HOME_CLEARANCE`` and nothing is violated (a torque limit: the steps go on).
 
-    Raises:
-        ExciteError: no such posture within ``HOME_ROUNDS`` rounds, naming what binds at the best
-            posture found (the constraint and where: a capsule pair, a joint's torque).
+    Returns:
+        The posture (n,) [rad], how it was found in words, and whether it was: when no such posture
+        is found within ``HOME_ROUNDS`` rounds, the best posture found and what binds there (the
+        constraint's field and where: a capsule pair, a joint's torque) with the next step, and False.
     """
     centre, half = excitation.limits.centre[0], 0.95 * excitation.limits.half[0]
     scores = clearance(excitation, Q)
@@ -46,7 +46,7 @@ def home_posture(excitation: Excitation, Q: np.ndarray, rng: np.random.Generator
         for rounds in range(HOME_ROUNDS):
             if score >= HOME_CLEARANCE and violated_at_rest(excitation, best) is None:
                 clear = f"every capsule {score * 100:.1f} cm beyond its margin" if np.isfinite(score) else "no capsule"
-                return best, f"from {start}, {rounds} round(s) of random steps: {clear}"
+                return best, f"from {start}, {rounds} round(s) of random steps: {clear}", True
             steps = best + scale * half * rng.standard_normal((HOME_STEPS, centre.size))
             steps = np.clip(steps, centre - half, centre + half)
             step_scores = clearance(excitation, steps)
@@ -59,11 +59,9 @@ def home_posture(excitation: Excitation, Q: np.ndarray, rng: np.random.Generator
     binding = (
         f"{violated[0]} fails: {violated[1]}" if violated else f"capsules {score * 100:.2f} cm beyond their margins"
     )
-    raise ExciteError(
-        "robot.home_posture",
+    problem = (
         f"no posture found where every constraint holds at rest in {HOME_ROUNDS} rounds"
         + (f" (best clearance {score * 100:.1f} cm)" if np.isfinite(score) else "")
-        + f" with the {len(joints)} active joints {', '.join(joints)}; at the best posture found, {binding}",
-        None,
-        "the joints to move named (the joints option), e.g. one arm's, or that constraint's field loosened",
+        + f" with the {len(joints)} active joints {', '.join(joints)}; at the best posture found (written), {binding}"
     )
+    return best, problem + "; loosen that constraint's field, or move fewer joints (e.g. one arm's)", False

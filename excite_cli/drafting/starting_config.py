@@ -8,7 +8,6 @@ recorded as an assumption, in words, for the written file's comments.
 from __future__ import annotations
 
 import math
-import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -17,8 +16,8 @@ import pinocchio as pin
 
 from excite_cli.config import Problem
 from excite_cli.drafting.home_posture import home_posture
-from excite_cli.dynamics.urdf_meshes import collision_geometry
-from excite_cli.dynamics.urdf_source import urdf_model
+from excite_cli.drafting.joints import joint_choice
+from excite_cli.dynamics.urdf_source import apply_joint_ranges, robot_geometry, robot_model
 from excite_cli.errors import ExciteError
 from excite_cli.optimization.excitation import Excitation, build_excitation
 
@@ -36,69 +35,14 @@ NEVER_APART = 2 * CAPSULE_MARGIN
 @dataclass
 class StartingConfig:
     """A drafted config (the YAML's mapping, section by section) and the assumptions behind it:
-    {"section.field": why} for the comments, and the excluded pairs and ignored links with reasons."""
+    {"section.field": why} for the comments, the excluded pairs and ignored links with reasons, and
+    what must be fixed before it runs ("" when nothing)."""
 
     config: dict
     assumptions: dict[str, str] = field(default_factory=dict)
     excluded: list[tuple[str, str, str]] = field(default_factory=list)
     ignored: list[tuple[str, str]] = field(default_factory=list)
-
-
-def _mimics(path: Path) -> set[str]:
-    """The joints of the URDF that follow another (``<mimic>``)."""
-    return {j.get("name") for j in ET.parse(path).getroot().iter("joint") if j.find("mimic") is not None}
-
-
-def joint_choice(
-    path: Path, given: list[str] | None, draft: StartingConfig, model: pin.Model | None = None
-) -> tuple[list[str], dict[str, float]]:
-    """The active joints of a starting config and the others held, with the assumption in ``draft``.
-
-    Args:
-        path: the URDF; given: the active joints, or None: every revolute joint that follows no other.
-        model: pinocchio's model of the URDF, when the caller has built it already.
-
-    Returns:
-        The active joints and {held joint: value} (0 moved inside its limits) [rad or m].
-
-    Raises:
-        ExciteError: a given joint that is not a 1-DoF joint of the URDF; no joint given and no
-            revolute joint to move (naming the joints there are).
-    """
-    model = urdf_model(path) if model is None else model
-    one_dof = [n for i, n in enumerate(model.names) if i > 0 and model.joints[i].nq == 1]
-    continuous = [n for i, n in enumerate(model.names) if i > 0 and model.joints[i].nq == 2 and model.joints[i].nv == 1]
-    mimics = _mimics(path)
-    revolute = [n for n in one_dof if "R" in model.joints[model.getJointId(n)].shortname().replace("JointModel", "")]
-    active = list(given) if given else [n for n in revolute if n not in mimics]
-    if not active:
-        others = {"prismatic": [n for n in one_dof if n not in revolute], "continuous": continuous, "mimic": mimics}
-        said = "; ".join(f"{kind}: {', '.join(sorted(names))}" for kind, names in others.items() if names)
-        raise ExciteError(
-            "urdf",
-            f"{path.name} has no revolute joint for excite to move ({said or 'its joints are all fixed'})",
-            path.name,
-            "a URDF with a revolute joint, or the 1-DoF joints to move named",
-        )
-    unknown = [n for n in active if n not in one_dof]
-    if unknown:
-        raise ExciteError(
-            "joints", f"'{unknown[0]}' is not a 1-DoF joint of {path.name}", unknown[0], ", ".join(one_dof)
-        )
-    held = {}
-    for name in (n for n in one_dof if n not in active):
-        k = model.idx_qs[model.getJointId(name)]
-        held[name] = float(np.clip(0.0, model.lowerPositionLimit[k], model.upperPositionLimit[k]))
-    draft.assumptions["robot.active_joints"] = (
-        "the joints given" if given else "every revolute joint that follows no other (prismatic ones are held)"
-    )
-    if held:
-        draft.assumptions["robot.locked_joints"] = "the other joints, held at 0 (or their nearest limit)"
-    if continuous:
-        draft.assumptions["robot.active_joints"] += (
-            f"; continuous joints, which have no range to keep, are held at 0: {', '.join(continuous)}"
-        )
-    return active, held
+    problem: str = ""
 
 
 def _limits(model: pin.Model, active: list[str], draft: StartingConfig) -> dict:
@@ -130,12 +74,17 @@ def _limits(model: pin.Model, active: list[str], draft: StartingConfig) -> dict:
         "velocity": velocity,
         "acceleration": {n: round(ACCELERATION_PER_VELOCITY * v, 3) for n, v in velocity.items()},
     }
-    draft.assumptions["limits.position_margin"] = "0.1 rad inside every URDF limit (less for a joint of short range)"
-    draft.assumptions["limits.velocity"] = f"{VELOCITY_FRACTION:g} × the URDF's velocity limit" + (
+    draft.assumptions["limits.position_margin"] = "0.1 rad inside every limit of the file (less for a short range)"
+    draft.assumptions["limits.velocity"] = f"{VELOCITY_FRACTION:g} × the file's velocity limit" + (
         f" (1 rad/s where it has none: {', '.join(missing)})" if missing else ""
     )
     draft.assumptions["limits.acceleration"] = f"{ACCELERATION_PER_VELOCITY:g} × the velocity limit per second"
-    if all(model.effortLimit[model.idx_vs[i]] > 0 for i in ids):
+    data = model.createData()
+    pin.computeSubtreeMasses(model, data)
+    idle = [n for n, i in zip(active, ids) if not data.mass[i] > 0.0]
+    if idle:
+        draft.assumptions["limits.torque"] = f"none: {', '.join(idle)} move(s) no mass in the file (no <inertial>?)"
+    elif all(0 < model.effortLimit[model.idx_vs[i]] < math.inf for i in ids):
         limits["torque"] = "urdf"
         draft.assumptions["limits.torque"] = "the URDF's effort limits"
     return limits
@@ -144,7 +93,7 @@ def _limits(model: pin.Model, active: list[str], draft: StartingConfig) -> dict:
 def _base_floor(model: pin.Model, path: Path, package_dirs: list[str]) -> float:
     """Height [m] of the lowest point of the root link's collision geometry (0 without any), from the
     URDF ``path`` and its ``model``."""
-    geometry = collision_geometry(model, path, package_dirs)
+    geometry = robot_geometry(model, path, package_dirs)
     data, gdata = model.createData(), pin.GeometryData(geometry)
     pin.updateGeometryPlacements(model, data, geometry, gdata, pin.neutral(model))
     lowest = 0.0
@@ -210,44 +159,63 @@ def validated(config: dict, target: Path) -> Problem:
     return problem
 
 
+def _choose_joints(robot: dict, urdf: Path, joints: list[str] | None, draft: StartingConfig) -> pin.Model:
+    """The robot section's joints and ranges (:func:`~excite_cli.drafting.joints.joint_choice`) in
+    ``draft``; the file's model, with those ranges."""
+    model = robot_model(urdf)
+    choice = joint_choice(urdf, joints, model)
+    apply_joint_ranges(model, {n: tuple(r) for n, r in choice.ranges.items()}, urdf.name)
+    draft.config["robot"].update(active_joints=choice.active, locked_joints=choice.held)
+    if choice.ranges:
+        draft.config["robot"]["joint_ranges"] = choice.ranges
+    draft.config["robot"]["home_posture"] = {}
+    draft.assumptions.update(choice.assumptions)
+    return model
+
+
 def draft_config(
-    robot: dict, urdf: Path, package_dirs: list[str], joints: list[str] | None, target: Path
+    robot: dict, urdf: Path, package_dirs: list[str], joints: list[str] | None, target: Path, collision: bool = True
 ) -> StartingConfig:
-    """A starting config for the URDF of ``robot`` (the section's ``urdf`` and ``source``), to be
-    written to ``target``.
+    """A starting config for the URDF or MJCF of ``robot`` (the section's ``urdf`` and ``source``), to be
+    written to ``target``. When no home posture holds, the best one found is written and
+    ``StartingConfig.problem`` says what binds there (the file's comments too).
 
     Args:
         robot: {"urdf": ..., "source": ...} as the config will say them.
-        urdf: the URDF file; package_dirs: where its meshes are.
-        joints: the active joints, or None (see :func:`joint_choice`).
+        urdf: the robot's file; package_dirs: where its meshes are.
+        joints: the active joints, or None (see :func:`~excite_cli.drafting.joints.joint_choice`).
+        collision: fit capsules to the collision meshes and draft a mounting plane; False: neither
+            (no meshes are read).
 
     Raises:
-        ExciteError: an unknown joint; no posture where every constraint holds at rest.
+        ExciteError: an unknown joint; a mesh that cannot be read.
     """
     draft = StartingConfig({"robot": dict(robot)})
-    model = urdf_model(urdf)
-    active, held = joint_choice(urdf, joints, draft, model)
-    floor = round(_base_floor(model, urdf, package_dirs), 4) + 0.0  # no -0
-    draft.config["robot"].update(active_joints=active, locked_joints=held, home_posture={})
+    model = _choose_joints(robot, urdf, joints, draft)
+    active = draft.config["robot"]["active_joints"]
     draft.config["trajectory"] = dict(TRAJECTORY)
     draft.config["limits"] = _limits(model, active, draft)
-    plane = {"name": "mounting_plane", "type": "half_space", "point": [0.0, 0.0, floor], "normal": [0.0, 0.0, 1.0]}
-    draft.config["constraints"] = {
-        "self_collision": {"capsules": "auto", "margin": CAPSULE_MARGIN, "exclude_pairs": []},
-        "environment": {"shapes": [{**plane, "margin": PLANE_MARGIN}]},
-    }
+    if collision:
+        floor = round(_base_floor(model, urdf, package_dirs), 4) + 0.0  # no -0
+        plane = {"name": "mounting_plane", "type": "half_space", "point": [0.0, 0.0, floor], "normal": [0.0, 0.0, 1.0]}
+        draft.config["constraints"] = {
+            "self_collision": {"capsules": "auto", "margin": CAPSULE_MARGIN, "exclude_pairs": []},
+            "environment": {"shapes": [{**plane, "margin": PLANE_MARGIN}]},
+        }
+        draft.assumptions["constraints.environment"] = (
+            f"a plane under the base (z = {floor:g} m, the base's lowest collision point): the table top or floor"
+        )
     draft.config["optimizer"] = dict(OPTIMIZER)
     draft.config["sequence"] = {"iterations": 3}
     draft.config["output"] = f"results/{urdf.stem}.h5"
-    draft.assumptions["constraints.environment"] = (
-        f"a plane under the base (z = {floor:g} m, the base's lowest collision point): the table top or floor"
-    )
     excitation = build_excitation(validated(draft.config, target), check_home=False)
     if not any(c.name in ("self_collision", "world_collision") and c.capsules for c in excitation.constraints):
-        del draft.config["constraints"]
-        del draft.assumptions["constraints.environment"]
+        draft.config.pop("constraints", None)
+        draft.assumptions.pop("constraints.environment", None)
         draft.assumptions["constraints"] = (
-            "none: the URDF has no collision geometry on a moving link (give capsules in constraints.self_collision)"
+            "none: "
+            + ("the file has no collision geometry on a moving link" if collision else "collision geometry not read")
+            + " (give capsules in constraints.self_collision)"
         )
     Q = _random_postures(excitation, np.random.default_rng(0))
     _always_overlapping(excitation, Q, draft)
@@ -257,7 +225,8 @@ def draft_config(
         draft.config["constraints"]["environment"]["ignore_links"] = [link for link, _ in draft.ignored]
     # the same robot: its base parameters need not be computed again
     excitation = build_excitation(validated(draft.config, target), excitation.base, check_home=False)
-    home, why = home_posture(excitation, Q, np.random.default_rng(1))
+    home, why, found = home_posture(excitation, Q, np.random.default_rng(1))
     draft.config["robot"]["home_posture"] = {n: round(float(q), 4) for n, q in zip(active, home)}
-    draft.assumptions["robot.home_posture"] = f"searched: {why}"
+    draft.assumptions["robot.home_posture"] = f"searched: {why}" if found else f"FIX FIRST: {why}"
+    draft.problem = "" if found else why
     return draft

@@ -17,9 +17,10 @@ import numpy as np
 import pinocchio as pin
 
 from excite_cli.config import RobotConfig
+from excite_cli.dynamics.mjcf_source import check_mjcf, is_mjcf
 from excite_cli.dynamics.urdf_checks import check_urdf
-from excite_cli.dynamics.urdf_meshes import collision_geometry, package_folders
-from excite_cli.dynamics.urdf_source import resolve_urdf, urdf_model
+from excite_cli.dynamics.urdf_meshes import package_folders
+from excite_cli.dynamics.urdf_source import apply_joint_ranges, resolve_urdf, robot_geometry, robot_model
 from excite_cli.errors import ExciteError
 
 #: Order of pinocchio's 10 dynamic parameters of one body (``Inertia.toDynamicParameters``).
@@ -210,7 +211,8 @@ def load_robot(
     joint_rows_only: bool = False,
     physical: bool = True,
 ) -> Robot:
-    """Build the :class:`Robot` of a ``robot`` section: load the URDF, lock the non-active joints.
+    """Build the :class:`Robot` of a ``robot`` section: load the URDF or MJCF, give the joints
+    ``robot.joint_ranges``, lock the non-active joints.
 
     Args:
         cfg: the validated ``robot`` section.
@@ -225,14 +227,19 @@ def load_robot(
 
     Raises:
         ExciteError: missing URDF, unknown joint name, a joint that is not 1-DoF, a locked value
-            outside the joint's limits, a body or active joint that cannot be (:func:`check_urdf`).
+            outside the joint's limits, a body or active joint that cannot be (:func:`check_urdf`,
+            :func:`check_mjcf`), a joint range that cannot be (:func:`apply_joint_ranges`).
     """
     path, package_dirs = (
         resolve_urdf(cfg, folder) if urdf is None else (urdf, package_folders(urdf, [str(urdf.parent)]))
     )
-    # before urdfdom, which prints what it cannot parse
-    problems = check_urdf(path, list(cfg.active_joints), physical, list(cfg.locked_joints))
-    full = urdf_model(path, *([pin.JointModelFreeFlyer()] if cfg.floating_base else []))
+    active, locked = list(cfg.active_joints), list(cfg.locked_joints)
+    mjcf = is_mjcf(path)
+    problems = [] if mjcf else check_urdf(path, active, physical, locked)  # before urdfdom prints what it cannot parse
+    full = robot_model(path, cfg.floating_base)
+    if mjcf:
+        check_mjcf(path, full, active, locked)
+    apply_joint_ranges(full, cfg.joint_ranges, path.name)
 
     movable = _check_joints(cfg, full)
     q_full = pin.neutral(full)
@@ -241,7 +248,7 @@ def load_robot(
     lock_ids = [full.getJointId(n) for n in movable if n not in cfg.active_joints]
     geometry = None
     if collision:
-        geometry = collision_geometry(full, path, package_dirs)
+        geometry = robot_geometry(full, path, package_dirs)
         try:
             model, geometry = pin.buildReducedModel(full, geometry, lock_ids, q_full)
         except ValueError as exc:  # a joint and a link of one name (so100's "gripper"): pinocchio cannot reduce

@@ -17,7 +17,7 @@ listed in ``robot.locked_joints`` (held on purpose, as the Panda's second finger
 active): otherwise the model would silently differ from the robot.
 
 The file is a URDF at all (:func:`check_is_urdf`): a vendor's ``.xacro`` as shipped parsed as a URDF
-with every joint fixed, and an MJCF as two raw urdfdom lines. Links an active joint moves that have
+with every joint fixed. Links an active joint moves that have
 no mass (ROS-Industrial's KUKA iiwa has no ``<inertial>`` anywhere) are said in a warning: the
 regressor does not need their inertias, but the feed-forward torque and the torque limits do.
 """
@@ -45,12 +45,12 @@ XACRO = "{http://www.ros.org/wiki/xacro}"
 
 
 def check_is_urdf(root: ElementTree.Element, path: Path) -> None:
-    """That the XML at ``path`` (its ``root`` element) is a URDF, not a xacro file to expand first or
-    an MJCF.
+    """That the XML at ``path`` (its ``root`` element) is a URDF, not a xacro file to expand first
+    (an MJCF is read by :mod:`~excite_cli.dynamics.mjcf_source`, not here).
 
     Raises:
-        ExciteError: (``robot.urdf``) a xacro file (its ending or xacro elements), an MJCF (root
-            ``<mujoco>``), or another root element than ``<robot>``, naming the next step.
+        ExciteError: (``robot.urdf``) a xacro file (its ending or xacro elements), naming the command that
+            expands it, or another root element than ``<robot>``.
     """
     if path.name.endswith(".xacro") or any(e.tag.startswith(XACRO) for e in root.iter()):
         raise ExciteError(
@@ -58,12 +58,6 @@ def check_is_urdf(root: ElementTree.Element, path: Path) -> None:
             f"{path.name} is a xacro file: its macros are not expanded",
             expected=f"the URDF it expands to: xacro {path.name} > robot.urdf (pip install xacro, or "
             f"ros2 run xacro xacro {path.name}), then robot.urdf: robot.urdf",
-        )
-    if root.tag == "mujoco":
-        raise ExciteError(
-            "robot.urdf",
-            f"{path.name} is an MJCF (MuJoCo) model; excite reads URDF",
-            expected="the robot's URDF (its vendor's description package ships one)",
         )
     if root.tag != "robot":
         raise ExciteError("robot.urdf", f"{path.name} is not a URDF: its root element is <{root.tag}>, not <robot>")
@@ -135,22 +129,36 @@ def check_joints(root: ElementTree.Element, active: list[str], locked: list[str]
         if lower > upper and joints[name].get("type") != "continuous":
             problem = f"joint '{name}' has lower limit {lower:g} above upper {upper:g}"
             raise ExciteError("robot.urdf", problem, None, "lower ≤ upper")
+    couplings = {}
     for name, joint in joints.items():
         mimic = joint.find("mimic")
-        followed = None if mimic is None else mimic.get("joint")
-        if mimic is not None and name in active:
+        if mimic is not None:
+            how = f"multiplier {mimic.get('multiplier', '1')}, offset {mimic.get('offset', '0')}"
+            couplings[name] = (mimic.get("joint"), how)
+    check_couplings(couplings, active, locked)
+
+
+def check_couplings(couplings: dict[str, tuple[str, str]], active: list[str], locked: list[str] = ()) -> None:
+    """Joints that follow another (a URDF ``<mimic>``, an MJCF joint equality): {follower: (leader,
+    how, in words)}. A follower may not be active; one whose leader is active must be held on purpose
+    (in ``locked``), as the module docstring says.
+
+    Raises:
+        ExciteError: (``robot.active_joints`` or ``robot.locked_joints``) naming the joint.
+    """
+    for name, (followed, how) in couplings.items():
+        if name in active:
             raise ExciteError(
                 "robot.active_joints",
                 f"joint '{name}' mimics '{followed}', a coupling the model does not represent",
                 name,
-                "active joints without <mimic>",
+                "active joints that follow no other",
             )
-        if mimic is not None and followed in active and name not in locked:
+        if followed in active and name not in locked:
             raise ExciteError(
                 "robot.locked_joints",
-                f"joint '{name}' mimics active joint '{followed}' (multiplier {mimic.get('multiplier', '1')}, "
-                f"offset {mimic.get('offset', '0')}), a coupling the model does not represent: it would be held "
-                f"still while '{followed}' moves",
+                f"joint '{name}' mimics active joint '{followed}' ({how}), a coupling the model does not "
+                f"represent: it would be held still while '{followed}' moves",
                 name,
                 f"'{name}' listed in robot.locked_joints (held on purpose) or '{followed}' not active",
             )
@@ -181,7 +189,7 @@ def _warn_massless(root: ElementTree.Element, active: list[str], children: dict[
         warnings.warn(
             f"{path.name} gives no mass to anything {', '.join(idle)} move(s): their torque is 0 whatever the "
             "motion (no <inertial> in the URDF?); the trajectory still excites them, but the feed-forward torque "
-            "export writes and the torque limits are 0 there",
+            "export writes is 0 there and torque limits cannot be checked",
             ExciteWarning,
             stacklevel=3,
         )

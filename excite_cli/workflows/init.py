@@ -13,9 +13,11 @@ import yaml
 
 from excite_cli.atomic import atomic_path
 from excite_cli.config import RobotConfig
-from excite_cli.drafting.starting_config import StartingConfig, draft_config, joint_choice, validated
+from excite_cli.drafting.joints import joint_choice
+from excite_cli.drafting.starting_config import StartingConfig, draft_config, validated
+from excite_cli.dynamics.mjcf_source import is_mjcf
 from excite_cli.dynamics.urdf_checks import check_urdf
-from excite_cli.dynamics.urdf_source import installed_share, resolve_urdf
+from excite_cli.dynamics.urdf_source import installed_share, resolve_urdf, robot_model
 from excite_cli.errors import ExciteError, FileNotFound
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.measured.bags import is_bag
@@ -57,7 +59,7 @@ def robot_source(urdf: str, target: Path) -> dict:
     share = installed_share()
     if share is not None and (share / "example-robot-data" / "robots" / urdf).is_file():
         return {"urdf": urdf, "source": "example-robot-data"}
-    raise FileNotFound("urdf", urdf, "URDF (a file, or a path inside example-robot-data's robots folder)")
+    raise FileNotFound("urdf", urdf, "URDF or MJCF (a file, or a path inside example-robot-data's robots folder)")
 
 
 def _identify_config(
@@ -67,7 +69,9 @@ def _identify_config(
     user named them, written relative to ``target``'s folder; default a CSV ``runs/run_1.csv``): ROS
     bags need no columns (joints matched by name), other files the columns ``excite simulate`` writes
     (which, among bags, are the files' only)."""
-    active, held = joint_choice(urdf, joints, draft)
+    choice = joint_choice(urdf, joints, robot_model(urdf))
+    active, held = choice.active, choice.held
+    draft.assumptions.update(choice.assumptions)
     files = [os.path.relpath(Path(r).resolve(), target.resolve().parent) for r in runs] or ["runs/run_1.csv"]
     bags = [r for r in runs if is_bag(Path(r))]
     draft.config = {
@@ -141,20 +145,26 @@ def run_init(
     kind: str = "optimize",
     force: bool = False,
     runs: Optional[list[str]] = None,
+    collision: bool = True,
+    package_dirs: Optional[list[str]] = None,
 ):
-    """Write a starting config of ``kind`` for ``urdf`` to ``target``.
+    """Write a starting config of ``kind`` for ``urdf`` to ``target``. An ``optimize`` config passes the
+    dry run before it is written, unless no home posture was found: then it is written with what binds
+    commented (``StartingConfig.problem``) and not checked.
 
     Args:
-        urdf: a URDF file or a path inside example-robot-data's robots folder.
+        urdf: a URDF or MJCF file, or a path inside example-robot-data's robots folder.
         joints: the active joints (default: every revolute joint that follows no other).
         kind: ``optimize`` (the whole problem, which passes the dry run) or ``identify`` (robot and
             the data section to fill in).
         runs: ``identify``: the measured runs (files or ROS 2 bag folders), each must exist.
+        collision: fit capsules and draft a mounting plane from the collision meshes (False: none).
+        package_dirs: folders that hold the packages ``package://`` meshes name (``robot.package_dirs``).
 
     Raises:
         ExciteError: unknown kind or joint, a URDF not found or that no model can have
             (:func:`~excite_cli.dynamics.urdf_checks.check_urdf`), an output that may not be written, no
-            joint to move, no home posture where every constraint holds (see :func:`draft_config`).
+            joint to move (see :func:`draft_config`).
     """
     if kind not in KINDS:
         raise ExciteError("kind", f"'{kind}' is not a config kind", kind, " or ".join(KINDS))
@@ -163,13 +173,17 @@ def run_init(
     target = check_target(Path(target), "output", force)
     joints = [j.strip() for given in joints or [] for j in given.split(",") if j.strip()] or None
     robot = robot_source(urdf, target)
-    path, package_dirs = resolve_urdf(RobotConfig.model_construct(**robot), target.resolve().parent)
-    check_urdf(path, [], physical=False)  # before pinocchio, which crashes on some
+    if package_dirs:
+        robot["package_dirs"] = [os.path.relpath(Path(d).resolve(), target.resolve().parent) for d in package_dirs]
+    path, folders = resolve_urdf(RobotConfig.model_construct(**robot), target.resolve().parent)
+    if not is_mjcf(path):
+        check_urdf(path, [], physical=False)  # before pinocchio, which crashes on some
     plan = None
     if kind == "optimize":
-        draft = draft_config(robot, path, package_dirs, joints, target)
+        draft = draft_config(robot, path, folders, joints, target, collision)
         text = _text(draft, urdf, kind)
-        plan = plan_optimize(validated(yaml.safe_load(text), target))
+        problem = validated(yaml.safe_load(text), target)
+        plan = None if draft.problem else plan_optimize(problem)
     else:
         draft = StartingConfig({})
         _identify_config(robot, path, joints, draft, _existing(runs or []), target)

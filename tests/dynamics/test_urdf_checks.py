@@ -109,11 +109,6 @@ def test_a_mimic_joint_held_while_its_leader_moves_is_refused_unless_locked_on_p
             '<robot name="arm" xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:arm prefix=""/></robot>',
             "arm.urdf is a xacro file",
         ),
-        (
-            "fr3.xml",
-            '<mujoco model="fr3"><worldbody/></mujoco>',
-            "fr3.xml is an MJCF (MuJoCo) model; excite reads URDF",
-        ),
         ("scene.sdf", '<sdf version="1.6"><model name="m"/></sdf>', "its root element is <sdf>, not <robot>"),
     ],
 )

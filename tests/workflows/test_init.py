@@ -136,7 +136,10 @@ def test_recorded_bags_get_a_config_without_columns_that_identifies_the_friction
             "expected each data file named as a run of its own",
         ),
         (["init", UR3, "--joints", "elbow_joint,nope"], "'nope' is not a 1-DoF joint of ur3_robot.urdf"),
-        (["init", "nothing/here.urdf"], "URDF (a file, or a path inside example-robot-data's robots folder) not found"),
+        (
+            ["init", "nothing/here.urdf"],
+            "URDF or MJCF (a file, or a path inside example-robot-data's robots folder) not found",
+        ),
         (["init", UR3, "--kind", "simulate"], "'simulate' is not a config kind"),
         (["init", UR3, "-o", "taken.yaml"], "taken.yaml exists"),
         (
@@ -170,5 +173,5 @@ def test_a_urdf_file_without_collision_geometry_gets_no_collision_constraint(tmp
     problem = load_problem(run.target)
     assert (problem.robot.urdf, problem.robot.source) == ("../pendulum.urdf", "file")  # beside the config
     assert problem.constraints.self_collision is None and problem.constraints.environment is None
-    assert "constraints: none: the URDF has no collision geometry" in run.target.read_text()
+    assert "constraints: none: the file has no collision geometry" in run.target.read_text()
     assert run.plan.excitation.robot.joint_names == ["hinge", "tip_joint"]

@@ -23,6 +23,7 @@ import numpy as np
 import pinocchio as pin
 
 from excite_cli.atomic import atomic_path
+from excite_cli.dynamics.mjcf_source import is_mjcf
 from excite_cli.dynamics.robot import Robot
 from excite_cli.dynamics.urdf_meshes import mesh_path
 from excite_cli.errors import ExciteError
@@ -167,8 +168,8 @@ def _set_inertial(body, mass: float, com: np.ndarray, I: np.ndarray | None) -> N
     body.mass, body.ipos, body.iquat = mass, com, [1.0, 0.0, 0.0, 0.0]
     if I is None:
         body.fullinertia, body.inertia = np.full(6, np.nan), np.zeros(3)
-    else:
-        body.fullinertia = [I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]]
+    else:  # an MJCF's diagonal inertia gives way (MuJoCo takes one of the two)
+        body.fullinertia, body.inertia = [I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]], np.zeros(3)
 
 
 def _joint_fields(spec, robot: Robot, effects: list[tuple[Term, str, float]], model: MjcfModel) -> None:
@@ -209,6 +210,21 @@ def _motors(mujoco, spec, robot: Robot) -> None:
             motor.ctrlrange, motor.ctrllimited = limit, mujoco.mjtLimited.mjLIMITED_TRUE
 
 
+def _clear_controls(spec, notes: list[str]) -> None:
+    """An MJCF's own actuators, tendons (and their equalities), sensors and keyframes, removed: the
+    motors written here replace the actuators, and the rest would name joints that are welded or
+    states of another size."""
+    kinds = {"actuator": spec.actuators, "tendon": spec.tendons, "sensor": spec.sensors, "keyframe": spec.keys}
+    tendons = {t.name for t in spec.tendons}
+    for equality in [e for e in spec.equalities if e.name1 in tendons or e.name2 in tendons]:
+        spec.delete(equality)
+    for kind, elements in kinds.items():
+        for element in list(elements):
+            spec.delete(element)
+        if elements:
+            notes.append(f"the file's {kind}s left out ({len(elements)})")
+
+
 def write_mjcf(
     urdf: Path,
     package_dirs: list[str],
@@ -221,7 +237,8 @@ def write_mjcf(
     """Write the identified model as MJCF to ``target`` (atomically), compiled by MuJoCo first.
 
     Args:
-        urdf: the URDF the identification used; package_dirs: folders its ``package://`` meshes are in.
+        urdf: the URDF or MJCF the identification used; package_dirs: folders its ``package://``
+            meshes are in (an MJCF's: its meshdir).
         robot: the identification model (active joints, bodies, merged links).
         locked: ``robot.locked_joints`` {joint: value [rad or m]}.
         standard: (p,) the physically consistent standard parameters φ, 10 per body [kg, kg·m, kg·m²].
@@ -233,6 +250,9 @@ def write_mjcf(
     """
     mujoco, spec = urdf_spec(urdf)
     model = MjcfModel(Path(target), list(robot.joint_names))
+    if is_mjcf(urdf):  # meshes are in the file's meshdir
+        package_dirs = [*package_dirs, str(urdf.parent / spec.meshdir)]
+        _clear_controls(spec, model.notes)
     _resolve_meshes(spec, urdf, package_dirs, model.notes)
     weld_joints(mujoco, spec, robot.joint_names, locked, model.notes)
     _inertias(spec, robot, standard, model.notes)

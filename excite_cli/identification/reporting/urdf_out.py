@@ -84,13 +84,17 @@ def write_urdf(
         note: a line for the header comment (where the parameters come from).
 
     Raises:
-        ExciteError: the URDF cannot be parsed, lacks a body link, or the file cannot be written.
+        ExciteError: the URDF cannot be parsed, is an MJCF, lacks a body link, or the file cannot be
+            written.
     """
     try:
         tree = ET.parse(source)
     except (ET.ParseError, OSError) as exc:
         raise ExciteError("robot.urdf", f"cannot parse {source}: {exc}") from None
     root = tree.getroot()
+    if root.tag == "mujoco":
+        problem = f"the robot's file {source.name} is an MJCF: a URDF copy of it cannot be written"
+        raise ExciteError("urdf_out", problem, expected="the identified model as MJCF (mjcf_out)")
     links = {link.get("name"): link for link in root.findall("link")}
     joints = {joint.get("name"): joint for joint in root.findall("joint")}
     for i, (body, merged) in enumerate(merged_links(robot).items()):

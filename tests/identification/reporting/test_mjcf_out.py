@@ -8,7 +8,7 @@ import mujoco
 import numpy as np
 import pinocchio as pin
 import pytest
-from conftest import CONFIGS, JOINTS
+from conftest import CONFIGS, JOINTS, panda_mjcf
 
 from excite_cli.config_file import load_problem
 from excite_cli.dynamics.robot import load_robot
@@ -17,6 +17,7 @@ from excite_cli.errors import ExciteError
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.effects import Term
 from excite_cli.identification.reporting.mjcf_out import JOINT_FIELDS, write_mjcf
+from excite_cli.identification.reporting.urdf_out import write_urdf
 
 LOCKED = {"panda_joint7": 0.7, "panda_finger_joint1": 0.02, "panda_finger_joint2": 0.02}
 
@@ -140,3 +141,27 @@ def test_without_mujoco_the_option_says_so_in_one_line(tmp_path, monkeypatch):
     with pytest.raises(ExciteError, match="needs MuJoCo, which is not installed") as error:
         write_mjcf(urdf, dirs, robot, {}, robot.urdf_parameters(), [], tmp_path / "panda.xml")
     assert error.value.field == "mjcf_out" and not (tmp_path / "panda.xml").exists()
+
+
+def test_an_mjcf_robot_is_written_from_its_mjcf_and_its_controls_left_out(tmp_path):
+    """A robot described in MJCF (MuJoCo wrote the Panda's, then a lab's position actuators and a
+    keyframe were added): the identified MJCF is built from that file; its actuators give way to torque
+    motors and its keyframe (of a state with the fingers' joints) is left out, said in the notes."""
+    path = panda_mjcf(tmp_path)
+    spec = mujoco.MjSpec.from_file(str(path))
+    for name in JOINTS:
+        spec.add_actuator(name=f"servo_{name}", target=name, trntype=mujoco.mjtTrn.mjTRN_JOINT)
+    spec.add_key(name="home", qpos=np.zeros(9))
+    path.write_text(spec.to_xml())
+    problem, _ = _panda()
+    problem.robot.urdf, problem.robot.source = str(path), "file"
+    robot = load_robot(problem.robot, None, joint_rows_only=True, physical=False)
+    written = write_mjcf(path, [], robot, {}, robot.urdf_parameters(), [], tmp_path / "identified.xml")
+    assert "the file's actuators left out (7)" in written.notes and "the file's keyframes left out (1)" in written.notes
+    states = robot.random_states(20, np.random.default_rng(2))
+    model, tau = _inverse(written.path, robot, states)
+    assert model.nu == 7 and [model.actuator(k).name for k in range(7)] == JOINTS  # the motors excite writes
+    truth = np.array([robot.torques(*x) for x in zip(*states)])
+    assert np.abs(tau - truth).max() <= 1e-5 * np.abs(truth).max()
+    with pytest.raises(ExciteError, match="urdf_out: the robot's file panda.xml is an MJCF"):
+        write_urdf(path, tmp_path / "identified.urdf", robot, robot.urdf_parameters(), [], "note")

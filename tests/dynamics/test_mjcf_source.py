@@ -1,0 +1,100 @@
+"""An MJCF read by pinocchio's MJCF parser is the same robot as its URDF: MuJoCo writes the Panda's
+MJCF from example-robot-data's URDF, and excite's regressor and base parameters of it equal those of
+the URDF. MuJoCo's units (degrees unless said), joints without a range, couplings, and what the
+parser would drop are each checked."""
+
+import numpy as np
+import pytest
+from conftest import JOINTS, panda_mjcf
+
+from excite_cli.config import RobotConfig
+from excite_cli.dynamics.base_parameters import compute_base_parameters
+from excite_cli.dynamics.mjcf_source import is_mjcf, mjcf_couplings
+from excite_cli.dynamics.robot import load_robot
+from excite_cli.errors import ExciteError
+
+ARM = """<mujoco model="arm">{compiler}
+  <worldbody>
+    <body name="upper" pos="0 0 0.1">
+      <inertial pos="0 0 0.1" mass="1" diaginertia="0.01 0.01 0.001"/>
+      <joint name="shoulder" axis="0 1 0" range="-90 90"/>
+      <geom type="capsule" fromto="0 0 0 0 0 0.2" size="0.03"/>
+      <body name="fore" pos="0 0 0.2">
+        <joint name="elbow" axis="0 1 0" {elbow}/>
+        <geom type="capsule" fromto="0 0 0 0 0 0.2" size="0.03"/>
+        <body name="finger" pos="0 0 0.2">
+          <joint name="finger" axis="0 1 0" range="0 30"/>
+          <geom type="box" size="0.01 0.01 0.01"/>
+        </body>
+      </body>
+    </body>
+  </worldbody>{equality}
+</mujoco>
+"""
+
+
+def arm(tmp_path, compiler="", elbow='range="-120 120"', equality=""):
+    path = tmp_path / "arm.xml"
+    path.write_text(ARM.format(compiler=compiler, elbow=elbow, equality=equality))
+    return path
+
+
+def test_the_mjcf_panda_has_the_regressor_and_base_parameters_of_its_urdf(tmp_path):
+    path = panda_mjcf(tmp_path)
+    assert is_mjcf(path) and mjcf_couplings(path) == {
+        "panda_finger_joint2": ("panda_finger_joint1", "polycoef 0 1 0 0 0")
+    }
+    locked = {"panda_finger_joint1": 0.0, "panda_finger_joint2": 0.0}
+    mjcf = load_robot(RobotConfig(urdf=str(path), active_joints=JOINTS, locked_joints=locked), collision=True)
+    urdf = load_robot(
+        RobotConfig(
+            urdf="panda_description/urdf/panda.urdf",
+            source="example-robot-data",
+            active_joints=JOINTS,
+            locked_joints=locked,
+        )
+    )
+    np.testing.assert_allclose(mjcf.lower, urdf.lower) and np.testing.assert_allclose(mjcf.upper, urdf.upper)
+    assert np.all(np.isinf(mjcf.velocity_limit))  # MJCF has none: limits.velocity asks
+    rng = np.random.default_rng(0)
+    for q, qd, qdd in zip(*(rng.uniform(-1, 1, (3, 5, 7)))):
+        scale = np.abs(urdf.regressor(q, qd, qdd)).max()
+        assert np.abs(mjcf.regressor(q, qd, qdd) - urdf.regressor(q, qd, qdd)).max() < 1e-6 * scale
+    base_mjcf, base_urdf = compute_base_parameters(mjcf), compute_base_parameters(urdf)
+    assert base_mjcf.names == base_urdf.names and base_mjcf.count == 43
+    values = base_mjcf.from_standard(mjcf.urdf_parameters()), base_urdf.from_standard(urdf.urdf_parameters())
+    assert np.abs(values[0] - values[1]).max() < 1e-5 * np.abs(values[1]).max()  # MuJoCo writes 6 digits
+    assert mjcf.collision_model.ngeoms >= 8  # its geoms: a mesh per link
+
+
+def test_angles_are_read_in_mujocos_unit_and_a_joint_without_range_gets_one(tmp_path):
+    robot = load_robot(RobotConfig(urdf=str(arm(tmp_path)), active_joints=["shoulder", "elbow"]))
+    np.testing.assert_allclose(robot.lower, np.radians([-90, -120])) and np.testing.assert_allclose(
+        robot.upper, np.radians([90, 120])
+    )
+    radian = arm(tmp_path, compiler='<compiler angle="radian"/>', elbow="")
+    robot = load_robot(
+        RobotConfig(urdf=str(radian), active_joints=["shoulder", "elbow"], joint_ranges={"elbow": (-1.0, 2.0)})
+    )
+    np.testing.assert_allclose(robot.lower, [-90, -1.0]) and np.testing.assert_allclose(robot.upper, [90, 2.0])
+    with pytest.raises(ExciteError, match=r"robot.joint_ranges.shoulder: \[-100, 0\] reaches past the limits"):
+        load_robot(RobotConfig(urdf=str(radian), active_joints=["shoulder"], joint_ranges={"shoulder": (-100.0, 0.0)}))
+
+
+def test_a_coupled_joint_is_checked_as_a_mimic(tmp_path):
+    equality = '<equality><joint joint1="finger" joint2="elbow"/></equality>'
+    path = arm(tmp_path, equality=equality)
+    with pytest.raises(ExciteError, match="robot.locked_joints: joint 'finger' mimics active joint 'elbow'"):
+        load_robot(RobotConfig(urdf=str(path), active_joints=["shoulder", "elbow"]))
+    with pytest.raises(ExciteError, match="robot.active_joints: joint 'finger' mimics 'elbow'"):
+        load_robot(RobotConfig(urdf=str(path), active_joints=["finger"]))
+    held = RobotConfig(urdf=str(path), active_joints=["shoulder", "elbow"], locked_joints={"finger": 0.0})
+    assert load_robot(held).joint_names == ["shoulder", "elbow"]
+
+
+def test_joints_the_parser_would_drop_are_refused(tmp_path):
+    """MuJoCo writes a URDF's fixed links as <frame> elements, which pinocchio's parser skips with what
+    is in them: the Panda's fingers and hand vanished, mass and all, without a word."""
+    path = panda_mjcf(tmp_path, frames=True)
+    with pytest.raises(ExciteError, match="leaves out joint.s. panda_finger_joint1, panda_finger_joint2 of panda.xml"):
+        load_robot(RobotConfig(urdf=str(path), active_joints=JOINTS))
