@@ -1,6 +1,8 @@
 """`excite init` on every arm example-robot-data ships, as a new user would run it (no --joints): each
-one writes a config that passes the dry run, or says in one line why not. Prints one line per URDF:
-``init ARM: ok (J joints, H home clearance) in T s`` or ``init ARM: refused in T s: <the line>``.
+one writes a config that passes the dry run, one with what binds at the best posture marked FIX FIRST
+(no home posture), or says in one line why not. Prints one line per URDF: ``init ARM: ok in T s;
+robot: ...``, ``init ARM: written in T s, with a problem to fix: ...`` or ``init ARM: refused in T s:
+<the line>``.
 
     .venv/bin/python bench/init_arms.py
 """
@@ -43,7 +45,10 @@ def main() -> None:
             wall = time.perf_counter() - start
             traceback = "Traceback" in done.stdout + done.stderr
             errors = [line for line in done.stderr.splitlines() if line.startswith("error:")]
-            if done.returncode == 0:
+            fix = next((line.strip() for line in done.stdout.splitlines() if "FIX FIRST" in line), "")
+            if done.returncode == 0 and fix:
+                print(f"init {arm}: written in {wall:.0f} s, with a problem to fix: {fix}")
+            elif done.returncode == 0:
                 joints = next((line for line in done.stdout.splitlines() if line.startswith("robot:")), "")
                 print(f"init {arm}: ok in {wall:.0f} s; {joints}")
             else:

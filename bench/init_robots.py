@@ -27,7 +27,7 @@ import numpy as np
 import pinocchio as pin
 
 from excite_cli.config_file import load_problem
-from excite_cli.dynamics.urdf_source import example_robot_data_root
+from excite_cli.dynamics.urdf_source import example_robot_data_root, robot_model
 
 ROBOTS = {
     "UR10": "ur_description/urdf/ur10_robot.urdf",
@@ -62,7 +62,7 @@ def _independent_check(config: Path, csv: Path) -> tuple[float, float, float, fl
     problem = load_problem(config)
     share = example_robot_data_root()
     urdf = str(share / "example-robot-data" / "robots" / problem.robot.urdf)
-    model = pin.buildModelFromUrdf(urdf)
+    model = robot_model(Path(urdf))  # continuous joints as revolute: one angle each, as the export writes them
     geometry = pin.buildGeomFromUrdf(model, urdf, pin.COLLISION, package_dirs=[str(share)])
     data, gdata = model.createData(), pin.GeometryData(geometry)
     header, table = _exported(csv)
@@ -70,6 +70,8 @@ def _independent_check(config: Path, csv: Path) -> tuple[float, float, float, fl
     q_idx = [model.idx_qs[model.getJointId(j)] for j in problem.robot.active_joints]
     v_idx = [model.idx_vs[model.getJointId(j)] for j in problem.robot.active_joints]
     lower, upper = model.lowerPositionLimit[q_idx], model.upperPositionLimit[q_idx]
+    for k, joint in enumerate(problem.robot.active_joints):  # a continuous joint: the config's range
+        lower[k], upper[k] = problem.robot.joint_ranges.get(joint, (lower[k], upper[k]))
     q, qd, qdd = (table[:, 1 + k * n : 1 + (k + 1) * n] for k in range(3))
     position = np.max(np.abs(q - (lower + upper) / 2) / ((upper - lower) / 2))
     velocity = np.max(np.abs(qd) / model.velocityLimit[v_idx])
