@@ -27,6 +27,7 @@ from excite_cli.config.constraints import (
 from excite_cli.config.effects import EffectsConfig, MotorConfig
 from excite_cli.config.problem import (
     LimitsConfig,
+    NoiseConfig,
     OptimizerConfig,
     Problem,
     RandomBaselineConfig,
@@ -50,6 +51,7 @@ __all__ = [
     "Fraction",
     "LimitsConfig",
     "MotorConfig",
+    "NoiseConfig",
     "OptimizerConfig",
     "PerJoint",
     "Problem",

@@ -164,6 +164,16 @@ class OptimizerConfig(Section):
         return value
 
 
+class NoiseConfig(Section):
+    """The torque noise the design is for (:mod:`excite_cli.optimization.noise`): per joint an absolute
+    part σ [Nm] and a part ρ [1] relative to the torque; each regressor row weighs 1/√(σ_j² + ρ_j² τ_j(t)²)."""
+
+    absolute: PerJoint = 0.1
+    """σ_j [Nm], one value or {joint: Nm}: the torque reading's own noise (an identify report as prior gives its)."""
+    relative: PerJoint = 0.0
+    """ρ_j [1], one value or {joint: value}: noise growing with the torque, as a motor current's (0.02: 2 %)."""
+
+
 class RandomBaselineConfig(Section):
     """``compare-random``: pool size and seed of the random candidates."""
 
@@ -199,6 +209,8 @@ class Problem(Section):
     """The solver and its starts."""
     sequence: SequenceConfig = SequenceConfig()
     """Sequential generation (Sec. IV-B)."""
+    noise: Optional[NoiseConfig] = None
+    """The torque noise the regressor rows are weighed by; none: every row weighs the same."""
     random_baseline: RandomBaselineConfig = RandomBaselineConfig()
     """compare-random's candidates."""
     output: str = "results/excite.h5"

@@ -38,6 +38,7 @@ from excite_cli.dynamics.effect_columns import EffectColumns
 from excite_cli.dynamics.robot import Robot
 from excite_cli.dynamics.virtual_dynamics import VirtualDynamics
 from excite_cli.errors import ExciteError
+from excite_cli.optimization.noise import RowNoise
 from excite_cli.trajectory.fourier import FourierBasis
 
 #: The smallest eigenvalue of CᵀC, relative to the largest, down to which the eigenvalues of CᵀC give
@@ -68,8 +69,8 @@ class Criterion:
         frame: L (b+e, b+e): the criterion is that of C L (module docstring); None: of C, the paper's.
         effects: e effect columns beside the b base columns, C = [Y_B | Y_E] per row
             (:mod:`~excite_cli.dynamics.effect_columns`), or None: the rigid body alone.
-        row_weights: (n_rows,) each regressor row's weight in the trajectory's rows (a joint's σ̄/σ_j
-            when the prior is measured data weighed by its noise), or None: unweighted.
+        noise: the rows' noise (:mod:`~excite_cli.optimization.noise`): each row of the trajectory
+            weighs σ̄/√(σ_j² + ρ_j² τ_j(t)²), or None: unweighted.
     """
 
     robot: Robot
@@ -79,7 +80,7 @@ class Criterion:
     objective: CriterionRecord = field(default_factory=lambda: CRITERIA["log_cond"])
     frame: np.ndarray | None = None
     effects: EffectColumns | None = None
-    row_weights: np.ndarray | None = None
+    noise: RowNoise | None = None
     _dynamics: VirtualDynamics = field(init=False, repr=False)
     _data: pin.Data = field(init=False, repr=False)
     _prior_gram: np.ndarray = field(init=False, repr=False)
@@ -109,13 +110,19 @@ class Criterion:
 
     def regressor(self, alpha: np.ndarray) -> np.ndarray:
         """Ŷ_B of the trajectory α (n, 2N+1): (T·n_rows, b) (Eq. 3 with Y_B = Y X), and its effect
-        columns beside it when there are any: (T·n_rows, b+e)."""
-        return self._regressor(*self.basis.evaluate(alpha))
+        columns beside it when there are any: (T·n_rows, b+e); each row weighed by its noise when the
+        criterion has one."""
+        return self._regressor(*self.basis.evaluate(alpha))[0]
 
-    def _regressor(self, Q: np.ndarray, QD: np.ndarray, QDD: np.ndarray) -> np.ndarray:
-        own = self.robot.regressor_stack(Q, QD, QDD, self._data)[:, self.base.independent]  # Y X, X a selection
+    def _regressor(self, Q: np.ndarray, QD: np.ndarray, QDD: np.ndarray) -> tuple:
+        """The weighed rows Ŷ (T·n_rows, b+e), their weights s and ds/dτ (T·n_rows,) (None without noise)."""
+        full = self.robot.regressor_stack(Q, QD, QDD, self._data)
+        own = full[:, self.base.independent]  # Y X, X a selection
         own = own if self.effects is None else np.hstack([own, self.effects.columns(QD, QDD)])
-        return own if self.row_weights is None else own * np.tile(self.row_weights, Q.shape[0])[:, None]
+        if self.noise is None:
+            return own, None, None
+        s, ds = self.noise.weights(full @ self.noise.reference)  # τ = Y φ_URDF
+        return own * s[:, None], s, ds
 
     def stacked(self, own: np.ndarray) -> np.ndarray:
         """C = [C₀; Ŷ_B] (Eq. 41)."""
@@ -131,7 +138,7 @@ class Criterion:
                 about half the time (G1, 560 × 90: 0.9 ms against 1.7 ms with the regressor, one BLAS
                 thread); finite differences need the singular values.
         """
-        Q, QD, QDD, own = self._motion(alpha)
+        Q, QD, QDD, own, _, _ = self._motion(alpha)
         if Q.shape[0] * self.robot.n_rows + self.prior.shape[0] < self.columns:
             return float("inf")
         eig = np.linalg.eigvalsh(self._gram(own)) if from_gram else None
@@ -139,13 +146,14 @@ class Criterion:
             eig = np.linalg.svd(self.framed(self.stacked(own)), compute_uv=False)[::-1] ** 2
         return self.objective.terms(eig)[0]
 
-    def _motion(self, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """Q, Q̇, Q̈ (T, n) of α and its regressor rows Ŷ (T·n_rows, b+e), kept for the next call at the
-        same α (a solver asks for the value, then the gradient, at each accepted point)."""
+    def _motion(self, alpha: np.ndarray) -> tuple:
+        """Q, Q̇, Q̈ (T, n) of α, its regressor rows Ŷ (T·n_rows, b+e) and their weights s and ds/dτ
+        (:meth:`_regressor`), kept for the next call at the same α (a solver asks for the value, then
+        the gradient, at each accepted point)."""
         key = alpha.tobytes()
         if self._last is None or self._last[0] != key:
             Q, QD, QDD = self.basis.evaluate(alpha)
-            self._last = (key, (Q, QD, QDD, self._regressor(Q, QD, QDD)))
+            self._last = (key, (Q, QD, QDD, *self._regressor(Q, QD, QDD)))
         return self._last[1]
 
     def _gram(self, own: np.ndarray) -> np.ndarray:
@@ -159,25 +167,65 @@ class Criterion:
         Ties σ₁ = σ₂ give one valid subgradient (that of the eigenbasis); rank loss is floored
         (:data:`~excite_cli.criteria.record.RANK_FLOOR`) so the result is finite.
         """
-        Q, QD, QDD, own = self._motion(alpha)
+        motion = self._motion(alpha)
         # eigenpairs of the b×b Gram matrix CᵀC = C₀ᵀC₀ + ŶᵀŶ give σ² and v; C v = σ u (Eqs. 8, 16)
-        eig, V = np.linalg.eigh(self._gram(own))
+        eig, V = np.linalg.eigh(self._gram(motion[3]))
         value, used, coefficients = self.objective.terms(eig)
-        directions = V[:, used] if self.frame is None else self.frame @ V[:, used]  # v_r, or L ṽ_r
-        T, rows, b = Q.shape[0], self.robot.n_rows, self.base.count
-        weighted = (own @ directions) * coefficients  # a_r (C v_r): the rows' weights (M, R)
-        if self.row_weights is not None:  # ∂f/∂Y of the unweighted rows: times each row's weight
-            weighted = weighted * np.tile(self.row_weights, T)[:, None]
-        if used.size > len(self._dynamics.slots):  # fewer passes with a virtual parameter per instant and row
+        return value, self._chained(motion, V[:, used], coefficients)
+
+    def singular_values(self, alpha: np.ndarray) -> np.ndarray:
+        """σ (b,) of C (of C L with the frame), ascending, from the eigenvalues of CᵀC."""
+        return np.sqrt(np.maximum(np.linalg.eigvalsh(self._gram(self._motion(alpha)[3])), 0.0))
+
+    def cluster_gradients(self, alpha: np.ndarray, indices: np.ndarray) -> np.ndarray:
+        """The gradients in α (k, k, n, 2N+1) of h_ab = v_aᵀ (CᵀC) v_b / (2 λ̄) for the eigenvectors
+        v_a, v_b of CᵀC (of Lᵀ CᵀC L with the frame) of the singular values ``indices`` (k,) of one
+        cluster (ascending order), held fixed, λ̄ the mean of their eigenvalues. At a multiple singular
+        value σ every subgradient of log σ is Σ_ab S_ab ∇h_ab with S ⪰ 0 of trace 1 (the derivative of
+        an eigenvalue of multiplicity k, Overton 1992); h_aa's alone are the gradients of each log σ_a.
+        Each off-diagonal pair is two passes: v_aᵀGv_b = ½(u₊ᵀGu₊ − u₋ᵀGu₋), u± = (v_a ± v_b)/√2."""
+        motion = self._motion(alpha)
+        eig, V = np.linalg.eigh(self._gram(motion[3]))
+        mean = float(max(eig[indices].mean(), np.finfo(float).tiny))
+        k = len(indices)
+        out = np.zeros((k, k, *alpha.shape))
+        for a in range(k):
+            for b in range(a, k):
+                va, vb = V[:, indices[a]], V[:, indices[b]]
+                if a == b:
+                    out[a, a] = self._chained(motion, va[:, None], np.array([1.0 / mean]))
+                    continue
+                plus, minus = np.column_stack([va + vb, va - vb]).T / np.sqrt(2.0)
+                both = self._chained(motion, np.column_stack([plus, minus]), np.array([0.5, -0.5]) / mean)
+                out[a, b] = out[b, a] = both
+        return out
+
+    def _chained(self, motion: tuple, V: np.ndarray, coefficients: np.ndarray) -> np.ndarray:
+        """The gradient in α (n, 2N+1) of a criterion whose gradient in C is Σ_r a_r (C v_r) v_rᵀ, from
+        the motion (:meth:`_motion`), eigenvectors V (b, R) of the (framed) CᵀC and a_r (R,)."""
+        Q, QD, QDD, own, s, ds = motion
+        directions = V if self.frame is None else self.frame @ V  # v_r, or L ṽ_r
+        T, rows, b, R = Q.shape[0], self.robot.n_rows, self.base.count, V.shape[1]
+        projected = own @ directions  # C v_r (M, R)
+        weighted = projected * coefficients  # a_r (C v_r): ∂f/∂C = Σ_r a_r (C v_r) v_rᵀ, the rows' weights
+        torque_weights = None
+        if s is not None:  # C = diag(s) Y: ∂f/∂Y = s ∂f/∂C, and ∂f/∂s = Σ_r a_r (C v_r)(Y v_r)
+            torque_weights = (weighted * projected).sum(axis=1) / s * ds if self.noise.varying else None
+            weighted = weighted * s[:, None]
+        if R > len(self._dynamics.slots):  # fewer passes with a virtual parameter per instant and row
             phis = np.zeros((T, rows, self.robot.n_parameters))
             phis[:, :, self.base.independent] = (weighted @ directions[:b].T).reshape(T, rows, -1)
             dq, dqd, dqdd = self._dynamics.row_derivatives(phis, Q, QD, QDD)
         else:
-            phis = np.zeros((self.robot.n_parameters, used.size))
+            phis = np.zeros((self.robot.n_parameters, R))
             phis[self.base.independent] = directions[:b]  # X v_r
-            weights = weighted.T.reshape(used.size, T, rows)  # row weights a_r (Ŷ_B v_r) at each instant
+            weights = weighted.T.reshape(R, T, rows)  # row weights a_r (Ŷ_B v_r) at each instant
             dq, dqd, dqdd = self._dynamics.weighted_derivatives(phis, weights, Q, QD, QDD)
+        if torque_weights is not None:  # through the weights: ∂f/∂τ ∂τ(x_t; φ_URDF)/∂x_t
+            weights = torque_weights.reshape(1, T, rows)
+            extra = self._dynamics.weighted_derivatives(self.noise.reference[:, None], weights, Q, QD, QDD)
+            dq, dqd, dqdd = dq + extra[0], dqd + extra[1], dqdd + extra[2]
         if self.effects is not None:  # ∂f/∂Y_E = Σ_r a_r (C v_r) v_{r,E}ᵀ, through the effect columns' motion
             effect_qd, effect_qdd = self.effects.chain(weighted @ directions[b:].T, QD, QDD)
             dqd, dqdd = dqd + effect_qd, dqdd + effect_qdd
-        return value, self.basis.chain(dq, dqd, dqdd)
+        return self.basis.chain(dq, dqd, dqdd)

@@ -29,6 +29,7 @@ from excite_cli.identification.reporting.design_model import MeasuredPrior
 from excite_cli.optimization.criterion import Criterion, condition_number
 from excite_cli.optimization.information import excitation_level, parameter_magnitudes, scaled_frame
 from excite_cli.optimization.model_columns import design_effects, measured_prior
+from excite_cli.optimization.noise import RowNoise, row_noise
 from excite_cli.trajectory.boundary import BoundaryConditions, boundary_rows
 from excite_cli.trajectory.fourier import FourierBasis, FourierTrajectory, sample_times
 
@@ -86,7 +87,7 @@ class Excitation:
             objective=criterion_record(objective or self.problem.optimizer.objective),
             frame=self.scaled_frame if scaling == "urdf" else None,
             effects=self.effects,
-            row_weights=self.row_weights,
+            noise=self.noise,
         )
 
     def excitation_level(self, C: np.ndarray) -> float:
@@ -106,15 +107,9 @@ class Excitation:
         return self.base.count + (self.effects.count if self.effects else 0)
 
     @property
-    def row_weights(self) -> np.ndarray | None:
-        """(n_rows,) the trajectory's row weights: with a measured prior, each joint's σ̄/σ_j as the
-        prior's rows have (the base wrench rows, which no joint measures, 1); else None."""
-        if self.measured is None:
-            return None
-        weights = np.ones(self.robot.n_rows)
-        by_joint = dict(zip(self.measured.joints, self.measured.weights()))
-        weights[self.robot.n_rows - self.robot.n_joints :] = [by_joint[j] for j in self.robot.joint_names]
-        return weights
+    def noise(self) -> RowNoise | None:
+        """The regressor rows' noise (``noise``, σ_j from a measured prior's report), or None: unweighted."""
+        return row_noise(self.problem.noise, self.robot, self.measured)
 
     @property
     def effect_names(self) -> tuple[str, ...]:
@@ -235,6 +230,7 @@ def build_excitation(problem: Problem, base: BaseParameters | None = None, check
         effects=effects,
         measured=measured_prior(problem, robot),
     )
+    row_noise(problem.noise, robot, excitation.measured)  # the noise section checked before any work
     if check_home:
         _check_home_posture(excitation)
     return excitation

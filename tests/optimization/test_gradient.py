@@ -11,6 +11,7 @@ from excite_cli.criteria import CRITERIA, NAMES
 from excite_cli.errors import ExciteWarning
 from excite_cli.optimization.criterion import Criterion, condition_number
 from excite_cli.optimization.excitation import build_excitation
+from excite_cli.optimization.noise import RowNoise
 from excite_cli.optimization.verify import check_gradient, finite_difference_gradient
 
 
@@ -190,11 +191,14 @@ def test_excitation_level_with_effects_is_the_geometric_mean_singular_value_of_t
 
 
 def test_gradient_with_row_weights_matches_finite_differences(ur5_problem):
-    """Rows weighted per joint (σ̄/σ_j of a measured prior), stacked under a weighted prior, with effect columns."""
+    """Rows weighted per joint (σ̄/σ_j of a measured prior, no part relative to the torque), stacked
+    under a weighted prior, with effect columns."""
     problem = small(ur5_problem)
     problem.effects = EffectsConfig(joints={"*": ["coulomb", "viscous"]}, coulomb_velocity=0.05)
     excitation = build_excitation(problem)
-    weights = np.linspace(0.5, 2.0, excitation.robot.n_rows)
+    sigma = np.linspace(0.5, 2.0, excitation.robot.n_rows)
+    noise = RowNoise(sigma, np.zeros_like(sigma), 1.0, excitation.robot.urdf_parameters())
+    weights = 1.0 / sigma
     plain = excitation.criterion()
     prior = (
         plain.regressor(_feasible_alpha(excitation, seed=4))
@@ -207,7 +211,7 @@ def test_gradient_with_row_weights_matches_finite_differences(ur5_problem):
         prior,
         CRITERIA["log_det"],
         effects=excitation.effects,
-        row_weights=weights,
+        noise=noise,
     )
     alpha = _feasible_alpha(excitation, seed=7)
     np.testing.assert_allclose(

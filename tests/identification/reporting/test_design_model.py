@@ -121,7 +121,8 @@ def test_optimize_with_the_report_as_prior_weighs_both_the_prior_and_its_own_row
     plain = build_excitation(load_problem(CONFIGS / "smoke.yaml")).criterion().regressor(alpha)
     weights = np.tile(measured.weights(), own.shape[0] // measured.weights().size)
     np.testing.assert_allclose(own, plain * weights[:, None], rtol=1e-9, atol=1e-12)
-    assert excitation.row_weights is not None and not np.allclose(excitation.row_weights, 1.0)
+    np.testing.assert_allclose(excitation.noise.sigma, measured.floored)  # the report's σ_j weigh the new rows
+    assert not np.allclose(excitation.noise.weights(np.zeros(measured.floored.size))[0], 1.0)
 
 
 def test_the_reports_rows_hold_its_effects_as_the_fit_saw_them(simulated_identification):

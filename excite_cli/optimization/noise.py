@@ -1,0 +1,90 @@
+"""The torque noise a design is for: heteroscedastic weights of the regressor rows.
+
+A lab's torque reading has noise of variance σ_j² + ρ_j² τ_j(t)² at joint j and instant t: an
+absolute part σ_j [Nm] (a torque sensor's) and a part ρ_j [1] growing with the torque (a motor
+current's model: gear friction and torque-constant errors scale with the load). Weighted least
+squares weighs each row by the inverse noise, so the information the measurements will deliver is
+CᵀW²C with the rows of C scaled by
+
+    s_{t,j} = σ̄ / √(σ_j² + ρ_j² τ_j(t)²)
+
+(Gautier 1997 with a noise that depends on the sample; σ̄, the geometric mean of the σ_j, keeps the
+criterion on the scale of the unweighted rows: equal noise on every joint and ρ = 0 weigh each row
+1). τ is the rigid body's inverse dynamics with the URDF's inertias at the trajectory's motion, so
+the weights move with α and their gradient ∂s/∂τ = −s ρ² τ / (σ² + ρ²τ²) enters the criterion's
+(:mod:`~excite_cli.optimization.criterion`). The rows of the base wrench (a floating base's, which
+no joint's sensor measures) weigh as a row of noise σ̄.
+
+With an identify report as prior data (``sequence.prior``), σ_j are the report's
+(:class:`~excite_cli.identification.reporting.design_model.MeasuredPrior`): the rows of its recording
+are weighed by them, and the new trajectory's by the same σ_j and the config's ρ.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from excite_cli.config import NoiseConfig
+from excite_cli.constraints.joint_limits import per_joint
+from excite_cli.dynamics.robot import Robot
+from excite_cli.identification.reporting.design_model import MeasuredPrior
+
+
+@dataclass(frozen=True)
+class RowNoise:
+    """The noise of each regressor row of one instant.
+
+    Attributes:
+        sigma: (n_rows,) the absolute part σ [Nm] of each row's noise.
+        rho: (n_rows,) the part ρ [1] relative to the row's torque (0 on the base wrench rows).
+        scale: σ̄ [Nm], the geometric mean of the joints' σ_j: a row of noise σ̄ weighs 1.
+        reference: (p,) the standard parameters φ [kg, kg·m, kg·m²] the torques are computed with
+            (the URDF's).
+    """
+
+    sigma: np.ndarray
+    rho: np.ndarray
+    scale: float
+    reference: np.ndarray
+
+    @property
+    def varying(self) -> bool:
+        """Whether the weights depend on the torque (some ρ > 0)."""
+        return bool(np.any(self.rho > 0.0))
+
+    def weights(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """s (M,) = σ̄ / √(σ² + ρ² τ²) of M = T·n_rows rows whose torques are ``tau`` (M,) [Nm],
+        instants one after the other, and ds/dτ (M,) [1/Nm]."""
+        reps = tau.size // self.sigma.size
+        sigma, rho = np.tile(self.sigma, reps), np.tile(self.rho, reps)
+        variance = sigma**2 + rho**2 * tau**2
+        s = self.scale / np.sqrt(variance)
+        return s, -s * rho**2 * tau / variance
+
+
+def row_noise(cfg: NoiseConfig | None, robot: Robot, measured: MeasuredPrior | None) -> RowNoise | None:
+    """The rows' noise of the ``noise`` section (σ_j from ``measured``, an identify report's, when
+    there is one); None where every row weighs the same (no section and no measured prior).
+
+    Raises:
+        ExciteError: (``noise.absolute``, ``noise.relative``) an unknown joint, a σ that is not positive
+            and finite, a ρ that is negative or not finite.
+    """
+    if cfg is None and measured is None:
+        return None
+    n, rows = robot.n_joints, robot.n_rows
+    if measured is not None:
+        by_joint = dict(zip(measured.joints, measured.floored))
+        sigma = np.array([by_joint[j] for j in robot.joint_names])
+    else:
+        sigma = per_joint("noise.absolute", cfg.absolute, np.full(n, np.nan), robot)
+    rho = np.zeros(n) if cfg is None else per_joint("noise.relative", cfg.relative, np.zeros(n), robot, True)
+    scale = measured.noise if measured is not None else float(np.exp(np.log(sigma).mean()))
+    return RowNoise(
+        sigma=np.concatenate([np.full(rows - n, scale), sigma]),
+        rho=np.concatenate([np.zeros(rows - n), rho]),
+        scale=scale,
+        reference=robot.urdf_parameters(),
+    )

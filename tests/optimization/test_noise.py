@@ -1,0 +1,78 @@
+"""The torque noise a design is for: each row weighs σ̄/√(σ_j² + ρ_j² τ_j(t)²) with τ pinocchio's
+inverse dynamics of the URDF at the motion, the criterion's gradient (through the weights too)
+against finite differences, and the noise section's bad values named."""
+
+import numpy as np
+import pytest
+from conftest import small
+
+from excite_cli.config import NoiseConfig
+from excite_cli.errors import ExciteError
+from excite_cli.optimization.excitation import build_excitation
+from excite_cli.optimization.verify import finite_difference_gradient
+
+
+def _alpha(excitation, seed):
+    return excitation.limits.random_start(excitation.trajectory.n_coefficients, np.random.default_rng(seed), 0.7)
+
+
+def test_each_row_weighs_by_its_noise_at_the_torque_of_the_motion(panda_problem):
+    problem = small(panda_problem)
+    joints = problem.robot.active_joints
+    problem.noise = NoiseConfig(absolute={joints[0]: 0.2, **{j: 0.05 for j in joints[1:]}}, relative=0.02)
+    excitation = build_excitation(problem)
+    alpha = _alpha(excitation, 3)
+    weighted = excitation.criterion().regressor(alpha)
+    problem.noise = None
+    plain = build_excitation(problem).criterion().regressor(alpha)
+    robot, (Q, QD, QDD) = excitation.robot, excitation.cost_basis.evaluate(alpha)
+    tau = np.array([robot.torques(q, qd, qdd) for q, qd, qdd in zip(Q, QD, QDD)])  # pinocchio's RNEA
+    sigma = np.array([0.2] + [0.05] * (len(joints) - 1))
+    scale = np.exp(np.log(sigma).mean())  # σ̄: the geometric mean
+    expected = scale / np.sqrt(sigma**2 + 0.02**2 * tau**2)  # (T, n)
+    np.testing.assert_allclose(weighted, plain * expected.reshape(-1, 1), rtol=1e-9, atol=1e-12)
+    assert expected.min() < 0.5 * expected.max()  # the weights do move with the torque
+
+
+def test_equal_absolute_noise_is_the_unweighted_design(panda_problem):
+    problem = small(panda_problem)
+    alpha = _alpha(build_excitation(problem), 1)
+    plain = build_excitation(problem).criterion()
+    problem.noise = NoiseConfig(absolute=0.3, relative=0.0)
+    noisy = build_excitation(problem).criterion()
+    np.testing.assert_allclose(noisy.regressor(alpha), plain.regressor(alpha), rtol=1e-12)
+    assert noisy.value(alpha) == pytest.approx(plain.value(alpha), rel=1e-12)
+
+
+@pytest.mark.parametrize(
+    "name, objective",
+    [("panda_problem", "log_det"), ("panda_problem", "log_trace_inverse"), ("g1_problem", "log_cond")],
+)
+def test_gradient_through_weights_that_move_with_the_torque_matches_finite_differences(name, objective, request):
+    problem = small(request.getfixturevalue(name))
+    problem.optimizer.objective = objective
+    problem.noise = NoiseConfig(absolute=0.05, relative=0.05)
+    excitation = build_excitation(problem)
+    criterion, alpha = excitation.criterion(), _alpha(excitation, 5)
+    _, analytic = criterion.value_and_gradient(alpha)
+    fd = finite_difference_gradient(criterion, alpha, step=1e-6, central=True)
+    assert np.linalg.norm(analytic - fd) / np.linalg.norm(fd) < 1e-6
+    problem.noise = NoiseConfig(absolute=0.05, relative=0.0)  # the weights' own term matters
+    _, fixed = build_excitation(problem).criterion().value_and_gradient(alpha)
+    assert np.linalg.norm(fixed - fd) / np.linalg.norm(fd) > 1e-3
+
+
+@pytest.mark.parametrize(
+    "noise, expected",
+    [
+        ({"absolute": 0.0}, "noise.absolute: joint 'panda_joint1' needs a positive finite limit"),
+        ({"relative": -0.1}, "noise.relative: joint 'panda_joint1' needs a non-negative finite margin"),
+        ({"absolute": {"elbow": 0.1}}, "noise.absolute: 'elbow' is not an active joint"),
+    ],
+)
+def test_a_noise_that_cannot_be_is_named(panda_problem, noise, expected):
+    problem = small(panda_problem)
+    problem.noise = NoiseConfig(**noise)
+    with pytest.raises(ExciteError) as raised:
+        build_excitation(problem)
+    assert raised.value.describe().startswith(expected)
