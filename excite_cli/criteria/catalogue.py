@@ -38,6 +38,8 @@ CRITERIA = {
             lambda lam, np: _condition(lam, np, log=False),
             shown_as="cond",
             source="Eq. 5",
+            extremes=(1.0, -1.0),
+            exponentiate_extremes=True,
         ),
         CriterionRecord(
             "log_cond",
@@ -46,6 +48,7 @@ CRITERIA = {
             shown_as="cond",
             exponentiate=True,
             source="Eqs. 5, 17",
+            extremes=(1.0, -1.0),
         ),
         CriterionRecord(
             "log_det",
@@ -58,6 +61,7 @@ CRITERIA = {
             "a large excitation of the worst excited direction",
             lambda lam, np: (float(-0.5 * np.log(lam[0])), np.array([0]), np.array([-1.0 / lam[0]])),
             source="E-optimality, the paper's ref. [20]",
+            extremes=(0.0, -1.0),
         ),
         CriterionRecord(
             "log_trace_inverse",

@@ -33,6 +33,11 @@ class CriterionRecord:
             exponentiated when it is a log) or the criterion's own value.
         exponentiate: tables show exp(value) (a log criterion shown as the condition number).
         source: where it comes from.
+        extremes: for a criterion of the extreme singular values only, non-smooth where one is
+            multiple: (w_max, w_min) with f = w_max log σ_max + w_min log σ_min (or exp of that with
+            ``exponentiate_extremes``); () for a smooth criterion. The stationarity test of
+            :mod:`~excite_cli.optimization.optimality` uses it.
+        exponentiate_extremes: f = exp(w_max log σ_max + w_min log σ_min) (cond itself).
     """
 
     name: str
@@ -41,6 +46,8 @@ class CriterionRecord:
     shown_as: str = ""
     exponentiate: bool = False
     source: str = ""
+    extremes: tuple[float, ...] = ()
+    exponentiate_extremes: bool = False
 
     def terms(self, eigenvalues: Any) -> tuple[float, Any, Any]:
         """The value, the indices r (R,) of the eigenpairs the gradient needs and their coefficients

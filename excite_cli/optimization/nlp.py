@@ -11,7 +11,7 @@ from scipy.optimize import minimize
 
 from excite_cli.constraints import Constraint, accepted
 from excite_cli.optimization.criterion import Criterion
-from excite_cli.optimization.optimality import Optimality, kkt_optimality
+from excite_cli.optimization.optimality import Optimality, clarke_optimality, extreme_clusters, kkt_optimality
 from excite_cli.trajectory.boundary import BoundaryConditions
 
 #: SLSQP iterations of the projection onto the feasible set (it converges in 10-50 on the G1 problem).
@@ -87,9 +87,29 @@ class Evaluations:
         """First-order optimality at α (n, 2N+1), in the variables z."""
         return self.kkt(self.boundary.to_variables(alpha))
 
-    def kkt(self, z: np.ndarray) -> Optimality:
-        """First-order optimality at z (n_z,)."""
-        return kkt_optimality(self.gradient(z), *self.constraints(z))
+    def kkt(self, z: np.ndarray, nonsmooth: bool = True) -> Optimality:
+        """First-order optimality at z (n_z,): the KKT residual, or (``nonsmooth``) for a criterion of
+        the extreme singular values where one is multiple, Clarke's
+        (:mod:`~excite_cli.optimization.optimality`), whichever is smaller."""
+        smooth = kkt_optimality(self.gradient(z), *self.constraints(z))
+        if not nonsmooth or not self.criterion.objective.extremes or smooth.residual == 0.0:
+            return smooth
+        return self._once("clarke", z, lambda: self._clarke(z, smooth))
+
+    def _clarke(self, z: np.ndarray, smooth: Optimality) -> Optimality:
+        """The Clarke residual at z where an extreme singular value is multiple, else ``smooth``."""
+        alpha, record = self.boundary.to_alpha(z), self.criterion.objective
+        clusters = extreme_clusters(self.criterion.singular_values(alpha), record.extremes)
+        if all(len(indices) == 1 for indices, _ in clusters):
+            return smooth
+        scale = self.criterion.value(alpha) if record.exponentiate_extremes else 1.0
+        pieces = []
+        for indices, weight in clusters:
+            gradients = self.criterion.cluster_gradients(alpha, indices)
+            k = len(indices)
+            pieces.append(scale * weight * self.boundary.chain(gradients.reshape(k * k, -1)).reshape(k, k, -1))
+        clarke = clarke_optimality(pieces, self.gradient(z), *self.constraints(z))
+        return clarke if clarke.residual < smooth.residual else smooth
 
 
 def project(problem: Evaluations, z: np.ndarray, iterations: int = PROJECTION_ITERATIONS) -> Optional[np.ndarray]:

@@ -26,10 +26,13 @@ from excite_cli.optimization.optimality import (
     STILL_IMPROVING,
     TIME_BUDGET,
     Optimality,
+    clarke_optimality,
+    extreme_clusters,
     kkt_optimality,
     stop_reason,
 )
 from excite_cli.optimization.optimizer import repair
+from excite_cli.optimization.verify import finite_difference_gradient
 
 runner = CliRunner()
 
@@ -46,6 +49,56 @@ def test_kkt_residual_of_an_analytic_problem():
     # a multiplier of the wrong sign is not allowed: pushing into the constraint is not stationary
     wrong = kkt_optimality(np.array([-2.0, 0.0]), np.array([0.0]), np.array([[-1.0, 0.0]]))
     assert wrong.residual == pytest.approx(1.0)
+
+
+def test_clarke_residual_of_an_analytic_nonsmooth_problem():
+    """min λ_max([[x, y], [y, −x]]) + y/2 = √(x² + y²) + y/2, at (0, 0) where both eigenvalues are 0:
+    h_11 = x, h_22 = −x, h_12 = y (plus the smooth y/2 on the diagonal, which a trace-1 S keeps).
+    S = [[½, −¼], [−¼, ½]] ⪰ 0 gives 0; each eigenvalue's own gradient, (±1, ½), leaves 1 (KKT), and
+    their convex combinations (S diagonal) leave ½. Off the kink, (1, 0), the cluster is one value."""
+    cluster = np.array([[[1.0, 0.5], [0.0, 1.0]], [[0.0, 1.0], [-1.0, 0.5]]])
+    none, no_jacobian = np.zeros(0), np.zeros((0, 2))
+    at_kink = clarke_optimality([cluster], np.array([1.0, 0.5]), none, no_jacobian)
+    assert at_kink.residual == pytest.approx(0.0, abs=1e-7)
+    assert kkt_optimality(np.array([1.0, 0.5]), none, no_jacobian).residual == pytest.approx(1.0)
+    diagonal = cluster * np.eye(2)[:, :, None]  # S diagonal only: (S11 − S22, ½)
+    assert clarke_optimality([diagonal], np.array([1.0, 0.5]), none, no_jacobian).residual == pytest.approx(
+        0.5, abs=1e-7
+    )
+    # with a constraint −y ≤ 0 active, ν takes the y part: 0 with the diagonal alone too
+    jacobian = np.array([[0.0, -1.0]])
+    assert clarke_optimality([diagonal], np.array([1.0, 0.5]), np.array([0.0]), jacobian).residual < 1e-7
+
+
+def test_the_clusters_are_the_singular_values_near_an_extreme():
+    sigma = np.array([1.0, 1.005, 1.5, 3.0, 9.95, 10.0])
+    (top, w_top), (bottom, w_bottom) = extreme_clusters(sigma, (1.0, -1.0))
+    assert top.tolist() == [5, 4] and bottom.tolist() == [0, 1] and (w_top, w_bottom) == (1.0, -1.0)
+    assert [c[0].tolist() for c in extreme_clusters(sigma, (0.0, -1.0))] == [[0, 1]]  # E-optimality: σ_min
+
+
+def test_a_clusters_gradients_match_finite_differences_with_its_eigenvectors_held(ur5_problem):
+    """∇h_ab of h_ab = v_aᵀ CᵀC v_b / (2λ̄) with v held at α, against central differences of h_ab."""
+    problem = copy.deepcopy(ur5_problem)
+    problem.trajectory.harmonics, problem.trajectory.cost_samples = 3, 20
+    excitation = build_excitation(problem)
+    criterion = excitation.criterion()
+    alpha = excitation.limits.random_start(excitation.trajectory.n_coefficients, np.random.default_rng(3), 0.7)
+    indices = np.array([0, 1, 4])
+    gradients = criterion.cluster_gradients(alpha, indices)
+    C = criterion.regressor(alpha)
+    eig, V = np.linalg.eigh(C.T @ C)
+    V, mean = V[:, indices], eig[indices].mean()
+    for a, b in [(0, 0), (0, 2), (1, 2)]:
+
+        class Pair:  # h_ab with the eigenvectors of α, for the finite differences
+            def value(self, x):
+                rows = criterion.regressor(x)
+                return float(V[:, a] @ rows.T @ rows @ V[:, b] / (2 * mean))
+
+        fd = finite_difference_gradient(Pair(), alpha, step=1e-6, central=True)
+        assert np.linalg.norm(gradients[a, b] - fd) / np.linalg.norm(fd) < 1e-6
+    assert np.allclose(gradients[0, 2], gradients[2, 0])
 
 
 def test_stop_reasons():
