@@ -12,14 +12,13 @@ continuous joint (a revolute joint without a range) moves within one turn each w
 from __future__ import annotations
 
 import math
-import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 
-from excite_cli.dynamics.mjcf_source import is_mjcf, mjcf_couplings
+from excite_cli.dynamics.urdf_source import joint_couplings
 from excite_cli.errors import ExciteError
 
 #: Words that name a gripper's or a hand's joints, and a mobile base's wheels.
@@ -37,13 +36,6 @@ class JointChoice:
     held: dict[str, float]
     ranges: dict[str, list[float]] = field(default_factory=dict)
     assumptions: dict[str, str] = field(default_factory=dict)
-
-
-def followers(path: Path) -> set[str]:
-    """The joints of the URDF or MJCF at ``path`` that follow another."""
-    if is_mjcf(path):
-        return set(mjcf_couplings(path))
-    return {j.get("name") for j in ET.parse(path).getroot().iter("joint") if j.find("mimic") is not None}
 
 
 def gripper_joints(model: pin.Model, movable: list[str]) -> list[str]:
@@ -84,7 +76,7 @@ def joint_choice(path: Path, given: list[str] | None, model: pin.Model) -> Joint
             revolute joint to move (naming the joints there are).
     """
     one_dof = [n for i, n in enumerate(model.names) if i > 0 and model.joints[i].nq == 1]
-    mimics = followers(path)
+    mimics = set(joint_couplings(path))
     revolute = [n for n in one_dof if "R" in model.joints[model.getJointId(n)].shortname().replace("JointModel", "")]
     gripper = [] if given else gripper_joints(model, one_dof)
     bodies = {f.name for f in model.frames if f.type == pin.FrameType.BODY}

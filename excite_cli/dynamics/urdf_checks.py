@@ -129,13 +129,18 @@ def check_joints(root: ElementTree.Element, active: list[str], locked: list[str]
         if lower > upper and joints[name].get("type") != "continuous":
             problem = f"joint '{name}' has lower limit {lower:g} above upper {upper:g}"
             raise ExciteError("robot.urdf", problem, None, "lower ≤ upper")
+    check_couplings(urdf_couplings(root), active, locked)
+
+
+def urdf_couplings(root: ElementTree.Element) -> dict[str, tuple[str, str]]:
+    """{follower: (leader, how, in words)} of the URDF's ``<mimic>`` joints (its ``root`` element)."""
     couplings = {}
-    for name, joint in joints.items():
+    for joint in root.iter("joint"):
         mimic = joint.find("mimic")
         if mimic is not None:
             how = f"multiplier {mimic.get('multiplier', '1')}, offset {mimic.get('offset', '0')}"
-            couplings[name] = (mimic.get("joint"), how)
-    check_couplings(couplings, active, locked)
+            couplings[joint.get("name")] = (mimic.get("joint"), how)
+    return couplings
 
 
 def check_couplings(couplings: dict[str, tuple[str, str]], active: list[str], locked: list[str] = ()) -> None:

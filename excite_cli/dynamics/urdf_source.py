@@ -16,7 +16,8 @@ import numpy as np
 import pinocchio as pin
 
 from excite_cli.config import RobotConfig, resolve_path
-from excite_cli.dynamics.mjcf_source import is_mjcf, mjcf_geometry, mjcf_model
+from excite_cli.dynamics.mjcf_source import is_mjcf, mjcf_couplings, mjcf_geometry, mjcf_model
+from excite_cli.dynamics.urdf_checks import urdf_couplings
 from excite_cli.dynamics.urdf_meshes import collision_geometry, package_folders
 from excite_cli.errors import ExciteError
 from excite_cli.inputs import input_file
@@ -113,6 +114,12 @@ def robot_geometry(model: pin.Model, path: Path, package_dirs: list[str]) -> pin
         ExciteError: see :func:`~excite_cli.dynamics.urdf_meshes.collision_geometry`, :func:`mjcf_geometry`.
     """
     return mjcf_geometry(model, path) if is_mjcf(path) else collision_geometry(model, path, package_dirs)
+
+
+def joint_couplings(path: Path) -> dict[str, tuple[str, str]]:
+    """{follower: (leader, how, in words)} of the joints of the URDF or MJCF at ``path`` that follow
+    another (a ``<mimic>``, a joint equality)."""
+    return mjcf_couplings(path) if is_mjcf(path) else urdf_couplings(ElementTree.parse(path).getroot())
 
 
 def apply_joint_ranges(model: pin.Model, ranges: dict[str, tuple[float, float]], file_name: str) -> None:
