@@ -6,9 +6,12 @@ baseline (the same number of random feasible starts, each the start the optimize
 Then, for 5 noise seeds:
 
 - measurements: every trajectory of the sequence sampled at 100 Hz over its duration, torques from
-  pinocchio's RNEA with the URDF's inertias plus white noise of 2 % of each joint's RMS torque on the
-  unseen motion (a sensor's noise does not depend on the motion, so every criterion gets the same);
-- identification: weighted least squares of the base parameters on all of them (weights 1/σ_j);
+  pinocchio's RNEA with the URDF's inertias plus white noise: ``--noise absolute`` (default) 2 % of
+  each joint's RMS torque on the unseen motion (a torque sensor's noise does not depend on the motion,
+  so every criterion gets the same); ``--noise relative`` σ_j(t) = √(s_j² + (0.02 τ_j(t))²), a noise
+  growing with the torque (a motor current's) with a floor s_j of 0.2 % of that RMS, and every
+  criterion designs for it (the config's ``noise: {absolute: s_j, relative: 0.02}``);
+- identification: weighted least squares of the base parameters on all of them (weights 1/σ);
 - parameter error: the RMS over the b identifiable directions of L⁻¹(β̂ − β), the error in an
   orthonormal basis of the identifiable subspace of the standard parameters each scaled by its URDF
   magnitude (:mod:`excite_cli.optimization.information`; a value of 1 is an error as large as the
@@ -24,7 +27,7 @@ Printed per criterion: cond(C) on the base columns and cond(C L) (the condition 
 not depend on the base columns) after the last iteration, ē, the mean errors over the noise seeds
 and the optimization's wall time.
 
-Run: `.venv/bin/python bench/criteria.py [CONFIG ...] [--criteria OBJECTIVE:SCALING ...] [--seeds S ...]`
+Run: `.venv/bin/python bench/criteria.py [CONFIG ...] [--criteria OBJECTIVE:SCALING ...] [--seeds S ...] [--noise absolute|relative]`
 (default the G1 arms and the Panda with joint limits, every criterion and random, seed 0; figures are
 means over the seeds). Asserts nothing.
 """
@@ -41,6 +44,7 @@ from pathlib import Path
 
 import numpy as np
 
+from excite_cli.config import NoiseConfig
 from excite_cli.config_file import load_problem
 from excite_cli.optimization.criterion import condition_number
 from excite_cli.optimization.engine import Engine, default_workers
@@ -59,7 +63,8 @@ CRITERIA = (
 )
 DEFAULT_CONFIGS = [ROOT / "configs" / "g1_arms.yaml", ROOT / "configs" / "panda_joint_limits.yaml"]
 RATE = 100.0  # Hz
-NOISE = 0.02  # of each joint's RMS torque on the unseen motion
+NOISE = 0.02  # of each joint's RMS torque on the unseen motion (absolute), or of the torque (relative)
+FLOOR = 0.002  # the relative noise's floor, of each joint's RMS torque on the unseen motion
 SEEDS = 5
 UNSEEN_SEED = 12345
 
@@ -73,16 +78,26 @@ def samples(excitation, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return Y, np.array([robot.torques(*x) for x in zip(Q, QD, QDD)])
 
 
-def in_the_loop(excitation, alphas: list[np.ndarray], unseen: np.ndarray) -> tuple[float, float, float, float]:
+def noise_scale(excitation, relative: bool) -> tuple[np.ndarray, float]:
+    """The absolute noise (n,) [Nm] and the part relative to the torque [1] of the measurements."""
+    _, tau_unseen = samples(excitation, excitation.random_start(np.random.default_rng(UNSEEN_SEED)))
+    rms = np.sqrt((tau_unseen**2).mean(axis=0))
+    return (FLOOR * rms, NOISE) if relative else (NOISE * rms, 0.0)
+
+
+def in_the_loop(
+    excitation, alphas: list[np.ndarray], unseen: np.ndarray, relative: bool
+) -> tuple[float, float, float, float]:
     """Mean over noise seeds of the RMS and largest scaled parameter error, and the unseen torque error;
     and the RMS parameter error the noise gives on average (predicted, no noise drawn)."""
     truth = excitation.base.from_standard(excitation.robot.urdf_parameters())
     Y_unseen, tau_unseen = samples(excitation, unseen)
-    sigma = NOISE * np.sqrt((tau_unseen**2).mean(axis=0))  # (n,)
+    absolute, rho = noise_scale(excitation, relative)
     data = [samples(excitation, a) for a in alphas]
     Y = np.vstack([y for y, _ in data])
     tau = np.vstack([t for _, t in data])
-    weights = np.tile(1.0 / sigma, tau.shape[0])
+    sigma = np.sqrt(absolute**2 + (rho * tau) ** 2)  # (samples, n)
+    weights = 1.0 / sigma.ravel()
     inverse_frame = np.linalg.inv(excitation.scaled_frame)
     covariance = inverse_frame @ np.linalg.inv((Y * weights[:, None]).T @ (Y * weights[:, None])) @ inverse_frame.T
     expected = float(np.sqrt(np.trace(covariance) / covariance.shape[0]))
@@ -98,11 +113,14 @@ def in_the_loop(excitation, alphas: list[np.ndarray], unseen: np.ndarray) -> tup
     return float(np.mean(rms)), float(np.mean(worst)), float(np.mean(torque)), expected
 
 
-def run(config: Path, objective: str, scaling: str, seed: int) -> tuple:
-    """The sequence of one criterion (or the random starts) with optimizer seed ``seed``, its figures
-    and its wall time."""
+def run(config: Path, objective: str, scaling: str, seed: int, relative: bool) -> tuple:
+    """The sequence of one criterion (or the random starts) with optimizer seed ``seed``, designed for
+    the ``relative`` noise when asked, its figures and its wall time."""
     problem = load_problem(config)
     problem.optimizer.objective, problem.optimizer.scaling, problem.optimizer.seed = objective, scaling, seed
+    if relative:
+        absolute, rho = noise_scale(build_excitation(problem), relative)
+        problem.noise = NoiseConfig(absolute=dict(zip(problem.robot.active_joints, absolute.tolist())), relative=rho)
     excitation = build_excitation(problem)
     begin = time.perf_counter()
     iterations = problem.sequence.iterations
@@ -117,7 +135,7 @@ def run(config: Path, objective: str, scaling: str, seed: int) -> tuple:
     C = np.vstack([excitation.criterion(objective="log_cond", scaling="none").regressor(a) for a in alphas])
     unseen = excitation.random_start(np.random.default_rng(UNSEEN_SEED))
     figures = (condition_number(C), excitation.scaled_condition_number(C), excitation.excitation_level(C))
-    return (*figures, *in_the_loop(excitation, alphas, unseen), wall)
+    return (*figures, *in_the_loop(excitation, alphas, unseen, relative), wall)
 
 
 def main() -> None:
@@ -125,13 +143,15 @@ def main() -> None:
     parser.add_argument("configs", type=Path, nargs="*", default=DEFAULT_CONFIGS)
     parser.add_argument("--criteria", nargs="+", default=[f"{o}:{s}" for o, s in CRITERIA] + ["random:none"])
     parser.add_argument("--seeds", type=int, nargs="+", default=[0])
+    parser.add_argument("--noise", choices=("absolute", "relative"), default="absolute")
     args = parser.parse_args()
+    relative = args.noise == "relative"
     header = f"{'criterion':<22} {'cond(C)':>8} {'cond(CL)':>9} {'e [Nm]':>8} {'param err RMS':>14} {'worst dir.':>11} {'unseen torque':>14} {'predicted':>10} {'wall [s]':>9}"
     for config in args.configs:
-        print(f"\n{config.name}, optimizer seeds {args.seeds} (means)\n{header}")
+        print(f"\n{config.name}, {args.noise} noise, optimizer seeds {args.seeds} (means)\n{header}")
         for criterion in args.criteria:
             objective, scaling = criterion.split(":")
-            rows = np.array([run(config, objective, scaling, seed) for seed in args.seeds])
+            rows = np.array([run(config, objective, scaling, seed, relative) for seed in args.seeds])
             cond, scaled, level, rms, worst, torque, predicted, wall = rows.mean(axis=0)
             label = objective if objective in ("random", "log_det") else f"{objective}, {scaling}"
             print(
