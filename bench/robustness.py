@@ -1,7 +1,7 @@
-"""Does `excite optimize` end every restart at a result, on any arm and any seed? The sequential
-generation of each robot's config (its iterations, restarts and screening) with excite's default
-criterion, whatever the config names (the Panda's and UR5's name the paper's log cond), for several
-seeds, on every core.
+"""Does `excite optimize` end every restart at a result, on any arm, any seed and any criterion? The
+sequential generation of each robot's config (its iterations, restarts and screening) with excite's
+default criterion, whatever the config names (the Panda's and UR5's name the paper's log cond), or
+each criterion given (`--criteria`), for several seeds, on every core.
 
 Robots: the shipped G1 arms, Panda, UR5 and UR10 with a lab's limits (configs/ur10_lab.yaml), and the
 configs `excite init` writes for the UR10, UR3, xArm 7 and Unitree Z1 of example-robot-data, as it
@@ -9,8 +9,9 @@ writes them. Printed per robot:
 
 - failed: restarts (every start, screened ones included) whose solver failed, or that ended at their
   start or a bisection towards it (`RestartResult.succeeded` false), of all restarts;
-- converged: kept restarts (one per iteration) whose end point meets optimizer.optimality_tolerance
-  (KKT residual), of all kept; and the largest KKT residual of a kept restart;
+- converged: kept restarts (one per iteration, every iteration) whose end point meets
+  optimizer.optimality_tolerance (the KKT residual, or Clarke's where cond's or σ_min's extreme singular
+  values are multiple), of all kept; and the largest residual of a kept restart;
 - spread: how much worse the last iteration's criterion (of the stacked regressor) is on the worst
   seed than on the best, in singular values of C: for log det (−log det(CᵀC)/b, of σ²) the ratio of
   the geometric means of σ (that of the excitation ē), exp(Δ/2), for log cond that of cond(C),
@@ -18,10 +19,10 @@ writes them. Printed per robot:
 - worst novelty: the largest correlation of an iteration's motion with an earlier one's;
 - wall: mean wall time of one seed's run.
 
-One line per robot: `robust ROBOT: failed F of R restarts, converged C of K kept, spread S %, worst
-novelty N, wall W s`.
+One line per robot and criterion: `robust ROBOT (CRITERION): failed F of R restarts, converged C of K
+kept, spread S %, worst novelty N, wall W s`.
 
-    .venv/bin/python bench/robustness.py [--robots G1 "UR10 lab" ...] [--seeds 0 1 ...]
+    .venv/bin/python bench/robustness.py [--robots G1 "UR10 lab" ...] [--seeds 0 1 ...] [--criteria log_det log_cond ...]
 
 Asserts nothing. The identification of each seed's trajectories is bench/criteria.py's measure:
 `bench/criteria.py configs/ur10_lab.yaml --criteria log_det:none log_cond:none --seeds 0 1 2 3 4`.
@@ -44,6 +45,7 @@ import numpy as np
 
 from excite_cli.config import OptimizerConfig
 from excite_cli.config_file import load_problem
+from excite_cli.criteria import NAMES
 from excite_cli.optimization.engine import Engine, default_workers
 from excite_cli.optimization.excitation import build_excitation
 from excite_cli.optimization.optimality import CONVERGED
@@ -75,14 +77,14 @@ def config_of(robot: str, folder: Path) -> Path:
     return path
 
 
-def run_robot(robot: str, config: Path, seeds: list[int]) -> str:
-    """The robot's line (module docstring), after one row per seed."""
+def run_robot(robot: str, config: Path, seeds: list[int], objective: str = DEFAULT_OBJECTIVE) -> str:
+    """The robot's line with the criterion ``objective`` (module docstring), after one row per seed."""
     restarts = failed = converged = kept = 0
     worst_kkt, worst_correlation, values, walls = 0.0, -1.0, [], []
     for seed in seeds:
         problem = load_problem(config)
         problem.optimizer.seed = seed
-        problem.optimizer.objective = DEFAULT_OBJECTIVE
+        problem.optimizer.objective = objective
         excitation = build_excitation(problem)
         workers = min(default_workers(), problem.optimizer.screened or problem.optimizer.restarts)
         begin = time.perf_counter()
@@ -99,7 +101,7 @@ def run_robot(robot: str, config: Path, seeds: list[int]) -> str:
                 worst_correlation = max(worst_correlation, r.max_correlation)
         values.append(results[-1].best.objective)
         print(
-            f"  {robot} seed {seed}: criterion {values[-1]:.4f}, kept KKT "
+            f"  {robot} ({objective}) seed {seed}: criterion {values[-1]:.4f}, kept KKT "
             f"{' '.join(f'{r.best.optimality.residual:.1e}' for r in results)}, stops "
             f"{', '.join(r.stop for r in results)}, correlations "
             f"{' '.join(f'{r.max_correlation:.2f}' for r in results[1:])}, {walls[-1]:.0f} s",
@@ -108,7 +110,7 @@ def run_robot(robot: str, config: Path, seeds: list[int]) -> str:
     power = 0.5 if problem.optimizer.objective == "log_det" else 1.0  # log det is of σ², the others of σ
     spread = 100.0 * (np.exp(power * (max(values) - min(values))) - 1.0)
     return (
-        f"robust {robot}: failed {failed} of {restarts} restarts, converged {converged} of {kept} kept "
+        f"robust {robot} ({objective}): failed {failed} of {restarts} restarts, converged {converged} of {kept} kept "
         f"(largest KKT {worst_kkt:.1e}), spread {spread:.1f} %, worst novelty {worst_correlation:.2f}, "
         f"wall {np.mean(walls):.0f} s"
     )
@@ -118,9 +120,11 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--robots", nargs="+", default=[*SHIPPED, *INIT], choices=[*SHIPPED, *INIT])
     parser.add_argument("--seeds", type=int, nargs="+", default=list(range(10)))
+    parser.add_argument("--criteria", nargs="+", default=[DEFAULT_OBJECTIVE], choices=NAMES)
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as folder:
-        lines = [run_robot(robot, config_of(robot, Path(folder)), args.seeds) for robot in args.robots]
+        configs = {robot: config_of(robot, Path(folder)) for robot in args.robots}
+        lines = [run_robot(r, configs[r], args.seeds, o) for r in args.robots for o in args.criteria]
     print("\n".join(lines))
 
 

@@ -40,7 +40,7 @@ def _small(path, **optimizer) -> None:
     """The config at ``path`` with a short trajectory and one short restart (a test's budget)."""
     config = yaml.safe_load(path.read_text())
     config["trajectory"].update(harmonics=3, cost_samples=25, cost_period=0.4)
-    config["optimizer"] = {"max_iterations": 30, "restarts": 1, "workers": 1, **optimizer}
+    config["optimizer"] = {"max_iterations": 10, "restarts": 1, "workers": 1, **optimizer}
     path.write_text(yaml.safe_dump(config))
 
 
