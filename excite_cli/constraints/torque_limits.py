@@ -86,7 +86,8 @@ class TorqueLimits(Constraint):
             "max_violation_torque_Nm": float(np.max(np.abs(use * self.limit) - self.limit)),
             "max_torque_use": float(use.max()),
         }
-        where = f"torque of joint {j + 1} at {use[t, j]:.3f} of its limit (t = {time[t]:.2f} s)"
+        joint = self.robot.joint_names[j]
+        where = f"torque of joint '{joint}' at {use[t, j]:.3f} of its limit (t = {time[t]:.2f} s)"
         return FineCheck(max_violation=float(use.max() - 1.0), details=details, where=where)
 
     def track(self, alpha: np.ndarray, basis: FourierBasis) -> dict[str, np.ndarray]:

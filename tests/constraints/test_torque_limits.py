@@ -2,6 +2,8 @@
 the Jacobian of pinocchio's RNEA derivatives; checked against central differences and against
 pinocchio's RNEA of the exported motion, computed here from the URDF independently."""
 
+import re
+
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -70,7 +72,10 @@ def test_a_home_posture_beyond_the_torque_limits_stops_before_optimizing(tmp_pat
     config = yaml.safe_load((CONFIGS / "smoke.yaml").read_text())
     config["limits"]["torque"] = 0.01  # gravity alone needs more on the shoulder
     (tmp_path / "weak.yaml").write_text(yaml.safe_dump(config))
-    assert_refused(tmp_path, ["optimize", str(tmp_path / "weak.yaml")], "limits.torque: violated before optimization")
+    line = assert_refused(
+        tmp_path, ["optimize", str(tmp_path / "weak.yaml")], "limits.torque: violated before optimization"
+    )
+    assert re.search(r"torque of joint 'panda_joint\d' at", line)  # named as the config names it (was "joint 6")
 
 
 @pytest.mark.parametrize(
