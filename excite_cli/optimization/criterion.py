@@ -33,6 +33,7 @@ import numpy as np
 import pinocchio as pin
 
 from excite_cli.criteria import CRITERIA, CriterionRecord
+from excite_cli.criteria.record import RANK_FLOOR
 from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.dynamics.effect_columns import EffectColumns
 from excite_cli.dynamics.robot import Robot
@@ -176,6 +177,17 @@ class Criterion:
     def singular_values(self, alpha: np.ndarray) -> np.ndarray:
         """σ (b,) of C (of C L with the frame), ascending, from the eigenvalues of CᵀC."""
         return np.sqrt(np.maximum(np.linalg.eigvalsh(self._gram(self._motion(alpha)[3])), 0.0))
+
+    def log_singular_values(self, alpha: np.ndarray, indices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """log σ_i (k,) of C (of C L with the frame) for the singular values ``indices`` (k,) (ascending
+        order), and their gradients in α (k, n, 2N+1): ∂ log σ_i = v_iᵀ Cᵀ∂C v_i / λ_i (Eq. 17's terms one
+        at a time; a multiple σ_i has the gradient of the eigenbasis numpy returns). λ is floored as the
+        criterion floors it (:data:`~excite_cli.criteria.record.RANK_FLOOR`): rank loss gives finite values."""
+        motion = self._motion(alpha)
+        eig, V = np.linalg.eigh(self._gram(motion[3]))
+        lam = np.maximum(eig[indices], max((RANK_FLOOR**2) * eig[-1], np.finfo(float).tiny))
+        gradients = np.array([self._chained(motion, V[:, [i]], np.array([1.0 / x])) for i, x in zip(indices, lam)])
+        return 0.5 * np.log(lam), gradients.reshape(len(indices), *alpha.shape)
 
     def cluster_gradients(self, alpha: np.ndarray, indices: np.ndarray) -> np.ndarray:
         """The gradients in α (k, k, n, 2N+1) of h_ab = v_aᵀ (CᵀC) v_b / (2 λ̄) for the eigenvectors

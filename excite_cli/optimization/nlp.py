@@ -1,6 +1,7 @@
 """The optimization problem as a solver sees it: the criterion and the stacked constraints in the
-optimizer's variables z (:mod:`excite_cli.trajectory.boundary`), each evaluated once per point, and
-the feasible point nearest to a solver's iterate."""
+optimizer's variables z (:mod:`excite_cli.trajectory.boundary`), each evaluated once per point; the
+epigraph form of a criterion of the extreme singular values; and the feasible point nearest to a
+solver's iterate."""
 
 from __future__ import annotations
 
@@ -10,12 +11,24 @@ import numpy as np
 from scipy.optimize import minimize
 
 from excite_cli.constraints import Constraint, accepted
+from excite_cli.criteria.record import RANK_FLOOR
 from excite_cli.optimization.criterion import Criterion
-from excite_cli.optimization.optimality import Optimality, clarke_optimality, extreme_clusters, kkt_optimality
+from excite_cli.optimization.optimality import (
+    CLUSTER_SIZE,
+    Optimality,
+    clarke_optimality,
+    extreme_clusters,
+    kkt_optimality,
+)
 from excite_cli.trajectory.boundary import BoundaryConditions
 
 #: SLSQP iterations of the projection onto the feasible set (it converges in 10-50 on the G1 problem).
 PROJECTION_ITERATIONS = 60
+#: Singular values at each extreme the epigraph form bounds (one solver constraint each).
+EPIGRAPH_SIZE = CLUSTER_SIZE
+#: A bound's gradient is computed (a pass of RNEA derivatives) where its log σ is within this [1] of
+#: its extreme; a farther one is inactive by more than that, and its row of the Jacobian is zero.
+EPIGRAPH_BAND = 0.05
 
 
 class Evaluations:
@@ -110,6 +123,79 @@ class Evaluations:
             pieces.append(scale * weight * self.boundary.chain(gradients.reshape(k * k, -1)).reshape(k, k, -1))
         clarke = clarke_optimality(pieces, self.gradient(z), *self.constraints(z))
         return clarke if clarke.residual < smooth.residual else smooth
+
+
+class Epigraph:
+    """The epigraph form of a criterion of the extreme singular values (cond, log cond, E-optimality:
+    :attr:`~excite_cli.criteria.record.CriterionRecord.extremes` = (w_max, w_min)), smooth where the
+    criterion is not (shared/DESIGN.md, "Optimizing cond is non-smooth"), in the variables w = (z, t):
+
+        minimize Σ_k w_k t_k  s.t.  g(z) ≤ 0,  log σ_i(z) ≤ t_max for the ``EPIGRAPH_SIZE`` largest σ_i,
+                                               log σ_i(z) ≥ t_min for the ``EPIGRAPH_SIZE`` smallest
+
+    (an extreme weighed zero has no t). At a solution t_max = log σ_max and t_min = log σ_min, the
+    objective is w_max log σ_max + w_min log σ_min (log cond; cond is its exponential, with the same
+    minimizers), and its KKT conditions are Clarke's for the criterion: the bounds' multipliers weigh
+    the singular values' gradients (Overton 1992). The solver sees this problem; everything else z.
+    """
+
+    def __init__(self, problem: Evaluations):
+        self.problem = problem
+        self.sides = [(side, weight) for side, weight in enumerate(problem.criterion.objective.extremes) if weight]
+
+    def start(self, z: np.ndarray) -> np.ndarray:
+        """w (n_z + sides,) at z (n_z,): each t at its extreme log σ."""
+        logs = np.log(self._singular_values(z))
+        return np.concatenate([z, [logs[-1] if side == 0 else logs[0] for side, _ in self.sides]])
+
+    def _singular_values(self, z: np.ndarray) -> np.ndarray:
+        sigma = self.problem.criterion.singular_values(self.problem.boundary.to_alpha(z))
+        return np.maximum(sigma, max(RANK_FLOOR * sigma[-1], np.finfo(float).tiny))  # as the criterion floors σ
+
+    def value(self, w: np.ndarray) -> float:
+        return float(sum(weight * t for (_, weight), t in zip(self.sides, w[-len(self.sides) :])))
+
+    def gradient(self, w: np.ndarray) -> np.ndarray:
+        return np.concatenate([np.zeros(w.size - len(self.sides)), [weight for _, weight in self.sides]])
+
+    def _bounds(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The bounded singular values' log σ_i (m_e,), their gradients in z (m_e, n_z), each bound's
+        side (m_e,) and sign (+1: log σ_i ≤ t, −1: log σ_i ≥ t)."""
+
+        def compute():
+            logs = np.log(self._singular_values(z))
+            count = min(EPIGRAPH_SIZE, logs.size)
+            indices, sides, signs = [], [], []
+            for k, (side, _) in enumerate(self.sides):
+                indices.append(np.arange(logs.size - 1, logs.size - 1 - count, -1) if side == 0 else np.arange(count))
+                sides.append(np.full(count, k))
+                signs.append(np.full(count, 1.0 if side == 0 else -1.0))
+            indices, sides, signs = np.concatenate(indices), np.concatenate(sides), np.concatenate(signs)
+            extreme = np.where(signs > 0, logs[-1], logs[0])
+            near = np.unique(indices[np.abs(logs[indices] - extreme) <= EPIGRAPH_BAND])
+            gradients = np.zeros((indices.size, z.size))
+            if near.size:
+                _, alpha_gradients = self.problem.criterion.log_singular_values(self.problem.boundary.to_alpha(z), near)
+                chained = self.problem.boundary.chain(alpha_gradients.reshape(near.size, -1))
+                for row, i in enumerate(near):
+                    gradients[indices == i] = chained[row]
+            return logs[indices], gradients, sides, signs
+
+        return self.problem._once("epigraph", z, compute)
+
+    def constraint_values(self, w: np.ndarray) -> np.ndarray:
+        z, t = w[: -len(self.sides)], w[-len(self.sides) :]
+        logs, _, sides, signs = self._bounds(z)
+        return np.concatenate([self.problem.constraint_values(z), signs * (logs - t[sides])])
+
+    def constraint_jacobian(self, w: np.ndarray) -> np.ndarray:
+        z = w[: -len(self.sides)]
+        _, gradients, sides, signs = self._bounds(z)
+        jacobian = self.problem.constraint_jacobian(z)
+        bounds_t = np.zeros((sides.size, len(self.sides)))
+        bounds_t[np.arange(sides.size), sides] = -signs
+        top = np.hstack([jacobian, np.zeros((jacobian.shape[0], len(self.sides)))])
+        return np.vstack([top, np.hstack([signs[:, None] * gradients, bounds_t])])
 
 
 def project(problem: Evaluations, z: np.ndarray, iterations: int = PROJECTION_ITERATIONS) -> Optional[np.ndarray]:

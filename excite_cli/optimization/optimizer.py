@@ -2,7 +2,9 @@
 
 The solver (``optimizer.method``, :mod:`excite_cli.optimization.solvers`) works on the optimizer's variables z
 (boundary conditions met exactly, preconditioned); the criterion and every constraint supply
-analytic gradients. Quasi-Newton iterates of this problem approach the constraint boundary from
+analytic gradients; a criterion of the extreme singular values (cond, log cond, E-optimality) is
+solved in its epigraph form (:class:`~excite_cli.optimization.nlp.Epigraph`), smooth where the
+criterion has a kink at its optimum. Quasi-Newton iterates of this problem approach the constraint boundary from
 outside (on the G1 problem SLSQP's iterates stay up to 3 cm outside the CoM region for most of
 the run), so a restart ends at the feasible point nearest to the solver's last iterate
 (:func:`~excite_cli.optimization.nlp.project`): what the restart found is then judged by a point
@@ -13,7 +15,7 @@ and an honest stop reason.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Callable, Optional, Sequence
 
 import numpy as np
@@ -22,7 +24,7 @@ from excite_cli.config import OptimizerConfig
 from excite_cli.constraints import Constraint, accepted, farthest_accepted
 from excite_cli.constraints.lse import GRID_MARGIN
 from excite_cli.optimization.criterion import Criterion
-from excite_cli.optimization.nlp import Evaluations, project
+from excite_cli.optimization.nlp import Epigraph, Evaluations, project
 from excite_cli.optimization.optimality import INFEASIBLE, SOLVER_FAILED, Optimality, stop_reason
 from excite_cli.optimization.solvers import solve
 from excite_cli.trajectory.boundary import BoundaryConditions
@@ -195,14 +197,20 @@ def optimize_restart(
             progress(index, len(history), history[-1][0])
 
     deadline = begin + (np.inf if time_limit is None else time_limit)
+    z0 = boundary.to_variables(start)
+    until_done = _until_done(problem, on_iterate, options.optimality_tolerance, deadline)
+    # a criterion of the extreme singular values is solved in its epigraph form (smooth where it is not)
+    nlp = Epigraph(problem) if criterion.objective.extremes else problem
+    w0 = nlp.start(z0) if isinstance(nlp, Epigraph) else z0
     run = solve(
         options.method,
-        problem,
-        boundary.to_variables(start),
+        nlp,
+        w0,
         max_iterations or options.max_iterations,
         options.tolerance,
-        _until_done(problem, on_iterate, options.optimality_tolerance, deadline),
+        lambda w: until_done(w[: z0.size]),
     )
+    run = replace(run, z=run.z[: z0.size])
     out_of_time = time.perf_counter() > deadline
     if len(history) < run.iterations:  # a solver that ends inside an iteration calls back no more: its last iterate
         on_iterate(run.z)

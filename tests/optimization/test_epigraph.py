@@ -1,0 +1,63 @@
+"""The epigraph form of the paper's criterion: its bounds' Jacobian against finite differences, and a
+log cond restart that ends at a point where the extreme singular values are multiple (a kink, where
+no gradient vanishes) and is Clarke-stationary there."""
+
+import copy
+
+import numpy as np
+from conftest import UR5, write_config
+
+from excite_cli.config_file import load_problem
+from excite_cli.optimization import nlp
+from excite_cli.optimization.excitation import build_excitation
+from excite_cli.optimization.nlp import Epigraph, Evaluations
+from excite_cli.optimization.optimality import CONVERGED, extreme_clusters
+from excite_cli.optimization.restarts import RestartTask
+
+
+def _small_ur5(tmp_path, objective: str):
+    data = copy.deepcopy(UR5)
+    data["trajectory"].update(harmonics=3, cost_samples=20, cost_period=0.4, constraint_period=0.05)
+    data["optimizer"] = {"objective": objective, "max_iterations": 400, "seed": 1, "workers": 1}
+    return build_excitation(load_problem(write_config(tmp_path, data)))
+
+
+def test_the_bounds_jacobian_matches_finite_differences(tmp_path, monkeypatch):
+    monkeypatch.setattr(nlp, "EPIGRAPH_BAND", np.inf)  # every bound's gradient, far ones too
+    excitation = _small_ur5(tmp_path, "log_cond")
+    criterion = excitation.criterion()
+    alpha = excitation.random_start(np.random.default_rng(2))
+    evaluations = Evaluations(criterion, excitation.constraints, excitation.boundary, criterion.value(alpha))
+    epigraph = Epigraph(evaluations)
+    z = excitation.boundary.to_variables(alpha)
+    w = epigraph.start(z)
+    sigma = criterion.singular_values(alpha)
+    assert np.allclose(w[-2:], np.log([sigma[-1], sigma[0]]))  # t_max, t_min at the extremes
+    assert np.isclose(epigraph.value(w), criterion.value(alpha), rtol=1e-9)  # log cond
+    w = w + np.r_[np.zeros(z.size), 0.1, -0.1]  # the bounds off their extremes
+    jacobian = epigraph.constraint_jacobian(w)
+    step = 1e-6
+    for k in range(w.size):
+        e = np.zeros(w.size)
+        e[k] = step
+        fd = (epigraph.constraint_values(w + e) - epigraph.constraint_values(w - e)) / (2 * step)
+        assert np.allclose(jacobian[:, k], fd, rtol=1e-5, atol=1e-6 * np.abs(jacobian).max()), k
+    values = epigraph.constraint_values(w)
+    assert values[-nlp.EPIGRAPH_SIZE * 2 :].max() < 0.0  # t_max above log σ_max, t_min below log σ_min
+
+
+def test_a_log_cond_restart_ends_clarke_stationary_at_a_kink(tmp_path):
+    """At its end point the largest and smallest singular values are multiple, the smooth KKT
+    residual there stays far above the tolerance (no gradient of one eigenbasis vanishes), and
+    Clarke's measure meets it: the restart converged at the non-smooth optimum."""
+    excitation = _small_ur5(tmp_path, "log_cond")
+    tolerance = excitation.problem.optimizer.optimality_tolerance
+    criterion = excitation.criterion()
+    result = RestartTask(1, 0, 1, np.zeros((0, excitation.base.count)))(excitation)
+    assert result.succeeded and result.stop == CONVERGED and result.optimality.residual <= tolerance
+    clusters = extreme_clusters(criterion.singular_values(result.alpha), (1.0, -1.0))
+    assert max(len(indices) for indices, _ in clusters) >= 2
+    evaluations = Evaluations(criterion, excitation.constraints, excitation.boundary, result.objective)
+    z = excitation.boundary.to_variables(result.alpha)
+    assert evaluations.kkt(z, nonsmooth=False).residual > 10 * tolerance
+    assert evaluations.kkt(z).residual <= tolerance
