@@ -9,8 +9,9 @@ Then, for 5 noise seeds:
   pinocchio's RNEA with the URDF's inertias plus white noise: ``--noise absolute`` (default) 2 % of
   each joint's RMS torque on the unseen motion (a torque sensor's noise does not depend on the motion,
   so every criterion gets the same); ``--noise relative`` σ_j(t) = √(s_j² + (0.02 τ_j(t))²), a noise
-  growing with the torque (a motor current's) with a floor s_j of 0.2 % of that RMS, and every
-  criterion designs for it (the config's ``noise: {absolute: s_j, relative: 0.02}``);
+  growing with the torque (a motor current's) with a floor s_j of 0.2 % of that RMS; every criterion
+  designs for the noise of the measurements, as a lab declares its sensor (the config's
+  ``noise: {absolute: s_j, relative: 0 or 0.02}``);
 - identification: weighted least squares of the base parameters on all of them (weights 1/σ);
 - parameter error: the RMS over the b identifiable directions of L⁻¹(β̂ − β), the error in an
   orthonormal basis of the identifiable subspace of the standard parameters each scaled by its URDF
@@ -115,12 +116,11 @@ def in_the_loop(
 
 def run(config: Path, objective: str, scaling: str, seed: int, relative: bool) -> tuple:
     """The sequence of one criterion (or the random starts) with optimizer seed ``seed``, designed for
-    the ``relative`` noise when asked, its figures and its wall time."""
+    the noise of the measurements (absolute, or ``relative``), its figures and its wall time."""
     problem = load_problem(config)
     problem.optimizer.objective, problem.optimizer.scaling, problem.optimizer.seed = objective, scaling, seed
-    if relative:
-        absolute, rho = noise_scale(build_excitation(problem), relative)
-        problem.noise = NoiseConfig(absolute=dict(zip(problem.robot.active_joints, absolute.tolist())), relative=rho)
+    absolute, rho = noise_scale(build_excitation(problem), relative)
+    problem.noise = NoiseConfig(absolute=dict(zip(problem.robot.active_joints, absolute.tolist())), relative=rho)
     excitation = build_excitation(problem)
     begin = time.perf_counter()
     iterations = problem.sequence.iterations

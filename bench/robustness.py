@@ -22,7 +22,7 @@ writes them. Printed per robot:
 One line per robot and criterion: `robust ROBOT (CRITERION): failed F of R restarts, converged C of K
 kept, spread S %, worst novelty N, wall W s`.
 
-    .venv/bin/python bench/robustness.py [--robots G1 "UR10 lab" ...] [--seeds 0 1 ...] [--criteria log_det log_cond ...]
+    .venv/bin/python bench/robustness.py [--robots G1 "UR10 lab" ...] [--seeds 0 1 ...] [--criteria log_det log_trace_inverse:urdf ...]
 
 Asserts nothing. The identification of each seed's trajectories is bench/criteria.py's measure:
 `bench/criteria.py configs/ur10_lab.yaml --criteria log_det:none log_cond:none --seeds 0 1 2 3 4`.
@@ -77,14 +77,17 @@ def config_of(robot: str, folder: Path) -> Path:
     return path
 
 
-def run_robot(robot: str, config: Path, seeds: list[int], objective: str = DEFAULT_OBJECTIVE) -> str:
-    """The robot's line with the criterion ``objective`` (module docstring), after one row per seed."""
+def run_robot(robot: str, config: Path, seeds: list[int], criterion: str = DEFAULT_OBJECTIVE) -> str:
+    """The robot's line with ``criterion``, ``OBJECTIVE`` or ``OBJECTIVE:SCALING`` (the config's scaling
+    unless given; module docstring), after one row per seed."""
+    objective, _, scaling = criterion.partition(":")
     restarts = failed = converged = kept = 0
     worst_kkt, worst_correlation, values, walls = 0.0, -1.0, [], []
     for seed in seeds:
         problem = load_problem(config)
         problem.optimizer.seed = seed
         problem.optimizer.objective = objective
+        problem.optimizer.scaling = scaling or problem.optimizer.scaling
         excitation = build_excitation(problem)
         workers = min(default_workers(), problem.optimizer.screened or problem.optimizer.restarts)
         begin = time.perf_counter()
@@ -101,7 +104,7 @@ def run_robot(robot: str, config: Path, seeds: list[int], objective: str = DEFAU
                 worst_correlation = max(worst_correlation, r.max_correlation)
         values.append(results[-1].best.objective)
         print(
-            f"  {robot} ({objective}) seed {seed}: criterion {values[-1]:.4f}, kept KKT "
+            f"  {robot} ({criterion}) seed {seed}: criterion {values[-1]:.4f}, kept KKT "
             f"{' '.join(f'{r.best.optimality.residual:.1e}' for r in results)}, stops "
             f"{', '.join(r.stop for r in results)}, correlations "
             f"{' '.join(f'{r.max_correlation:.2f}' for r in results[1:])}, {walls[-1]:.0f} s",
@@ -110,7 +113,7 @@ def run_robot(robot: str, config: Path, seeds: list[int], objective: str = DEFAU
     power = 0.5 if problem.optimizer.objective == "log_det" else 1.0  # log det is of σ², the others of σ
     spread = 100.0 * (np.exp(power * (max(values) - min(values))) - 1.0)
     return (
-        f"robust {robot} ({objective}): failed {failed} of {restarts} restarts, converged {converged} of {kept} kept "
+        f"robust {robot} ({criterion}): failed {failed} of {restarts} restarts, converged {converged} of {kept} kept "
         f"(largest KKT {worst_kkt:.1e}), spread {spread:.1f} %, worst novelty {worst_correlation:.2f}, "
         f"wall {np.mean(walls):.0f} s"
     )
@@ -120,8 +123,12 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--robots", nargs="+", default=[*SHIPPED, *INIT], choices=[*SHIPPED, *INIT])
     parser.add_argument("--seeds", type=int, nargs="+", default=list(range(10)))
-    parser.add_argument("--criteria", nargs="+", default=[DEFAULT_OBJECTIVE], choices=NAMES)
+    parser.add_argument("--criteria", nargs="+", default=[DEFAULT_OBJECTIVE], help="OBJECTIVE or OBJECTIVE:SCALING")
     args = parser.parse_args()
+    for criterion in args.criteria:
+        objective, _, scaling = criterion.partition(":")
+        if objective not in NAMES or scaling not in ("", "none", "urdf"):
+            parser.error(f"--criteria {criterion}: expected one of {', '.join(NAMES)}, optionally :none or :urdf")
     with tempfile.TemporaryDirectory() as folder:
         configs = {robot: config_of(robot, Path(folder)) for robot in args.robots}
         lines = [run_robot(r, configs[r], args.seeds, o) for r in args.robots for o in args.criteria]
