@@ -175,17 +175,17 @@ def polish_kept(
     runs: list[RestartResult],
     deadline: float,
     hook: Optional[ProgressHook] = None,
-) -> list[RestartResult]:
+) -> tuple[list[RestartResult], RestartResult]:
     """``runs`` with the restart the iteration keeps (:func:`kept_restart`) polished
-    (:func:`~excite_cli.optimization.restarts.polish`, the same arguments). A polished end point can
-    lose its playable transitions (seen on the G1: the restart polished to KKT 9.1e-4 could not be
-    played, and the next one was kept as it was, stalled at 4.4e-2); then the restart kept next is
-    polished too, each at most once, so the one kept has always been polished."""
+    (:func:`~excite_cli.optimization.restarts.polish`, the same arguments), and that restart. A
+    polished end point can lose its playable transitions (seen on the G1: the restart polished to KKT
+    9.1e-4 could not be played, and the next one was kept as it was, stalled at 4.4e-2); then the
+    restart kept next is polished too, each at most once, so the one kept has always been polished."""
     polished: set[int] = set()
-    while (index := kept_restart(excitation, runs).index) not in polished:
-        runs = polish(excitation, engine, k, seed, prior, runs, index, deadline, hook)
-        polished.add(index)
-    return runs
+    while (kept := kept_restart(excitation, runs)).index not in polished:
+        runs = polish(excitation, engine, k, seed, prior, runs, kept.index, deadline, hook)
+        polished.add(kept.index)
+    return runs, kept
 
 
 def transition_checks(excitation: Excitation, alpha: np.ndarray) -> dict[str, float | str]:
@@ -261,8 +261,7 @@ def run_sequence(
                 expected="more starts or a longer optimizer.time_budget, or limits that leave the robot room",
             )
         deadline = start + excitation.problem.optimizer.time_budget
-        runs = polish_kept(excitation, engine, k, seed, stacked, runs, deadline, hook)
-        best = kept_restart(excitation, runs)
+        runs, best = polish_kept(excitation, engine, k, seed, stacked, runs, deadline, hook)
         result = describe(excitation, k, best.alpha, stacked, time.perf_counter() - start, runs, results, best.index)
         results.append(result)
         if on_iteration:

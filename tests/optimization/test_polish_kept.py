@@ -29,7 +29,7 @@ def test_the_restart_kept_is_one_that_was_polished(monkeypatch):
 
     monkeypatch.setattr(sequence, "polish", polish)
     monkeypatch.setattr(sequence, "transition_checks", transition_checks)
-    out = sequence.polish_kept(None, None, 1, 0, np.zeros((0, 2)), runs, 0.0)
+    out, kept = sequence.polish_kept(None, None, 1, 0, np.zeros((0, 2)), runs, 0.0)
     assert polished == [0, 1]
-    kept = sequence.kept_restart(None, out)
+    assert kept is sequence.kept_restart(None, out)
     assert kept.index == 1 and kept.stop == CONVERGED and kept.objective == 1.5
