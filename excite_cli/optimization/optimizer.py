@@ -26,7 +26,7 @@ from excite_cli.constraints.lse import GRID_MARGIN
 from excite_cli.optimization.criterion import Criterion
 from excite_cli.optimization.nlp import Epigraph, Evaluations, project
 from excite_cli.optimization.optimality import INFEASIBLE, SOLVER_FAILED, Optimality, stop_reason
-from excite_cli.optimization.solvers import solve
+from excite_cli.optimization.solvers import criterion_scale, solve
 from excite_cli.trajectory.boundary import BoundaryConditions
 from excite_cli.trajectory.fourier import FourierBasis
 
@@ -58,6 +58,8 @@ class RestartResult:
             ``inside`` (the best iterate inside every constraint), ``bisection`` (towards the start),
             ``start``, or ``none`` (no end point met a constraint that needs motion; ``alpha`` is
             the start and ``objective`` inf).
+        scale: the factor [1] the solver's criterion was multiplied by
+            (:attr:`~excite_cli.optimization.solvers.SolverRun.scale`), which a continuation keeps.
     """
 
     index: int
@@ -71,6 +73,7 @@ class RestartResult:
     optimality: Optimality = Optimality(np.nan, 0, np.nan, np.nan)
     stop: str = ""
     end: str = ""
+    scale: Optional[float] = None
 
     @property
     def succeeded(self) -> bool:
@@ -144,6 +147,21 @@ def _until_done(
     return callback
 
 
+def own_scale(criterion: Criterion, boundary: BoundaryConditions, start: np.ndarray) -> float:
+    """The criterion's scale for the solver [1] (:func:`~excite_cli.optimization.solvers.criterion_scale`)
+    from the gradient at ``start`` (n, 2N+1) of the trajectory's own criterion, without C₀.
+
+    With C₀ stacked, the criterion's gradient at a start of little motion is small (the trajectory
+    adds little to the prior's information) while its curvature is not (the information grows with
+    the square of the motion: the criterion is concave along the motion's amplitude); scaled to that
+    gradient, the criterion's curvature came out 100–300 × that of a first iteration, and SLSQP's
+    quasi-Newton matrix with it. On the UR10 with a lab's limits, iteration 2 (A-optimality), 11 of
+    16 screened starts ended "More than 3*n iterations in LSQ subproblem", most where they began;
+    scaled by the trajectory's own gradient, which does not depend on the prior, none did."""
+    own = replace(criterion, prior=np.zeros((0, 0)))
+    return criterion_scale(boundary.chain(own.value_and_gradient(start)[1].ravel()))
+
+
 def optimize_restart(
     criterion: Criterion,
     constraints: Sequence[Constraint],
@@ -155,6 +173,7 @@ def optimize_restart(
     max_iterations: Optional[int] = None,
     fine_basis: Optional[FourierBasis] = None,
     time_limit: Optional[float] = None,
+    scale: Optional[float] = None,
 ) -> RestartResult:
     """Minimize the criterion over α with ``options.method`` from one feasible start.
 
@@ -185,6 +204,8 @@ def optimize_restart(
         max_iterations: solver iterations (default ``options.max_iterations``).
         fine_basis: the basis of the fine re-check (default: none).
         time_limit: wall time [s] after which the solver stops (default: none).
+        scale: the criterion's scale for the solver, that of the restart this one continues
+            (default: set at the start, :func:`~excite_cli.optimization.solvers.solve`).
     """
     begin = time.perf_counter()
     start_value = criterion.value(start)
@@ -202,6 +223,8 @@ def optimize_restart(
     # a criterion of the extreme singular values is solved in its epigraph form (smooth where it is not)
     nlp = Epigraph(problem) if criterion.objective.extremes else problem
     w0 = nlp.start(z0) if isinstance(nlp, Epigraph) else z0
+    if scale is None and not isinstance(nlp, Epigraph):  # the epigraph's criterion is its bounds' weights
+        scale = own_scale(criterion, boundary, start)
     run = solve(
         options.method,
         nlp,
@@ -209,6 +232,7 @@ def optimize_restart(
         max_iterations or options.max_iterations,
         options.tolerance,
         lambda w: until_done(w[: z0.size]),
+        scale,
     )
     run = replace(run, z=run.z[: z0.size])
     out_of_time = time.perf_counter() > deadline
@@ -248,4 +272,5 @@ def optimize_restart(
         optimality,
         stop,
         end,
+        run.scale,
     )

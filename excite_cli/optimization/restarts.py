@@ -30,6 +30,8 @@ class RestartTask:
             that continues), or None.
         iterations: solver iterations (default ``optimizer.max_iterations``).
         time_limit: wall time [s] after which its solver stops (default: none).
+        scale: the criterion's scale of the run it continues (:attr:`RestartResult.scale`), or None
+            for a start of its own.
     """
 
     iteration: int
@@ -39,6 +41,7 @@ class RestartTask:
     warm_start: Optional[np.ndarray] = None
     iterations: Optional[int] = None
     time_limit: Optional[float] = None
+    scale: Optional[float] = None
 
     def rng(self) -> np.random.Generator:
         """The restart's own random generator."""
@@ -58,6 +61,7 @@ class RestartTask:
             self.iterations,
             excitation.fine_basis,
             self.time_limit,
+            self.scale,
         )
 
 
@@ -138,7 +142,7 @@ def polish(
         current = runs[at]
         if current.stop == CONVERGED or _left(deadline) <= 0.0:
             break
-        task = RestartTask(k, kept, seed, prior, current.alpha, opts.max_iterations, _left(deadline))
+        task = RestartTask(k, kept, seed, prior, current.alpha, opts.max_iterations, _left(deadline), current.scale)
         shifted = (lambda r, it, value: hook(r, current.iterations + it, value)) if hook else None
         more = engine.run([task], shifted, (lambda c: shifted(c.index, c.iterations, c.objective)) if hook else None)[0]
         if not more.succeeded or more.objective > current.objective:
@@ -170,7 +174,8 @@ def _restart_round(
     if not chosen:  # every screened start failed: nothing to continue
         return runs
     more = [
-        RestartTask(k, r.index, seed, prior, r.alpha, opts.max_iterations - iterations, _left(deadline)) for r in chosen
+        RestartTask(k, r.index, seed, prior, r.alpha, opts.max_iterations - iterations, _left(deadline), r.scale)
+        for r in chosen
     ]
     shift = indices.stop  # continuations count on their own in the progress
     shifted = (lambda r, it, value: hook(shift + r, it, value)) if hook else None

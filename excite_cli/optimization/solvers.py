@@ -23,8 +23,8 @@ iterations in LSQ subproblem" at or near their start. Scaled, none did (bench/ro
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Callable, Protocol
+from dataclasses import dataclass, replace
+from typing import Callable, Optional, Protocol
 
 import numpy as np
 from scipy.optimize import BFGS, NonlinearConstraint, minimize
@@ -66,6 +66,7 @@ class SolverRun:
         limit: it stopped at its iteration limit.
         failed: it stopped on a failure of its own (line search, incompatible subproblem,
             restoration), not at a limit and not on its convergence test.
+        scale: the factor [1] the solver's criterion was multiplied by (:func:`criterion_scale`).
     """
 
     z: np.ndarray
@@ -73,6 +74,7 @@ class SolverRun:
     message: str
     limit: bool
     failed: bool
+    scale: float = 1.0
 
 
 def criterion_scale(gradient: np.ndarray) -> float:
@@ -83,12 +85,13 @@ def criterion_scale(gradient: np.ndarray) -> float:
 
 
 class _ScaledCriterion:
-    """``nlp`` with its criterion (value and gradient) multiplied by :func:`criterion_scale` of its
-    gradient at z0 (n_z,), which is handed back when the solver asks for it; constraints as they are."""
+    """``nlp`` with its criterion (value and gradient) multiplied by ``scale``, or by
+    :func:`criterion_scale` of its gradient at z0 (n_z,), which is handed back when the solver asks
+    for it; constraints as they are."""
 
-    def __init__(self, nlp: NLP, z0: np.ndarray):
+    def __init__(self, nlp: NLP, z0: np.ndarray, scale: Optional[float] = None):
         self.nlp, self._start = nlp, (z0.tobytes(), nlp.gradient(z0))
-        self.scale = criterion_scale(self._start[1])
+        self.scale = criterion_scale(self._start[1]) if scale is None else scale
         self.constraint_values, self.constraint_jacobian = nlp.constraint_values, nlp.constraint_jacobian
 
     def value(self, z: np.ndarray) -> float:
@@ -99,15 +102,25 @@ class _ScaledCriterion:
 
 
 def solve(
-    method: str, nlp: NLP, z0: np.ndarray, max_iterations: int, tolerance: float, on_iterate: IterateHook
+    method: str,
+    nlp: NLP,
+    z0: np.ndarray,
+    max_iterations: int,
+    tolerance: float,
+    on_iterate: IterateHook,
+    scale: Optional[float] = None,
 ) -> SolverRun:
     """Run ``method`` (one of ``METHODS``) from z0 (n_z,) for at most ``max_iterations`` iterations, on
-    the criterion scaled by :func:`criterion_scale` at z0 (module docstring).
+    the criterion scaled by :func:`criterion_scale` at z0 (module docstring), or by ``scale``.
 
     Args:
         tolerance: the solver's own convergence tolerance (SLSQP ``ftol``, trust-constr ``gtol``,
             IPOPT ``tol``) on the criterion as given: the solver gets it scaled as the criterion is.
         on_iterate: called with every accepted iterate.
+        scale: the scale of a run this one continues (:attr:`SolverRun.scale`). Rescaled at a point
+            near its optimum, where the criterion's gradient is small, the first step of a fresh
+            quasi-Newton matrix is as long as a start's (``FIRST_STEP``) and leaves the optimum:
+            on the G1 with A-optimality, 2 of 3 kept restarts polished this way ended stalled.
 
     Raises:
         ExciteError: an unknown method, or ``ipopt`` without cyipopt installed.
@@ -115,8 +128,9 @@ def solve(
     methods = {"SLSQP": _slsqp, "trust-constr": _trust_constr, "ipopt": _ipopt}
     if method not in methods:
         raise ExciteError("optimizer.method", f"unknown '{method}', expected one of {', '.join(METHODS)}")
-    scaled = _ScaledCriterion(nlp, z0)
-    return methods[method](scaled, z0, max_iterations, tolerance * scaled.scale, on_iterate)
+    scaled = _ScaledCriterion(nlp, z0, scale)
+    run = methods[method](scaled, z0, max_iterations, tolerance * scaled.scale, on_iterate)
+    return replace(run, scale=scaled.scale)
 
 
 def _slsqp(nlp: NLP, z0: np.ndarray, max_iterations: int, tolerance: float, on_iterate: IterateHook) -> SolverRun:

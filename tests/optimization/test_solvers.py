@@ -79,3 +79,20 @@ def test_the_first_step_moves_no_variable_more_than_first_step():
     z0 = np.array([0.1, 0.0])
     solve("SLSQP", Disc([1000.1, 0.0]), z0, 1, 1e-12, seen.append)
     assert np.abs(seen[0] - z0).max() == pytest.approx(FIRST_STEP, rel=1e-6)
+
+
+def test_a_continuation_keeps_the_scale_of_the_run_it_continues():
+    """Near an optimum inside the disc the gradient is small; rescaled there, a fresh run's first step
+    is FIRST_STEP long and leaves the optimum 100 × farther than it was; with the scale of the run it
+    continues (set where the gradient was 0.8), its first step is that scale times the gradient."""
+    from excite_cli.optimization.solvers import FIRST_STEP
+
+    first = solve("SLSQP", Disc([0.3, 0.4]), np.zeros(2), 1, 1e-12, lambda z: None)
+    assert first.scale == pytest.approx(FIRST_STEP / 0.8)
+    near = np.array([0.301, 0.4])  # 1e-3 from the optimum, gradient (2e-3, 0)
+    fresh, kept = [], []
+    solve("SLSQP", Disc([0.3, 0.4]), near, 1, 1e-12, fresh.append)
+    run = solve("SLSQP", Disc([0.3, 0.4]), near, 1, 1e-12, kept.append, first.scale)
+    assert np.abs(fresh[0] - near).max() == pytest.approx(FIRST_STEP, rel=1e-6)
+    assert np.abs(kept[0] - near).max() == pytest.approx(first.scale * 2e-3, rel=1e-6)
+    assert run.scale == first.scale
