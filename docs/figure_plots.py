@@ -48,7 +48,10 @@ def _filled(rows: list[list[str]], column: int) -> list[list[str]]:
 def sequential(folder: Path) -> Path:
     rows = _filled(table("Sequential generation on the G1 arms")[1:], 0)
     fig, ax = plt.subplots(figsize=(5, 3.2))
-    labels = {"log_det": "log det (default; optimizes the information)", "log_cond": "log cond (the paper's criterion)"}
+    labels = {
+        "log_trace_inverse": "A-optimality (default; the parameters' expected error)",
+        "log_cond": "log cond (the paper's criterion)",
+    }
     for criterion in dict.fromkeys(r[0] for r in rows):
         mine = [r for r in rows if r[0] == criterion]
         name = re.sub(r"[`*]", "", criterion).split(" (")[0]

@@ -98,5 +98,5 @@ def test_paths_are_relative_to_the_config_file_and_the_effective_config_is_compl
     assert resolve_path("/data/prior.h5", problem.folder) == Path("/data/prior.h5")
     assert resolve_path("prior.h5", None) == Path("prior.h5")
     stored = yaml.safe_load(effective_yaml(problem))
-    assert stored["optimizer"]["objective"] == "log_det" and stored["optimizer"]["scaling"] == "none"
+    assert stored["optimizer"]["objective"] == "log_trace_inverse" and stored["optimizer"]["scaling"] == "urdf"
     assert Problem.model_validate(stored).model_dump() == problem.model_dump()  # what ran can be run again

@@ -8,7 +8,7 @@ import math
 from pathlib import Path
 from typing import Literal, Optional, Union
 
-from pydantic import Field, PositiveFloat, field_validator, model_validator
+from pydantic import Field, PositiveFloat, field_serializer, field_validator, model_validator
 from pydantic.json_schema import SkipJsonSchema
 
 from excite_cli.config.base import (
@@ -25,7 +25,7 @@ from excite_cli.config.base import (
 )
 from excite_cli.config.constraints import ConstraintsConfig
 from excite_cli.config.effects import EffectsConfig
-from excite_cli.criteria import NAMES
+from excite_cli.criteria import NAMES, criterion_record
 
 
 class RobotConfig(Section):
@@ -123,12 +123,18 @@ class OptimizerConfig(Section):
         )
         return runs + self.polish_rounds * self.max_iterations
 
+    @property
+    def criterion_scaling(self) -> str:
+        """The regressor the criterion is taken of: ``scaling``, or the criterion's own
+        (:attr:`~excite_cli.criteria.record.CriterionRecord.scaling`) when ``scaling`` is not set."""
+        return self.scaling or criterion_record(self.objective).scaling
+
     method: Literal["SLSQP", "trust-constr", "ipopt"] = "SLSQP"
     """The solver: `SLSQP`, `trust-constr` or `ipopt`."""
-    objective: Literal[NAMES] = "log_det"
+    objective: Literal[NAMES] = "log_trace_inverse"
     """The criterion minimized, one record each in excite_cli/criteria (what each rewards: docs, how it works)."""
-    scaling: Literal["none", "urdf"] = "none"
-    """`none`: the criterion of C (the paper's); `urdf`: of C L, which does not depend on the base columns."""
+    scaling: Optional[Literal["none", "urdf"]] = None
+    """`none`: of C (the paper's); `urdf`: of C L (independent of the base columns); default: the criterion's own."""
     max_iterations: int = Field(200, ge=1, le=100_000)
     """Solver iterations per restart at most (a restart stops earlier once it meets optimality_tolerance)."""
     tolerance: float = Field(1e-6, gt=0.0)
@@ -153,6 +159,10 @@ class OptimizerConfig(Section):
     """A Dask scheduler address ([tcp:// or tls://]host:port) to run the restarts on instead."""
     worker_wait: float = Field(120.0, gt=0.0, le=86_400.0)
     """Seconds [s] a run on `scheduler` waits without any worker before it stops."""
+
+    @field_serializer("scaling")
+    def _resolved_scaling(self, _value: Optional[str]) -> str:
+        return self.criterion_scaling  # what the run used, so the stored config runs the same again
 
     @field_validator("scheduler")
     @classmethod

@@ -68,6 +68,7 @@ CRITERIA = {
             "a small RMS parameter error of least squares per unit of torque noise",
             _log_trace_inverse,
             source="A-optimality (Pukelsheim 1993)",
+            scaling="urdf",  # of C L: the RMS error of parameters in the units the URDF gives them
         ),
     )
 }

@@ -38,6 +38,8 @@ class CriterionRecord:
             ``exponentiate_extremes``); () for a smooth criterion. The stationarity test of
             :mod:`~excite_cli.optimization.optimality` uses it.
         exponentiate_extremes: f = exp(w_max log σ_max + w_min log σ_min) (cond itself).
+        scaling: the regressor it is taken of unless ``optimizer.scaling`` says: ``none`` (C, the
+            paper's) or ``urdf`` (C L, the frame in which it measures what it is meant to).
     """
 
     name: str
@@ -48,6 +50,7 @@ class CriterionRecord:
     source: str = ""
     extremes: tuple[float, ...] = ()
     exponentiate_extremes: bool = False
+    scaling: str = "none"
 
     def terms(self, eigenvalues: Any) -> tuple[float, Any, Any]:
         """The value, the indices r (R,) of the eigenpairs the gradient needs and their coefficients

@@ -149,7 +149,7 @@ TRAJECTORY = {
     "constraint_period": 0.02,
     "boundary": "rest",
 }
-OPTIMIZER = {"objective": "log_det", "max_iterations": 400, "restarts": 4, "starts": 16, "screen_iterations": 40}
+OPTIMIZER = {"max_iterations": 400, "restarts": 4, "starts": 16, "screen_iterations": 40}
 
 
 def validated(config: dict, target: Path) -> Problem:

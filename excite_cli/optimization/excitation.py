@@ -77,14 +77,16 @@ class Excitation:
         self, prior: np.ndarray | None = None, objective: str | None = None, scaling: str | None = None
     ) -> Criterion:
         """The criterion of ``objective`` (default ``optimizer.objective``) with C₀ = ``prior`` (m₁, b)
-        (Eq. 41), of C (``scaling`` ``none``) or of C L (``urdf``; default ``optimizer.scaling``)."""
-        scaling = scaling or self.problem.optimizer.scaling
+        (Eq. 41), of C (``scaling`` ``none``) or of C L (``urdf``; default ``optimizer.scaling``, else
+        the criterion's own, :attr:`~excite_cli.criteria.record.CriterionRecord.scaling`)."""
+        record = criterion_record(objective or self.problem.optimizer.objective)
+        scaling = scaling or self.problem.optimizer.scaling or record.scaling
         return Criterion(
             self.robot,
             self.base,
             self.cost_basis,
             prior=np.zeros((0, self.columns)) if prior is None else prior,
-            objective=criterion_record(objective or self.problem.optimizer.objective),
+            objective=record,
             frame=self.scaled_frame if scaling == "urdf" else None,
             effects=self.effects,
             noise=self.noise,

@@ -82,7 +82,7 @@ def test_a_clusters_gradients_match_finite_differences_with_its_eigenvectors_hel
     problem = copy.deepcopy(ur5_problem)
     problem.trajectory.harmonics, problem.trajectory.cost_samples = 3, 20
     excitation = build_excitation(problem)
-    criterion = excitation.criterion()
+    criterion = excitation.criterion(objective="log_cond", scaling="none")  # clusters are cond's, of C
     alpha = excitation.limits.random_start(excitation.trajectory.n_coefficients, np.random.default_rng(3), 0.7)
     indices = np.array([0, 1, 4])
     gradients = criterion.cluster_gradients(alpha, indices)
@@ -191,7 +191,7 @@ def test_a_restart_stops_where_it_meets_the_kkt_tolerance_or_its_time_limit(tmp_
 
 
 def test_the_kept_restart_continues_from_a_fresh_matrix_until_it_converges(tmp_path):
-    """A restart stopped at 15 iterations short of the tolerance, polished in rounds of 15: each round
+    """A restart stopped at 15 iterations short of the tolerance, polished in rounds of 40: each round
     starts at the end point of the one before (iterations and history joined), none ends higher, and
     the last converges, its KKT residual recomputed by central differences. A converged restart, or
     polish_rounds 0, is left as it is; one the deadline leaves unpolished says "time budget"."""
@@ -205,6 +205,7 @@ def test_the_kept_restart_continues_from_a_fresh_matrix_until_it_converges(tmp_p
     prior = np.zeros((0, excitation.base.count))
     first = RestartTask(1, 0, 1, prior)(excitation)
     assert first.succeeded and first.stop != CONVERGED and first.iterations == 15
+    opts.max_iterations = 40  # rounds long enough to learn the curvature: each keeps the run's scale
     deadline = time.perf_counter() + 600.0
     with Engine(excitation) as serial:
         polished = polish(excitation, serial, 1, 1, prior, [first], 0, deadline)[0]
@@ -243,6 +244,7 @@ def test_every_method_ends_feasible_and_below_its_start(ur5_problem, method):
     if method == "ipopt":
         pytest.importorskip("cyipopt", reason="IPOPT not installed (Makefile target ipopt)")
     ur5_problem.optimizer.method = method
+    ur5_problem.optimizer.objective = "log_det"  # the methods, on the criterion they were tuned on
     ur5_problem.optimizer.max_iterations = 40
     excitation = build_excitation(ur5_problem)
     from excite_cli.optimization.restarts import RestartTask
