@@ -123,11 +123,15 @@ class OptimizerConfig(Section):
         )
         return runs + self.polish_rounds * self.max_iterations
 
-    @property
-    def criterion_scaling(self) -> str:
-        """The regressor the criterion is taken of: ``scaling``, or the criterion's own
-        (:attr:`~excite_cli.criteria.record.CriterionRecord.scaling`) when ``scaling`` is not set."""
-        return self.scaling or criterion_record(self.objective).scaling
+    def scaling_of(self, objective: str) -> str:
+        """The regressor ``objective``'s criterion is taken of (``none``: C, ``urdf``: C L): ``scaling``,
+        or the criterion's own (:attr:`~excite_cli.criteria.record.CriterionRecord.scaling`) when
+        ``scaling`` is not set.
+
+        Raises:
+            ExciteError: an unknown objective.
+        """
+        return self.scaling or criterion_record(objective).scaling
 
     method: Literal["SLSQP", "trust-constr", "ipopt"] = "SLSQP"
     """The solver: `SLSQP`, `trust-constr` or `ipopt`."""
@@ -162,7 +166,7 @@ class OptimizerConfig(Section):
 
     @field_serializer("scaling")
     def _resolved_scaling(self, _value: Optional[str]) -> str:
-        return self.criterion_scaling  # what the run used, so the stored config runs the same again
+        return self.scaling_of(self.objective)  # what the run used, so the stored config runs the same again
 
     @field_validator("scheduler")
     @classmethod

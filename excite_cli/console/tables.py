@@ -111,7 +111,7 @@ def iterations(
 def _restarts(results: Sequence[IterationResult], optimizer: OptimizerConfig) -> Table:
     """Every restart of every iteration: start and end value of the criterion optimized, KKT
     residual, active constraints, solver iterations, end point, stop reason."""
-    matrix = "CL" if optimizer.criterion_scaling == "urdf" else "C"
+    matrix = "CL" if optimizer.scaling_of(optimizer.objective) == "urdf" else "C"
     record = CRITERIA[optimizer.objective]
     shown, label = record.shown, f"{record.label}({matrix})"
     restarts = [

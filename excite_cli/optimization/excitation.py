@@ -79,14 +79,14 @@ class Excitation:
         """The criterion of ``objective`` (default ``optimizer.objective``) with C₀ = ``prior`` (m₁, b)
         (Eq. 41), of C (``scaling`` ``none``) or of C L (``urdf``; default ``optimizer.scaling``, else
         the criterion's own, :attr:`~excite_cli.criteria.record.CriterionRecord.scaling`)."""
-        record = criterion_record(objective or self.problem.optimizer.objective)
-        scaling = scaling or self.problem.optimizer.scaling or record.scaling
+        objective = objective or self.problem.optimizer.objective
+        scaling = scaling or self.problem.optimizer.scaling_of(objective)
         return Criterion(
             self.robot,
             self.base,
             self.cost_basis,
             prior=np.zeros((0, self.columns)) if prior is None else prior,
-            objective=record,
+            objective=criterion_record(objective),
             frame=self.scaled_frame if scaling == "urdf" else None,
             effects=self.effects,
             noise=self.noise,
