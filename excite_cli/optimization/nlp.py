@@ -1,7 +1,7 @@
 """The optimization problem as a solver sees it: the criterion and the stacked constraints in the
 optimizer's variables z (:mod:`excite_cli.trajectory.boundary`), each evaluated once per point; the
 epigraph form of a criterion of the extreme singular values; and the feasible point nearest to a
-solver's iterate."""
+solver's iterate (or, where that fails, a feasible point towards it)."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ from typing import Callable, Optional, Sequence
 import numpy as np
 from scipy.optimize import minimize
 
-from excite_cli.constraints import Constraint, accepted
+from excite_cli.constraints import Constraint, accepted, farthest_accepted
 from excite_cli.criteria.record import RANK_FLOOR
 from excite_cli.optimization.criterion import Criterion
 from excite_cli.optimization.optimality import (
@@ -22,6 +22,8 @@ from excite_cli.optimization.optimality import (
 )
 from excite_cli.trajectory.boundary import BoundaryConditions
 
+#: Bisection steps towards a feasible point (the segment's length / 2¹²).
+BISECTIONS = 12
 #: SLSQP iterations of the projection onto the feasible set (it converges in 10-50 on the G1 problem).
 PROJECTION_ITERATIONS = 60
 #: Singular values at each extreme the epigraph form bounds (one solver constraint each).
@@ -222,3 +224,30 @@ def project(problem: Evaluations, z: np.ndarray, iterations: int = PROJECTION_IT
         alpha = c.restore(alpha)
     alpha = problem.boundary.project(alpha)
     return alpha if accepted(problem.all, alpha) else None
+
+
+def repair(
+    constraints: Sequence[Constraint],
+    alpha: np.ndarray,
+    feasible: np.ndarray,
+    boundary: Optional[BoundaryConditions] = None,
+    steps: int = BISECTIONS,
+) -> np.ndarray:
+    """A feasible point near α: the constraints' own exact repairs, moved back onto the boundary
+    conditions, then, if some constraint still rejects it, the farthest point towards it from
+    ``feasible`` (bisection on the segment, which keeps the boundary conditions: they are affine).
+
+    Args:
+        constraints: all constraints.
+        alpha: (n, 2N+1) point to repair, typically the last SQP iterate.
+        feasible: (n, 2N+1) point every constraint accepts (the restart's start).
+        boundary: the boundary conditions both points meet, if any.
+        steps: bisection steps.
+    """
+    for c in constraints:
+        alpha = c.restore(alpha)
+    if boundary is not None:
+        alpha = boundary.project(alpha)
+    if accepted(constraints, alpha):
+        return alpha
+    return feasible + farthest_accepted(constraints, feasible, alpha, steps) * (alpha - feasible)

@@ -24,16 +24,17 @@ from excite_cli.config import OptimizerConfig
 from excite_cli.constraints import Constraint, accepted, farthest_accepted
 from excite_cli.constraints.lse import GRID_MARGIN
 from excite_cli.optimization.criterion import Criterion
-from excite_cli.optimization.nlp import Epigraph, Evaluations, project
+from excite_cli.optimization.nlp import BISECTIONS, Epigraph, Evaluations, project, repair
 from excite_cli.optimization.optimality import INFEASIBLE, SOLVER_FAILED, Optimality, stop_reason
-from excite_cli.optimization.solvers import criterion_scale, solve
+from excite_cli.optimization.solvers import SolverRun, criterion_scale, solve
 from excite_cli.trajectory.boundary import BoundaryConditions
 from excite_cli.trajectory.fourier import FourierBasis
 
 #: Progress hook: (restart index, solver iteration, objective at the current iterate).
 ProgressHook = Callable[[int, int, float], None]
-#: Bisection steps towards a feasible point (the segment's length / 2¹²).
-BISECTIONS = 12
+#: Runs of the solver after one that failed on its own (:func:`_solve_recovering`), and the factor on
+#: the criterion's scale of each.
+RECOVERIES, RECOVERY_SCALE = 2, 0.5
 #: The solver's iterates between two Clarke tests of a non-smooth criterion (each a small SDP).
 NONSMOOTH_EVERY = 10
 
@@ -91,33 +92,6 @@ def best_restart(results: Sequence[RestartResult]) -> RestartResult:
     return min(candidates, key=lambda r: (r.objective, r.index))
 
 
-def repair(
-    constraints: Sequence[Constraint],
-    alpha: np.ndarray,
-    feasible: np.ndarray,
-    boundary: Optional[BoundaryConditions] = None,
-    steps: int = BISECTIONS,
-) -> np.ndarray:
-    """A feasible point near α: the constraints' own exact repairs, moved back onto the boundary
-    conditions, then, if some constraint still rejects it, the farthest point towards it from
-    ``feasible`` (bisection on the segment, which keeps the boundary conditions: they are affine).
-
-    Args:
-        constraints: all constraints.
-        alpha: (n, 2N+1) point to repair, typically the last SQP iterate.
-        feasible: (n, 2N+1) point every constraint accepts (the restart's start).
-        boundary: the boundary conditions both points meet, if any.
-        steps: bisection steps.
-    """
-    for c in constraints:
-        alpha = c.restore(alpha)
-    if boundary is not None:
-        alpha = boundary.project(alpha)
-    if accepted(constraints, alpha):
-        return alpha
-    return feasible + farthest_accepted(constraints, feasible, alpha, steps) * (alpha - feasible)
-
-
 def _until_done(
     problem: Evaluations, on_iterate: Callable[[np.ndarray], None], tolerance: float, deadline: float
 ) -> Callable[[np.ndarray], None]:
@@ -145,6 +119,43 @@ def _until_done(
             raise StopIteration
 
     return callback
+
+
+def _solve_recovering(
+    options: OptimizerConfig,
+    nlp: Evaluations | Epigraph,
+    z0: np.ndarray,
+    iterations: int,
+    on_iterate: Callable[[np.ndarray], None],
+    scale: Optional[float],
+    problem: Evaluations,
+) -> SolverRun:
+    """:func:`~excite_cli.optimization.solvers.solve`, and where the solver fails on its own (SLSQP's
+    "More than 3*n iterations in LSQ subproblem" or "Positive directional derivative in linesearch",
+    IPOPT's restoration) with iterations left, up to ``RECOVERIES`` more runs of it from the best
+    iterate inside every constraint so far (the start if none), each with the criterion's scale
+    times ``RECOVERY_SCALE`` and a fresh quasi-Newton matrix. The solver's iterations add up.
+
+    Why: a first step that drives two capsules through each other leaves the solver where a
+    capsule pair's distance no longer points out of the collision (the segments cross), and its
+    linearized constraints stop being consistent; a shorter first step from the same point passes
+    (the UR10 with a lab's limits: a start that failed at its first iterates reached the best
+    criterion of its 16 screened starts with half the scale)."""
+
+    def variables(z: np.ndarray) -> np.ndarray:  # the epigraph's bounds start at their extremes
+        return nlp.start(z) if isinstance(nlp, Epigraph) else z
+
+    run = solve(options.method, nlp, variables(z0), iterations, options.tolerance, on_iterate, scale)
+    done = run.iterations
+    for _ in range(RECOVERIES):
+        if not run.failed or done >= iterations:
+            break
+        inside = problem.best_inside
+        z = z0 if inside is None else problem.boundary.to_variables(inside)
+        scale = run.scale * RECOVERY_SCALE
+        run = solve(options.method, nlp, variables(z), iterations - done, options.tolerance, on_iterate, scale)
+        done += run.iterations
+    return replace(run, iterations=done)
 
 
 def own_scale(criterion: Criterion, boundary: BoundaryConditions, start: np.ndarray) -> float:
@@ -186,11 +197,11 @@ def optimize_restart(
     hold exactly, with diagonal preconditioning s, see :mod:`excite_cli.trajectory.boundary`); everything else
     sees α. The restart ends with the best of: the start, the best iterate whose aggregated
     constraints were all ≤ 0, and the feasible point nearest to the last iterate
-    (:func:`~excite_cli.optimization.nlp.project`; if the projection fails, :func:`repair`); each is
-    confirmed by every constraint's exact grid check.
+    (:func:`~excite_cli.optimization.nlp.project`; if the projection fails,
+    :func:`~excite_cli.optimization.nlp.repair`); each is confirmed by every constraint's exact grid check.
     The one kept is confirmed on ``fine_basis`` too, the re-check its result is judged by (the grid
     margin covers the overshoot between grid instants, but not always): where that check fails, it
-    is moved towards the start until the check holds (bisection, as in :func:`repair`).
+    is moved towards the start until the check holds (bisection, as in :func:`~excite_cli.optimization.nlp.repair`).
 
     Args:
         criterion: the criterion (value and gradient).
@@ -222,17 +233,10 @@ def optimize_restart(
     until_done = _until_done(problem, on_iterate, options.optimality_tolerance, deadline)
     # a criterion of the extreme singular values is solved in its epigraph form (smooth where it is not)
     nlp = Epigraph(problem) if criterion.objective.extremes else problem
-    w0 = nlp.start(z0) if isinstance(nlp, Epigraph) else z0
     if scale is None and not isinstance(nlp, Epigraph):  # the epigraph's criterion is its bounds' weights
         scale = own_scale(criterion, boundary, start)
-    run = solve(
-        options.method,
-        nlp,
-        w0,
-        max_iterations or options.max_iterations,
-        options.tolerance,
-        lambda w: until_done(w[: z0.size]),
-        scale,
+    run = _solve_recovering(
+        options, nlp, z0, max_iterations or options.max_iterations, lambda w: until_done(w[: z0.size]), scale, problem
     )
     run = replace(run, z=run.z[: z0.size])
     out_of_time = time.perf_counter() > deadline

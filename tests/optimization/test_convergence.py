@@ -17,7 +17,7 @@ from excite_cli.cli import app
 from excite_cli.config_file import load_problem
 from excite_cli.constraints import accepted
 from excite_cli.optimization.excitation import build_excitation
-from excite_cli.optimization.nlp import Evaluations, project
+from excite_cli.optimization.nlp import Evaluations, project, repair
 from excite_cli.optimization.optimality import (
     ACTIVE_TOLERANCE,
     CONVERGED,
@@ -31,7 +31,6 @@ from excite_cli.optimization.optimality import (
     kkt_optimality,
     stop_reason,
 )
-from excite_cli.optimization.optimizer import repair
 from excite_cli.optimization.verify import finite_difference_gradient
 
 runner = CliRunner()

@@ -1,10 +1,16 @@
 """The criterion's scale for the solver is that of the trajectory's own criterion: C₀ stacked above it
-changes where the optimum is, not what a step of the variables is worth."""
+changes where the optimum is, not what a step of the variables is worth; a solver run that fails
+goes on with half of it."""
+
+from dataclasses import replace
 
 import numpy as np
 from conftest import small
 
+from excite_cli.constraints import accepted
+from excite_cli.optimization import optimizer, solvers
 from excite_cli.optimization.excitation import build_excitation
+from excite_cli.optimization.optimality import SOLVER_FAILED
 from excite_cli.optimization.optimizer import own_scale
 from excite_cli.optimization.solvers import criterion_scale
 
@@ -26,3 +32,32 @@ def test_the_scale_is_the_trajectorys_own_whatever_the_prior(panda_problem):
     assert criterion_scale(gradient(stacked[1])) > 10.0 * alone  # what the scale was set by before
     for criterion in [excitation.criterion(), *stacked]:
         assert own_scale(criterion, excitation.boundary, start) == alone
+
+
+def test_a_solver_that_fails_goes_on_from_its_best_point_inside_with_half_the_scale(panda_problem, monkeypatch):
+    """The first solver run is cut after 5 iterations and reported failed (as SLSQP's "More than 3*n
+    iterations in LSQ subproblem" is): the restart runs the solver again, from a point every
+    constraint accepts that is better than the start (its best iterate inside), with the criterion's
+    scale halved, for the iterations left; its iterations add up, and it does not end failed."""
+    problem = small(panda_problem)
+    excitation = build_excitation(problem)
+    start = excitation.random_start(np.random.default_rng(5))
+    calls = []
+
+    def solve(method, nlp, z0, iterations, tolerance, on_iterate, scale=None):
+        run = solvers.solve(method, nlp, z0, 5 if not calls else iterations, tolerance, on_iterate, scale)
+        calls.append((z0.copy(), iterations, scale, run))
+        return replace(run, failed=True, message="forced") if len(calls) == 1 else run
+
+    monkeypatch.setattr(optimizer, "solve", solve)
+    criterion = excitation.criterion()
+    result = optimizer.optimize_restart(
+        criterion, excitation.constraints, problem.optimizer, start, excitation.boundary, max_iterations=60
+    )
+    assert len(calls) == 2
+    (_, first_budget, _, first), (z, budget, scale, second) = calls
+    assert first.iterations == 5 and budget == first_budget - 5 == 55
+    assert scale == 0.5 * first.scale
+    point = excitation.boundary.to_alpha(z)
+    assert accepted(excitation.constraints, point) and criterion.value(point) < criterion.value(start)
+    assert result.iterations == 5 + second.iterations and result.stop != SOLVER_FAILED
