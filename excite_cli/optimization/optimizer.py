@@ -131,7 +131,7 @@ def _solve_recovering(
     problem: Evaluations,
 ) -> SolverRun:
     """:func:`~excite_cli.optimization.solvers.solve`, and where the solver fails on its own (SLSQP's
-    "More than 3*n iterations in LSQ subproblem" or "Positive directional derivative in linesearch",
+    "More than 3*n iterations in LSQ subproblem" or "Positive directional derivative for linesearch",
     IPOPT's restoration) with iterations left, up to ``RECOVERIES`` more runs of it from the best
     iterate inside every constraint so far (the start if none), each with the criterion's scale
     times ``RECOVERY_SCALE`` and a fresh quasi-Newton matrix. The solver's iterations add up.
