@@ -47,7 +47,7 @@ def test_a_solver_that_fails_goes_on_from_its_best_point_inside_with_half_the_sc
     def solve(method, nlp, z0, iterations, tolerance, on_iterate, scale=None):
         run = solvers.solve(method, nlp, z0, 5 if not calls else iterations, tolerance, on_iterate, scale)
         calls.append((z0.copy(), iterations, scale, run))
-        return replace(run, failed=True, message="forced") if len(calls) == 1 else run
+        return replace(run, failed=True, limit=False, message="forced") if len(calls) == 1 else run
 
     monkeypatch.setattr(optimizer, "solve", solve)
     criterion = excitation.criterion()
@@ -61,3 +61,31 @@ def test_a_solver_that_fails_goes_on_from_its_best_point_inside_with_half_the_sc
     point = excitation.boundary.to_alpha(z)
     assert accepted(excitation.constraints, point) and criterion.value(point) < criterion.value(start)
     assert result.iterations == 5 + second.iterations and result.stop != SOLVER_FAILED
+
+
+def test_a_solver_that_stops_on_its_own_test_short_of_stationarity_goes_on_with_a_finer_tolerance(
+    panda_problem, monkeypatch
+):
+    """The first solver run is cut after 5 iterations and reported as ended by its own test (as
+    SLSQP's "Optimization terminated successfully" when a later iteration's first step changes the
+    criterion by less than its tolerance), far from a KKT point: the solver runs again from its last
+    iterate with the same scale and a tolerance 1000 times finer, for the iterations left."""
+    problem = small(panda_problem)
+    excitation = build_excitation(problem)
+    start = excitation.random_start(np.random.default_rng(5))
+    calls = []
+
+    def solve(method, nlp, z0, iterations, tolerance, on_iterate, scale=None):
+        run = solvers.solve(method, nlp, z0, 5 if not calls else iterations, tolerance, on_iterate, scale)
+        calls.append((z0.copy(), tolerance, scale, run))
+        return replace(run, limit=False, message="own test") if len(calls) == 1 else run
+
+    monkeypatch.setattr(optimizer, "solve", solve)
+    result = optimizer.optimize_restart(
+        excitation.criterion(), excitation.constraints, problem.optimizer, start, excitation.boundary, max_iterations=60
+    )
+    assert len(calls) == 2
+    (_, first_tolerance, _, first), (z, tolerance, scale, second) = calls
+    np.testing.assert_array_equal(z, first.z)
+    assert scale == first.scale and tolerance == 1e-3 * first_tolerance
+    assert result.iterations == 5 + second.iterations
