@@ -266,7 +266,7 @@ def search(report: Report, runners_up: int = 2) -> list[Table | str]:
 
 
 def bodies(report: Report, robot: Robot) -> Table:
-    """Identified (physically consistent) bodies beside the URDF's, and the active constraints."""
+    """Identified (physically consistent) bodies beside the URDF's, the active constraints and the rotors."""
     urdf, fit = robot.urdf_parameters(), report.consistent
     vector = lambda v: " ".join(f"{x:+.3f}" for x in v)  # noqa: E731
     rows = []
@@ -294,5 +294,7 @@ def bodies(report: Report, robot: Robot) -> Table:
         "active: "
         + (", ".join(fit.active) or "none")
         + "\nplain least squares (same regularization) is not physical for: "
-        + (", ".join(f"{name} (mass {m:.3f} kg)" for name, m in plain) or "none"),
+        + (", ".join(f"{name} (mass {m:.3f} kg)" for name, m in plain) or "none")
+        + "\nrotor inertias held apart from the bodies (in the regrouped base parameters) [kg m²]: "
+        + (", ".join(f"{j} {a:.4g}" for j, a in zip(fit.rotor_joints, fit.rotors)) or "none"),
     )

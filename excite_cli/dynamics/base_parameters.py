@@ -177,3 +177,34 @@ def compute_base_parameters(robot: Robot, seed: int = 0, samples: int | None = N
     count = samples or max(20, int(np.ceil(3 * robot.n_parameters / robot.n_rows)))
     W = robot.regressor_stack(*robot.random_states(count, rng))
     return base_from_regressor(W, robot.parameter_names)
+
+
+def rotor_regrouping(robot: Robot, base: BaseParameters, seed: int = 0) -> np.ndarray:
+    """How each joint's rotor inertia (armature I_a, the column q̈_j on joint j's torque row) regroups
+    with the base parameters: R (b, n) with Y_B R[:, j] = that column at every state, or a zero column
+    where it does not (its armature is then separately identifiable, an effect column of its own).
+
+    A joint whose axis no link before it turns (a serial arm's first joints) has an armature that
+    only adds to a regrouped link inertia (e.g. Izz of link 1), so least squares cannot tell the two
+    apart; the physically consistent fit can, holding the rotor as a parameter of its own (Wensing,
+    Kim, Slotine, RA-L 2017, identify rotors beside the links).
+
+    Args:
+        robot: the robot; base: its base parameters (:func:`compute_base_parameters`).
+        seed: seed of the random states.
+
+    Returns:
+        (b, n) R, coefficients rounded as the regrouping's (``SIGNIFICANT_DIGITS``).
+    """
+    rng = np.random.default_rng(seed)
+    count = max(20, int(np.ceil(3 * robot.n_parameters / robot.n_rows)))
+    Q, QD, QDD = robot.random_states(count, rng)
+    Y_B = robot.regressor_stack(Q, QD, QDD)[:, base.independent]
+    first = robot.n_rows - robot.n_joints  # the joints' rows follow the base wrench's, if any
+    columns = np.zeros((count, robot.n_rows, robot.n_joints))
+    columns[:, first + np.arange(robot.n_joints), np.arange(robot.n_joints)] = QDD
+    columns = columns.reshape(-1, robot.n_joints)
+    R = scipy.linalg.lstsq(Y_B, columns)[0]
+    residual = np.linalg.norm(columns - Y_B @ R, axis=0)
+    R[:, residual > RANK_TOLERANCE * np.linalg.norm(Y_B, axis=0).max()] = 0.0
+    return _rounded(R)

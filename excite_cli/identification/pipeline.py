@@ -276,5 +276,5 @@ def write_identified_urdf(
         effects,
         f"physically consistent parameters identified from {problem.source_path or 'measured data'}",
     )
-    X, phi_base = base.composition_matrix, report.consistent.base
+    X, phi_base = base.composition_matrix, report.consistent.bodies_base  # the rotors are comments in a URDF
     return urdf_deviation(problem.robot, robot, lambda q, qd, qdd: robot.regressor(q, qd, qdd) @ X @ phi_base, target)

@@ -6,10 +6,16 @@ import subprocess
 import sys
 
 import numpy as np
+import pinocchio as pin
 import pytest
 from conftest import CONFIGS, robot_of
 
-from excite_cli.dynamics.base_parameters import base_from_regressor, compute_base_parameters, pivoted_columns
+from excite_cli.dynamics.base_parameters import (
+    base_from_regressor,
+    compute_base_parameters,
+    pivoted_columns,
+    rotor_regrouping,
+)
 
 
 @pytest.mark.parametrize("name", ["g1_problem", "panda_problem", "ur5_problem"])
@@ -35,6 +41,38 @@ def test_number_of_base_parameters_is_the_regressor_rank(name, request):
     W = robot.regressor_stack(*robot.random_states(60, np.random.default_rng(7)))
     assert base.count == np.linalg.matrix_rank(W)
     assert np.linalg.matrix_rank(W @ base.composition_matrix) == base.count
+
+
+@pytest.mark.parametrize(("name", "regrouped"), [("panda_problem", 2), ("ur5_problem", 2), ("g1_problem", 4)])
+def test_rotor_regrouping_is_the_armature_pinocchio_adds(name, regrouped, request):
+    """Y_B R a equals what pinocchio's RNEA adds with armature a on the joints R says regroup (a serial
+    arm's first two, each of the G1's shoulder pitch and roll); the others' armature is no combination
+    of the base parameters' columns."""
+    robot = robot_of(request.getfixturevalue(name))
+    base = compute_base_parameters(robot)
+    R = rotor_regrouping(robot, base)
+    held = np.flatnonzero(np.abs(R).sum(axis=0) > 0)
+    assert held.size == regrouped
+    rng = np.random.default_rng(11)
+    armature = np.zeros(robot.n_joints)
+    armature[held] = rng.uniform(0.1, 0.5, held.size)
+    geared = pin.Model(robot.model)
+    geared.armature[robot.v_idx] = armature
+    data = geared.createData()
+    Q, QD, QDD = robot.random_states(40, rng)
+    for q, qd, qdd in zip(Q[:10], QD[:10], QDD[:10]):
+        added = pin.rnea(geared, data, *robot.state(q, qd, qdd))[robot.row_idx] - robot.torques(q, qd, qdd)
+        np.testing.assert_allclose(
+            robot.regressor(q, qd, qdd) @ base.composition_matrix @ R @ armature, added, atol=1e-9
+        )
+    Y_B = robot.regressor_stack(Q, QD, QDD) @ base.composition_matrix
+    first = robot.n_rows - robot.n_joints
+    for j in sorted(set(range(robot.n_joints)) - set(held)):
+        column = np.zeros((len(Q), robot.n_rows))
+        column[:, first + j] = QDD[:, j]
+        column = column.ravel()
+        residual = column - Y_B @ np.linalg.lstsq(Y_B, column, rcond=None)[0]
+        assert np.linalg.norm(residual) > 0.1 * np.linalg.norm(column)
 
 
 def test_panda_count_matches_the_literature(panda_problem):

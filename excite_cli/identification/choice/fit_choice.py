@@ -35,7 +35,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from excite_cli.dynamics.base_parameters import BaseParameters
+from excite_cli.dynamics.base_parameters import BaseParameters, rotor_regrouping
 from excite_cli.dynamics.robot import Robot
 from excite_cli.identification.choice.search import effect_count, objective
 from excite_cli.identification.choice.selection import Selection
@@ -125,7 +125,8 @@ class FitChoice:
 
 class ConsistentModel:
     """The physically consistent fit of one model [Y_B, ``terms``] on any normal equations of its
-    unknowns (all fit data, or one fold's training data): one compiled program.
+    unknowns (all fit data, or one fold's training data): one compiled program, with a rotor of its
+    own for every joint whose armature regroups with the bodies' and is not one of ``terms``.
 
     Args:
         terms: the model's terms; selection: the fit data's normal equations and the joints' weights.
@@ -138,7 +139,10 @@ class ConsistentModel:
     ):
         names = [f"{name} {t.where(robot.joint_names)}" for t in terms for name in coefficient_names(t, offset_runs)]
         reference = selection.normal.system(selection.weights, terms)[0]
-        self.program = ConsistentProgram(reference, base.regrouping, robot.urdf_parameters(), names, robot.body_names)
+        R, held = rotor_regrouping(robot, base), {t.joint for t in terms if t.effect == "armature" and not t.coupling}
+        rotors = {name: R[:, j] for j, name in enumerate(robot.joint_names) if R[:, j].any() and j not in held}
+        phi = robot.urdf_parameters()
+        self.program = ConsistentProgram(reference, base.regrouping, phi, names, robot.body_names, rotors)
 
     def fit(self, G: np.ndarray, c: np.ndarray, rows: int, regularization: float) -> ConsistentFit:
         """The SDP of :class:`ConsistentProgram` on the weighted normal equations G, c of ``rows`` rows.

@@ -10,8 +10,8 @@ and J_i ≻ 0 is exactly "some positive mass distribution has these parameters":
 the triangle inequalities of its principal moments (Wensing, Kim, Slotine, "Linear matrix inequalities
 for physically consistent inertial parameter identification", RA-L 2017). The problem
 
-    min_φ,θ  (1/M) ‖W (Y_B K φ + E θ − τ)‖² + λ ‖D⁻¹ (φ − φ_URDF)‖²
-    s.t.     J_i(φ_i) ⪰ ε_i 𝟙 for every body,  θ_k ≥ 0 for Coulomb, viscous and armature coefficients
+    min_φ,a,θ  (1/M) ‖W (Y_B (K φ + R a) + E θ − τ)‖² + λ ‖D⁻¹ (φ − φ_URDF)‖²
+    s.t.       J_i(φ_i) ⪰ ε_i 𝟙 for every body,  a ≥ 0,  θ_k ≥ 0 for Coulomb, viscous and armature coefficients
 
 is a semidefinite program (solved by cvxpy with Clarabel); Y_B K φ = Y φ (Eq. 2), W the per-joint
 weights of the weighted least-squares fit. D scales each body's parameters by its URDF mass m₀ (and
@@ -20,6 +20,15 @@ consistent one closest to the CAD model (the regularization of Sousa & Cortesão
 Lee et al., RA-L 2020, in a Euclidean metric). The data term enters through the weighted normal
 equations of [Y_B, E] (a factor of them), so the SDP has only as many unknowns as parameters and
 a cross-validation fold costs no design matrix.
+
+The rotors a [kg·m²] are the armature of the joints whose rotor inertia regroups with a link's in the
+base parameters (R, :func:`~excite_cli.dynamics.base_parameters.rotor_regrouping`: a serial arm's
+first joints), parameters of their own beside the bodies (Wensing, Kim, Slotine 2017 identify rotors
+with the links the same way). Least squares cannot tell a rotor from the link inertia it regroups
+with; without a, the consistent fit must put a geared joint's rotor into the links' inertias, pulled
+toward the URDF, and bend the bodies (a simulated Panda with 0.3 kg·m² on joints 1 and 2: link 3's
+mass 46 % low). The prior does not pull a, so the regrouped base parameter holds what the data say
+and the bodies stay near the URDF where the data do not move them.
 """
 
 from __future__ import annotations
@@ -78,7 +87,10 @@ class ConsistentFit:
     Attributes:
         standard: (p,) standard parameters φ [kg, kg·m, kg·m²], 10 per body (pinocchio's order).
         effects: (k,) effect coefficients θ, in the design's column order.
-        base: (b,) base parameters K φ (Eq. 2).
+        base: (b,) base parameters K φ + R a (Eq. 2; the bodies and the rotors regrouped with them).
+        rotors: (r,) rotor inertias a [kg·m²] of the joints ``rotor_joints`` (module docstring).
+        rotor_joints: (r,) the joints whose rotors are held apart from the bodies.
+        bodies_base: (b,) the bodies' part of ``base``, K φ (what a URDF of ``standard`` has).
         min_eigenvalues: (bodies,) smallest eigenvalue of each pseudo-inertia [kg·m²].
         active: the constraints at their bound, in words (e.g. ``pseudo-inertia of panda_link7``).
         status: the solver's status (``optimal``, or ``optimal_inaccurate`` when Clarabel stopped
@@ -94,6 +106,9 @@ class ConsistentFit:
     active: list[str]
     status: str
     unconstrained: np.ndarray
+    rotors: np.ndarray
+    rotor_joints: list[str]
+    bodies_base: np.ndarray
 
 
 def nearest_physical(phi: np.ndarray) -> np.ndarray:
@@ -166,6 +181,8 @@ class ConsistentProgram:
         effect_names: (k,) ``"<coefficient> <joint>"`` of each effect column (e.g. ``"Fc panda_joint1"``);
             coefficients named in ``NONNEGATIVE`` are kept ≥ 0.
         bodies: (p/10,) body names, for the ``active`` list.
+        rotors: {joint: (b,) column of R}: the joints whose rotor inertia regroups with the bodies',
+            each kept ≥ 0 as a parameter of its own (module docstring; default none).
     """
 
     def __init__(
@@ -175,21 +192,26 @@ class ConsistentProgram:
         phi_urdf: np.ndarray,
         effect_names: list[str],
         bodies: list[str],
+        rotors: dict[str, np.ndarray] | None = None,
     ):
         phi_urdf = nearest_physical(phi_urdf)  # unseen parameters stay at φ_URDF: it must be feasible
         self.regrouping, self.phi_urdf, self.names, self.bodies = regrouping, phi_urdf, effect_names, bodies
         self.scale = scale = body_scales(phi_urdf)
         b, k, p = regrouping.shape[0], len(effect_names), scale.size
+        self.rotor_joints = list(rotors or {})
+        self.rotors = np.column_stack([rotors[j] for j in self.rotor_joints]) if rotors else np.zeros((b, 0))
+        self.first_effect = p + (r := len(self.rotor_joints))  # [δ; a] come before the effects θ
         self.nonnegative = np.array([name.split()[0] in NONNEGATIVE for name in effect_names], dtype=bool)
-        # [Y_B K D, E]: the design in the unknowns [δ; θ], φ = φ_URDF + D δ
-        self.to_unknowns = np.zeros((b + k, p + k))
+        # [Y_B K D, Y_B R, E]: the design in the unknowns [δ; a; θ], φ = φ_URDF + D δ
+        self.to_unknowns = np.zeros((b + k, p + r + k))
         self.to_unknowns[:b, :p] = regrouping * scale
-        self.to_unknowns[b:, p:] = np.eye(k)
+        self.to_unknowns[:b, p : p + r] = self.rotors
+        self.to_unknowns[b:, p + r :] = np.eye(k)
         column = np.sqrt(np.maximum(np.diag(self.to_unknowns.T @ reference @ self.to_unknowns), 0.0))
         self.unseen = column <= 1e-9 * column.max()
         column[self.unseen] = 1.0
         self.column = column
-        size = p + k
+        size = p + r + k
         self.R, self.z = cp.Parameter((size, size)), cp.Parameter(size)  # the data term ‖R u − z‖², scaled by 1/M
         self.weight, self.pinned = cp.Parameter(nonneg=True), cp.Parameter(k, nonneg=True)
         self.u = u = cp.Variable(size)  # u = column ⊙ [δ; θ]
@@ -202,10 +224,12 @@ class ConsistentProgram:
             >> MARGIN * np.diag([1.0] * 3 + [LENGTH**2])
             for i in range(len(bodies))
         ]
+        if r:
+            constraints.append(u[p : p + r] >= 0)
         if k and self.nonnegative.any():
-            constraints.append(u[p + np.flatnonzero(self.nonnegative)] >= 0)
+            constraints.append(u[p + r + np.flatnonzero(self.nonnegative)] >= 0)
         if k:  # an effect column a fold's data never see (a held-out run's offset) is kept at 0
-            constraints.append(cp.multiply(self.pinned, u[p:]) == 0)
+            constraints.append(cp.multiply(self.pinned, u[p + r :]) == 0)
         objective = cp.sum_squares(self.R @ u - self.z) + self.weight * cp.sum_squares(delta)
         self.problem = cp.Problem(cp.Minimize(objective), constraints)
 
@@ -216,7 +240,7 @@ class ConsistentProgram:
         Raises:
             ExciteError: the solver finds no solution (the message gives its status).
         """
-        b, p = self.regrouping.shape[0], self.scale.size
+        b, p, q = self.regrouping.shape[0], self.scale.size, self.first_effect
         column = self.column
         normal = self.to_unknowns.T @ G @ self.to_unknowns / np.outer(column, column)
         right = self.to_unknowns.T @ (c - G[:, :b] @ (self.regrouping @ self.phi_urdf)) / column
@@ -228,11 +252,11 @@ class ConsistentProgram:
         z = np.zeros(normal.shape[0])
         z[: kept.sum()] = (vectors[:, kept].T @ right) / np.sqrt(eigenvalues[kept])
         self.R.value, self.z.value, self.weight.value = R / np.sqrt(rows), z / np.sqrt(rows), regularization
-        self.pinned.value = (np.diag(normal)[p:] <= 0.0).astype(float)
+        self.pinned.value = (np.diag(normal)[q:] <= 0.0).astype(float)
         problem = _solve(self.problem)
         u = self.u.value
         standard = self.phi_urdf + self.scale * (u[:p] / column[:p])
-        coefficients = u[p:] / column[p:]
+        rotors, coefficients = u[p:q] / column[p:q], u[q:] / column[q:]
         eigen = np.array(
             [np.linalg.eigvalsh(pseudo_inertia(standard[10 * i : 10 * i + 10]))[0] for i in range(len(self.bodies))]
         )
@@ -245,9 +269,20 @@ class ConsistentProgram:
         epsilon = MARGIN * self.scale[0::10] * LENGTH**2
         active = [f"pseudo-inertia of {name}" for name, e, eps in zip(self.bodies, eigen, epsilon) if e <= ACTIVE * eps]
         active += [f"{self.names[c]} ≥ 0" for c in np.flatnonzero(self.nonnegative & (coefficients <= 1e-9))]
+        active += [f"rotor of {j} ≥ 0" for j, a in zip(self.rotor_joints, rotors) if a <= 1e-9]
         stacked = np.vstack([R / np.sqrt(rows), np.sqrt(regularization) * np.diag(1.0 / column)[:p]])
         plain = np.linalg.lstsq(stacked, np.concatenate([z / np.sqrt(rows), np.zeros(p)]), rcond=None)[0]
         unconstrained = self.phi_urdf + self.scale * plain[:p] / column[:p]
+        bodies = self.regrouping @ standard
         return ConsistentFit(
-            standard, coefficients, self.regrouping @ standard, eigen, active, str(problem.status), unconstrained
+            standard,
+            coefficients,
+            bodies + self.rotors @ rotors,
+            eigen,
+            active,
+            str(problem.status),
+            unconstrained,
+            rotors,
+            self.rotor_joints,
+            bodies,
         )

@@ -136,7 +136,7 @@ def check_mjcf(
         model.path,
         robot,
         base.composition_matrix,
-        consistent.base,
+        consistent.bodies_base,  # the rotors are the joints' armature in the MJCF
         model,
         problem.identification.coulomb_velocity,
     )

@@ -170,9 +170,15 @@ class Report:
 
     def effect_values(self, consistent: bool = False) -> list[tuple[Term, str, float, float]]:
         """(term, coefficient, value, std) for every chosen effect coefficient, in order: of the
-        least-squares fit, or with ``consistent`` of the physically consistent one (std NaN)."""
+        least-squares fit, or with ``consistent`` of the physically consistent one (std NaN), followed
+        by its rotors held apart from the bodies, as the armature of their joints (what a model file
+        of its bodies lacks)."""
         b = len(self.base_names)
         values = self.consistent.effects if consistent else self.selection.fit.x[b:]
         stds = np.full(values.size, np.nan) if consistent else self.selection.fit.std[b:]
         names = [(term, name) for term in self.selection.terms for name in coefficient_names(term, self.offset_runs)]
-        return [(term, name, float(v), float(s)) for (term, name), v, s in zip(names, values, stds)]
+        out = [(term, name, float(v), float(s)) for (term, name), v, s in zip(names, values, stds)]
+        if consistent:
+            rotors = zip(self.consistent.rotor_joints, self.consistent.rotors)
+            out += [(Term("armature", self.joints.index(j)), "Ia", float(a), float("nan")) for j, a in rotors]
+        return out

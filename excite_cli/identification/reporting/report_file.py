@@ -257,14 +257,16 @@ def _write_validation(g: h5py.Group, report: Report) -> None:
 
 
 def _write_consistent(g: h5py.Group, report: Report, robot: Robot) -> None:
-    """The physically consistent fit: standard parameters, per-body properties beside the URDF's,
-    active constraints, its validation errors."""
+    """The physically consistent fit: standard parameters, rotor inertias, per-body properties beside the
+    URDF's, active constraints, its validation errors."""
     consistent = report.consistent
     g.create_dataset("standard_parameters", data=consistent.standard).attrs["unit"] = (
         "kg, kg m, kg m^2 (pinocchio order per body)"
     )
     write_strings(g, "standard_parameter_names", robot.parameter_names)
-    g.create_dataset("base_parameters_consistent", data=consistent.base)
+    g.create_dataset("base_parameters_consistent", data=consistent.base).attrs["description"] = "K phi + R a"
+    g.create_dataset("rotor_inertias", data=consistent.rotors).attrs["unit"] = "kg m^2 (a, apart from the bodies)"
+    write_strings(g, "rotor_joints", consistent.rotor_joints)
     g.attrs["solver_status"] = consistent.status
     write_strings(g, "active_constraints", consistent.active)
     urdf = robot.urdf_parameters()
@@ -285,13 +287,8 @@ def _write_consistent(g: h5py.Group, report: Report, robot: Robot) -> None:
     for i, row in enumerate(bodies):
         m, c, I, moments = body_properties(consistent.standard[10 * i : 10 * i + 10])
         um, uc, _, umoments = body_properties(urdf[10 * i : 10 * i + 10])
-        row["body"], row["mass"], row["com"], row["principal_moments"], row["inertia_com"] = (
-            robot.body_names[i],
-            m,
-            c,
-            moments,
-            I,
-        )
+        row["body"], row["mass"], row["com"] = robot.body_names[i], m, c
+        row["principal_moments"], row["inertia_com"] = moments, I
         row["urdf_mass"], row["urdf_com"], row["urdf_principal_moments"] = um, uc, umoments
         row["pseudo_inertia_min_eigenvalue"] = consistent.min_eigenvalues[i]
     table = g.create_dataset("bodies", data=bodies)

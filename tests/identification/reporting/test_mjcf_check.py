@@ -22,7 +22,9 @@ def _write(simulated_identification, target):
 def test_mujoco_reproduces_the_identified_model_and_its_validation_error(simulated_identification, tmp_path):
     problem, report, robot, base, regressor = simulated_identification
     model = _write(simulated_identification, tmp_path / "panda.xml")
-    assert {a for _, a in model.fields} == {"damping", "frictionloss"} and model.unwritten == []
+    assert {a for _, a in model.fields} <= {"damping", "frictionloss", "armature"} and model.unwritten == []
+    # the rotors the consistent fit holds apart from the bodies are their joints' armature
+    assert {j for j, a in model.fields if a == "armature"} == set(report.consistent.rotor_joints) != set()
     check = check_mjcf(problem, report, robot, base, model)
     assert check.rigid <= 1e-5 and check.friction <= 1e-5
     np.testing.assert_allclose(check.relative_excite, report.relative_consistent, rtol=1e-12)
@@ -36,7 +38,8 @@ def test_mujoco_reproduces_the_identified_model_and_its_validation_error(simulat
         assert g.attrs["mjcf"] == str(model.path) and g.attrs["rigid_deviation"] == check.rigid
         np.testing.assert_array_equal(g["validation_mujoco"][()], check.relative_mujoco)
         fields = g["joint_fields"][()]
-        assert len(fields) == 14 and np.all(fields["value"] > 0) and len(g["not_in_mjcf"]) == 0
+        assert len(fields) == 14 + len(report.consistent.rotor_joints) and len(g["not_in_mjcf"]) == 0
+        assert np.all(fields["value"] >= 0)
 
 
 def test_a_file_that_is_not_the_identified_model_fails_the_check(simulated_identification, tmp_path):
