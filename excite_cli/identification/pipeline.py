@@ -4,7 +4,7 @@ the validation data, which neither the fit nor the selection saw."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -21,6 +21,7 @@ from excite_cli.identification.effects import EFFECTS, Term
 from excite_cli.identification.fitting.channels import dead_channels
 from excite_cli.identification.fitting.dataset import Dataset, build_datasets, fit_position_range
 from excite_cli.identification.fitting.least_squares import joint_weights, least_squares, predict, torque_errors
+from excite_cli.identification.fitting.noise import middle
 from excite_cli.identification.fitting.normal import NormalEquations, excited_rank
 from excite_cli.identification.fitting.plausibility import implausible
 from excite_cli.identification.measured.gaps import split_at_gaps
@@ -205,6 +206,9 @@ def run_identification(
     labels = [r.label for r in problem.data.runs]
     offset_runs = [labels[k] for k in data.fitted]
     selection, choice = choose_fit(selection, robot, base, offset_runs, cfg, oversampling, consistent_beside)
+    sandwich = middle(fit_data, selection.fit.x, selection.terms, selection.weights, data.rate)  # the stds'
+    fit = least_squares(selection.normal, selection.terms, selection.weights, middle=sandwich)
+    selection = replace(selection, fit=fit)
     measured = val_data.tau.reshape(-1, val_data.n)
     before = predict(val_data, selection.rigid.x, [])
     plain = predict(val_data, selection.fit.x, selection.terms)

@@ -168,7 +168,8 @@ def test_undeclared_friction_and_armature_are_found_and_written_to_mjcf(tmp_path
         dof = mj.joint(joint).dofadr[0]
         assert mj.dof_frictionloss[dof] == pytest.approx(TRUE["coulomb"], rel=0.05)
         assert mj.dof_damping[dof] == pytest.approx(TRUE["viscous"], rel=0.05)
-        assert mj.dof_armature[dof] == pytest.approx(ARMATURE.get(joint, 0.0), rel=0.05)
+        # joints 1-2 carry the rotors the consistent fit holds apart (none in the data: near 0)
+        assert mj.dof_armature[dof] == pytest.approx(ARMATURE.get(joint, 0.0), rel=0.05, abs=1e-3)
     assert model.unwritten == [] and check.unwritten == []
     assert check.rigid <= 1e-5 and check.friction <= 1e-5
     # MuJoCo's friction follows q̈ + b q̇ near velocity reversals (friction_differs), so its error on the

@@ -34,11 +34,10 @@ def test_the_scale_is_the_trajectorys_own_whatever_the_prior(panda_problem):
         assert own_scale(criterion, excitation.boundary, start) == alone
 
 
-def test_a_solver_that_fails_goes_on_from_its_best_point_inside_with_half_the_scale(panda_problem, monkeypatch):
-    """The first solver run is cut after 5 iterations and reported failed (as SLSQP's "More than 3*n
-    iterations in LSQ subproblem" is): the restart runs the solver again, from a point every
-    constraint accepts that is better than the start (its best iterate inside), with the criterion's
-    scale halved, for the iterations left; its iterations add up, and it does not end failed."""
+def _first_run_cut(panda_problem, monkeypatch, **ending):
+    """A restart whose first solver run is cut after 5 iterations and reported with ``ending`` (its
+    other runs as the solver ends them): the excitation, the start, each run's (start z, iteration
+    budget, tolerance, scale, run) and the restart's result."""
     problem = small(panda_problem)
     excitation = build_excitation(problem)
     start = excitation.random_start(np.random.default_rng(5))
@@ -46,19 +45,27 @@ def test_a_solver_that_fails_goes_on_from_its_best_point_inside_with_half_the_sc
 
     def solve(method, nlp, z0, iterations, tolerance, on_iterate, scale=None):
         run = solvers.solve(method, nlp, z0, 5 if not calls else iterations, tolerance, on_iterate, scale)
-        calls.append((z0.copy(), iterations, scale, run))
-        return replace(run, failed=True, limit=False, message="forced") if len(calls) == 1 else run
+        calls.append((z0.copy(), iterations, tolerance, scale, run))
+        return replace(run, limit=False, **ending) if len(calls) == 1 else run
 
     monkeypatch.setattr(optimizer, "solve", solve)
-    criterion = excitation.criterion()
     result = optimizer.optimize_restart(
-        criterion, excitation.constraints, problem.optimizer, start, excitation.boundary, max_iterations=60
+        excitation.criterion(), excitation.constraints, problem.optimizer, start, excitation.boundary, max_iterations=60
     )
+    return excitation, start, calls, result
+
+
+def test_a_solver_that_fails_goes_on_from_its_best_point_inside_with_half_the_scale(panda_problem, monkeypatch):
+    """The first solver run is cut after 5 iterations and reported failed (as SLSQP's "More than 3*n
+    iterations in LSQ subproblem" is): the restart runs the solver again, from a point every
+    constraint accepts that is better than the start (its best iterate inside), with the criterion's
+    scale halved, for the iterations left; its iterations add up, and it does not end failed."""
+    excitation, start, calls, result = _first_run_cut(panda_problem, monkeypatch, failed=True, message="forced")
     assert len(calls) == 2
-    (_, first_budget, _, first), (z, budget, scale, second) = calls
+    (_, first_budget, _, _, first), (z, budget, _, scale, second) = calls
     assert first.iterations == 5 and budget == first_budget - 5 == 55
     assert scale == 0.5 * first.scale
-    point = excitation.boundary.to_alpha(z)
+    point, criterion = excitation.boundary.to_alpha(z), excitation.criterion()
     assert accepted(excitation.constraints, point) and criterion.value(point) < criterion.value(start)
     assert result.iterations == 5 + second.iterations and result.stop != SOLVER_FAILED
 
@@ -70,22 +77,9 @@ def test_a_solver_that_stops_on_its_own_test_short_of_stationarity_goes_on_with_
     SLSQP's "Optimization terminated successfully" when a later iteration's first step changes the
     criterion by less than its tolerance), far from a KKT point: the solver runs again from its last
     iterate with the same scale and a tolerance 1000 times finer, for the iterations left."""
-    problem = small(panda_problem)
-    excitation = build_excitation(problem)
-    start = excitation.random_start(np.random.default_rng(5))
-    calls = []
-
-    def solve(method, nlp, z0, iterations, tolerance, on_iterate, scale=None):
-        run = solvers.solve(method, nlp, z0, 5 if not calls else iterations, tolerance, on_iterate, scale)
-        calls.append((z0.copy(), tolerance, scale, run))
-        return replace(run, limit=False, message="own test") if len(calls) == 1 else run
-
-    monkeypatch.setattr(optimizer, "solve", solve)
-    result = optimizer.optimize_restart(
-        excitation.criterion(), excitation.constraints, problem.optimizer, start, excitation.boundary, max_iterations=60
-    )
+    _, _, calls, result = _first_run_cut(panda_problem, monkeypatch, message="own test")
     assert len(calls) == 2
-    (_, first_tolerance, _, first), (z, tolerance, scale, second) = calls
+    (_, _, first_tolerance, _, first), (z, _, tolerance, scale, second) = calls
     np.testing.assert_array_equal(z, first.z)
     assert scale == first.scale and tolerance == 1e-3 * first_tolerance
     assert result.iterations == 5 + second.iterations

@@ -6,7 +6,9 @@ residual standard deviation of that joint under ordinary least squares of the ri
 fixed for every fit of one identification (the effect selection's and the final one), so the
 reported model is the one that was scored. The estimates' standard deviations come from
 σ² (AᵀWA)⁻¹, scaled by √r: after the parallel low-pass at f_c, samples at f_s carry only about
-2 f_c T independent values (r = f_s / (2 f_c), the oversampling). Every fit goes through the
+2 f_c T independent values (r = f_s / (2 f_c), the oversampling); or, given AᵀWΣWA from the
+residuals' spectra (:mod:`~excite_cli.identification.fitting.noise`), from the sandwich
+(AᵀWA)⁻¹ (AᵀWΣWA) (AᵀWA)⁻¹, as the reported fit's are. Every fit goes through the
 per-joint normal equations of :mod:`excite_cli.identification.fitting.normal` (no design matrix is formed).
 """
 
@@ -36,23 +38,28 @@ class Fit:
 
 
 def least_squares(
-    normal: NormalEquations, effects: list[Term], weights: np.ndarray | None = None, oversampling: float = 1.0
+    normal: NormalEquations,
+    effects: list[Term],
+    weights: np.ndarray | None = None,
+    oversampling: float = 1.0,
+    middle: np.ndarray | None = None,
 ) -> Fit:
     """Ordinary (Eq. 4) or weighted least squares of the model [Y_B, ``effects``] with standard
-    deviations σ² diag((AᵀWA)⁻¹), scaled by √r.
+    deviations (module docstring).
 
     Args:
         normal: the data's normal equations.
         weights: (n,) weight of each joint's rows (WLS, see :func:`joint_weights`), or None (LS).
-        oversampling: samples per independent sample (r ≥ 1).
+        oversampling: samples per independent sample r (≥ 1), for σ² (AᵀWA)⁻¹ r.
+        middle: (m, m) AᵀWΣWA for the sandwich instead (m the model's unknowns).
     """
     G, c, s = normal.system(weights, effects)
     x = solve(G, c)
     dof = max(1, normal.rows - x.size)
     s2 = sse(G, c, s, x) / dof
-    std = np.sqrt(oversampling * s2 * np.maximum(covariance_diagonal(G), 0.0))
     sigma = np.sqrt(normal.joint_sse(x, effects) / (normal.rows / normal.n) / (dof / normal.rows))
-    return Fit(x, std, sigma)
+    variance = oversampling * s2 * covariance_diagonal(G) if middle is None else covariance_diagonal(G, middle)
+    return Fit(x, np.sqrt(np.maximum(variance, 0.0)), sigma)
 
 
 def joint_weights(normal: NormalEquations, weighted: bool) -> np.ndarray | None:

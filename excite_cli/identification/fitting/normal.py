@@ -151,8 +151,11 @@ def outside_fraction(G: np.ndarray, model: int) -> float:
     return float(np.trace(C - inside) / max(np.trace(C), 1e-300))
 
 
-def covariance_diagonal(G: np.ndarray) -> np.ndarray:
-    """diag(G⁻¹) with unit-diagonal scaling."""
+def covariance_diagonal(G: np.ndarray, middle: np.ndarray | None = None) -> np.ndarray:
+    """diag(G⁻¹), or of the sandwich G⁻¹ M G⁻¹ with ``middle`` M (the same size as G), with
+    unit-diagonal scaling."""
     scaled, d = _unit_diagonal(G)
     inverse = np.linalg.pinv(scaled, rcond=1e-13, hermitian=True)
-    return np.diag(inverse) / d**2
+    if middle is None:
+        return np.diag(inverse) / d**2
+    return np.einsum("ij,jk,ki->i", inverse, middle / np.outer(d, d), inverse) / d**2
