@@ -173,10 +173,14 @@ def compute_base_parameters(robot: Robot, seed: int = 0, samples: int | None = N
     Raises:
         ExciteError: no parameter is excited by the regressor rows (b = 0).
     """
-    rng = np.random.default_rng(seed)
+    return base_from_regressor(robot.regressor_stack(*_random_states(robot, seed, samples)), robot.parameter_names)
+
+
+def _random_states(robot: Robot, seed: int, samples: int | None = None) -> tuple[np.ndarray, ...]:
+    """(samples, n) random positions, velocities and accelerations (default: enough for 3× more
+    regressor rows than parameters)."""
     count = samples or max(20, int(np.ceil(3 * robot.n_parameters / robot.n_rows)))
-    W = robot.regressor_stack(*robot.random_states(count, rng))
-    return base_from_regressor(W, robot.parameter_names)
+    return robot.random_states(count, np.random.default_rng(seed))
 
 
 def rotor_regrouping(robot: Robot, base: BaseParameters, seed: int = 0) -> np.ndarray:
@@ -196,9 +200,8 @@ def rotor_regrouping(robot: Robot, base: BaseParameters, seed: int = 0) -> np.nd
     Returns:
         (b, n) R, coefficients rounded as the regrouping's (``SIGNIFICANT_DIGITS``).
     """
-    rng = np.random.default_rng(seed)
-    count = max(20, int(np.ceil(3 * robot.n_parameters / robot.n_rows)))
-    Q, QD, QDD = robot.random_states(count, rng)
+    Q, QD, QDD = _random_states(robot, seed)
+    count = Q.shape[0]
     Y_B = robot.regressor_stack(Q, QD, QDD)[:, base.independent]
     first = robot.n_rows - robot.n_joints  # the joints' rows follow the base wrench's, if any
     columns = np.zeros((count, robot.n_rows, robot.n_joints))

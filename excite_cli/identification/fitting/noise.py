@@ -50,7 +50,8 @@ def pieces(data: Dataset, rate: float) -> list[np.ndarray]:
 
 
 def residual_spectra(residual: np.ndarray, stretches: list[np.ndarray], rate: float):
-    """Two-sided power spectral density of each joint's residual, Welch over every stretch.
+    """Two-sided power spectral density of each joint's residual, Welch over every stretch at least
+    one segment long (``SEGMENT``, or the longest stretch if shorter).
 
     Args:
         residual: (N, n) [Nm]; stretches: contiguous instants (:func:`pieces`); rate: f_s [Hz].
@@ -58,9 +59,9 @@ def residual_spectra(residual: np.ndarray, stretches: list[np.ndarray], rate: fl
     Returns:
         frequencies (F,) [Hz] ascending and S (F, n) [Nm²/Hz].
     """
-    length = min([int(SEGMENT * rate)] + [p.size for p in stretches])
+    length = min(int(SEGMENT * rate), max(p.size for p in stretches))
     total, weight = 0.0, 0
-    for rows in stretches:
+    for rows in [p for p in stretches if p.size >= length]:
         f, S = signal.welch(residual[rows], fs=rate, nperseg=length, detrend=False, return_onesided=False, axis=0)
         total, weight = total + rows.size * S, weight + rows.size
     order = np.argsort(f)

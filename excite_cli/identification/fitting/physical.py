@@ -27,7 +27,7 @@ first joints), parameters of their own beside the bodies (Wensing, Kim, Slotine 
 with the links the same way). Least squares cannot tell a rotor from the link inertia it regroups
 with; without a, the consistent fit must put a geared joint's rotor into the links' inertias, pulled
 toward the URDF, and bend the bodies (a simulated Panda with 0.3 kg·m² on joints 1 and 2: link 3's
-mass 46 % low). The prior does not pull a, so the regrouped base parameter holds what the data say
+mass 39 % low). The prior does not pull a, so the regrouped base parameter holds what the data say
 and the bodies stay near the URDF where the data do not move them.
 """
 
@@ -214,7 +214,7 @@ class ConsistentProgram:
         size = p + r + k
         self.R, self.z = cp.Parameter((size, size)), cp.Parameter(size)  # the data term ‖R u − z‖², scaled by 1/M
         self.weight, self.pinned = cp.Parameter(nonneg=True), cp.Parameter(k, nonneg=True)
-        self.u = u = cp.Variable(size)  # u = column ⊙ [δ; θ]
+        self.u = u = cp.Variable(size)  # u = column ⊙ [δ; a; θ]
         delta = cp.multiply(u[:p], 1.0 / column[:p])
         phi = phi_urdf + cp.multiply(scale, delta)
         # T J T ⪰ ε T² with T = diag(1/ℓ, 1/ℓ, 1/ℓ, 1)/√m₀: a congruence, same cone, entries of order 1
