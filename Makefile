@@ -29,7 +29,7 @@ optimize: $(STAMP)
 	$(VENV)/bin/excite optimize $(CONFIG) --force
 
 test: $(STAMP)
-	$(PY) -m pytest -q -rs -n auto
+	$(PY) -m pytest -q -rs -n auto --durations=10
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check .
