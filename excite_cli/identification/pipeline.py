@@ -191,13 +191,11 @@ def run_identification(
     candidates = candidate_terms(cfg, robot.n_joints, couplings)
     data = prepare_data(problem, robot, base, declared + [t for t in candidates if t not in declared])
     fit_data, val_data = data.fit, data.validation
-    oversampling = max(1.0, data.rate / (2.0 * data.cutoff))
     selection = select_effects(
         fit_data,
         cfg,
         declared,
         margin=1.0 / data.cutoff,
-        oversampling=oversampling,
         recordings=fold_groups(problem.data.runs, problem.folder, cfg.folds_by, data.fitted),
         fitted_offsets=set(np.unique(val_data.run).tolist()) <= set(data.fitted),
         couplings=couplings,
@@ -205,7 +203,7 @@ def run_identification(
     )
     labels = [r.label for r in problem.data.runs]
     offset_runs = [labels[k] for k in data.fitted]
-    selection, choice = choose_fit(selection, robot, base, offset_runs, cfg, oversampling, consistent_beside)
+    selection, choice = choose_fit(selection, robot, base, offset_runs, cfg, consistent_beside)
     sandwich = middle(fit_data, selection.fit.x, selection.terms, selection.weights, data.rate)  # the stds'
     fit = least_squares(selection.normal, selection.terms, selection.weights, middle=sandwich)
     selection = replace(selection, fit=fit)

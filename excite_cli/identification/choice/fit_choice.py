@@ -193,7 +193,7 @@ def _scores(selection: Selection, model: Model, lams: list[float | None], consis
     return np.array(out)
 
 
-def kept_selection(selection: Selection, model: Model, oversampling: float) -> Selection:
+def kept_selection(selection: Selection, model: Model) -> Selection:
     """``selection`` with ``model`` as its chosen model: its terms, least-squares fit and CV errors."""
     if model.search == selection.chosen and not model.at_start:
         return selection
@@ -201,7 +201,7 @@ def kept_selection(selection: Selection, model: Model, oversampling: float) -> S
     return replace(
         selection,
         terms=model.terms,
-        fit=least_squares(selection.normal, model.terms, selection.weights, oversampling),
+        fit=least_squares(selection.normal, model.terms, selection.weights),
         cv_error=search.initial_error if model.at_start else search.cv_error,
         cv_joint=selection.cross_validation.error(model.terms)[1],
         chosen=model.search,
@@ -215,7 +215,6 @@ def choose_fit(
     base: BaseParameters,
     offset_runs: list[str],
     cfg: IdentificationConfig,
-    oversampling: float = 1.0,
     consistent_beside: bool = False,
 ) -> tuple[Selection, FitChoice]:
     """Score every model of :func:`compared_models` under every fit of ``cfg.fit`` on the selection's
@@ -227,7 +226,6 @@ def choose_fit(
         robot, base, offset_runs: for the consistent fits (:class:`ConsistentModel`).
         cfg: ``fit``, ``regularization`` (λ, one or several) and ``least_squares_margin``; the price p
             pays is the selection's ``min_improvement``, the same the search used.
-        oversampling: samples per independent sample of the fit data, for the least-squares std.
         consistent_beside: fit the consistent model (at the first λ) even when least squares is the
             only fit (the identified URDF needs one).
 
@@ -268,4 +266,4 @@ def choose_fit(
         consistent=fit,
         margin=cfg.least_squares_margin if any(lam is not None for lam in lams) and None in lams else 0.0,
     )
-    return kept_selection(selection, models[win], oversampling), choice
+    return kept_selection(selection, models[win]), choice

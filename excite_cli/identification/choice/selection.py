@@ -152,7 +152,6 @@ def select_effects(
     cfg: IdentificationConfig,
     declared: list[Term],
     margin: float,
-    oversampling: float = 1.0,
     recordings: np.ndarray | None = None,
     fitted_offsets: bool = False,
     couplings: list[tuple[float, ...]] = (),
@@ -165,8 +164,6 @@ def select_effects(
         cfg: candidates, ``min_improvement``, ``max_effects``, ``folds``, ``method``, shape grids.
         declared: terms in the model from the start, never removed.
         margin: [s] left out of a fold's fit around its held-out block (correlated samples).
-        oversampling: samples per independent sample r (≥ 1) of the filtered data, for the
-            standard deviations.
         recordings: the recording of each run, indexed by ``fit_data.run``: two or more make the
             folds whole recordings; None: time blocks (:class:`CrossValidation`).
         fitted_offsets: every validation run is fitted too, so its offsets are known (recording folds
@@ -197,8 +194,8 @@ def select_effects(
     return Selection(
         terms=terms,
         declared=len(declared),
-        fit=least_squares(total, terms, weights, oversampling),
-        rigid=least_squares(total, [], weights, oversampling),
+        fit=least_squares(total, terms, weights),
+        rigid=least_squares(total, [], weights),
         weights=weights,
         cv_rigid=cv.error([])[0],
         cv_error=searches[chosen].cv_error,

@@ -5,10 +5,9 @@ Weighted least squares follows Gautier (1997): each joint's rows are weighted by
 residual standard deviation of that joint under ordinary least squares of the rigid-body model,
 fixed for every fit of one identification (the effect selection's and the final one), so the
 reported model is the one that was scored. The estimates' standard deviations come from
-σ² (AᵀWA)⁻¹, scaled by √r: after the parallel low-pass at f_c, samples at f_s carry only about
-2 f_c T independent values (r = f_s / (2 f_c), the oversampling); or, given AᵀWΣWA from the
-residuals' spectra (:mod:`~excite_cli.identification.fitting.noise`), from the sandwich
-(AᵀWA)⁻¹ (AᵀWΣWA) (AᵀWA)⁻¹, as the reported fit's are. Every fit goes through the
+σ² (AᵀWA)⁻¹ (white residuals), or, given AᵀWΣWA from the residuals' spectra
+(:mod:`~excite_cli.identification.fitting.noise`: filtered residuals are correlated), from the
+sandwich (AᵀWA)⁻¹ (AᵀWΣWA) (AᵀWA)⁻¹, as the reported fit's are. Every fit goes through the
 per-joint normal equations of :mod:`excite_cli.identification.fitting.normal` (no design matrix is formed).
 """
 
@@ -41,7 +40,6 @@ def least_squares(
     normal: NormalEquations,
     effects: list[Term],
     weights: np.ndarray | None = None,
-    oversampling: float = 1.0,
     middle: np.ndarray | None = None,
 ) -> Fit:
     """Ordinary (Eq. 4) or weighted least squares of the model [Y_B, ``effects``] with standard
@@ -50,15 +48,14 @@ def least_squares(
     Args:
         normal: the data's normal equations.
         weights: (n,) weight of each joint's rows (WLS, see :func:`joint_weights`), or None (LS).
-        oversampling: samples per independent sample r (≥ 1), for σ² (AᵀWA)⁻¹ r.
-        middle: (m, m) AᵀWΣWA for the sandwich instead (m the model's unknowns).
+        middle: (m, m) AᵀWΣWA for the sandwich (m the model's unknowns), or None for σ² (AᵀWA)⁻¹.
     """
     G, c, s = normal.system(weights, effects)
     x = solve(G, c)
     dof = max(1, normal.rows - x.size)
     s2 = sse(G, c, s, x) / dof
     sigma = np.sqrt(normal.joint_sse(x, effects) / (normal.rows / normal.n) / (dof / normal.rows))
-    variance = oversampling * s2 * covariance_diagonal(G) if middle is None else covariance_diagonal(G, middle)
+    variance = s2 * covariance_diagonal(G) if middle is None else covariance_diagonal(G, middle)
     return Fit(x, np.sqrt(np.maximum(variance, 0.0)), sigma)
 
 

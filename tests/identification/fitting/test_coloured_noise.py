@@ -39,13 +39,14 @@ def _noise(kind: str, size: int, rng: np.random.Generator) -> np.ndarray:
     return 0.05 * out[200 : 200 + size]
 
 
-def _fit(time, A, tau, oversampling=None):
+def _fit(time, A, tau):
+    """The sandwich fit, and the standard deviations of the filter's scalar correction σ² (AᵀA)⁻¹ r,
+    r = f_s / (2 f_c) (what excite reported before)."""
     data = Dataset(A, tau, time, np.zeros(time.size, dtype=int), {})
     normal = NormalEquations(data, [])
-    if oversampling is not None:
-        return least_squares(normal, [], None, oversampling)
-    x = least_squares(normal, []).x
-    return least_squares(normal, [], None, middle=middle(data, x, [], None, RATE))
+    plain = least_squares(normal, [])
+    sandwich = least_squares(normal, [], None, middle=middle(data, plain.x, [], None, RATE))
+    return sandwich, plain.std * np.sqrt(RATE / (2 * 5.0))
 
 
 @pytest.mark.parametrize("kind", ["white", "low-passed", "with encoder noise"])
@@ -55,14 +56,13 @@ def test_the_sandwich_is_the_spread_over_noise_draws(kind):
     estimates, stds, scalar = [], [], []
     for _ in range(200):
         tau = A @ theta + _noise(kind, time.size, rng)
-        fit = _fit(time, A, tau)
+        fit, corrected = _fit(time, A, tau)
         estimates.append(fit.x)
         stds.append(fit.std)
-        if kind == "with encoder noise":
-            scalar.append(_fit(time, A, tau, oversampling=RATE / (2 * 5.0)).std)
+        scalar.append(corrected)
     spread = np.std(estimates, axis=0, ddof=1)  # ±5 % with 200 draws
     np.testing.assert_allclose(np.mean(stds, axis=0), spread, rtol=0.15)
-    if scalar:  # the filter's scalar correction charges noise the motion never sees
+    if kind == "with encoder noise":  # the filter's scalar correction charges noise the motion never sees
         assert np.all(np.mean(scalar, axis=0) > 2 * spread)
 
 
