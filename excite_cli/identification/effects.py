@@ -120,6 +120,9 @@ EFFECTS = {
     )
 }
 EFFECT_NAMES = tuple(EFFECTS)
+#: Coefficients that no physical joint has negative (dry and viscous friction dissipate, a rotor's
+#: inertia is a mass distribution's): every fit keeps them ≥ 0, the search's and the reported ones alike.
+NONNEGATIVE = ("Fc", "Fv", "Ia")
 #: Default grid of a shape velocity [rad/s]: factors of 2 to 2.5 from 0.02 to 0.5 rad/s.
 SHAPE_GRID = (0.02, 0.05, 0.1, 0.2, 0.5)
 
@@ -232,6 +235,18 @@ def effect_columns(
     if kind.position and q_range is not None:
         q = np.clip(q, *q_range)
     return np.column_stack(kind.columns(Signals(q, qd, qdd, np.tanh(qd / coulomb_velocity), shape, rigid)))
+
+
+def nonnegative_columns(terms: list[Term], sizes: list[int]) -> np.ndarray:
+    """(Σ sizes,) which columns of the effect blocks ``terms`` (``sizes`` columns each) have a
+    coefficient of ``NONNEGATIVE`` (an offset's per-run columns never do)."""
+    return np.concatenate(
+        [np.zeros(0, dtype=bool)]
+        + [
+            np.zeros(size, dtype=bool) if t.kind.per_run else np.isin(t.kind.coefficients, NONNEGATIVE)
+            for t, size in zip(terms, sizes)
+        ]
+    )
 
 
 def coefficient_names(term: Term, offset_runs: list[str]) -> list[str]:

@@ -36,7 +36,7 @@ import numpy as np
 from excite_cli.config import resolve_path
 from excite_cli.errors import ExciteError
 from excite_cli.identification.config import RunConfig
-from excite_cli.identification.effects import Term
+from excite_cli.identification.effects import Term, nonnegative_columns
 from excite_cli.identification.fitting.dataset import Dataset
 from excite_cli.identification.fitting.normal import NormalEquations, solve
 
@@ -120,6 +120,7 @@ class CrossValidation:
         sizes = [data.blocks[key].shape[1] for key in keys]
         starts = self.b + np.concatenate([[0], np.cumsum(sizes)]).astype(int)
         self.place = {key: np.arange(starts[k], starts[k + 1]) for k, key in enumerate(keys)}
+        self.bounded = dict(zip(keys, np.split(nonnegative_columns(keys, sizes), np.cumsum(sizes)[:-1])))
         w2 = np.ones(self.n) if weights is None else np.asarray(weights, dtype=float) ** 2
         held = [NormalEquations(data, keys, np.flatnonzero(fold == k)).stacked(keys) for k in range(self.folds)]
         margin_parts = [NormalEquations(data, keys, np.flatnonzero(m)).stacked(keys) for m in margins]
@@ -149,6 +150,10 @@ class CrossValidation:
             start += size
         return out
 
+    def nonnegative(self, terms: list[Term]) -> np.ndarray:
+        """Which unknowns of the model [Y_B, ``terms``] every fit keeps ≥ 0 (friction, armature)."""
+        return np.concatenate([np.zeros(self.b, dtype=bool)] + [self.bounded[t] for t in terms])
+
     def training_system(self, k: int, terms: list[Term]) -> tuple[np.ndarray, np.ndarray, int]:
         """Fold k's weighted training normal equations G (P, P), c (P,) of the model [Y_B, ``terms``]
         and the number of rows behind them: what any fit of fold k is fitted to."""
@@ -163,8 +168,12 @@ class CrossValidation:
         idx = self.unknowns(terms)
         offsets = self._offset_positions(terms)
         out = np.zeros((len(self.held), self.n))
+        bounded = self.nonnegative(terms)
         for k, (Gj, cj, sj) in enumerate(self.held):
-            x = solve(*self.training_system(k, terms)[:2]) if refit is None else np.array(refit(k), dtype=float)
+            if refit is None:
+                x = solve(*self.training_system(k, terms)[:2], bounded)
+            else:
+                x = np.array(refit(k), dtype=float)
             held_G, held_c = Gj[:, idx][:, :, idx], cj[:, idx]
             for j, columns in offsets:  # the held-out runs' offsets (module docstring)
                 out_of_fit = self.run_fold == k

@@ -5,7 +5,8 @@ free to take values no robot has and extrapolate badly to motions the fit did no
 physically consistent fit (:mod:`~excite_cli.identification.fitting.physical`) keeps every body a real mass
 distribution and, with weight λ, near the CAD model; on well-excited data it costs a little. Which
 one transfers depends on the data set, and so do the effects a model needs: the effect search runs
-under least squares (:mod:`~excite_cli.identification.choice.selection`), where an effect may only be
+under least squares with the consistent fit's bounds on friction and armature
+(:mod:`~excite_cli.identification.choice.selection`), where an effect may only be
 standing in for base parameters the data leave free, which the consistent fit pins. So the models
 the search passed through at its ends (each search's start and end) are scored under every
 candidate fit on the folds that chose the effects (:class:`~excite_cli.identification.choice.crossval.

@@ -20,7 +20,9 @@ joint) and keeps the end with the lowest J (of searches ending at the same model
 Candidates whose columns lie in the span of the rigid-body model (e.g. the armature of a joint whose
 rotor inertia regroups with a link's) are not separately identifiable and are skipped. Every fit,
 in the folds and the final one, uses the same per-joint weights (WLS: 1/σ_j of the rigid-body fit,
-Gautier 1997), so the reported model is exactly the one the search scored.
+Gautier 1997) and keeps Coulomb, viscous and armature coefficients ≥ 0 (the consistent fit's bounds,
+:data:`~excite_cli.identification.effects.NONNEGATIVE`), so the reported model is exactly the one the
+search scored and no effect is chosen for a coefficient the reported fit cannot have.
 """
 
 from __future__ import annotations

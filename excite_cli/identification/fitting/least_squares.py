@@ -4,7 +4,10 @@ fitted model predicts.
 Weighted least squares follows Gautier (1997): each joint's rows are weighted by 1/σ_j, σ_j the
 residual standard deviation of that joint under ordinary least squares of the rigid-body model,
 fixed for every fit of one identification (the effect selection's and the final one), so the
-reported model is the one that was scored. The estimates' standard deviations come from
+reported model is the one that was scored. Coulomb, viscous and armature coefficients are kept ≥ 0
+(:data:`~excite_cli.identification.effects.NONNEGATIVE`, bounded least squares where the plain
+solution breaks a bound: :func:`~excite_cli.identification.fitting.normal.solve`); the standard
+deviations are those of the unbounded problem. The estimates' standard deviations come from
 σ² (AᵀWA)⁻¹ (white residuals), or, given AᵀWΣWA from the residuals' spectra
 (:mod:`~excite_cli.identification.fitting.noise`: filtered residuals are correlated), from the
 sandwich (AᵀWA)⁻¹ (AᵀWΣWA) (AᵀWA)⁻¹, as the reported fit's are. Every fit goes through the
@@ -51,7 +54,7 @@ def least_squares(
         middle: (m, m) AᵀWΣWA for the sandwich (m the model's unknowns), or None for σ² (AᵀWA)⁻¹.
     """
     G, c, s = normal.system(weights, effects)
-    x = solve(G, c)
+    x = solve(G, c, normal.nonnegative(effects))
     dof = max(1, normal.rows - x.size)
     s2 = sse(G, c, s, x) / dof
     sigma = np.sqrt(normal.joint_sse(x, effects) / (normal.rows / normal.n) / (dof / normal.rows))

@@ -19,8 +19,9 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.linalg
+import scipy.optimize
 
-from excite_cli.identification.effects import Term
+from excite_cli.identification.effects import Term, nonnegative_columns
 from excite_cli.identification.fitting.dataset import Dataset
 
 #: A candidate block keeps less than this fraction of its squared norm outside the model's span:
@@ -66,6 +67,11 @@ class NormalEquations:
     def columns(self, effects: list[Term]) -> int:
         """Number of unknowns of the model [Y_B, ``effects``]."""
         return self.b + sum(self.size[t] for t in effects)
+
+    def nonnegative(self, effects: list[Term]) -> np.ndarray:
+        """(m,) which unknowns of the model [Y_B, ``effects``] are kept ≥ 0 (``NONNEGATIVE``)."""
+        sizes = [self.size[t] for t in effects]
+        return np.concatenate([np.zeros(self.b, dtype=bool), nonnegative_columns(effects, sizes)])
 
     def _placement(self, effects: list[Term]) -> list[tuple[np.ndarray, np.ndarray]]:
         """Per joint j, (indices in j's local pieces, indices among the model's unknowns) of the base
@@ -119,14 +125,59 @@ def _unit_diagonal(G: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return G / np.outer(d, d), d
 
 
-def solve(G: np.ndarray, c: np.ndarray) -> np.ndarray:
-    """x of G x = c, columns scaled to unit diagonal (minimum-norm where G is singular)."""
+def solve(G: np.ndarray, c: np.ndarray, nonnegative: np.ndarray | None = None) -> np.ndarray:
+    """x of G x = c, columns scaled to unit diagonal (minimum-norm where G is singular): the least
+    squares of normal equations G (m, m), c (m,). With ``nonnegative`` (m,) (a mask), the least squares
+    with those unknowns ≥ 0 where the plain solution has one below 0 (:func:`_bounded`)."""
     scaled, d = _unit_diagonal(G)
-    try:
-        z = scipy.linalg.cho_solve(scipy.linalg.cho_factor(scaled), c / d)
-    except np.linalg.LinAlgError:
-        z = np.linalg.lstsq(scaled, c / d, rcond=1e-13)[0]
+    z = _solver(scaled)(c / d)
+    if nonnegative is not None and np.any(z[nonnegative] < 0.0):
+        z = _bounded(scaled, c / d, np.asarray(nonnegative, dtype=bool))
     return z / d
+
+
+def _solver(G: np.ndarray):
+    """y ↦ G⁻¹ y (y (m,) or (m, k)) for G scaled to unit diagonal: 0 for the unknowns whose column the
+    data never see (a held-out run's offset in a fold: a zero row and column), Cholesky for the rest,
+    or the pseudo-inverse where that is singular too (each the minimum-norm solution)."""
+    seen = np.diag(G) > 0.0
+    try:
+        factor = scipy.linalg.cho_factor(G[np.ix_(seen, seen)])
+    except np.linalg.LinAlgError:
+        inverse = np.linalg.pinv(G, rcond=1e-13, hermitian=True)
+        return lambda y: inverse @ y
+
+    def apply(y: np.ndarray) -> np.ndarray:
+        out = np.zeros(y.shape)
+        out[seen] = scipy.linalg.cho_solve(factor, y[seen])
+        return out
+
+    return apply
+
+
+def _bounded(G: np.ndarray, c: np.ndarray, bounded: np.ndarray) -> np.ndarray:
+    """argmin ½xᵀGx − cᵀx with x_i ≥ 0 where ``bounded``: the free unknowns F eliminated for given
+    bounded ones B (x_F = G_FF⁻¹(c_F − G_FB x_B)), the rest is ½x_BᵀSx_B − rᵀx_B, S the Schur
+    complement G_BB − G_BF G_FF⁻¹ G_FB, r = c_B − G_BF G_FF⁻¹ c_F: a non-negative least squares
+    ‖Ax_B − b‖² with AᵀA = S, Aᵀb = r (Lawson & Hanson, Solving Least Squares Problems, 1974, ch. 23;
+    scipy's ``nnls``)."""
+    free = ~bounded
+    solve_free = _solver(G[np.ix_(free, free)])
+    K = solve_free(G[np.ix_(free, bounded)])  # G_FF⁻¹ G_FB
+    S = G[np.ix_(bounded, bounded)] - G[np.ix_(bounded, free)] @ K
+    r = c[bounded] - K.T @ c[free]
+    try:
+        L = np.linalg.cholesky(0.5 * (S + S.T))  # S = L Lᵀ: A = Lᵀ, b = L⁻¹ r
+        A, b = L.T, scipy.linalg.solve_triangular(L, r, lower=True)
+    except np.linalg.LinAlgError:  # a bounded column the free ones span: S singular
+        eigenvalues, vectors = np.linalg.eigh(0.5 * (S + S.T))
+        kept = eigenvalues > 1e-13 * max(eigenvalues[-1], 1e-300)
+        A = np.sqrt(eigenvalues[kept])[:, None] * vectors[:, kept].T
+        b = vectors[:, kept].T @ r / np.sqrt(eigenvalues[kept])
+    x = np.zeros(c.size)
+    x[bounded] = scipy.optimize.nnls(A, b)[0]
+    x[free] = solve_free(c[free] - G[np.ix_(free, bounded)] @ x[bounded])
+    return x
 
 
 def excited_rank(G: np.ndarray, tolerance: float = 1e-12) -> int:

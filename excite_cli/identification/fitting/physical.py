@@ -41,6 +41,7 @@ import numpy as np
 import pinocchio as pin
 
 from excite_cli.errors import ExciteError
+from excite_cli.identification.effects import NONNEGATIVE
 
 #: Length scale ℓ [m] of the inertia parameters in the regularization.
 LENGTH = 0.1
@@ -48,8 +49,6 @@ LENGTH = 0.1
 MARGIN = 1e-5
 #: A pseudo-inertia whose smallest eigenvalue is below this many ε_i is reported as active.
 ACTIVE = 10.0
-#: Effect coefficients that must not be negative.
-NONNEGATIVE = ("Fc", "Fv", "Ia")
 
 
 def pseudo_inertia(phi: np.ndarray) -> np.ndarray:

@@ -3,6 +3,7 @@ synthetic model with known effects (two joints, a 3-parameter regressor, two run
 
 import numpy as np
 import pytest
+import scipy.optimize
 
 from excite_cli.identification.choice.crossval import CrossValidation, fold_assignment
 from excite_cli.identification.choice.search import Search, StepwiseSearch
@@ -80,6 +81,25 @@ def test_fold_errors_equal_explicit_weighted_refits():
     rms = np.sqrt((data.tau.reshape(-1, 2) ** 2).mean(axis=0))
     np.testing.assert_allclose(per_joint, 100 * np.sqrt(expected.sum(axis=0) / data.time.size) / rms, rtol=1e-8)
     assert error == pytest.approx(per_joint.mean())
+
+
+def test_folds_fit_friction_as_bounded_least_squares_of_the_design():
+    cfg = IdentificationConfig(candidates=["coulomb", "viscous"])
+    terms = [Term("coulomb", 0), Term("viscous", 1)]
+    data = dataset({Term("coulomb", 0): 0.5, Term("viscous", 1): -0.4}, cfg)  # friction rising as it slows
+    cv = CrossValidation(data, terms, None, folds=5, margin=0.05)
+    fold, margins = fold_assignment(data.time, data.run, 5, 0.05)
+    A = np.hstack([data.regressor] + [data.block(t) for t in terms])
+    assert np.linalg.lstsq(A, data.tau, rcond=None)[0][-1] < -0.3  # plain least squares: negative viscous
+    lower = np.array([-np.inf] * B + [0.0, 0.0])
+    expected = np.zeros((5, 2))
+    for k in range(5):
+        train = np.repeat(~(fold == k) & ~margins[k], 2)
+        x = scipy.optimize.lsq_linear(A[train], data.tau[train], bounds=(lower, np.inf), tol=1e-12).x
+        expected[k] = (((data.tau - A @ x)[np.repeat(fold == k, 2)].reshape(-1, 2)) ** 2).sum(axis=0)
+    np.testing.assert_allclose(cv.fold_sse(terms), expected, rtol=1e-6)
+    selection = select_effects(data, cfg, [], margin=0.05)
+    assert Term("viscous", 1) not in selection.terms  # held at 0 it explains nothing: never added
 
 
 def test_search_finds_the_true_effects_and_shape_and_lowers_its_objective_at_every_step():
