@@ -12,7 +12,13 @@ the defaults (nothing declared) and validated on data neither the fit nor the se
 - **sensor zeros**: two simulated Panda runs whose joint-3 torque sensor was zeroed at +0.4 and
   −0.3 Nm, each fitted and validated on alternate time blocks;
 - **shipped simulated runs** and the shipped real Panda splits (phase, blocks), where no position
-  effect or coupling should be proposed.
+  effect or coupling should be proposed;
+- **MuJoCo's physics** (`bench/mujoco_arm.py`): a Panda and a UR5 compiled by MuJoCo from their URDFs
+  with joint damping, frictionloss and armature on every joint and a payload on the flange, playing
+  excite trajectories with the feed-forward plus PD; an 18-bit encoder, 1.5 % torque noise; fitted on
+  some trajectories, validated on another. Their *true* is the floor: MuJoCo's own parameters through
+  excite's preprocessing, nothing fitted; a second line gives the consistent fit's link masses and
+  the effects against MuJoCo's.
 
 Printed per analogue: the mean relative validation error [%] of the rigid body, of the reported
 model (with the fit it chose), of the other fit excite computed, and of the true model (its terms
@@ -36,11 +42,16 @@ import yaml
 from coupled_wrist import JOINTS as UR5_JOINTS
 from coupled_wrist import ROBOT as UR5_ROBOT
 from coupled_wrist import true_error
+from mujoco_arm import ArmPhysics, arm_model, floor_error, record
 
+from excite_cli.config import RobotConfig
 from excite_cli.config_file import load_problem
+from excite_cli.dynamics.base_parameters import compute_base_parameters
+from excite_cli.dynamics.robot import load_robot
+from excite_cli.dynamics.urdf_source import resolve_urdf
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.effects import Term
-from excite_cli.identification.pipeline import run_identification
+from excite_cli.identification.pipeline import prepare_data, run_identification
 from excite_cli.identification.simulation_config import SimulationConfig
 from excite_cli.optimization.excitation import build_excitation
 from excite_cli.optimization.sequence import run_sequence
@@ -80,15 +91,18 @@ def found(report, joints: list[str]) -> str:
     return "; ".join(terms + dead) or "no position effect, coupling or dead channel"
 
 
-def line(name: str, problem, report, joints: list[str], truth: list[Term] | None) -> None:
+def line(name: str, problem, report, joints: list[str], truth: list[Term] | None, true: float | None = None) -> None:
+    """The analogue's row: rigid, chosen (fit), the other fit, the true model (``truth``'s terms fitted
+    by weighted least squares, or the figure ``true``) and what was found."""
     choice = report.fit_choice
+    true = true_error(problem, truth, report.live) if truth is not None else true
     other_name, other = (
         ("least squares", report.relative_least_squares)
         if choice.is_consistent
         else ("consistent", report.relative_consistent)
     )
     other_text = f"{report.mean(other):6.2f} ({other_name})" if other is not None else "—"
-    true_text = f"{true_error(problem, truth, report.live):6.2f}" if truth is not None else "     —"
+    true_text = f"{true:6.2f}" if true is not None else "     —"
     print(
         f"{name:<34} {report.mean(report.relative_before):6.2f} {report.mean(report.relative_after):6.2f} "
         f"({choice.name:<18}) {other_text:<24} {true_text}  {found(report, joints)}",
@@ -111,6 +125,44 @@ def edit_column(path: Path, column: str, change) -> None:
     table[column] = change(table[column])
     names = table.dtype.names
     np.savetxt(path, table.view((float, len(names))), delimiter=",", header=",".join(names), comments="", fmt="%.10g")
+
+
+def mujoco_analogue(folder: Path, name: str, robot: dict, result: Path, physics: ArmPhysics, roles: list[str]) -> None:
+    """Record every iteration of ``result`` (2 periods each) on MuJoCo's arm with ``physics``, identify
+    with the defaults (``roles`` of the runs: fit or validation) and print its row and a line of
+    the consistent fit's masses and the effects against MuJoCo's."""
+    cfg = RobotConfig(**robot)
+    model_robot = load_robot(cfg, joint_rows_only=True)
+    joints = model_robot.joint_names
+    mujoco, model = arm_model(resolve_urdf(cfg)[0], joints, physics)
+    runs = record(mujoco, model, model_robot, result, 2, 11, folder, name)
+    data = [{"file": str(path), "role": role} for path, role in zip(runs, roles)]
+    columns = {"q": [f"q_{j}" for j in joints], "tau": [f"tau_{j}" for j in joints]}
+    problem, report = identify(folder, name, robot, data, columns)
+    base = compute_base_parameters(model_robot)
+    truth = physics.truth(len(joints))
+    prepared = prepare_data(problem, model_robot, base, [t for t, _ in truth])
+    line(
+        f"MuJoCo {name}", problem, report, joints, None, floor_error(prepared, base, physics, model_robot, report.live)
+    )
+    fit = report.consistent
+    masses = fit.standard.reshape(-1, 10)[:, 0] / physics.standard(model_robot).reshape(-1, 10)[:, 0] - 1.0
+    found_values = {(t, coefficient): value for t, coefficient, value, _ in report.effect_values(consistent=True)}
+    rotors = dict(zip(fit.rotor_joints, fit.rotors))
+    worst, missing = {}, []
+    for term, value in truth:
+        got = found_values.get((term, term.kind.coefficients[0]), rotors.get(joints[term.joint]))
+        if got is None:
+            missing.append(term.label(joints))
+            continue
+        worst[term.effect] = max(worst.get(term.effect, 0.0), abs(got / value - 1.0))
+    print(
+        f"    consistent masses against MuJoCo's: {', '.join(f'{100 * m:+.1f}' for m in masses)} % "
+        f"(the last with the payload); largest effect errors: "
+        + ", ".join(f"{effect} {100 * e:.1f} %" for effect, e in worst.items())
+        + (f"; not found: {', '.join(missing)}" if missing else ""),
+        flush=True,
+    )
 
 
 def main() -> None:
@@ -215,6 +267,21 @@ def main() -> None:
             UR5_JOINTS,
             truth + [Term("motor", 4, None, (0, 0, 0, 0, 1.0, 1.0))],
         )
+
+        panda = ArmPhysics(
+            damping=np.array([0.6, 0.6, 0.5, 0.5, 0.2, 0.2, 0.1]),
+            frictionloss=np.array([0.8, 0.8, 0.6, 0.6, 0.3, 0.3, 0.2]),
+            armature=np.array([0.3, 0.3, 0.2, 0.2, 0.05, 0.05, 0.02]),
+            payload=(1.0, (0.0, 0.0, 0.207), (2e-3, 2e-3, 1e-3)),  # 10 cm beyond the flange
+        )
+        mujoco_analogue(folder, "panda", PANDA_ROBOT, smoke, panda, ["fit", "validation"])
+        ur5 = ArmPhysics(
+            damping=np.array([0.8, 0.8, 0.5, 0.2, 0.2, 0.1]),
+            frictionloss=np.array([1.5, 1.5, 1.0, 0.4, 0.4, 0.3]),
+            armature=np.array([0.2, 0.2, 0.1, 0.03, 0.03, 0.03]),
+            payload=(1.5, (0.0, 0.15, 0.0), (3e-3, 2e-3, 3e-3)),  # 7 cm beyond the flange (y of wrist_3_link)
+        )
+        mujoco_analogue(folder, "ur5", UR5_ROBOT, folder / "ur5.h5", ur5, ["fit", "fit", "validation"])
 
 
 if __name__ == "__main__":
