@@ -91,7 +91,19 @@ def test_only_the_printing_modules_use_the_command_line_libraries():
 
 
 #: Modules outside the role folders: the entry points and what every stage shares.
-TOP_LEVEL = {"__init__", "__main__", "atomic", "cli", "config_file", "errors", "h5", "inputs", "kernels", "memory"}
+TOP_LEVEL = {
+    "__init__",
+    "__main__",
+    "atomic",
+    "cli",
+    "config_file",
+    "errors",
+    "h5",
+    "inputs",
+    "kernels",
+    "memo",
+    "memory",
+}
 ROLE_FOLDERS = {
     "config",
     "trajectory",

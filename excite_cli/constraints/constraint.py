@@ -8,6 +8,7 @@ from typing import Sequence
 
 import numpy as np
 
+from excite_cli.memo import once
 from excite_cli.trajectory.fourier import FourierBasis
 
 
@@ -67,10 +68,7 @@ class Constraint(ABC):
     def _evaluated(self, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`evaluate` at α, or what it gave at the same α the last time (a solver asks for the
         values and then the Jacobian at the same point)."""
-        key = alpha.tobytes()
-        if getattr(self, "_last", (None,))[0] != key:
-            self._last = (key, self.evaluate(alpha))
-        return self._last[1]
+        return once(self, "evaluate", alpha, lambda: self.evaluate(alpha))
 
     @abstractmethod
     def check_samples(self, time: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> FineCheck:

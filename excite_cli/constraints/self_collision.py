@@ -22,6 +22,7 @@ from excite_cli.collision.segments import CapsulePairs, pair_aggregates, pair_di
 from excite_cli.constraints.constraint import Constraint, FineCheck
 from excite_cli.dynamics.kinematics import BatchKinematics
 from excite_cli.dynamics.robot import Robot
+from excite_cli.memo import once
 from excite_cli.trajectory.fourier import FourierBasis
 
 #: Distances are normalized by this length [m].
@@ -81,10 +82,7 @@ class SelfCollision(Constraint):
     def _ends(self, Q: np.ndarray) -> tuple[np.ndarray, ...]:
         """At the configurations Q (T, n): every capsule's segment ends (3, T, C) [m] and the joint
         placements (:func:`~excite_cli.collision.capsules.segment_ends`)."""
-        key = Q.tobytes()  # the values and then the Jacobian at the same point: computed once
-        if getattr(self, "_last_ends", (None,))[0] != key:
-            self._last_ends = (key, segment_ends(self.kinematics, self.capsules, Q))
-        return self._last_ends[1]
+        return once(self, "ends", Q, lambda: segment_ends(self.kinematics, self.capsules, Q))
 
     def evaluate(self, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """One aggregated value per pair (P,) and the Jacobian (P, α.size), see :meth:`Constraint.evaluate`

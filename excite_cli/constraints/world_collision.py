@@ -28,6 +28,7 @@ from excite_cli.constraints.lse import ACCEPT_MARGIN, smooth_max, smooth_max_val
 from excite_cli.constraints.self_collision import LENGTH_SCALE
 from excite_cli.dynamics.kinematics import BatchKinematics
 from excite_cli.dynamics.robot import Robot
+from excite_cli.memo import once
 from excite_cli.trajectory.fourier import FourierBasis
 
 
@@ -181,10 +182,7 @@ class WorldCollision(Constraint):
     def _closest(self, Q: np.ndarray) -> tuple[np.ndarray, ...]:
         """At the configurations Q (T, n): distances d (T, P) [m], the robot's closest points (3, T, P),
         the unit normals (3, T, P) from the world shape to them, and the joint placements."""
-        key = Q.tobytes()  # the values and then the Jacobian at the same point: computed once
-        if getattr(self, "_last_closest", (None,))[0] != key:
-            self._last_closest = (key, self._closest_points(Q))
-        return self._last_closest[1]
+        return once(self, "closest", Q, lambda: self._closest_points(Q))
 
     def _closest_points(self, Q: np.ndarray) -> tuple[np.ndarray, ...]:
         """:meth:`_closest`, computed."""

@@ -39,6 +39,7 @@ from excite_cli.dynamics.effect_columns import EffectColumns
 from excite_cli.dynamics.robot import Robot
 from excite_cli.dynamics.virtual_dynamics import VirtualDynamics
 from excite_cli.errors import ExciteError
+from excite_cli.memo import once
 from excite_cli.optimization.noise import RowNoise
 from excite_cli.trajectory.fourier import FourierBasis
 
@@ -85,7 +86,6 @@ class Criterion:
     _dynamics: VirtualDynamics = field(init=False, repr=False)
     _data: pin.Data = field(init=False, repr=False)
     _prior_gram: np.ndarray = field(init=False, repr=False)
-    _last: tuple[bytes, tuple] | None = field(init=False, repr=False, default=None)
 
     def __post_init__(self) -> None:
         if self.prior.size == 0:
@@ -151,11 +151,12 @@ class Criterion:
         """Q, Q̇, Q̈ (T, n) of α, its regressor rows Ŷ (T·n_rows, b+e) and their weights s and ds/dτ
         (:meth:`_regressor`), kept for the next call at the same α (a solver asks for the value, then
         the gradient, at each accepted point)."""
-        key = alpha.tobytes()
-        if self._last is None or self._last[0] != key:
+
+        def compute() -> tuple:
             Q, QD, QDD = self.basis.evaluate(alpha)
-            self._last = (key, (Q, QD, QDD, *self._regressor(Q, QD, QDD)))
-        return self._last[1]
+            return (Q, QD, QDD, *self._regressor(Q, QD, QDD))
+
+        return once(self, "motion", alpha, compute)
 
     def _gram(self, own: np.ndarray) -> np.ndarray:
         """CᵀC = C₀ᵀC₀ + ŶᵀŶ (b×b, Eq. 41), or Lᵀ CᵀC L with the frame."""

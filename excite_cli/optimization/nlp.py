@@ -5,13 +5,14 @@ solver's iterate (or, where that fails, a feasible point towards it)."""
 
 from __future__ import annotations
 
-from typing import Callable, Optional, Sequence
+from typing import Optional, Sequence
 
 import numpy as np
 from scipy.optimize import minimize
 
 from excite_cli.constraints import Constraint, accepted, farthest_accepted
 from excite_cli.criteria.record import RANK_FLOOR
+from excite_cli.memo import once
 from excite_cli.optimization.criterion import Criterion
 from excite_cli.optimization.optimality import (
     CLUSTER_SIZE,
@@ -48,14 +49,6 @@ class Evaluations:
     ):
         self.criterion, self.all, self.boundary = criterion, constraints, boundary
         self.best_value, self.best_inside = start_value, None
-        self._last: dict[str, tuple[bytes, object]] = {}
-
-    def _once(self, name: str, z: np.ndarray, compute: Callable[[], object]):
-        """``compute()``, or what it gave at the same z the last time ``name`` was asked for."""
-        key = z.tobytes()
-        if name not in self._last or self._last[name][0] != key:
-            self._last[name] = (key, compute())
-        return self._last[name][1]
 
     def value(self, z: np.ndarray) -> float:
         """The criterion at z."""
@@ -70,11 +63,12 @@ class Evaluations:
                 self.best_value, self.best_inside = value, alpha.copy()
             return value
 
-        return self._once("value", z, compute)
+        return once(self, "value", z, compute)
 
     def gradient(self, z: np.ndarray) -> np.ndarray:
         """The criterion's gradient in z (n_z,)."""
-        return self._once(
+        return once(
+            self,
             "gradient",
             z,
             lambda: self.boundary.chain(self.criterion.value_and_gradient(self.boundary.to_alpha(z))[1].ravel()),
@@ -83,12 +77,12 @@ class Evaluations:
     def constraint_values(self, z: np.ndarray) -> np.ndarray:
         """Stacked constraint values g (m,)."""
         alpha = self.boundary.to_alpha(z)
-        return self._once("values", z, lambda: np.concatenate([c.values(alpha) for c in self.all]))
+        return once(self, "values", z, lambda: np.concatenate([c.values(alpha) for c in self.all]))
 
     def constraint_jacobian(self, z: np.ndarray) -> np.ndarray:
         """Their Jacobian in z (m, n_z)."""
         alpha = self.boundary.to_alpha(z)
-        return self._once("jacobian", z, lambda: self.boundary.chain(np.vstack([c.jacobian(alpha) for c in self.all])))
+        return once(self, "jacobian", z, lambda: self.boundary.chain(np.vstack([c.jacobian(alpha) for c in self.all])))
 
     def objective(self, z: np.ndarray) -> tuple[float, np.ndarray]:
         """The criterion and its gradient in z."""
@@ -109,7 +103,7 @@ class Evaluations:
         smooth = kkt_optimality(self.gradient(z), *self.constraints(z))
         if not nonsmooth or not self.criterion.objective.extremes or smooth.residual == 0.0:
             return smooth
-        return self._once("clarke", z, lambda: self._clarke(z, smooth))
+        return once(self, "clarke", z, lambda: self._clarke(z, smooth))
 
     def _clarke(self, z: np.ndarray, smooth: Optimality) -> Optimality:
         """The Clarke residual at z where an extreme singular value is multiple, else ``smooth``."""
@@ -183,7 +177,7 @@ class Epigraph:
                     gradients[indices == i] = chained[row]
             return logs[indices], gradients, sides, signs
 
-        return self.problem._once("epigraph", z, compute)
+        return once(self.problem, "epigraph", z, compute)
 
     def constraint_values(self, w: np.ndarray) -> np.ndarray:
         z, t = w[: -len(self.sides)], w[-len(self.sides) :]

@@ -30,6 +30,7 @@ import numpy as np
 from scipy.optimize import BFGS, NonlinearConstraint, minimize
 
 from excite_cli.errors import ExciteError
+from excite_cli.memo import once
 
 #: The methods of ``optimizer.method``.
 METHODS = ("SLSQP", "trust-constr", "ipopt")
@@ -90,15 +91,19 @@ class _ScaledCriterion:
     for it; constraints as they are."""
 
     def __init__(self, nlp: NLP, z0: np.ndarray, scale: Optional[float] = None):
-        self.nlp, self._start = nlp, (z0.tobytes(), nlp.gradient(z0))
-        self.scale = criterion_scale(self._start[1]) if scale is None else scale
+        self.nlp = nlp
+        self.scale = criterion_scale(self._gradient(z0)) if scale is None else scale
         self.constraint_values, self.constraint_jacobian = nlp.constraint_values, nlp.constraint_jacobian
 
     def value(self, z: np.ndarray) -> float:
         return self.scale * self.nlp.value(z)
 
     def gradient(self, z: np.ndarray) -> np.ndarray:
-        return self.scale * (self._start[1] if z.tobytes() == self._start[0] else self.nlp.gradient(z))
+        return self.scale * self._gradient(z)
+
+    def _gradient(self, z: np.ndarray) -> np.ndarray:
+        """The nlp's gradient, once per point: the one at z0 that sets the scale is the solver's first."""
+        return once(self, "gradient", z, lambda: self.nlp.gradient(z))
 
 
 def solve(
