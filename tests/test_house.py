@@ -1,5 +1,6 @@
 """The house rules of the package, checked on its source: a thin command line, small modules and
-functions, imports that only run down the stack, criteria as records, (the import graph has no cycle), and the command
+functions, imports that only run down the stack, criteria as records, constraints told apart by their classes (the
+import graph has no cycle), and the command
 line's libraries (typer, rich) only in the modules that print, modules in role folders, identification
 independent of the optimizer, no command-line flag in a library message, tests that mirror the
 package's folders with every module tested in its own, and lower floors handed values, not problems."""
@@ -237,6 +238,36 @@ def test_a_criterion_is_one_record_and_nothing_outside_its_room_branches_on_its_
             and c.value in NAMES
             or isinstance(c, (ast.Tuple, ast.List, ast.Set))
             and any(isinstance(e, ast.Constant) and e.value in NAMES for e in c.elts)
+            for c in [node.left, *node.comparators]
+        )
+    ]
+    assert branching == []
+
+
+def _subclasses(cls: type) -> set[type]:
+    return {c for s in cls.__subclasses__() for c in {s} | _subclasses(s)}
+
+
+def test_a_constraint_s_kind_is_answered_by_its_class_not_by_its_name():
+    """What a caller asks of a constraint (its rows in words, the distance it keeps, whether it bounds
+    the torques) is a method or an attribute of its class: no module outside ``excite_cli/constraints``
+    compares anything with a constraint's name, so adding a constraint touches its own file."""
+    import excite_cli.optimization.excitation  # noqa: F401  (imports every constraint class)
+    from excite_cli.constraints import Constraint
+
+    names = {c.name for c in _subclasses(Constraint)}
+    assert {"joint_limits", "self_collision", "world_collision", "torque_limits"} <= names
+    branching = [
+        (name, node.lineno)
+        for name, tree in _modules().items()
+        if not name.startswith("excite_cli.constraints")
+        for node in ast.walk(tree)
+        if isinstance(node, ast.Compare)
+        and any(
+            isinstance(c, ast.Constant)
+            and c.value in names
+            or isinstance(c, (ast.Tuple, ast.List, ast.Set))
+            and any(isinstance(e, ast.Constant) and e.value in names for e in c.elts)
             for c in [node.left, *node.comparators]
         )
     ]

@@ -42,6 +42,8 @@ class Constraint(ABC):
             posture and the random starts need not; the solver moves into it).
         advisory: whether it predicts what the robot's own control decides (the zero-moment point, which
             the stance's compliance moves): the optimizer keeps it, ``export`` warns instead of refusing.
+        bounds_torque: whether it bounds the joint torques (|τ| ≤ τ_max), which a transition
+            (:mod:`~excite_cli.optimization.playback`) must keep as well.
     """
 
     name: str
@@ -51,6 +53,7 @@ class Constraint(ABC):
     track_units: dict[str, str] = {}
     needs_motion: bool = False
     advisory: bool = False
+    bounds_torque: bool = False
 
     @abstractmethod
     def evaluate(self, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -86,6 +89,11 @@ class Constraint(ABC):
     def in_words(self) -> str:
         """What its rows hold, in words (``check``); default: its config field."""
         return self.field
+
+    def clearance(self, Q: np.ndarray) -> np.ndarray:
+        """(K,) at each posture Q (K, n) [rad] the smallest distance [m] beyond its margin that it keeps
+        (a distance constraint's; default inf: it keeps no distance)."""
+        return np.full(len(Q), np.inf)
 
     def track(self, alpha: np.ndarray, basis: FourierBasis) -> dict[str, np.ndarray]:
         """Named time series worth plotting and storing, on ``basis``'s instants (default: none)."""

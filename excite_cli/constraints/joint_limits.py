@@ -50,6 +50,10 @@ class JointLimits(Constraint):
         self.basis = basis
         self._orders = (basis.q, basis.qd, basis.qdd)
 
+    def in_words(self) -> str:
+        """The rows, in words (for ``check``)."""
+        return f"position, velocity, acceleration × lower, upper × {self.lower.shape[1]} joints"
+
     def _normalized(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
         """(3, T, n) samples q, q̇, q̈ (T, n) scaled so that ±1 is a bound and 0 the centre."""
         return np.stack([(x - self.centre[d]) / self.half[d] for d, x in enumerate((q, qd, qdd))])

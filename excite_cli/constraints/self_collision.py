@@ -60,6 +60,15 @@ class SelfCollision(Constraint):
         # (P, n): +1 where an active joint moves only the second capsule, −1 only the first
         self._moves = ancestors[joints[second]].astype(float) - ancestors[joints[first]]
 
+    def in_words(self) -> str:
+        """The rows, in words (for ``check``)."""
+        links = {frozenset((self.capsules[i].link, self.capsules[j].link)) for i, j in self.pairs}
+        return f"one per capsule pair ({len(self.pairs)}, of {len(links)} link pairs)"
+
+    def clearance(self, Q: np.ndarray) -> np.ndarray:
+        """(K,) the smallest distance [m] beyond the margin over every pair at the postures Q (K, n)."""
+        return (self.distances(Q) - self.margin).min(axis=1, initial=np.inf)
+
     def _distance(self, rotations: np.ndarray, centres: np.ndarray, t: int, p: int) -> coal.DistanceResult:
         """coal's distance of pair p at instant t, from capsule placements (T, C, 3, 3), (T, C, 3)."""
         i, j = self.pairs[p]

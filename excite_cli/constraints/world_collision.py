@@ -175,6 +175,14 @@ class WorldCollision(Constraint):
             ancestors[[self.capsules[c].joint for c in self._capsule]].astype(float).reshape(-1, robot.n_joints)
         )
 
+    def in_words(self) -> str:
+        """The rows, in words (for ``check``)."""
+        return f"one per capsule and world shape ({len(self.pairs)})"
+
+    def clearance(self, Q: np.ndarray) -> np.ndarray:
+        """(K,) the smallest distance [m] beyond its shape's margin over every pair at the postures Q (K, n)."""
+        return (self.distances(Q) - self._margin).min(axis=1, initial=np.inf)
+
     def distances(self, Q: np.ndarray) -> np.ndarray:
         """Distances (T, P) [m] of every (capsule, shape) pair at the configurations Q (T, n)."""
         return self._closest_points(Q)[0]

@@ -16,14 +16,7 @@ HOME_ROUNDS, HOME_STEPS, HOME_CLEARANCE = 60, 64, 0.005
 def clearance(excitation: Excitation, Q: np.ndarray) -> np.ndarray:
     """(K,) at each posture Q (K, n) the smallest distance [m] beyond its margin over every capsule
     pair and every capsule and world shape (inf without such constraints)."""
-    out = np.full(len(Q), np.inf)
-    for c in excitation.constraints:
-        if c.name == "self_collision" and c.pairs:
-            out = np.minimum(out, (c.distances(Q) - c.margin).min(axis=1))
-        if c.name == "world_collision" and c.pairs:
-            margins = np.array([c.shapes[s].margin for _, s in c.pairs])
-            out = np.minimum(out, (c.distances(Q) - margins).min(axis=1))
-    return out
+    return np.min([np.full(len(Q), np.inf)] + [c.clearance(Q) for c in excitation.constraints], axis=0)
 
 
 def home_posture(excitation: Excitation, Q: np.ndarray, rng: np.random.Generator) -> tuple[np.ndarray, str, bool]:

@@ -15,6 +15,8 @@ import numpy as np
 import pinocchio as pin
 
 from excite_cli.config import Problem
+from excite_cli.constraints import SelfCollision
+from excite_cli.constraints.world_collision import WorldCollision
 from excite_cli.drafting.home_posture import home_posture
 from excite_cli.drafting.joints import joint_choice
 from excite_cli.dynamics.urdf_source import apply_joint_ranges, robot_geometry, robot_model
@@ -116,7 +118,7 @@ def _always_overlapping(excitation: Excitation, Q: np.ndarray, draft: StartingCo
     link pairs), with why; links within a world shape's margin at every posture: ignored by the world
     constraint, with why."""
     for c in excitation.constraints:
-        if c.name == "self_collision" and c.pairs:
+        if isinstance(c, SelfCollision) and c.pairs:
             d = c.distances(Q)
             for k, (i, j) in enumerate(c.pairs):
                 pair = (c.capsules[i].link, c.capsules[j].link)
@@ -128,7 +130,7 @@ def _always_overlapping(excitation: Excitation, Q: np.ndarray, draft: StartingCo
                         else f"overlapping by at least {-farthest:.1f} cm at all {len(Q)} random postures"
                     ) + ": the capsules of neighbouring links, which touch at every posture"
                     draft.excluded.append((*pair, why))
-        if c.name == "world_collision" and c.pairs:
+        if isinstance(c, WorldCollision) and c.pairs:
             d = c.distances(Q)
             for k, (i, s) in enumerate(c.pairs):
                 link = c.capsules[i].link
@@ -209,7 +211,7 @@ def draft_config(
     draft.config["sequence"] = {"iterations": 3}
     draft.config["output"] = f"results/{urdf.stem}.h5"
     excitation = build_excitation(validated(draft.config, target), check_home=False)
-    if not any(c.name in ("self_collision", "world_collision") and c.capsules for c in excitation.constraints):
+    if not any(isinstance(c, (SelfCollision, WorldCollision)) and c.capsules for c in excitation.constraints):
         draft.config.pop("constraints", None)
         draft.assumptions.pop("constraints.environment", None)
         draft.assumptions["constraints"] = (

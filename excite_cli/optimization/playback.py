@@ -177,7 +177,7 @@ def plan_playback(excitation: Excitation, alpha: np.ndarray, periods: int = 1) -
     trajectory = FourierSegment(excitation.trajectory, alpha, excitation.problem.trajectory.duration)
     first, last = trajectory.state(0.0), trajectory.state(trajectory.duration)
     limits = excitation.limits
-    torque = next((c for c in excitation.constraints if c.name == "torque_limits"), None)
+    torque = next((c for c in excitation.constraints if c.bounds_torque), None)
     pieces: list[Segment | None] = [plan_transition(home, first, limits, "transition in", torque)]
     for p in range(periods):
         pieces.append(trajectory)

@@ -83,19 +83,6 @@ class Plan:
     estimate: float
 
 
-def _what(constraint, joints: int) -> str:
-    """The rows of a constraint in words."""
-    pairs = getattr(constraint, "pairs", [])
-    if constraint.name == "self_collision":
-        links = {frozenset((constraint.capsules[i].link, constraint.capsules[j].link)) for i, j in pairs}
-        return f"one per capsule pair ({len(pairs)}, of {len(links)} link pairs)"
-    if constraint.name == "world_collision":
-        return f"one per capsule and world shape ({len(pairs)})"
-    if constraint.name == "joint_limits":
-        return f"position, velocity, acceleration × lower, upper × {joints} joints"
-    return constraint.in_words()
-
-
 def plan_optimize(problem: Problem) -> Plan:
     """Build ``problem`` as ``optimize`` does and time one solver iteration.
 
@@ -106,12 +93,12 @@ def plan_optimize(problem: Problem) -> Plan:
     excitation = build_excitation(problem)
     alpha = excitation.random_start(np.random.default_rng(problem.optimizer.seed))
     criterion = excitation.criterion()
-    n, chain = excitation.robot.n_joints, excitation.boundary.chain
+    chain = excitation.boundary.chain
     sizes, values, rows = [], [], []
     for c in excitation.constraints:
         g, jacobian = c.evaluate(alpha)
         norms = np.linalg.norm(chain(jacobian), axis=1)
-        sizes.append(ConstraintSize(c.name, g.size, _what(c, n), *(norms.min(), norms.max()) if g.size else ()))
+        sizes.append(ConstraintSize(c.name, g.size, c.in_words(), *(norms.min(), norms.max()) if g.size else ()))
         values.append(g)
         rows.append(chain(jacobian))
     values, rows = np.concatenate(values), np.vstack(rows)
