@@ -222,26 +222,31 @@ def test_lower_floors_take_sections_and_values_not_whole_problems():
     assert offenders == []
 
 
+def _comparisons_with(names: set[str], outside: str) -> list[tuple[str, int]]:
+    """(module, line) of every comparison with one of ``names`` (or a tuple, list or set holding one) in
+    the modules outside the package ``outside``."""
+    return [
+        (name, node.lineno)
+        for name, tree in _modules().items()
+        if not name.startswith(outside)
+        for node in ast.walk(tree)
+        if isinstance(node, ast.Compare)
+        and any(
+            isinstance(c, ast.Constant)
+            and c.value in names
+            or isinstance(c, (ast.Tuple, ast.List, ast.Set))
+            and any(isinstance(e, ast.Constant) and e.value in names for e in c.elts)
+            for c in [node.left, *node.comparators]
+        )
+    ]
+
+
 def test_a_criterion_is_one_record_and_nothing_outside_its_room_branches_on_its_name():
     """Adding a criterion is adding a record to ``excite_cli.criteria.catalogue.CRITERIA``: no module outside
     ``excite_cli/criteria`` compares anything with a criterion's name (that is what the record says)."""
     from excite_cli.criteria import NAMES
 
-    branching = [
-        (name, node.lineno)
-        for name, tree in _modules().items()
-        if not name.startswith("excite_cli.criteria")
-        for node in ast.walk(tree)
-        if isinstance(node, ast.Compare)
-        and any(
-            isinstance(c, ast.Constant)
-            and c.value in NAMES
-            or isinstance(c, (ast.Tuple, ast.List, ast.Set))
-            and any(isinstance(e, ast.Constant) and e.value in NAMES for e in c.elts)
-            for c in [node.left, *node.comparators]
-        )
-    ]
-    assert branching == []
+    assert _comparisons_with(NAMES, outside="excite_cli.criteria") == []
 
 
 def _subclasses(cls: type) -> set[type]:
@@ -257,18 +262,4 @@ def test_a_constraint_s_kind_is_answered_by_its_class_not_by_its_name():
 
     names = {c.name for c in _subclasses(Constraint)}
     assert {"joint_limits", "self_collision", "world_collision", "torque_limits"} <= names
-    branching = [
-        (name, node.lineno)
-        for name, tree in _modules().items()
-        if not name.startswith("excite_cli.constraints")
-        for node in ast.walk(tree)
-        if isinstance(node, ast.Compare)
-        and any(
-            isinstance(c, ast.Constant)
-            and c.value in names
-            or isinstance(c, (ast.Tuple, ast.List, ast.Set))
-            and any(isinstance(e, ast.Constant) and e.value in names for e in c.elts)
-            for c in [node.left, *node.comparators]
-        )
-    ]
-    assert branching == []
+    assert _comparisons_with(names, outside="excite_cli.constraints") == []
