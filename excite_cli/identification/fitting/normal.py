@@ -170,14 +170,22 @@ def _bounded(G: np.ndarray, c: np.ndarray, bounded: np.ndarray) -> np.ndarray:
         L = np.linalg.cholesky(0.5 * (S + S.T))  # S = L Lᵀ: A = Lᵀ, b = L⁻¹ r
         A, b = L.T, scipy.linalg.solve_triangular(L, r, lower=True)
     except np.linalg.LinAlgError:  # a bounded column the free ones span: S singular
-        eigenvalues, vectors = np.linalg.eigh(0.5 * (S + S.T))
-        kept = eigenvalues > 1e-13 * max(eigenvalues[-1], 1e-300)
-        A = np.sqrt(eigenvalues[kept])[:, None] * vectors[:, kept].T
-        b = vectors[:, kept].T @ r / np.sqrt(eigenvalues[kept])
+        A, b = square_root(0.5 * (S + S.T), r)
     x = np.zeros(c.size)
     x[bounded] = scipy.optimize.nnls(A, b)[0]
     x[free] = solve_free(c[free] - G[np.ix_(free, bounded)] @ x[bounded])
     return x
+
+
+def square_root(G: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A (k, m), b (k,) with AᵀA = G and Aᵀb = c for normal equations G (m, m) (symmetric positive
+    semidefinite), c (m,): ‖Ax − b‖² = xᵀGx − 2cᵀx + const, a least-squares form of them, from the
+    eigenpairs of G with eigenvalues above 1e-13 × the largest (k of them; the rest, directions G does
+    not see, dropped)."""
+    eigenvalues, vectors = np.linalg.eigh(G)
+    kept = eigenvalues > 1e-13 * max(eigenvalues[-1], 1e-300)
+    roots = np.sqrt(eigenvalues[kept])
+    return roots[:, None] * vectors[:, kept].T, (vectors[:, kept].T @ c) / roots
 
 
 def excited_rank(G: np.ndarray, tolerance: float = 1e-12) -> int:

@@ -42,6 +42,7 @@ import pinocchio as pin
 
 from excite_cli.errors import ExciteError
 from excite_cli.identification.effects import NONNEGATIVE
+from excite_cli.identification.fitting.normal import square_root
 
 #: Length scale ℓ [m] of the inertia parameters in the regularization.
 LENGTH = 0.1
@@ -244,12 +245,9 @@ class ConsistentProgram:
         normal = self.to_unknowns.T @ G @ self.to_unknowns / np.outer(column, column)
         right = self.to_unknowns.T @ (c - G[:, :b] @ (self.regrouping @ self.phi_urdf)) / column
         normal[self.unseen, :], normal[:, self.unseen] = 0.0, 0.0
-        eigenvalues, vectors = np.linalg.eigh(normal)
-        kept = eigenvalues > 1e-13 * max(eigenvalues[-1], 1e-300)
-        R = np.zeros_like(normal)  # RᵀR = the scaled normal matrix
-        R[: kept.sum()] = np.sqrt(eigenvalues[kept])[:, None] * vectors[:, kept].T
-        z = np.zeros(normal.shape[0])
-        z[: kept.sum()] = (vectors[:, kept].T @ right) / np.sqrt(eigenvalues[kept])
+        A, b = square_root(normal, right)
+        R, z = np.zeros_like(normal), np.zeros(normal.shape[0])  # RᵀR = the scaled normal matrix (padded)
+        R[: len(A)], z[: len(b)] = A, b
         self.R.value, self.z.value, self.weight.value = R / np.sqrt(rows), z / np.sqrt(rows), regularization
         self.pinned.value = (np.diag(normal)[q:] <= 0.0).astype(float)
         problem = _solve(self.problem)
