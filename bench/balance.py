@@ -1,5 +1,5 @@
 """Does the standing robot stay on its feet? Each iteration of the shipped G1 problem, optimized for
-every seed, played in MuJoCo on a floor (excite_cli/dynamics/mujoco_stance.py: MuJoCo compiles the
+every seed, played in MuJoCo on a floor (excite_cli/design/mujoco_stance.py: MuJoCo compiles the
 URDF itself; the soles' contact spheres, the free root, MuJoCo's integrator and soft contacts), as
 `excite export` plays it (home → one period → home, at 2 kHz, speed 1 and faster), the moving joints
 driven by the feed-forward torque plus a PD on tracking, the joints the problem locks held
@@ -36,11 +36,11 @@ import numpy as np
 
 from excite_cli.config_file import load_problem
 from excite_cli.constraints.zmp import zero_moment_point
-from excite_cli.dynamics.mujoco_stance import TIMESTEP, Stance, play_standing, standing_model
+from excite_cli.design.excitation import build_excitation
+from excite_cli.design.mujoco_stance import TIMESTEP, Stance, play_standing, standing_model
+from excite_cli.design.playback import plan_playback
 from excite_cli.dynamics.urdf_source import resolve_urdf
 from excite_cli.identification.reporting.mjcf_out import import_mujoco
-from excite_cli.optimization.excitation import build_excitation
-from excite_cli.optimization.playback import plan_playback
 from excite_cli.storage.results import read_alphas
 from excite_cli.workflows.optimize import run_optimize
 

@@ -28,6 +28,7 @@ import numpy as np
 import yaml
 
 from excite_cli.config_file import load_problem
+from excite_cli.design.excitation import build_excitation
 from excite_cli.dynamics.base_parameters import compute_base_parameters
 from excite_cli.dynamics.robot import load_robot
 from excite_cli.identification.config import IdentifyProblem
@@ -36,8 +37,7 @@ from excite_cli.identification.fitting.least_squares import joint_weights, least
 from excite_cli.identification.fitting.normal import NormalEquations
 from excite_cli.identification.pipeline import prepare_data, run_identification
 from excite_cli.identification.simulation_config import SimulationConfig
-from excite_cli.optimization.excitation import build_excitation
-from excite_cli.optimization.sequence import run_sequence
+from excite_cli.search.sequence import run_sequence
 from excite_cli.storage.results import write_result
 from excite_cli.workflows.simulate import simulate_runs
 

@@ -15,7 +15,7 @@ Then, for 5 noise seeds:
 - identification: weighted least squares of the base parameters on all of them (weights 1/σ);
 - parameter error: the RMS over the b identifiable directions of L⁻¹(β̂ − β), the error in an
   orthonormal basis of the identifiable subspace of the standard parameters each scaled by its URDF
-  magnitude (:mod:`excite_cli.optimization.information`; a value of 1 is an error as large as the
+  magnitude (:mod:`excite_cli.design.information`; a value of 1 is an error as large as the
   parameters themselves), and the largest such direction error; beside it the error the noise
   gives on average, without drawing any: √(trace(L⁻¹ (YᵀWᵀWY)⁻¹ L⁻ᵀ)/b), W the weights (the
   standard deviations of weighted least squares; one seed's trajectories are then judged by what they
@@ -47,11 +47,11 @@ import numpy as np
 
 from excite_cli.config import NoiseConfig
 from excite_cli.config_file import load_problem
-from excite_cli.optimization.criterion import condition_number
-from excite_cli.optimization.engine import Engine, default_workers
-from excite_cli.optimization.excitation import build_excitation
-from excite_cli.optimization.restarts import RestartTask
-from excite_cli.optimization.sequence import run_sequence
+from excite_cli.design.criterion import condition_number
+from excite_cli.design.excitation import build_excitation
+from excite_cli.search.engine import Engine, default_workers
+from excite_cli.search.restarts import RestartTask
+from excite_cli.search.sequence import run_sequence
 
 ROOT = Path(__file__).resolve().parent.parent
 CRITERIA = (

@@ -1,6 +1,6 @@
 """How far the first quasi-Newton step may go: restarts of one problem with the criterion scaled so
 that the first step moves no joint by more than FIRST_STEP of its half-range
-(:func:`excite_cli.optimization.solvers.criterion_scale`), for several values of it.
+(:func:`excite_cli.search.solvers.criterion_scale`), for several values of it.
 
 The same random starts for every value (iteration 1 of the config's seed, restarts 0 … R−1), one
 process, one BLAS thread; prints per value and restart the end value, the solver iterations, the stop
@@ -26,10 +26,10 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from excite_cli.config_file import load_problem, with_overrides
+from excite_cli.design.excitation import build_excitation
 from excite_cli.memory import keep_freed_memory
-from excite_cli.optimization import solvers
-from excite_cli.optimization.excitation import build_excitation
-from excite_cli.optimization.restarts import RestartTask
+from excite_cli.search import solvers
+from excite_cli.search.restarts import RestartTask
 
 
 def main() -> None:

@@ -46,6 +46,7 @@ from mujoco_arm import ArmPhysics, arm_model, floor_error, record
 
 from excite_cli.config import RobotConfig
 from excite_cli.config_file import load_problem
+from excite_cli.design.excitation import build_excitation
 from excite_cli.dynamics.base_parameters import compute_base_parameters
 from excite_cli.dynamics.robot import load_robot
 from excite_cli.dynamics.urdf_source import resolve_urdf
@@ -53,8 +54,7 @@ from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.effects import Term
 from excite_cli.identification.pipeline import prepare_data, run_identification
 from excite_cli.identification.simulation_config import SimulationConfig
-from excite_cli.optimization.excitation import build_excitation
-from excite_cli.optimization.sequence import run_sequence
+from excite_cli.search.sequence import run_sequence
 from excite_cli.storage.results import write_result
 from excite_cli.workflows.simulate import simulate_runs
 

@@ -52,9 +52,9 @@ import numpy as np
 
 from excite_cli.config import EffectsConfig, MotorConfig
 from excite_cli.config_file import load_problem
-from excite_cli.optimization.engine import Engine, default_workers
-from excite_cli.optimization.excitation import build_excitation
-from excite_cli.optimization.sequence import describe, run_sequence
+from excite_cli.design.excitation import build_excitation
+from excite_cli.search.engine import Engine, default_workers
+from excite_cli.search.sequence import describe, run_sequence
 
 ROOT = Path(__file__).resolve().parent.parent
 ROBOTS = {"G1": ROOT / "configs" / "g1_arms.yaml", "Panda": ROOT / "configs" / "panda_joint_limits.yaml"}

@@ -24,10 +24,10 @@ import numpy as np
 from threadpoolctl import threadpool_info, threadpool_limits
 
 from excite_cli.config_file import load_problem
+from excite_cli.design.excitation import build_excitation
+from excite_cli.design.verify import finite_difference_gradient
 from excite_cli.memory import keep_freed_memory
-from excite_cli.optimization.excitation import build_excitation
-from excite_cli.optimization.optimizer import optimize_restart
-from excite_cli.optimization.verify import finite_difference_gradient
+from excite_cli.search.optimizer import optimize_restart
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -60,7 +60,7 @@ def profile(config: Path, iterations: int) -> None:
         timed(c, "evaluate", f"{c.name}: values + Jacobian", spent, calls)
         timed(c, "check_samples", f"{c.name}: exact checks", spent, calls)
     start_alpha = excitation.random_start(np.random.default_rng(0))
-    keep_freed_memory()  # as every process that runs restarts (excite_cli.optimization.engine)
+    keep_freed_memory()  # as every process that runs restarts (excite_cli.search.engine)
     with threadpool_limits(limits=1):
         start = time.perf_counter()
         result = optimize_restart(

@@ -46,10 +46,10 @@ import numpy as np
 from excite_cli.config import OptimizerConfig
 from excite_cli.config_file import load_problem
 from excite_cli.criteria import NAMES
-from excite_cli.optimization.engine import Engine, default_workers
-from excite_cli.optimization.excitation import build_excitation
-from excite_cli.optimization.optimality import CONVERGED
-from excite_cli.optimization.sequence import run_sequence
+from excite_cli.design.excitation import build_excitation
+from excite_cli.search.engine import Engine, default_workers
+from excite_cli.search.kkt import CONVERGED
+from excite_cli.search.sequence import run_sequence
 
 ROOT = Path(__file__).resolve().parent.parent
 DEFAULT_OBJECTIVE = OptimizerConfig.model_fields["objective"].default

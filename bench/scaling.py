@@ -18,9 +18,9 @@ import time
 from pathlib import Path
 
 from excite_cli.config_file import load_problem
-from excite_cli.optimization.engine import Engine, default_workers
-from excite_cli.optimization.excitation import build_excitation
-from excite_cli.optimization.sequence import run_sequence
+from excite_cli.design.excitation import build_excitation
+from excite_cli.search.engine import Engine, default_workers
+from excite_cli.search.sequence import run_sequence
 
 ROOT = Path(__file__).resolve().parent.parent
 ARM = ["shoulder_pitch", "shoulder_roll", "shoulder_yaw", "elbow", "wrist_roll", "wrist_pitch", "wrist_yaw"]

@@ -26,12 +26,12 @@ from threadpoolctl import threadpool_limits
 
 import excite_cli.constraints.lse as lse
 from excite_cli.config_file import load_problem
+from excite_cli.design.excitation import build_excitation
 from excite_cli.memory import keep_freed_memory
-from excite_cli.optimization.excitation import build_excitation
-from excite_cli.optimization.nlp import Evaluations
-from excite_cli.optimization.optimality import kkt_optimality
-from excite_cli.optimization.restarts import RestartTask
-from excite_cli.optimization.solvers import solve
+from excite_cli.search.kkt import kkt_optimality
+from excite_cli.search.nlp import Evaluations
+from excite_cli.search.restarts import RestartTask
+from excite_cli.search.solvers import solve
 
 
 def first_converged(excitation, seed: int, iterations: int, every: int, tolerance: float) -> tuple:

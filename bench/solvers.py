@@ -20,10 +20,10 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from excite_cli.config_file import load_problem, with_overrides
+from excite_cli.design.excitation import build_excitation
 from excite_cli.memory import keep_freed_memory
-from excite_cli.optimization.excitation import build_excitation
-from excite_cli.optimization.restarts import RestartTask
-from excite_cli.optimization.solvers import METHODS
+from excite_cli.search.restarts import RestartTask
+from excite_cli.search.solvers import METHODS
 
 
 def main() -> None:

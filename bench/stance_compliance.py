@@ -32,8 +32,8 @@ from balance import setup, sway
 from scipy.linalg import null_space
 
 from excite_cli.constraints.zmp import zero_moment_point
-from excite_cli.dynamics.mujoco_stance import TIMESTEP, Stance, play_standing, standing_model
-from excite_cli.optimization.playback import plan_playback
+from excite_cli.design.mujoco_stance import TIMESTEP, Stance, play_standing, standing_model
+from excite_cli.design.playback import plan_playback
 from excite_cli.storage.results import read_alphas
 
 ROOT = Path(__file__).resolve().parent.parent

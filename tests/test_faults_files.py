@@ -190,7 +190,7 @@ def test_a_scheduler_that_is_a_web_server_is_one_line(tmp_path):
 def test_a_scheduler_without_the_cluster_extra_is_one_line(tmp_path, monkeypatch):
     """distributed is the ``cluster`` extra: a plain ``pip install`` runs locally, and a scheduler
     asked for without it is one line, before anything is computed or written."""
-    import excite_cli.optimization.scheduler as scheduler_module
+    import excite_cli.search.scheduler as scheduler_module
 
     real = scheduler_module.find_spec
     monkeypatch.setattr(scheduler_module, "find_spec", lambda name: None if name == "distributed" else real(name))

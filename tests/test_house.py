@@ -1,9 +1,9 @@
 """The house rules of the package, checked on its source: a thin command line, small modules and
-functions, imports that only run down the stack, criteria as records, constraints told apart by their classes (the
-import graph has no cycle), and the command
-line's libraries (typer, rich) only in the modules that print, modules in role folders, identification
-independent of the optimizer, no command-line flag in a library message, tests that mirror the
-package's folders with every module tested in its own, and lower floors handed values, not problems."""
+functions, an import graph without a cycle whose every import runs down the floors (so identification
+reaches neither the design nor the search), criteria as records, constraints told apart by their
+classes, the command line's libraries (typer, rich) only in the modules that print, modules in role
+folders, no command-line flag in a library message, tests that mirror the package's folders with
+every module tested in its own, and lower floors handed values, not whole problems (through any path)."""
 
 import ast
 import re
@@ -91,35 +91,74 @@ def test_only_the_printing_modules_use_the_command_line_libraries():
     assert users == PRINTING
 
 
-#: Modules outside the role folders: the entry points and what every stage shares.
-TOP_LEVEL = {
-    "__init__",
-    "__main__",
-    "atomic",
-    "cli",
-    "config_file",
-    "errors",
-    "h5",
-    "inputs",
+#: The floors of the package from the ground up: the modules every stage shares, then the role folders
+#: (and the top-level modules between them) in the order data flows. A module imports only from its
+#: own floor or the floors under it (:func:`test_every_import_runs_down_the_floors`).
+FLOORS = (
     "kernels",
+    "__init__",
+    "errors",
     "memo",
     "memory",
-}
-ROLE_FOLDERS = {
+    "inputs",
+    "atomic",
+    "h5",
+    "criteria",
     "config",
     "trajectory",
     "dynamics",
     "collision",
     "constraints",
-    "criteria",
-    "optimization",
-    "drafting",
     "identification",
+    "config_file",
+    "design",
+    "search",
+    "drafting",
     "storage",
     "plots",
-    "console",
     "workflows",
+    "console",
+    "cli",
+    "__main__",
+)
+ROLE_FOLDERS = {
+    "criteria",
+    "config",
+    "trajectory",
+    "dynamics",
+    "collision",
+    "constraints",
+    "identification",
+    "design",
+    "search",
+    "drafting",
+    "storage",
+    "plots",
+    "workflows",
+    "console",
 }
+#: Modules outside the role folders: the entry points and what every stage shares.
+TOP_LEVEL = set(FLOORS) - ROLE_FOLDERS
+
+
+def _floor(module: str) -> int:
+    """The floor (index in :data:`FLOORS`) of an ``excite_cli`` module: its folder's, or its own at the top level."""
+    parts = module.split(".")
+    return FLOORS.index(parts[1] if len(parts) > 1 else "__init__")
+
+
+def test_every_import_runs_down_the_floors():
+    """No module imports from a floor above its own (so identification, under the design and the
+    search, reaches none of them, nor the files or the plots)."""
+    modules = _modules()
+    upward = sorted(
+        (name, dep)
+        for name, tree in modules.items()
+        for dep in _imports(tree)
+        if dep in modules and _floor(dep) > _floor(name)
+    )
+    assert upward == []
+    assert _floor("excite_cli.identification.pipeline") < _floor("excite_cli.design.excitation")
 
 
 def test_every_module_sits_in_a_role_folder_or_is_a_named_top_level_module():
@@ -131,18 +170,6 @@ def test_every_module_sits_in_a_role_folder_or_is_a_named_top_level_module():
     ]
     assert misplaced == []
     assert {p.name for p in PACKAGE.iterdir() if p.is_dir() and p.name != "__pycache__"} == ROLE_FOLDERS
-
-
-def test_identification_does_not_reach_the_optimizer_its_files_or_its_plots():
-    modules = _modules()
-    graph = {name: {m for m in _imports(tree) if m in modules and m != name} for name, tree in modules.items()}
-    reached, todo = set(), [n for n in modules if n.startswith("excite_cli.identification")]
-    while todo:
-        for dep in graph[todo.pop()] - reached:
-            reached.add(dep)
-            todo.append(dep)
-    assert "excite_cli.dynamics.robot" in reached  # the walk saw the imports
-    assert sorted(m for m in reached if m.split(".")[1] in ("optimization", "storage", "plots")) == []
 
 
 def _messages(tree: ast.Module) -> list[str]:
@@ -200,6 +227,14 @@ def test_tests_mirror_the_package_and_every_module_is_tested_in_its_own_folder()
     assert untested == []
 
 
+#: The whole problems, as a module can import them: from their package or their own module.
+_PROBLEMS = {
+    "excite_cli.config.Problem",
+    "excite_cli.config.problem.Problem",
+    "excite_cli.identification.config.IdentifyProblem",
+}
+
+
 def test_lower_floors_take_sections_and_values_not_whole_problems():
     """Robots, data, constraints, trajectories and the identification's measured, fitting and choice
     rooms are handed the config section or the value they use, never a whole problem (the report
@@ -216,8 +251,7 @@ def test_lower_floors_take_sections_and_values_not_whole_problems():
     offenders = [
         name
         for name, tree in _modules().items()
-        if name.removeprefix("excite_cli.").startswith(lower)
-        and {"excite_cli.config.Problem", "excite_cli.identification.config.IdentifyProblem"} & _imports(tree)
+        if name.removeprefix("excite_cli.").startswith(lower) and _PROBLEMS & _imports(tree)
     ]
     assert offenders == []
 
@@ -243,10 +277,19 @@ def _comparisons_with(names: set[str], outside: str) -> list[tuple[str, int]]:
 
 def test_a_criterion_is_one_record_and_nothing_outside_its_room_branches_on_its_name():
     """Adding a criterion is adding a record to ``excite_cli.criteria.catalogue.CRITERIA``: no module outside
-    ``excite_cli/criteria`` compares anything with a criterion's name (that is what the record says)."""
+    ``excite_cli/criteria`` compares anything with a criterion's name (that is what the record says),
+    nor picks a record by a name written in its code."""
     from excite_cli.criteria import NAMES
 
     assert _comparisons_with(NAMES, outside="excite_cli.criteria") == []
+    keyed = [
+        (name, node.lineno)
+        for name, tree in _modules().items()
+        if not name.startswith("excite_cli.criteria")
+        for node in ast.walk(tree)
+        if isinstance(node, ast.Subscript) and isinstance(node.slice, ast.Constant) and node.slice.value in NAMES
+    ]
+    assert keyed == []
 
 
 def _subclasses(cls: type) -> set[type]:
@@ -257,7 +300,7 @@ def test_a_constraint_s_kind_is_answered_by_its_class_not_by_its_name():
     """What a caller asks of a constraint (its rows in words, the distance it keeps, whether it bounds
     the torques) is a method or an attribute of its class: no module outside ``excite_cli/constraints``
     compares anything with a constraint's name, so adding a constraint touches its own file."""
-    import excite_cli.optimization.excitation  # noqa: F401  (imports every constraint class)
+    import excite_cli.design.excitation  # noqa: F401  (imports every constraint class)
     from excite_cli.constraints import Constraint
 
     names = {c.name for c in _subclasses(Constraint)}

@@ -98,9 +98,9 @@ class LimitsConfig(Section):
 
 
 class OptimizerConfig(Section):
-    """Solver settings: method (:mod:`excite_cli.optimization.solvers`), objective, iterations, the solver's own
+    """Solver settings: method (:mod:`excite_cli.search.solvers`), objective, iterations, the solver's own
     tolerance and the first-order optimality tolerance a restart must meet to count as converged
-    (:mod:`excite_cli.optimization.optimality`), seed, restarts, the random starts screened for
+    (:mod:`excite_cli.search.kkt`), seed, restarts, the random starts screened for
     ``screen_iterations`` before the best ``restarts`` continue (``starts``, default: no
     screening), the runs the kept restart continues by until it converges (``polish_rounds``), and
     where restarts run (``workers`` local processes, default the machine's cores; or a Dask
@@ -179,7 +179,7 @@ class OptimizerConfig(Section):
 
 
 class NoiseConfig(Section):
-    """The torque noise the design is for (:mod:`excite_cli.optimization.noise`): per joint an absolute
+    """The torque noise the design is for (:mod:`excite_cli.design.noise`): per joint an absolute
     part σ [Nm] and a part ρ [1] relative to the torque; each regressor row weighs 1/√(σ_j² + ρ_j² τ_j(t)²)."""
 
     absolute: PerJoint = 0.1

@@ -16,8 +16,8 @@ from excite_cli.criteria import CRITERIA
 
 if TYPE_CHECKING:  # annotations only: the command line's frame imports this module at start-up
     from excite_cli.config import Problem
-    from excite_cli.optimization.optimizer import ProgressHook
-    from excite_cli.optimization.sequence import IterationResult
+    from excite_cli.search.optimizer import ProgressHook
+    from excite_cli.search.sequence import IterationResult
 
 #: [s] between two progress lines in a log (no terminal).
 LOG_PERIOD = 30.0

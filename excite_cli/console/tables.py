@@ -11,7 +11,7 @@ from rich.table import Table
 
 from excite_cli.config import OptimizerConfig
 from excite_cli.criteria import CRITERIA
-from excite_cli.optimization.sequence import IterationResult
+from excite_cli.search.sequence import IterationResult
 from excite_cli.workflows.check import Plan
 from excite_cli.workflows.compare import Comparison
 from excite_cli.workflows.init import InitRun

@@ -43,7 +43,7 @@ class Constraint(ABC):
         advisory: whether it predicts what the robot's own control decides (the zero-moment point, which
             the stance's compliance moves): the optimizer keeps it, ``export`` warns instead of refusing.
         bounds_torque: whether it bounds the joint torques (|τ| ≤ τ_max), which a transition
-            (:mod:`~excite_cli.optimization.playback`) must keep as well.
+            (:mod:`~excite_cli.design.playback`) must keep as well.
     """
 
     name: str

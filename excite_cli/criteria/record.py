@@ -4,7 +4,7 @@ value and gradient with respect to C from the eigenvalues of CᵀC.
 Every criterion here is a function of the eigenvalues λ of the information matrix CᵀC, and its
 gradient in C has the form Σ_r a_r (C v_r) v_rᵀ over eigenvectors v_r (Eq. 17 for the condition number;
 its D-, E- and A-optimal analogues), so a record gives the value, the indices r it needs and the
-coefficients a_r; :class:`~excite_cli.optimization.criterion.Criterion` turns them into the gradient in
+coefficients a_r; :class:`~excite_cli.design.criterion.Criterion` turns them into the gradient in
 the Fourier coefficients. numpy is handed to the formula, so the command line can list the records'
 names without loading it.
 """
@@ -36,7 +36,7 @@ class CriterionRecord:
         extremes: for a criterion of the extreme singular values only, non-smooth where one is
             multiple: (w_max, w_min) with f = w_max log σ_max + w_min log σ_min (or exp of that with
             ``exponentiate_extremes``); () for a smooth criterion. The stationarity test of
-            :mod:`~excite_cli.optimization.optimality` uses it.
+            :mod:`~excite_cli.search.kkt` uses it.
         exponentiate_extremes: f = exp(w_max log σ_max + w_min log σ_min) (cond itself).
         scaling: the regressor it is taken of unless ``optimizer.scaling`` says: ``none`` (C, the
             paper's) or ``urdf`` (C L, the frame in which it measures what it is meant to).

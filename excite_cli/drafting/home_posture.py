@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from excite_cli.optimization.excitation import Excitation, violated_at_rest
+from excite_cli.design.excitation import Excitation, violated_at_rest
 
 #: Rounds of random steps, steps per round, clearance sought beyond the margins [m].
 HOME_ROUNDS, HOME_STEPS, HOME_CLEARANCE = 60, 64, 0.005

@@ -17,11 +17,11 @@ import pinocchio as pin
 from excite_cli.config import Problem
 from excite_cli.constraints import SelfCollision
 from excite_cli.constraints.world_collision import WorldCollision
+from excite_cli.design.excitation import Excitation, build_excitation
 from excite_cli.drafting.home_posture import home_posture
 from excite_cli.drafting.joints import joint_choice
 from excite_cli.dynamics.urdf_source import apply_joint_ranges, robot_geometry, robot_model
 from excite_cli.errors import ExciteError
-from excite_cli.optimization.excitation import Excitation, build_excitation
 
 #: Random postures the capsule overlaps and the home posture are searched over.
 POSTURES = 300

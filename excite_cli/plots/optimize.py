@@ -19,11 +19,11 @@ from excite_cli.constraints import ComRegion, SelfCollision  # noqa: E402
 from excite_cli.constraints.support import SupportPolygon  # noqa: E402
 from excite_cli.constraints.world_collision import WorldCollision, WorldShape, world_shapes  # noqa: E402
 from excite_cli.constraints.zmp import ZeroMomentPoint  # noqa: E402
-from excite_cli.optimization.excitation import Excitation  # noqa: E402
-from excite_cli.optimization.sequence import IterationResult  # noqa: E402
+from excite_cli.design.excitation import Excitation  # noqa: E402
 from excite_cli.plots.figure import save_figure  # noqa: E402
 from excite_cli.plots.shapes import draw_shape, stadium  # noqa: E402
 from excite_cli.plots.skeleton import capsule_segments, skeleton  # noqa: E402
+from excite_cli.search.sequence import IterationResult  # noqa: E402
 
 
 def plot_result(target: Path, excitation: Excitation, results: Sequence[IterationResult]) -> list[Path]:

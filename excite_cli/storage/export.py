@@ -3,7 +3,7 @@
 The file holds time [s], q [rad], q̇ [rad/s], q̈ [rad/s²] of the active joints and the feed-forward
 torque τ = RNEA(q, q̇, q̈) [Nm] of the URDF model (base held fixed, locked joints at their values):
 a quintic transition from the home posture at rest, P periods of the trajectory, a transition back
-(:mod:`excite_cli.optimization.playback`), at the optimized speed or ``speed`` times faster. Every
+(:mod:`excite_cli.design.playback`), at the optimized speed or ``speed`` times faster. Every
 constraint of the problem is checked again on the exported samples; a file that violates one is not
 written, except for predictions the robot's own control decides (the zero-moment point,
 :attr:`~excite_cli.constraints.constraint.Constraint.advisory`), which are reported and warned about.
@@ -18,9 +18,9 @@ import numpy as np
 
 from excite_cli.atomic import atomic_path
 from excite_cli.config_file import with_overrides
+from excite_cli.design.excitation import build_excitation
+from excite_cli.design.playback import check_motion, plan_playback
 from excite_cli.errors import ExciteError
-from excite_cli.optimization.excitation import build_excitation
-from excite_cli.optimization.playback import check_motion, plan_playback
 from excite_cli.storage.formats import ROS_FORMATS, check_format
 from excite_cli.storage.results import problem_of_result, read_alphas
 from excite_cli.storage.rosbag import check_goal_size, write_rosbag

@@ -16,13 +16,13 @@ from pydantic import ValidationError
 
 from excite_cli.config import Problem, effective_yaml
 from excite_cli.config_file import parse_yaml
+from excite_cli.design.excitation import Excitation
 from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.errors import ExciteError
 from excite_cli.h5 import atomic_h5, open_h5, read_strings, write_strings
-from excite_cli.optimization.excitation import Excitation
-from excite_cli.optimization.optimality import Optimality
-from excite_cli.optimization.optimizer import RestartResult
-from excite_cli.optimization.sequence import IterationResult, describe, stacked_regressors
+from excite_cli.search.kkt import Optimality
+from excite_cli.search.optimizer import RestartResult
+from excite_cli.search.sequence import IterationResult, describe, stacked_regressors
 
 UNITS = {
     "alpha": "rad",
@@ -37,7 +37,7 @@ UNITS = {
 def results_table(results: Sequence[IterationResult]) -> np.ndarray:
     """Table I as a structured array: iteration, cond_own, cond_stacked (on the base and effect columns, the
     paper's), scaled_cond_own, scaled_cond_stacked (cond(C L)) and excitation_own, excitation_stacked
-    (ē [N·m]), which do not depend on the choice of base columns (:mod:`excite_cli.optimization.information`),
+    (ē [N·m]), which do not depend on the choice of base columns (:mod:`excite_cli.design.information`),
     and max_correlation with an earlier iteration (NaN for the first, :mod:`excite_cli.trajectory.similarity`)."""
     fields = ("cond_own", "cond_stacked", "scaled_cond_own", "scaled_cond_stacked", "excitation_own")
     fields += ("excitation_stacked", "max_correlation")

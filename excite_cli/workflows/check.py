@@ -10,10 +10,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from excite_cli.config import Problem
-from excite_cli.optimization.engine import default_workers
-from excite_cli.optimization.excitation import Excitation, build_excitation
-from excite_cli.optimization.optimality import ACTIVE_TOLERANCE
-from excite_cli.optimization.solvers import criterion_scale
+from excite_cli.design.excitation import Excitation, build_excitation
+from excite_cli.search.engine import default_workers
+from excite_cli.search.kkt import ACTIVE_TOLERANCE
+from excite_cli.search.solvers import criterion_scale
 
 #: Evaluations timed for the estimate (the median is kept).
 TIMED = 5
@@ -43,7 +43,7 @@ class Scaling:
     Attributes:
         gradient: the criterion's largest gradient component ‖∇f‖_∞.
         scale: the factor the solver multiplies the criterion by
-            (:func:`~excite_cli.optimization.solvers.criterion_scale`).
+            (:func:`~excite_cli.search.solvers.criterion_scale`).
         active: constraints within ``ACTIVE_TOLERANCE`` of their bound.
         active_condition: condition number of those constraints' Jacobian (NaN when none is active;
             large: nearly parallel rows, which the solver's subproblems cannot tell apart).

@@ -10,13 +10,13 @@ from typing import Callable, Optional
 import numpy as np
 
 from excite_cli.config import Problem
+from excite_cli.design.excitation import Excitation, build_excitation
 from excite_cli.errors import ExciteError
 from excite_cli.h5 import open_h5, read_strings
-from excite_cli.optimization.excitation import Excitation, build_excitation
-from excite_cli.optimization.optimizer import ProgressHook
-from excite_cli.optimization.random_baseline import draw_pool, greedy_selection, pool_convergence
-from excite_cli.optimization.sequence import describe, stacked_regressors
 from excite_cli.plots.optimize import plot_comparison
+from excite_cli.search.optimizer import ProgressHook
+from excite_cli.search.random_baseline import draw_pool, greedy_selection, pool_convergence
+from excite_cli.search.sequence import describe, stacked_regressors
 from excite_cli.storage.paths import check_target, output_lock
 from excite_cli.storage.results import check_base, read_table, results_table, write_result
 from excite_cli.workflows.optimize import engine_for, run_optimize

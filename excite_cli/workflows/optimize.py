@@ -11,14 +11,14 @@ import yaml
 
 from excite_cli.config import Problem, effective_yaml, resolve_path
 from excite_cli.config_file import parse_yaml
+from excite_cli.design.excitation import Excitation, build_excitation
+from excite_cli.design.information import predicted_std
 from excite_cli.errors import ExciteError, FileNotFound, Interrupted, exit_status
 from excite_cli.h5 import open_h5
-from excite_cli.optimization.engine import Engine, default_workers
-from excite_cli.optimization.excitation import Excitation, build_excitation
-from excite_cli.optimization.information import predicted_std
-from excite_cli.optimization.optimizer import ProgressHook
-from excite_cli.optimization.sequence import IterationResult, run_sequence
 from excite_cli.plots.optimize import plot_result
+from excite_cli.search.engine import Engine, default_workers
+from excite_cli.search.optimizer import ProgressHook
+from excite_cli.search.sequence import IterationResult, run_sequence
 from excite_cli.storage.paths import check_target, output_lock
 from excite_cli.storage.prior import read_prior
 from excite_cli.storage.results import read_iterations, write_result
@@ -111,7 +111,7 @@ def run_optimize(
     Raises:
         ExciteError: bad target, prior data or problem; a result to resume made with another config;
             another run writing ``target`` (:func:`output_lock`); workers lost during the run
-            (:class:`~excite_cli.optimization.engine.Engine`) or no restart of an iteration succeeded
+            (:class:`~excite_cli.search.engine.Engine`) or no restart of an iteration succeeded
             (:class:`~excite_cli.errors.NoSolution`), with the finished iterations kept in ``target``.
         Interrupted: Ctrl-C or SIGTERM; the finished iterations are in ``target``, the workers stopped.
     """

@@ -16,9 +16,9 @@ from excite_cli.console.identification import validation
 from excite_cli.console.progress import Bars
 from excite_cli.errors import ExciteError, OutputExists
 from excite_cli.identification.validate import RunError
-from excite_cli.optimization.optimality import Optimality
-from excite_cli.optimization.optimizer import RestartResult
-from excite_cli.optimization.sequence import IterationResult
+from excite_cli.search.kkt import Optimality
+from excite_cli.search.optimizer import RestartResult
+from excite_cli.search.sequence import IterationResult
 
 
 def _text(renderables) -> str:

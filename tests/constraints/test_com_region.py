@@ -5,8 +5,8 @@ from conftest import CONFIGS
 
 from excite_cli.config_file import load_problem
 from excite_cli.constraints.com_region import ComRegion
-from excite_cli.optimization.excitation import build_excitation
-from excite_cli.optimization.verify import constraint_jacobian_error
+from excite_cli.design.excitation import build_excitation
+from excite_cli.design.verify import constraint_jacobian_error
 
 
 def test_com_polygon_region():

@@ -6,8 +6,8 @@ import pinocchio as pin
 import pytest
 from conftest import small
 
+from excite_cli.design.excitation import build_excitation
 from excite_cli.dynamics.virtual_dynamics import VirtualDynamics
-from excite_cli.optimization.excitation import build_excitation
 
 
 @pytest.mark.parametrize("name, base_rows", [("g1_problem", False), ("g1_problem", True), ("panda_problem", False)])

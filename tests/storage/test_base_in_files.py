@@ -7,10 +7,10 @@ import pytest
 from conftest import CONFIGS
 
 from excite_cli.config_file import load_problem
+from excite_cli.design.excitation import build_excitation
 from excite_cli.errors import ExciteError
 from excite_cli.h5 import read_strings, write_strings
-from excite_cli.optimization.excitation import build_excitation
-from excite_cli.optimization.sequence import describe
+from excite_cli.search.sequence import describe
 from excite_cli.storage.prior import read_prior
 from excite_cli.storage.results import read_iterations, write_result
 

@@ -5,8 +5,8 @@ import pytest
 from conftest import CONFIGS, small
 
 from excite_cli.config_file import load_problem
+from excite_cli.design.excitation import build_excitation
 from excite_cli.errors import ExciteError
-from excite_cli.optimization.excitation import build_excitation
 from excite_cli.trajectory.boundary import BoundaryConditions, boundary_rows
 from excite_cli.trajectory.fourier import FourierTrajectory
 

@@ -10,7 +10,7 @@ from typer.testing import CliRunner
 
 from excite_cli.cli import app
 from excite_cli.config_file import load_problem
-from excite_cli.optimization.engine import Engine
+from excite_cli.search.engine import Engine
 
 runner = CliRunner()
 

@@ -8,6 +8,7 @@ from typer.testing import CliRunner
 
 from excite_cli.cli import app
 from excite_cli.config_file import load_problem
+from excite_cli.design.excitation import build_excitation
 from excite_cli.errors import ExciteError
 from excite_cli.h5 import read_strings
 from excite_cli.identification.reporting.design_model import (
@@ -17,7 +18,6 @@ from excite_cli.identification.reporting.design_model import (
     with_report_model,
 )
 from excite_cli.identification.reporting.report_file import write_identification
-from excite_cli.optimization.excitation import build_excitation
 from excite_cli.storage.prior import read_prior
 
 

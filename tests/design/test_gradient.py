@@ -8,11 +8,11 @@ from conftest import small
 
 from excite_cli.config import EffectsConfig, MotorConfig
 from excite_cli.criteria import CRITERIA, NAMES
+from excite_cli.design.criterion import Criterion, condition_number
+from excite_cli.design.excitation import build_excitation
+from excite_cli.design.noise import RowNoise
+from excite_cli.design.verify import check_gradient, finite_difference_gradient
 from excite_cli.errors import ExciteWarning
-from excite_cli.optimization.criterion import Criterion, condition_number
-from excite_cli.optimization.excitation import build_excitation
-from excite_cli.optimization.noise import RowNoise
-from excite_cli.optimization.verify import check_gradient, finite_difference_gradient
 
 
 def _feasible_alpha(excitation, seed=0):
@@ -51,7 +51,7 @@ def test_scaled_condition_number_is_that_of_the_scaled_standard_regressor_in_any
     # gives the same value, while the paper's cond(C) changes.
     import dataclasses
 
-    from excite_cli.optimization.information import parameter_magnitudes, scaled_frame
+    from excite_cli.design.information import parameter_magnitudes, scaled_frame
 
     excitation = build_excitation(small(ur5_problem))
     robot, base = excitation.robot, excitation.base
@@ -208,8 +208,8 @@ def test_gradient_with_row_weights_matches_finite_differences(ur5_problem):
         excitation.robot,
         excitation.base,
         excitation.cost_basis,
-        prior,
         CRITERIA["log_det"],
+        prior,
         effects=excitation.effects,
         noise=noise,
     )

@@ -1,9 +1,9 @@
 """Where independent pieces of work run: in this process, in a local process pool, or on a Dask
 distributed cluster.
 
-The restarts of an iteration (:class:`~excite_cli.optimization.restarts.RestartTask`) and the random candidates
-of ``compare-random`` (:class:`~excite_cli.optimization.random_baseline.DrawTask`) are tasks: each has an index
-and its own seed, and is called with the problem's :class:`~excite_cli.optimization.excitation.Excitation`, so
+The restarts of an iteration (:class:`~excite_cli.search.restarts.RestartTask`) and the random candidates
+of ``compare-random`` (:class:`~excite_cli.search.random_baseline.DrawTask`) are tasks: each has an index
+and its own seed, and is called with the problem's :class:`~excite_cli.design.excitation.Excitation`, so
 its result does not depend on where or in which order it runs. Pool and cluster workers build the
 excitation from the validated problem and the main process's base parameters once and keep it (one
 per worker thread): no worker computes a base of its own. Every process that
@@ -25,11 +25,11 @@ from typing import Any, Callable, Iterator, Optional, Protocol, Sequence
 from threadpoolctl import threadpool_limits
 
 from excite_cli.config import Problem
+from excite_cli.design.excitation import Excitation, build_excitation
 from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.errors import NO_VALUE, ExciteError, ExciteWarning
 from excite_cli.memory import keep_freed_memory
-from excite_cli.optimization.excitation import Excitation, build_excitation
-from excite_cli.optimization.scheduler import CONNECT_TIMEOUT, check_scheduler
+from excite_cli.search.scheduler import CONNECT_TIMEOUT, check_scheduler
 
 #: Seconds a stopped worker process is given to end.
 WORKER_STOP = 5.0

@@ -7,9 +7,9 @@ import pytest
 from conftest import small
 
 from excite_cli.config import NoiseConfig
+from excite_cli.design.excitation import build_excitation
+from excite_cli.design.verify import finite_difference_gradient
 from excite_cli.errors import ExciteError
-from excite_cli.optimization.excitation import build_excitation
-from excite_cli.optimization.verify import finite_difference_gradient
 
 
 def _alpha(excitation, seed):

@@ -12,7 +12,7 @@ CᵀW²C with the rows of C scaled by
 criterion on the scale of the unweighted rows: equal noise on every joint and ρ = 0 weigh each row
 1). τ is the rigid body's inverse dynamics with the URDF's inertias at the trajectory's motion, so
 the weights move with α and their gradient ∂s/∂τ = −s ρ² τ / (σ² + ρ²τ²) enters the criterion's
-(:mod:`~excite_cli.optimization.criterion`). The rows of the base wrench (a floating base's, which
+(:mod:`~excite_cli.design.criterion`). The rows of the base wrench (a floating base's, which
 no joint's sensor measures) weigh as a row of noise σ̄.
 
 With an identify report as prior data (``sequence.prior``), σ_j are the report's

@@ -23,8 +23,8 @@ import numpy as np
 
 from excite_cli.constraints import Constraint, JointLimits
 from excite_cli.constraints.lse import ACCEPT_MARGIN, GRID_MARGIN
+from excite_cli.design.excitation import Excitation
 from excite_cli.errors import ExciteError
-from excite_cli.optimization.excitation import Excitation
 from excite_cli.trajectory.fourier import FourierTrajectory
 
 #: Transition durations are multiples of this [s], so that they are the same at every common rate.

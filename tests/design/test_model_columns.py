@@ -7,12 +7,12 @@ import pytest
 from conftest import CONFIGS
 
 from excite_cli.config_file import load_problem
+from excite_cli.design.information import predicted_std
+from excite_cli.design.model_columns import design_effects, measured_prior
 from excite_cli.dynamics.base_parameters import compute_base_parameters
 from excite_cli.dynamics.robot import load_robot
 from excite_cli.errors import ExciteError
 from excite_cli.h5 import write_strings
-from excite_cli.optimization.information import predicted_std
-from excite_cli.optimization.model_columns import design_effects, measured_prior
 
 
 def _report(path, joints, sigma):

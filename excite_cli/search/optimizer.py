@@ -1,14 +1,14 @@
 """One trajectory optimization (Eq. 7 under the constraints) from one feasible start.
 
-The solver (``optimizer.method``, :mod:`excite_cli.optimization.solvers`) works on the optimizer's variables z
+The solver (``optimizer.method``, :mod:`excite_cli.search.solvers`) works on the optimizer's variables z
 (boundary conditions met exactly, preconditioned); the criterion and every constraint supply
 analytic gradients; a criterion of the extreme singular values (cond, log cond, E-optimality) is
-solved in its epigraph form (:class:`~excite_cli.optimization.nlp.Epigraph`), smooth where the
+solved in its epigraph form (:class:`~excite_cli.search.nlp.Epigraph`), smooth where the
 criterion has a kink at its optimum. Quasi-Newton iterates of this problem approach the constraint boundary from
 outside (on the G1 problem SLSQP's iterates stay up to 3 cm outside the CoM region for most of
 the run), so a restart ends at the feasible point nearest to the solver's last iterate
-(:func:`~excite_cli.optimization.nlp.project`): what the restart found is then judged by a point
-every constraint accepts, with its first-order optimality (:mod:`excite_cli.optimization.optimality`)
+(:func:`~excite_cli.search.nlp.project`): what the restart found is then judged by a point
+every constraint accepts, with its first-order optimality (:mod:`excite_cli.search.kkt`)
 and an honest stop reason.
 """
 
@@ -23,10 +23,10 @@ import numpy as np
 from excite_cli.config import OptimizerConfig
 from excite_cli.constraints import Constraint, accepted, farthest_accepted
 from excite_cli.constraints.lse import GRID_MARGIN
-from excite_cli.optimization.criterion import Criterion
-from excite_cli.optimization.nlp import BISECTIONS, Epigraph, Evaluations, project, repair
-from excite_cli.optimization.optimality import INFEASIBLE, SOLVER_FAILED, Optimality, stop_reason
-from excite_cli.optimization.solvers import SolverRun, criterion_scale, solve
+from excite_cli.design.criterion import Criterion
+from excite_cli.search.kkt import INFEASIBLE, SOLVER_FAILED, Optimality, stop_reason
+from excite_cli.search.nlp import BISECTIONS, Epigraph, Evaluations, project, repair
+from excite_cli.search.solvers import SolverRun, criterion_scale, solve
 from excite_cli.trajectory.boundary import BoundaryConditions
 from excite_cli.trajectory.fourier import FourierBasis
 
@@ -54,14 +54,14 @@ class RestartResult:
         start_objective: criterion value at the start.
         history: (iterations, 2) objective and largest constraint value g (normalized, > 0 outside)
             at each accepted iterate of the solver.
-        optimality: first-order optimality at ``alpha`` (:func:`~excite_cli.optimization.optimality.kkt_optimality`).
-        stop: why it ended (:func:`~excite_cli.optimization.optimality.stop_reason`).
+        optimality: first-order optimality at ``alpha`` (:func:`~excite_cli.search.kkt.kkt_optimality`).
+        stop: why it ended (:func:`~excite_cli.search.kkt.stop_reason`).
         end: which point was kept: ``projected`` (the feasible point nearest the last iterate),
             ``inside`` (the best iterate inside every constraint), ``bisection`` (towards the start),
             ``start``, or ``none`` (no end point met a constraint that needs motion; ``alpha`` is
             the start and ``objective`` inf).
         scale: the factor [1] the solver's criterion was multiplied by
-            (:attr:`~excite_cli.optimization.solvers.SolverRun.scale`), which a continuation keeps.
+            (:attr:`~excite_cli.search.solvers.SolverRun.scale`), which a continuation keeps.
     """
 
     index: int
@@ -106,7 +106,7 @@ def _until_done(
     for hundreds of iterations past points that met the tolerance. The test costs a non-negative
     least squares on the active set (0.6 ms there): the gradient and Jacobian it needs at the
     iterate are those the solver asks for next. Where the criterion is non-smooth (an extreme
-    singular value multiple), the Clarke test (:mod:`~excite_cli.optimization.optimality`, 0.2 s on
+    singular value multiple), the Clarke test (:mod:`~excite_cli.search.kkt`, 0.2 s on
     the G1) runs every ``NONSMOOTH_EVERY``-th iterate."""
 
     count = iter(range(1 << 62))
@@ -136,7 +136,7 @@ def _solve_recovering(
     on_iterate: Callable[[np.ndarray], None],
     scale: Optional[float],
 ) -> SolverRun:
-    """:func:`~excite_cli.optimization.solvers.solve`, run again (up to ``RECOVERIES`` times, a fresh
+    """:func:`~excite_cli.search.solvers.solve`, run again (up to ``RECOVERIES`` times, a fresh
     quasi-Newton matrix each, for the iterations left; they add up) where it ended neither at its
     limit nor at the KKT test of :func:`_until_done`:
 
@@ -177,7 +177,7 @@ def _solve_recovering(
 
 
 def own_scale(criterion: Criterion, boundary: BoundaryConditions, start: np.ndarray) -> float:
-    """The criterion's scale for the solver [1] (:func:`~excite_cli.optimization.solvers.criterion_scale`)
+    """The criterion's scale for the solver [1] (:func:`~excite_cli.search.solvers.criterion_scale`)
     from the gradient at ``start`` (n, 2N+1) of the trajectory's own criterion, without C₀.
 
     With C₀ stacked, the criterion's gradient at a start of little motion is small (the trajectory
@@ -215,11 +215,11 @@ def optimize_restart(
     hold exactly, with diagonal preconditioning s, see :mod:`excite_cli.trajectory.boundary`); everything else
     sees α. The restart ends with the best of: the start, the best iterate whose aggregated
     constraints were all ≤ 0, and the feasible point nearest to the last iterate
-    (:func:`~excite_cli.optimization.nlp.project`; if the projection fails,
-    :func:`~excite_cli.optimization.nlp.repair`); each is confirmed by every constraint's exact grid check.
+    (:func:`~excite_cli.search.nlp.project`; if the projection fails,
+    :func:`~excite_cli.search.nlp.repair`); each is confirmed by every constraint's exact grid check.
     The one kept is confirmed on ``fine_basis`` too, the re-check its result is judged by (the grid
     margin covers the overshoot between grid instants, but not always): where that check fails, it
-    is moved towards the start until the check holds (bisection, as in :func:`~excite_cli.optimization.nlp.repair`).
+    is moved towards the start until the check holds (bisection, as in :func:`~excite_cli.search.nlp.repair`).
 
     Args:
         criterion: the criterion (value and gradient).
@@ -234,7 +234,7 @@ def optimize_restart(
         fine_basis: the basis of the fine re-check (default: none).
         time_limit: wall time [s] after which the solver stops (default: none).
         scale: the criterion's scale for the solver, that of the restart this one continues
-            (default: set at the start, :func:`~excite_cli.optimization.solvers.solve`).
+            (default: set at the start, :func:`~excite_cli.search.solvers.solve`).
     """
     begin = time.perf_counter()
     start_value = criterion.value(start)

@@ -13,8 +13,8 @@ from typer.testing import CliRunner
 from excite_cli.cli import app
 from excite_cli.constraints import JointLimits
 from excite_cli.constraints.lse import GRID_MARGIN
+from excite_cli.design.playback import RESOLUTION, Transition, plan_transition
 from excite_cli.dynamics.urdf_source import example_robot_data_root
-from excite_cli.optimization.playback import RESOLUTION, Transition, plan_transition
 from excite_cli.storage.export import export_trajectory
 from excite_cli.storage.rosbag import TOPIC
 

@@ -10,13 +10,13 @@ from typing import Callable, Optional, Sequence
 
 import numpy as np
 
+from excite_cli.design.criterion import condition_number
+from excite_cli.design.excitation import Excitation
+from excite_cli.design.playback import check_motion, plan_playback
 from excite_cli.errors import ExciteError, NoSolution
-from excite_cli.optimization.criterion import condition_number
-from excite_cli.optimization.engine import Engine
-from excite_cli.optimization.excitation import Excitation
-from excite_cli.optimization.optimizer import ProgressHook, RestartResult, best_restart
-from excite_cli.optimization.playback import check_motion, plan_playback
-from excite_cli.optimization.restarts import polish, run_restarts
+from excite_cli.search.engine import Engine
+from excite_cli.search.optimizer import ProgressHook, RestartResult, best_restart
+from excite_cli.search.restarts import polish, run_restarts
 from excite_cli.trajectory.similarity import correlation
 
 
@@ -31,21 +31,21 @@ class IterationResult:
         regressor: C⁽ᵏ⁾, (T·n_rows, b) base regressor at the cost samples.
         cond_own: cond(C⁽ᵏ⁾); cond_stacked: cond([C₀; C⁽ᵏ⁾]) (Table I), on the base (and effect) columns.
         scaled_cond_own, scaled_cond_stacked: cond(C L) of the same, the condition number that does
-            not depend on the choice of base columns (:mod:`excite_cli.optimization.information`).
+            not depend on the choice of base columns (:mod:`excite_cli.design.information`).
         excitation_own, excitation_stacked: ē of the same [N·m], the excitation figure that does
-            not depend on the choice of base columns (:mod:`excite_cli.optimization.information`).
+            not depend on the choice of base columns (:mod:`excite_cli.design.information`).
         max_violation: largest normalized constraint violation on the fine grid (≤ 0: satisfied).
         checks: per-constraint figures from the fine grid, units in the names, and those of the
             transitions from and to the home posture (:func:`transition_checks`).
         tracks: per-constraint time series on the constraint grid (``com_xy`` (T_grid, 2) [m],
             ``min_capsule_distance`` (T_grid,) [m]); track_units: their units, from the constraints.
         wall_time_s: optimization wall time [s].
-        restarts: every restart of the iteration (:class:`~excite_cli.optimization.optimizer.RestartResult`:
+        restarts: every restart of the iteration (:class:`~excite_cli.search.optimizer.RestartResult`:
             start and end value, solver iterations, first-order optimality, stop reason), in order.
         correlations: ρ of q with each earlier iteration's q on the constraint grid, in order
             (:func:`~excite_cli.trajectory.similarity.correlation`; 1: the same motion again).
         kept: the index of the restart whose end point α is (:func:`kept_restart`); −1: none recorded,
-            the best by :func:`~excite_cli.optimization.optimizer.best_restart`.
+            the best by :func:`~excite_cli.search.optimizer.best_restart`.
     """
 
     index: int
@@ -89,7 +89,7 @@ class IterationResult:
 
     @property
     def stop(self) -> str:
-        """Why the kept restart ended (:func:`~excite_cli.optimization.optimality.stop_reason`), or ``-``."""
+        """Why the kept restart ended (:func:`~excite_cli.search.kkt.stop_reason`), or ``-``."""
         return self.best.stop if self.best else "-"
 
 
@@ -177,7 +177,7 @@ def polish_kept(
     hook: Optional[ProgressHook] = None,
 ) -> tuple[list[RestartResult], RestartResult]:
     """``runs`` with the restart the iteration keeps (:func:`kept_restart`) polished
-    (:func:`~excite_cli.optimization.restarts.polish`, the same arguments), and that restart. A
+    (:func:`~excite_cli.search.restarts.polish`, the same arguments), and that restart. A
     polished end point can lose its playable transitions (seen on the G1: the restart polished to KKT
     9.1e-4 could not be played, and the next one was kept as it was, stalled at 4.4e-2); then the
     restart kept next is polished too, each at most once, so the one kept has always been polished."""
@@ -189,7 +189,7 @@ def polish_kept(
 
 
 def transition_checks(excitation: Excitation, alpha: np.ndarray) -> dict[str, float | str]:
-    """Durations [s] of the quintic transitions home → q(0) and q(T) → home (:mod:`excite_cli.optimization.playback`)
+    """Durations [s] of the quintic transitions home → q(0) and q(T) → home (:mod:`excite_cli.design.playback`)
     and every constraint's largest normalized violation on them, on the fine grid
     (``transition_max_violation`` ≤ 0: satisfied; +inf when no transition keeps the limits)."""
     try:
@@ -220,7 +220,7 @@ def run_sequence(
 ) -> list[IterationResult]:
     """Generate ``iterations`` trajectories, each stacking the regressors of the earlier ones (Eq. 41).
 
-    Every restart starts from its own random start (:class:`~excite_cli.optimization.restarts.RestartTask`).
+    Every restart starts from its own random start (:class:`~excite_cli.search.restarts.RestartTask`).
     None starts from the previous optimum: with C₀ holding its rows, the previous optimum is a stationary point of the
     next iteration's criterion too (stacking C on itself scales CᵀC by 2, which moves log det by a
     constant and leaves cond unchanged), so a solver started there stops there and the motion repeats.

@@ -15,10 +15,10 @@ from conftest import UR5, write_config
 from threadpoolctl import threadpool_limits
 
 from excite_cli.config_file import load_problem
-from excite_cli.optimization.engine import Engine
-from excite_cli.optimization.excitation import build_excitation
-from excite_cli.optimization.restarts import RestartTask
-from excite_cli.optimization.sequence import run_sequence
+from excite_cli.design.excitation import build_excitation
+from excite_cli.search.engine import Engine
+from excite_cli.search.restarts import RestartTask
+from excite_cli.search.sequence import run_sequence
 
 
 def test_a_seed_gives_bit_identical_starts_with_one_and_two_blas_threads(g1_problem):

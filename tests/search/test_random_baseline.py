@@ -12,9 +12,9 @@ from typer.testing import CliRunner
 
 from excite_cli.cli import app
 from excite_cli.config_file import load_problem
-from excite_cli.optimization.engine import Engine
-from excite_cli.optimization.excitation import build_excitation
-from excite_cli.optimization.random_baseline import DrawTask, draw_pool, greedy_selection, random_candidate
+from excite_cli.design.excitation import build_excitation
+from excite_cli.search.engine import Engine
+from excite_cli.search.random_baseline import DrawTask, draw_pool, greedy_selection, random_candidate
 
 HERE = TESTS
 

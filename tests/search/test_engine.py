@@ -22,17 +22,17 @@ import yaml
 from conftest import TESTS, tcp_server, write_config
 from pydantic import ValidationError
 
-import excite_cli.optimization.engine as engine_module
-import excite_cli.optimization.scheduler as scheduler_module
+import excite_cli.search.engine as engine_module
+import excite_cli.search.scheduler as scheduler_module
 from excite_cli.config import OptimizerConfig
 from excite_cli.config_file import load_problem
+from excite_cli.design.excitation import build_excitation
 from excite_cli.errors import ExciteError
-from excite_cli.optimization.engine import Engine
-from excite_cli.optimization.excitation import build_excitation
-from excite_cli.optimization.optimizer import RestartResult, best_restart
-from excite_cli.optimization.random_baseline import draw_pool
-from excite_cli.optimization.restarts import RestartTask
-from excite_cli.optimization.sequence import run_sequence
+from excite_cli.search.engine import Engine
+from excite_cli.search.optimizer import RestartResult, best_restart
+from excite_cli.search.random_baseline import draw_pool
+from excite_cli.search.restarts import RestartTask
+from excite_cli.search.sequence import run_sequence
 
 HERE = TESTS
 

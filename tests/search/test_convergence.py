@@ -16,9 +16,9 @@ from typer.testing import CliRunner
 from excite_cli.cli import app
 from excite_cli.config_file import load_problem
 from excite_cli.constraints import accepted
-from excite_cli.optimization.excitation import build_excitation
-from excite_cli.optimization.nlp import Evaluations, project, repair
-from excite_cli.optimization.optimality import (
+from excite_cli.design.excitation import build_excitation
+from excite_cli.design.verify import finite_difference_gradient
+from excite_cli.search.kkt import (
     ACTIVE_TOLERANCE,
     CONVERGED,
     SOLVER_FAILED,
@@ -31,7 +31,7 @@ from excite_cli.optimization.optimality import (
     kkt_optimality,
     stop_reason,
 )
-from excite_cli.optimization.verify import finite_difference_gradient
+from excite_cli.search.nlp import Evaluations, project, repair
 
 runner = CliRunner()
 
@@ -175,7 +175,7 @@ def test_a_restart_stops_where_it_meets_the_kkt_tolerance_or_its_time_limit(tmp_
     """With the solver's own test out of play (ftol 1e-14), a restart on the small problem stops at
     an iterate that meets the KKT tolerance, not at its 300 iterations; its end point meets the
     tolerance by central differences. With no time left it stops at the first iterate."""
-    from excite_cli.optimization.restarts import RestartTask
+    from excite_cli.search.restarts import RestartTask
 
     problem = load_problem(_small_problem(tmp_path, "log_det"))
     problem.optimizer.tolerance = 1e-14
@@ -194,8 +194,8 @@ def test_the_kept_restart_continues_from_a_fresh_matrix_until_it_converges(tmp_p
     starts at the end point of the one before (iterations and history joined), none ends higher, and
     the last converges, its KKT residual recomputed by central differences. A converged restart, or
     polish_rounds 0, is left as it is; one the deadline leaves unpolished says "time budget"."""
-    from excite_cli.optimization.engine import Engine
-    from excite_cli.optimization.restarts import RestartTask, polish
+    from excite_cli.search.engine import Engine
+    from excite_cli.search.restarts import RestartTask, polish
 
     problem = load_problem(_small_problem(tmp_path, "log_det"))
     opts = problem.optimizer
@@ -246,7 +246,7 @@ def test_every_method_ends_feasible_and_below_its_start(ur5_problem, method):
     ur5_problem.optimizer.objective = "log_det"  # the methods, on the criterion they were tuned on
     ur5_problem.optimizer.max_iterations = 40
     excitation = build_excitation(ur5_problem)
-    from excite_cli.optimization.restarts import RestartTask
+    from excite_cli.search.restarts import RestartTask
 
     result = RestartTask(1, 0, 2, np.zeros((0, excitation.base.count)))(excitation)
     assert accepted(excitation.constraints, result.alpha)
@@ -257,7 +257,7 @@ def test_every_method_ends_feasible_and_below_its_start(ur5_problem, method):
 def test_excitation_level_is_the_scaled_standard_regressor_and_does_not_depend_on_the_base(panda_problem):
     import dataclasses
 
-    from excite_cli.optimization.information import excitation_level, parameter_magnitudes
+    from excite_cli.design.information import excitation_level, parameter_magnitudes
 
     excitation = build_excitation(panda_problem)
     robot, base = excitation.robot, excitation.base
@@ -275,8 +275,8 @@ def test_excitation_level_is_the_scaled_standard_regressor_and_does_not_depend_o
 
 
 def test_screening_continues_the_best_starts_wherever_they_run(ur5_problem):
-    from excite_cli.optimization.engine import Engine
-    from excite_cli.optimization.restarts import run_restarts
+    from excite_cli.search.engine import Engine
+    from excite_cli.search.restarts import run_restarts
 
     opts = ur5_problem.optimizer
     opts.restarts, opts.starts, opts.screen_iterations, opts.max_iterations = 2, 5, 8, 30
@@ -301,7 +301,7 @@ def test_screening_continues_the_best_starts_wherever_they_run(ur5_problem):
 def test_a_failed_restart_is_never_kept_when_another_succeeded():
     """The lowest end value of a restart that failed, or that ended at its start or a bisection
     towards it, loses to any restart whose solver gave its own end point."""
-    from excite_cli.optimization.optimizer import RestartResult, best_restart
+    from excite_cli.search.optimizer import RestartResult, best_restart
 
     def restart(index, objective, stop, end):
         return RestartResult(index, np.zeros((1, 3)), objective, 10, "", 0.0, stop=stop, end=end)
@@ -322,9 +322,9 @@ def test_when_every_restart_fails_more_starts_run_then_the_run_stops(ur5_problem
     infeasible. More starts run, each from its own seed, until the time budget is spent; then the
     sequence stops with NoSolution (exit 1 on the command line) instead of keeping a start."""
     from excite_cli.errors import NoSolution
-    from excite_cli.optimization.engine import Engine
-    from excite_cli.optimization.restarts import run_restarts
-    from excite_cli.optimization.sequence import run_sequence
+    from excite_cli.search.engine import Engine
+    from excite_cli.search.restarts import run_restarts
+    from excite_cli.search.sequence import run_sequence
 
     ur5_problem.limits.torque, ur5_problem.limits.min_torque_use = "urdf", 0.95
     opts = ur5_problem.optimizer

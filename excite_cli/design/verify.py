@@ -9,7 +9,7 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from excite_cli.constraints import Constraint
-from excite_cli.optimization.criterion import Criterion
+from excite_cli.design.criterion import Criterion
 
 
 @dataclass(frozen=True)
@@ -63,7 +63,7 @@ def check_gradient(criterion: Criterion, alpha: np.ndarray, step: float = 1e-6, 
         step: finite-difference step (the paper used 1e-6).
         repeats: analytic gradients timed; their median is reported (robust to a busy machine).
 
-    Both are timed with one BLAS thread, as the optimizer runs (:mod:`excite_cli.optimization.engine`).
+    Both are timed with one BLAS thread, as the optimizer runs (:mod:`excite_cli.search.engine`).
     """
     with threadpool_limits(limits=1):
         criterion.value_and_gradient(alpha)  # first call makes the model copies

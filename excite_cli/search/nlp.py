@@ -12,9 +12,9 @@ from scipy.optimize import minimize
 
 from excite_cli.constraints import Constraint, accepted, farthest_accepted
 from excite_cli.criteria.record import RANK_FLOOR
+from excite_cli.design.criterion import Criterion
 from excite_cli.memo import once
-from excite_cli.optimization.criterion import Criterion
-from excite_cli.optimization.optimality import (
+from excite_cli.search.kkt import (
     CLUSTER_SIZE,
     Optimality,
     clarke_optimality,
@@ -99,7 +99,7 @@ class Evaluations:
     def kkt(self, z: np.ndarray, nonsmooth: bool = True) -> Optimality:
         """First-order optimality at z (n_z,): the KKT residual, or (``nonsmooth``) for a criterion of
         the extreme singular values where one is multiple, Clarke's
-        (:mod:`~excite_cli.optimization.optimality`), whichever is smaller."""
+        (:mod:`~excite_cli.search.kkt`), whichever is smaller."""
         smooth = kkt_optimality(self.gradient(z), *self.constraints(z))
         if not nonsmooth or not self.criterion.objective.extremes or smooth.residual == 0.0:
             return smooth

@@ -5,9 +5,9 @@ from dataclasses import replace
 
 import numpy as np
 
-from excite_cli.optimization import sequence
-from excite_cli.optimization.optimality import CONVERGED, STALLED
-from excite_cli.optimization.optimizer import RestartResult
+from excite_cli.search import sequence
+from excite_cli.search.kkt import CONVERGED, STALLED
+from excite_cli.search.optimizer import RestartResult
 
 
 def test_the_restart_kept_is_one_that_was_polished(monkeypatch):

@@ -21,15 +21,15 @@ from excite_cli.constraints.torque_limits import TorqueLimits, TorqueUse, torque
 from excite_cli.constraints.world_collision import WorldCollision, world_shapes
 from excite_cli.constraints.zmp import zmp_from_config
 from excite_cli.criteria import criterion_record
+from excite_cli.design.criterion import Criterion, condition_number
+from excite_cli.design.information import excitation_level, parameter_magnitudes, scaled_frame
+from excite_cli.design.model_columns import design_effects, measured_prior
+from excite_cli.design.noise import RowNoise, row_noise
 from excite_cli.dynamics.base_parameters import BaseParameters, compute_base_parameters
 from excite_cli.dynamics.effect_columns import EffectColumns
 from excite_cli.dynamics.robot import Robot, load_robot
 from excite_cli.errors import ExciteError
 from excite_cli.identification.reporting.design_model import MeasuredPrior
-from excite_cli.optimization.criterion import Criterion, condition_number
-from excite_cli.optimization.information import excitation_level, parameter_magnitudes, scaled_frame
-from excite_cli.optimization.model_columns import design_effects, measured_prior
-from excite_cli.optimization.noise import RowNoise, row_noise
 from excite_cli.trajectory.boundary import BoundaryConditions, boundary_rows
 from excite_cli.trajectory.fourier import FourierBasis, FourierTrajectory, sample_times
 
@@ -52,7 +52,7 @@ class Excitation:
         constraints: all constraints handed to the optimizer (joint limits first).
         boundary: boundary conditions (rest or periodic) and the optimizer's coordinates.
         scaled_frame: L (b+e, b+e): C L is the regressor in a basis that does not depend on the choice
-            of base columns (:func:`~excite_cli.optimization.information.scaled_frame`), each effect
+            of base columns (:func:`~excite_cli.design.information.scaled_frame`), each effect
             column scaled by its typical magnitude (:meth:`EffectColumns.magnitudes`).
         effects: the effect columns designed for beside the base columns (``effects``), or None.
         measured: how the rows of ``sequence.prior`` weigh when it is an identify report
@@ -94,13 +94,13 @@ class Excitation:
 
     def excitation_level(self, C: np.ndarray) -> float:
         """ē(C) [N·m] of base-regressor rows C (M, b+e), the excitation figure that does not depend on
-        the choice of base columns (:mod:`excite_cli.optimization.information`)."""
+        the choice of base columns (:mod:`excite_cli.design.information`)."""
         b = self.base.count
         return excitation_level(C, self.base, parameter_magnitudes(self.robot), np.diag(self.scaled_frame)[b:])
 
     def scaled_condition_number(self, C: np.ndarray) -> float:
         """cond(C L) of base-regressor rows C (M, b+e): the condition number that does not depend on
-        the choice of base columns (:mod:`excite_cli.optimization.information`)."""
+        the choice of base columns (:mod:`excite_cli.design.information`)."""
         return condition_number(C @ self.scaled_frame)
 
     @property

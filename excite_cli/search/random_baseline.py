@@ -18,8 +18,8 @@ import numpy as np
 
 from excite_cli.constraints import accepted, farthest_accepted
 from excite_cli.constraints.lse import GRID_MARGIN
-from excite_cli.optimization.engine import Engine
-from excite_cli.optimization.excitation import Excitation
+from excite_cli.design.excitation import Excitation
+from excite_cli.search.engine import Engine
 
 #: Bisection steps on the common oscillation scale.
 SCALE_STEPS = 10
@@ -62,7 +62,7 @@ def random_candidate(excitation: Excitation, rng: np.random.Generator) -> Option
 @dataclass(frozen=True)
 class DrawTask:
     """Draw up to ``count`` candidates, or for ``budget_s`` seconds (a task for
-    :class:`~excite_cli.optimization.engine.Engine`), from the seed ``SeedSequence(seed, spawn_key=(index,))``.
+    :class:`~excite_cli.search.engine.Engine`), from the seed ``SeedSequence(seed, spawn_key=(index,))``.
 
     Returns (when called) the kept α (k, n, 2N+1), their regressors (k, T·rows, b) and the draws made.
     """

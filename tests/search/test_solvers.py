@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from excite_cli.errors import ExciteError
-from excite_cli.optimization.solvers import METHODS, solve
+from excite_cli.search.solvers import METHODS, solve
 
 
 class Disc:
@@ -73,7 +73,7 @@ def test_the_first_step_moves_no_variable_more_than_first_step():
     """From far inside the disc towards a target 1000 away, the gradient's largest component is
     2000; SLSQP's first step (Hessian I) is the scaled gradient itself: FIRST_STEP in its largest
     component, not 2000 (which would leave the disc a thousand times over)."""
-    from excite_cli.optimization.solvers import FIRST_STEP
+    from excite_cli.search.solvers import FIRST_STEP
 
     seen = []
     z0 = np.array([0.1, 0.0])
@@ -85,7 +85,7 @@ def test_a_continuation_keeps_the_scale_of_the_run_it_continues():
     """Near an optimum inside the disc the gradient is small; rescaled there, a fresh run's first step
     is FIRST_STEP long and leaves the optimum 100 × farther than it was; with the scale of the run it
     continues (set where the gradient was 0.8), its first step is that scale times the gradient."""
-    from excite_cli.optimization.solvers import FIRST_STEP
+    from excite_cli.search.solvers import FIRST_STEP
 
     first = solve("SLSQP", Disc([0.3, 0.4]), np.zeros(2), 1, 1e-12, lambda z: None)
     assert first.scale == pytest.approx(FIRST_STEP / 0.8)

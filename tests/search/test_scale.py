@@ -8,11 +8,11 @@ import numpy as np
 from conftest import small
 
 from excite_cli.constraints import accepted
-from excite_cli.optimization import optimizer, solvers
-from excite_cli.optimization.excitation import build_excitation
-from excite_cli.optimization.optimality import SOLVER_FAILED
-from excite_cli.optimization.optimizer import own_scale
-from excite_cli.optimization.solvers import criterion_scale
+from excite_cli.design.excitation import build_excitation
+from excite_cli.search import optimizer, solvers
+from excite_cli.search.kkt import SOLVER_FAILED
+from excite_cli.search.optimizer import own_scale
+from excite_cli.search.solvers import criterion_scale
 
 
 def test_the_scale_is_the_trajectorys_own_whatever_the_prior(panda_problem):

@@ -8,11 +8,11 @@ import numpy as np
 from conftest import UR5, write_config
 
 from excite_cli.config_file import load_problem
-from excite_cli.optimization import nlp
-from excite_cli.optimization.excitation import build_excitation
-from excite_cli.optimization.nlp import Epigraph, Evaluations
-from excite_cli.optimization.optimality import CONVERGED, extreme_clusters
-from excite_cli.optimization.sequence import run_sequence
+from excite_cli.design.excitation import build_excitation
+from excite_cli.search import nlp
+from excite_cli.search.kkt import CONVERGED, extreme_clusters
+from excite_cli.search.nlp import Epigraph, Evaluations
+from excite_cli.search.sequence import run_sequence
 
 
 def _small_ur5(tmp_path, objective: str):

@@ -15,7 +15,7 @@ CᵀC (:meth:`~excite_cli.criteria.record.CriterionRecord.terms`): −log σ_min
 
 With a frame L (b, b) every criterion is that of C L instead of C (``optimizer.scaling: urdf``, the
 regressor in a basis of the identifiable subspace that does not depend on the choice of base columns,
-:func:`~excite_cli.optimization.information.scaled_frame`); with eigenvectors ṽ_r of LᵀCᵀCL the
+:func:`~excite_cli.design.information.scaled_frame`); with eigenvectors ṽ_r of LᵀCᵀCL the
 gradient in C is Σ_r a_r (C L ṽ_r)(L ṽ_r)ᵀ, so the passes take the virtual parameters X L ṽ_r.
 
 With effect columns (``effects``: friction, armature, offsets, coupled motors) C = [Y_B | Y_E] per row
@@ -32,15 +32,15 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
-from excite_cli.criteria import CRITERIA, CriterionRecord
+from excite_cli.criteria import CriterionRecord
 from excite_cli.criteria.record import RANK_FLOOR
+from excite_cli.design.noise import RowNoise
 from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.dynamics.effect_columns import EffectColumns
 from excite_cli.dynamics.robot import Robot
 from excite_cli.dynamics.virtual_dynamics import VirtualDynamics
 from excite_cli.errors import ExciteError
 from excite_cli.memo import once
-from excite_cli.optimization.noise import RowNoise
 from excite_cli.trajectory.fourier import FourierBasis
 
 #: The smallest eigenvalue of CᵀC, relative to the largest, down to which the eigenvalues of CᵀC give
@@ -66,20 +66,20 @@ class Criterion:
         robot: the robot.
         base: its base parameters (composition matrix X).
         basis: Fourier basis at the T cost samples.
+        objective: the criterion's record (:data:`~excite_cli.criteria.CRITERIA`).
         prior: C₀, (m₁, b) rows stacked above the trajectory's regressor (Eq. 41), or an empty array.
-        objective: the criterion's record.
         frame: L (b+e, b+e): the criterion is that of C L (module docstring); None: of C, the paper's.
         effects: e effect columns beside the b base columns, C = [Y_B | Y_E] per row
             (:mod:`~excite_cli.dynamics.effect_columns`), or None: the rigid body alone.
-        noise: the rows' noise (:mod:`~excite_cli.optimization.noise`): each row of the trajectory
+        noise: the rows' noise (:mod:`~excite_cli.design.noise`): each row of the trajectory
             weighs σ̄/√(σ_j² + ρ_j² τ_j(t)²), or None: unweighted.
     """
 
     robot: Robot
     base: BaseParameters
     basis: FourierBasis
+    objective: CriterionRecord
     prior: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
-    objective: CriterionRecord = field(default_factory=lambda: CRITERIA["log_cond"])
     frame: np.ndarray | None = None
     effects: EffectColumns | None = None
     noise: RowNoise | None = None

@@ -9,15 +9,15 @@ from typing import Optional
 
 import numpy as np
 
-from excite_cli.optimization.engine import Engine
-from excite_cli.optimization.excitation import Excitation
-from excite_cli.optimization.optimality import CONVERGED, TIME_BUDGET
-from excite_cli.optimization.optimizer import ProgressHook, RestartResult, optimize_restart
+from excite_cli.design.excitation import Excitation
+from excite_cli.search.engine import Engine
+from excite_cli.search.kkt import CONVERGED, TIME_BUDGET
+from excite_cli.search.optimizer import ProgressHook, RestartResult, optimize_restart
 
 
 @dataclass(frozen=True)
 class RestartTask:
-    """One restart of one iteration (a task for :class:`~excite_cli.optimization.engine.Engine`).
+    """One restart of one iteration (a task for :class:`~excite_cli.search.engine.Engine`).
 
     Its random start is drawn from its own seed, ``SeedSequence(seed, spawn_key=(iteration, index))``,
     so the result does not depend on where or in which order the restarts run.

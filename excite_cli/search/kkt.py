@@ -17,7 +17,7 @@ within 10⁻⁵ at a stalled G1 end point), where the gradient of any one eigenb
 sees, does not vanish and r stays large (0.49 there). The measure there is Clarke's (Clarke 1983):
 the singular values within ``CLUSTER`` of an extreme form its cluster, whose subdifferential of
 log σ is {Σ_ab S_ab ∇h_ab : S ⪰ 0, tr S = 1} (the derivative of a multiple eigenvalue, Overton 1992;
-h_ab from :meth:`~excite_cli.optimization.criterion.Criterion.cluster_gradients`), and
+h_ab from :meth:`~excite_cli.design.criterion.Criterion.cluster_gradients`), and
 
     r = min over S_c ⪰ 0 with tr S_c = 1, ν ≥ 0 of
         max(‖Σ_c w_c Σ_ab S_c,ab ∇h_c,ab + J_Aᵀν‖_∞, max_i ν_i |g_i|) / max(1, ‖∇f‖_∞)

@@ -1,2 +1,0 @@
-"""Designing persistently exciting trajectories: criterion, solvers, restarts, the sequence, the
-random baseline, playback."""
