@@ -52,7 +52,7 @@ import numpy as np
 
 from excite_cli.config import EffectsConfig, MotorConfig
 from excite_cli.config_file import load_problem
-from excite_cli.design.excitation import build_excitation
+from excite_cli.design.excitation import build_design, build_excitation
 from excite_cli.search.engine import Engine, default_workers
 from excite_cli.search.sequence import describe, run_sequence
 
@@ -154,10 +154,9 @@ def loop(config: Path, seed: int, design_criterion: tuple[str, str] | None = Non
     designer = build_excitation(design) if design_criterion is not None else model
     if weight != 1.0:
         emphasis = np.concatenate([np.ones(model.base.count), np.full(model.effects.count, 1.0 / weight)])
-        designer = replace(designer, scaled_frame=designer.scaled_frame * emphasis)
+        designer = build_design(replace(designer.spec, scaled_frame=designer.scaled_frame * emphasis))
     alpha1, blind_second = blind_runs(blind, seed)
-    # pool workers build the excitation from the problem, which does not hold the emphasis: serial then
-    workers = 1 if weight != 1.0 else min(default_workers(), design.optimizer.restarts)
+    workers = min(default_workers(), design.optimizer.restarts)  # workers build from the designer's spec
     with Engine(designer, workers) as engine:
         earlier = [describe(designer, 1, alpha1, np.zeros((0, designer.columns)))]
         designed_second = run_sequence(designer, 2, seed, engine=engine, finished=earlier)[-1].alpha

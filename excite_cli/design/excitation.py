@@ -1,7 +1,7 @@
-"""Everything one excitation design needs, built once from a validated :class:`~excite_cli.config.Problem`.
+"""Everything one excitation design needs, built from its resolved values (:mod:`~excite_cli.design.spec`).
 
-config ─► robot, base parameters, Fourier bases (cost samples, constraint grid, fine check grid),
-constraints ─► the optimizer and the sequential generation use these, never the config.
+spec ─► robot, Fourier bases (cost samples, constraint grid, fine check grid), constraints ─► the
+optimizer and the sequential generation use these, never the config file.
 """
 
 from __future__ import annotations
@@ -9,7 +9,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.linalg import block_diag
 
 from excite_cli.collision.capsules import capsule_pairs, capsules_from_config
 from excite_cli.config import Problem
@@ -22,15 +21,15 @@ from excite_cli.constraints.world_collision import WorldCollision, world_shapes
 from excite_cli.constraints.zmp import zmp_from_config
 from excite_cli.criteria import criterion_record
 from excite_cli.design.criterion import Criterion, condition_number
-from excite_cli.design.information import excitation_level, parameter_magnitudes, scaled_frame
-from excite_cli.design.model_columns import design_effects, measured_prior
+from excite_cli.design.information import excitation_level, parameter_magnitudes
 from excite_cli.design.noise import RowNoise, row_noise
-from excite_cli.dynamics.base_parameters import BaseParameters, compute_base_parameters
+from excite_cli.design.spec import DesignSpec, needs_collision, resolve
+from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.dynamics.effect_columns import EffectColumns
 from excite_cli.dynamics.robot import Robot, load_robot
 from excite_cli.errors import ExciteError
 from excite_cli.identification.reporting.design_model import MeasuredPrior
-from excite_cli.trajectory.boundary import BoundaryConditions, boundary_rows
+from excite_cli.trajectory.boundary import BoundaryConditions, boundary_conditions
 from excite_cli.trajectory.fourier import FourierBasis, FourierTrajectory, sample_times
 
 #: Decimals [rad] random starts are rounded to (see :meth:`Excitation.random_start`).
@@ -42,8 +41,9 @@ class Excitation:
     """A ready-to-optimize excitation problem.
 
     Attributes:
-        problem: the validated config.
-        robot, base: the robot and its base parameters (Eq. 2).
+        spec: the values it was built from (:class:`~excite_cli.design.spec.DesignSpec`): the config,
+            the base parameters, the effect columns, the scaling frame, the measured prior's weights.
+        robot: the robot (this process's pinocchio and coal objects).
         trajectory: the Fourier parameterization (Eq. 50).
         cost_basis: basis at the T cost samples (regressor rows, Eq. 3).
         grid_basis: basis on the constraint grid (every ``constraint_period``, end included).
@@ -51,17 +51,10 @@ class Excitation:
         limits: joint limits (Eq. 51).
         constraints: all constraints handed to the optimizer (joint limits first).
         boundary: boundary conditions (rest or periodic) and the optimizer's coordinates.
-        scaled_frame: L (b+e, b+e): C L is the regressor in a basis that does not depend on the choice
-            of base columns (:func:`~excite_cli.design.information.scaled_frame`), each effect
-            column scaled by its typical magnitude (:meth:`EffectColumns.magnitudes`).
-        effects: the effect columns designed for beside the base columns (``effects``), or None.
-        measured: how the rows of ``sequence.prior`` weigh when it is an identify report
-            (:class:`~excite_cli.identification.reporting.design_model.MeasuredPrior`), or None.
     """
 
-    problem: Problem
+    spec: DesignSpec
     robot: Robot
-    base: BaseParameters
     trajectory: FourierTrajectory
     cost_basis: FourierBasis
     grid_basis: FourierBasis
@@ -69,9 +62,31 @@ class Excitation:
     limits: JointLimits
     constraints: list[Constraint]
     boundary: BoundaryConditions
-    scaled_frame: np.ndarray
-    effects: EffectColumns | None = None
-    measured: MeasuredPrior | None = None
+
+    @property
+    def problem(self) -> Problem:
+        """The validated config."""
+        return self.spec.problem
+
+    @property
+    def base(self) -> BaseParameters:
+        """The robot's base parameters (Eq. 2)."""
+        return self.spec.base
+
+    @property
+    def effects(self) -> EffectColumns | None:
+        """The effect columns designed for beside the base columns (``effects``), or None."""
+        return self.spec.effects
+
+    @property
+    def scaled_frame(self) -> np.ndarray:
+        """L (b+e, b+e), read-only (:attr:`~excite_cli.design.spec.DesignSpec.scaled_frame`)."""
+        return self.spec.scaled_frame
+
+    @property
+    def measured(self) -> MeasuredPrior | None:
+        """How the rows of ``sequence.prior`` weigh when it is an identify report, or None."""
+        return self.spec.measured
 
     def criterion(
         self, prior: np.ndarray | None = None, objective: str | None = None, scaling: str | None = None
@@ -106,7 +121,7 @@ class Excitation:
     @property
     def columns(self) -> int:
         """b + e: the regressor's columns, base parameters then effect columns."""
-        return self.base.count + (self.effects.count if self.effects else 0)
+        return self.spec.columns
 
     @property
     def noise(self) -> RowNoise | None:
@@ -162,37 +177,69 @@ def home_posture(robot: Robot, limits: JointLimits) -> np.ndarray:
 
 
 def build_excitation(problem: Problem, base: BaseParameters | None = None, check_home: bool = True) -> Excitation:
-    """Load the robot and set up bases and constraints for ``problem``.
+    """Resolve ``problem`` (:func:`~excite_cli.design.spec.resolve`) and build its excitation.
 
     Args:
         problem: the validated config.
-        base: the robot's base parameters when already computed (a worker gets the main process's,
-            so that every process optimizes in the same base); default: computed here.
+        base: the robot's base parameters when already computed; default: computed here.
         check_home: refuse a home posture that violates a constraint (off: a caller searching for one).
 
     Raises:
-        ExciteError: bad robot or limits input (see :func:`load_robot`, :func:`joint_limit_bounds`), a
-            constraint violated at the home posture (with ``check_home``).
+        ExciteError: see :func:`~excite_cli.design.spec.resolve` and :func:`build_design`.
     """
-    ccfg = problem.constraints
-    collision = bool(ccfg.self_collision or ccfg.environment or ccfg.zmp or (ccfg.com and ccfg.com.support_links))
-    robot = load_robot(problem.robot, problem.folder, collision)
-    base = base or compute_base_parameters(robot)
-    effects = design_effects(problem, robot, base)
-    columns = base.count + (effects.count if effects else 0)
+    spec, robot = resolve(problem, base)
+    return build_design(spec, robot, check_home)
+
+
+def build_design(spec: DesignSpec, robot: Robot | None = None, check_home: bool = True) -> Excitation:
+    """Set up bases and constraints for ``spec``: what the main process and every worker build.
+
+    Args:
+        spec: the resolved design.
+        robot: the robot it was resolved on, in this process; default: loaded here (a worker's own
+            pinocchio and coal objects).
+        check_home: refuse a home posture that violates a constraint (off: a caller searching for one,
+            or a worker building what the main process checked).
+
+    Raises:
+        ExciteError: fewer regressor rows than columns (``trajectory.cost_samples``), bad limits input
+            (:func:`joint_limit_bounds`), a bad noise section, a constraint violated at the home
+            posture (with ``check_home``).
+    """
+    problem = spec.problem
+    robot = robot or load_robot(problem.robot, problem.folder, needs_collision(problem))
     tcfg = problem.trajectory
-    if tcfg.cost_samples * robot.n_rows < columns:
-        effect_part = f" and {effects.count} effect columns" if effects else ""
+    if tcfg.cost_samples * robot.n_rows < spec.columns:
+        effect_part = f" and {spec.effects.count} effect columns" if spec.effects else ""
         raise ExciteError(
             "trajectory.cost_samples",
             f"{tcfg.cost_samples} samples × {robot.n_rows} regressor rows are fewer "
-            f"than the robot's {base.count} base parameters{effect_part}; cond(C) would be infinite",
+            f"than the robot's {spec.base.count} base parameters{effect_part}; cond(C) would be infinite",
         )
     trajectory = FourierTrajectory(tcfg.harmonics, tcfg.base_frequency)
     fine_period = tcfg.constraint_period / problem.limits.check_refinement
     grid_basis = trajectory.basis(sample_times(tcfg.duration, tcfg.constraint_period, include_end=True))
     limits = JointLimits(*joint_limit_bounds(problem.limits, robot), grid_basis)
-    boundary = _boundary_conditions(problem, trajectory, limits, home_posture(robot, limits))
+    excitation = Excitation(
+        spec=spec,
+        robot=robot,
+        trajectory=trajectory,
+        cost_basis=trajectory.basis(sample_times(tcfg.duration, tcfg.cost_period)),
+        grid_basis=grid_basis,
+        fine_basis=trajectory.basis(sample_times(tcfg.duration, fine_period, include_end=True)),
+        limits=limits,
+        constraints=_constraints(problem, robot, grid_basis, limits),
+        boundary=boundary_conditions(tcfg, trajectory, limits.coefficient_scale(), home_posture(robot, limits)),
+    )
+    row_noise(problem.noise, robot, spec.measured)  # the noise section checked before any work
+    if check_home:
+        _check_home_posture(excitation)
+    return excitation
+
+
+def _constraints(problem: Problem, robot: Robot, grid_basis: FourierBasis, limits: JointLimits) -> list[Constraint]:
+    """Every constraint of ``problem`` on the constraint grid, the joint limits first."""
+    ccfg = problem.constraints
     constraints: list[Constraint] = [limits]
     if problem.limits.torque is not None:
         constraints.append(TorqueLimits(robot, grid_basis, torque_limit(problem.limits.torque, robot)))
@@ -213,53 +260,7 @@ def build_excitation(problem: Problem, base: BaseParameters | None = None, check
         world = WorldCollision(robot, grid_basis, capsules, world_shapes(ccfg.environment))
         if world.pairs:  # else no moving capsule can come within a shape's margin
             constraints.append(world)
-    frame = scaled_frame(base, parameter_magnitudes(robot))
-    if effects is not None:
-        magnitudes = effects.magnitudes(robot.model.effortLimit[robot.v_idx], limits.upper[1], limits.upper[2])
-        frame = block_diag(frame, np.diag(magnitudes))
-    excitation = Excitation(
-        problem=problem,
-        robot=robot,
-        base=base,
-        trajectory=trajectory,
-        cost_basis=trajectory.basis(sample_times(tcfg.duration, tcfg.cost_period)),
-        grid_basis=grid_basis,
-        fine_basis=trajectory.basis(sample_times(tcfg.duration, fine_period, include_end=True)),
-        limits=limits,
-        constraints=constraints,
-        boundary=boundary,
-        scaled_frame=frame,
-        effects=effects,
-        measured=measured_prior(problem, robot),
-    )
-    row_noise(problem.noise, robot, excitation.measured)  # the noise section checked before any work
-    if check_home:
-        _check_home_posture(excitation)
-    return excitation
-
-
-def _boundary_conditions(
-    problem: Problem, trajectory: FourierTrajectory, limits: JointLimits, home: np.ndarray
-) -> BoundaryConditions:
-    """The boundary conditions of ``trajectory.boundary`` / ``ends_at_home``
-    (see :mod:`excite_cli.trajectory.boundary`).
-
-    Raises:
-        ExciteError: the conditions leave the joints no oscillation (too few harmonics).
-    """
-    tcfg = problem.trajectory
-    rows = boundary_rows(trajectory, tcfg.duration, tcfg.boundary == "rest", tcfg.ends_at_home)
-    targets = np.zeros((home.size, rows.shape[0]))
-    if tcfg.ends_at_home:
-        targets[:, -2:] = home[:, None]
-    boundary = BoundaryConditions(rows, targets, limits.coefficient_scale())
-    if boundary.wave_space.shape[1] == 0:
-        raise ExciteError(
-            "trajectory.harmonics",
-            f"{tcfg.harmonics} harmonic(s) leave no free oscillation under "
-            f"boundary '{tcfg.boundary}'{' with ends_at_home' if tcfg.ends_at_home else ''}; use more harmonics",
-        )
-    return boundary
+    return constraints
 
 
 def violated_at_rest(excitation: Excitation, posture: np.ndarray | None = None) -> tuple[str, str] | None:

@@ -5,15 +5,18 @@ The restarts of an iteration (:class:`~excite_cli.search.restarts.RestartTask`) 
 of ``compare-random`` (:class:`~excite_cli.search.random_baseline.DrawTask`) are tasks: each has an index
 and its own seed, and is called with the problem's :class:`~excite_cli.design.excitation.Excitation`, so
 its result does not depend on where or in which order it runs. Pool and cluster workers build the
-excitation from the validated problem and the main process's base parameters once and keep it (one
-per worker thread): no worker computes a base of its own. Every process that
+excitation from the main process's :class:`~excite_cli.design.spec.DesignSpec` once and keep it (one
+per worker thread, for as long as the spec is the same): every value the main process resolved or
+changed in memory reaches them, and no worker computes a base of its own. Every process that
 runs tasks uses one BLAS thread, since the matrices are small and parallel workers would otherwise
 oversubscribe the cores, and keeps the memory it frees (:func:`~excite_cli.memory.keep_freed_memory`).
 """
 
 from __future__ import annotations
 
+import hashlib
 import os
+import pickle
 import signal
 import threading
 import time
@@ -24,9 +27,8 @@ from typing import Any, Callable, Iterator, Optional, Protocol, Sequence
 
 from threadpoolctl import threadpool_limits
 
-from excite_cli.config import Problem
-from excite_cli.design.excitation import Excitation, build_excitation
-from excite_cli.dynamics.base_parameters import BaseParameters
+from excite_cli.design.excitation import Excitation, build_design
+from excite_cli.design.spec import DesignSpec
 from excite_cli.errors import NO_VALUE, ExciteError, ExciteWarning
 from excite_cli.memory import keep_freed_memory
 from excite_cli.search.scheduler import CONNECT_TIMEOUT, check_scheduler
@@ -49,24 +51,24 @@ class Task(Protocol):
 _local = threading.local()
 
 
-def _worker_excitation(problem: Problem, base: BaseParameters) -> Excitation:
-    """The excitation of ``problem`` in ``base`` in this worker (thread), built on first use, without
-    repeating the warnings the main process gave when it built its own."""
-    key = (str(problem.source_path), problem.model_dump_json(), base.names)
+def _worker_excitation(spec: DesignSpec) -> Excitation:
+    """The excitation of ``spec`` in this worker (thread), built on first use and kept while the
+    spec's values (its pickle) stay the same."""
+    key = hashlib.sha256(pickle.dumps(spec)).digest()
     cache = getattr(_local, "cache", None)
     if cache is None or cache[0] != key:
-        with warnings.catch_warnings():
+        with warnings.catch_warnings():  # the main process gave them when it resolved the spec
             warnings.simplefilter("ignore", ExciteWarning)
-            _local.cache = cache = (key, build_excitation(problem, base))
+            _local.cache = cache = (key, build_design(spec, check_home=False))
     return cache[1]
 
 
-def run_on_worker(problem: Problem, base: BaseParameters, task: Task) -> Any:
-    """``task`` in a pool or cluster worker, with the worker's own excitation in the main process's
-    ``base`` and, from then on, one BLAS thread in the worker's process (a worker is there to run tasks)."""
+def run_on_worker(spec: DesignSpec, task: Task) -> Any:
+    """``task`` in a pool or cluster worker, with the worker's own excitation of the main process's
+    ``spec`` and, from then on, one BLAS thread in the worker's process (a worker is there to run tasks)."""
     threadpool_limits(limits=1)
     keep_freed_memory()
-    return task(_worker_excitation(problem, base))
+    return task(_worker_excitation(spec))
 
 
 def _quiet_abandoned_gathers(loop, context: dict) -> None:
@@ -92,7 +94,7 @@ class Engine:
 
     Use as a context manager: this process runs with one BLAS thread inside it (and keeps freed
     memory), and the pool or client is closed on exit. A Dask worker that dies mid-task is replaced
-    by another (the scheduler runs the task again, and a task is a pure function of problem, base and
+    by another (the scheduler runs the task again, and a task is a pure function of the spec and its
     seed, so the result is the same bit for bit); a cluster left without any worker for
     ``worker_wait`` seconds stops the run, as does a task that killed the workers it ran on.
 
@@ -169,15 +171,15 @@ class Engine:
             for task in tasks:
                 yield task, task(self.excitation, progress)
             return
-        problem, base = self.excitation.problem, self.excitation.base
+        spec = self.excitation.spec
         if self._client is not None:
-            futures = {self._client.submit(run_on_worker, problem, base, task, pure=False): task for task in tasks}
+            futures = {self._client.submit(run_on_worker, spec, task, pure=False): task for task in tasks}
             yield from self._dask_completed(futures)
             return
         if self._pool is None:  # sized by the work: more processes than tasks would only start and wait
             self._pool = ProcessPoolExecutor(max_workers=min(self.workers, len(tasks)), initializer=_worker_signals)
         try:  # a process killed while idle breaks the pool too: submit raises then
-            pool_futures = {self._pool.submit(run_on_worker, problem, base, task): task for task in tasks}
+            pool_futures = {self._pool.submit(run_on_worker, spec, task): task for task in tasks}
             for future in as_completed(pool_futures):
                 yield pool_futures[future], future.result()
         except BrokenProcessPool:

@@ -18,6 +18,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.linalg import null_space
 
+from excite_cli.config import TrajectoryConfig
+from excite_cli.errors import ExciteError
 from excite_cli.trajectory.fourier import FourierTrajectory
 
 #: Singular values below this (relative) make a boundary row redundant (t = T a whole period).
@@ -86,3 +88,26 @@ class BoundaryConditions:
         n, m, r = self.bases.shape
         out = np.einsum("kjm,jmr->kjr", g.reshape(-1, n, m) * self.scale, self.bases)
         return out.reshape(g.shape[:-1] + (n * r,)) if g.ndim > 1 else out.ravel()  # k may be 0 (no rows)
+
+
+def boundary_conditions(
+    tcfg: TrajectoryConfig, trajectory: FourierTrajectory, scale: np.ndarray, home: np.ndarray
+) -> BoundaryConditions:
+    """The boundary conditions of ``trajectory.boundary`` / ``ends_at_home`` with the optimizer's
+    preconditioning ``scale`` (n, 2N+1) [rad] and the home posture ``home`` (n,) [rad].
+
+    Raises:
+        ExciteError: the conditions leave the joints no oscillation (too few harmonics).
+    """
+    rows = boundary_rows(trajectory, tcfg.duration, tcfg.boundary == "rest", tcfg.ends_at_home)
+    targets = np.zeros((home.size, rows.shape[0]))
+    if tcfg.ends_at_home:
+        targets[:, -2:] = home[:, None]
+    boundary = BoundaryConditions(rows, targets, scale)
+    if boundary.wave_space.shape[1] == 0:
+        raise ExciteError(
+            "trajectory.harmonics",
+            f"{tcfg.harmonics} harmonic(s) leave no free oscillation under "
+            f"boundary '{tcfg.boundary}'{' with ends_at_home' if tcfg.ends_at_home else ''}; use more harmonics",
+        )
+    return boundary

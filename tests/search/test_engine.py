@@ -2,6 +2,7 @@
 trajectories and candidates, bit for bit, for the same seed; each restart draws its own start."""
 
 import contextlib
+import dataclasses
 import os
 import re
 import signal
@@ -26,7 +27,7 @@ import excite_cli.search.engine as engine_module
 import excite_cli.search.scheduler as scheduler_module
 from excite_cli.config import OptimizerConfig
 from excite_cli.config_file import load_problem
-from excite_cli.design.excitation import build_excitation
+from excite_cli.design.excitation import build_design, build_excitation
 from excite_cli.errors import ExciteError
 from excite_cli.search.engine import Engine
 from excite_cli.search.optimizer import RestartResult, best_restart
@@ -157,11 +158,9 @@ def test_a_dask_scheduler_passes_the_handshake():
 
 
 def test_workers_optimize_in_the_main_process_base(excitation):
-    # The base is computed once and shipped: a base whose columns are in another order than any
-    # process would compute (a stand-in for the base another BLAS kernel picked) is the one the
+    # The base is resolved once and shipped in the spec: a base whose columns are in another order than
+    # any process would compute (a stand-in for the base another BLAS kernel picked) is the one the
     # workers' criterion uses, so a restart's value is the main process's at the returned α.
-    import dataclasses
-
     base = excitation.base
     order = np.random.default_rng(0).permutation(base.count)
     shuffled = dataclasses.replace(
@@ -173,7 +172,7 @@ def test_workers_optimize_in_the_main_process_base(excitation):
     )
     problem = excitation.problem.model_copy(deep=True)
     problem.optimizer.scaling = "none"  # the frame L belongs to the base's order, which this test changes alone
-    other = dataclasses.replace(excitation, base=shuffled, problem=problem)
+    other = build_design(dataclasses.replace(excitation.spec, base=shuffled, problem=problem))
     prior = other.criterion().regressor(other.random_start(np.random.default_rng(3)))
     tasks = [RestartTask(1, r, 5, prior, iterations=5) for r in range(2)]
     with Engine(other, workers=2) as engine:
@@ -181,6 +180,30 @@ def test_workers_optimize_in_the_main_process_base(excitation):
     for run in runs:
         assert run.objective == pytest.approx(other.criterion(prior).value(run.alpha), rel=1e-12)
         assert run.objective != pytest.approx(excitation.criterion(prior).value(run.alpha), rel=1e-6)
+
+
+def _changed_in_memory(excitation):
+    """The excitation of ``excitation``'s spec with its scaling frame changed in memory, as
+    bench/loop.py weighs the effects: A-optimality then weighs the columns anew."""
+    spec = excitation.spec
+    emphasis = np.where(np.arange(spec.columns) % 2 == 0, 0.25, 1.0)
+    return build_design(dataclasses.replace(spec, scaled_frame=spec.scaled_frame * emphasis))
+
+
+def test_a_pool_worker_s_excitation_is_the_main_process_s_for_a_spec_changed_in_memory(excitation):
+    """Workers build from the main process's spec, not from the config: a frame changed in memory
+    gives the serial restarts bit for bit in a pool, and other restarts than the spec as resolved
+    (the Dask case: tests/search/test_reproducible.py)."""
+    changed = _changed_in_memory(excitation)
+    tasks = [RestartTask(1, r, 5, np.zeros((0, changed.columns)), iterations=5) for r in range(2)]
+    runs = {}
+    for name, design, workers in (("serial", changed, 1), ("pool", changed, 2), ("as resolved", excitation, 1)):
+        with Engine(design, workers=workers) as engine:
+            runs[name] = engine.run(tasks)
+    for ours, theirs, unchanged in zip(runs["serial"], runs["pool"], runs["as resolved"]):
+        np.testing.assert_array_equal(ours.alpha, theirs.alpha)
+        assert ours.objective == theirs.objective
+        assert not np.array_equal(ours.alpha, unchanged.alpha)
 
 
 @contextmanager

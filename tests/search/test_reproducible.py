@@ -3,6 +3,7 @@ and restarts on a real Dask cluster (``dask scheduler`` and ``dask worker`` proc
 equal to the same restarts in this process."""
 
 import copy
+import dataclasses
 import json
 import subprocess
 import sys
@@ -15,7 +16,7 @@ from conftest import UR5, write_config
 from threadpoolctl import threadpool_limits
 
 from excite_cli.config_file import load_problem
-from excite_cli.design.excitation import build_excitation
+from excite_cli.design.excitation import build_design, build_excitation
 from excite_cli.search.engine import Engine
 from excite_cli.search.restarts import RestartTask
 from excite_cli.search.sequence import run_sequence
@@ -82,13 +83,20 @@ def _dask(tmp_path: Path) -> tuple[list[subprocess.Popen], str]:
     return processes, json.loads(file.read_text())["address"]
 
 
-def test_restarts_on_real_dask_workers_equal_this_process(tmp_path):
+def test_restarts_on_real_dask_workers_equal_this_process_for_a_spec_changed_in_memory(tmp_path):
+    """Dask workers build from the main process's spec: with its scaling frame changed in memory (as
+    bench/loop.py weighs the effects) they give this process's sequence bit for bit, which differs
+    from the sequence of the spec as resolved."""
     data = copy.deepcopy(UR5)
     data["trajectory"].update(harmonics=3, cost_samples=20, cost_period=0.4, constraint_period=0.05)
     data["optimizer"] = {"max_iterations": 60, "restarts": 3, "seed": 7}
-    excitation = build_excitation(load_problem(write_config(tmp_path, data)))
+    resolved = build_excitation(load_problem(write_config(tmp_path, data)))
+    emphasis = np.where(np.arange(resolved.columns) % 2 == 0, 0.25, 1.0)
+    excitation = build_design(dataclasses.replace(resolved.spec, scaled_frame=resolved.scaled_frame * emphasis))
     with Engine(excitation) as serial:
         local = run_sequence(excitation, 2, 7, engine=serial)
+    with Engine(resolved) as serial:
+        assert local[0].alpha.tobytes() != run_sequence(resolved, 1, 7, engine=serial)[0].alpha.tobytes()
     processes, address = _dask(tmp_path)
     try:
         from dask.distributed import Client
