@@ -4,7 +4,7 @@ PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 CONFIG ?= configs/g1_arms.yaml
 
-.PHONY: install ipopt optimize test lint smoke bare view-check docs docs-serve figure-plots guide bench clean
+.PHONY: install ipopt optimize test end-to-end lint smoke bare view-check docs docs-serve figure-plots guide bench clean
 
 install: $(STAMP)
 
@@ -29,7 +29,11 @@ optimize: $(STAMP)
 	$(VENV)/bin/excite optimize $(CONFIG) --force
 
 test: $(STAMP)
-	$(PY) -m pytest -q -rs -n auto --durations=10
+	$(PY) -m pytest -q -rs -n auto -m "not end_to_end" --durations=10
+
+# The slowest checks of a command end to end (pytest -m end_to_end), run by .ci/run beside the smoke run.
+end-to-end: $(STAMP)
+	$(PY) -m pytest -q -rs -n auto -m end_to_end --durations=5
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check .

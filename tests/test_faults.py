@@ -131,6 +131,7 @@ def _children(pid: int) -> list[int]:
 
 
 @pytest.mark.skipif(not Path("/proc").is_dir(), reason="needs /proc to find the worker processes")
+@pytest.mark.end_to_end
 def test_sigterm_during_a_two_worker_optimize_stops_everything_and_keeps_finished_iterations(tmp_path):
     config = yaml.safe_load((CONFIGS / "smoke.yaml").read_text())
     config["trajectory"]["harmonics"] = 5

@@ -295,6 +295,7 @@ def test_offsets_per_run_and_a_known_payload(tmp_path, optimized):
     assert np.linalg.norm(plain.selection.fit.x[: base.count] - truth) > 0.02 * np.linalg.norm(truth)
 
 
+@pytest.mark.end_to_end
 def test_identify_command_writes_report_and_prior(tmp_path, optimized):
     # viscous friction on one joint: every search (declared, Coulomb, Coulomb and viscous) must move
     _simulate(tmp_path, optimized, {"coulomb": {"*": 0.5}, "viscous": {"panda_joint4": 0.3}})

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import h5py
 import numpy as np
+import pytest
 import yaml
 from conftest import CHAIN_INERTIAL, GOOD, PENDULUM, assert_refused, chain_urdf, panda_mjcf
 from typer.testing import CliRunner
@@ -44,6 +45,7 @@ def _small(path, **optimizer) -> None:
     path.write_text(yaml.safe_dump(config))
 
 
+@pytest.mark.end_to_end
 def test_an_mjcf_arm_goes_init_check_optimize_identify_with_the_base_parameters_of_its_urdf(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     panda_mjcf(tmp_path)

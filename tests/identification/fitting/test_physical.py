@@ -67,6 +67,7 @@ def test_nearest_physical_keeps_physical_bodies_and_mends_the_others_keeping_mas
 
 
 @pytest.mark.skipif(not (SHARED / "exciting_traj_1.csv").exists(), reason="shared Panda data not present")
+@pytest.mark.end_to_end
 def test_real_panda_consistent_fit_and_its_urdf(tmp_path):
     config = yaml.safe_load((CONFIGS / "panda_identify.yaml").read_text())
     config["data"]["runs"][0]["file"] = str(SHARED / "exciting_traj_1.csv")
