@@ -36,9 +36,9 @@ import numpy as np
 
 from excite_cli.config_file import load_problem
 from excite_cli.constraints.zmp import zero_moment_point
-from excite_cli.design.excitation import build_excitation
 from excite_cli.design.mujoco_stance import TIMESTEP, Stance, play_standing, standing_model
 from excite_cli.design.playback import plan_playback
+from excite_cli.design.resolve import build_excitation
 from excite_cli.dynamics.urdf_source import resolve_urdf
 from excite_cli.identification.reporting.mjcf_out import import_mujoco
 from excite_cli.storage.results import read_alphas

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from excite_cli.config_file import load_problem
-from excite_cli.design.excitation import build_excitation
+from excite_cli.design.resolve import build_excitation
 from excite_cli.design.verify import check_gradient
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -20,7 +20,7 @@ import numpy as np
 from excite_cli.config import ConstraintsConfig
 from excite_cli.config_file import load_problem
 from excite_cli.design.criterion import condition_number
-from excite_cli.design.excitation import build_excitation
+from excite_cli.design.resolve import build_excitation
 from excite_cli.search.sequence import run_sequence
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -48,7 +48,7 @@ import numpy as np
 from excite_cli.config import NoiseConfig
 from excite_cli.config_file import load_problem
 from excite_cli.design.criterion import condition_number
-from excite_cli.design.excitation import build_excitation
+from excite_cli.design.resolve import build_excitation
 from excite_cli.search.engine import Engine, default_workers
 from excite_cli.search.restarts import RestartTask
 from excite_cli.search.sequence import run_sequence
@@ -73,7 +73,7 @@ UNSEEN_SEED = 12345
 def samples(excitation, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Base regressor (T·n, b) and RNEA torques (T, n) of α sampled at ``RATE`` over its duration."""
     robot = excitation.robot
-    basis = excitation.trajectory.basis(np.arange(0.0, excitation.problem.trajectory.duration, 1.0 / RATE))
+    basis = excitation.trajectory.basis(np.arange(0.0, excitation.spec.trajectory.duration, 1.0 / RATE))
     Q, QD, QDD = basis.evaluate(alpha)
     Y = robot.regressor_stack(Q, QD, QDD)[:, excitation.base.independent]
     return Y, np.array([robot.torques(*x) for x in zip(Q, QD, QDD)])

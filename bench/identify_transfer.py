@@ -46,7 +46,7 @@ from mujoco_arm import ArmPhysics, arm_model, floor_error, record
 
 from excite_cli.config import RobotConfig
 from excite_cli.config_file import load_problem
-from excite_cli.design.excitation import build_excitation
+from excite_cli.design.resolve import build_excitation
 from excite_cli.dynamics.base_parameters import compute_base_parameters
 from excite_cli.dynamics.robot import load_robot
 from excite_cli.dynamics.urdf_source import resolve_urdf

@@ -52,7 +52,8 @@ import numpy as np
 
 from excite_cli.config import EffectsConfig, MotorConfig
 from excite_cli.config_file import load_problem
-from excite_cli.design.excitation import build_design, build_excitation
+from excite_cli.design.excitation import build_design
+from excite_cli.design.resolve import build_excitation
 from excite_cli.search.engine import Engine, default_workers
 from excite_cli.search.sequence import describe, run_sequence
 
@@ -64,7 +65,7 @@ RATE, NOISE, UNSEEN_SEED, NOISE_DRAWS = 100.0, 0.02, 12345, 20
 def measured(excitation, alpha: np.ndarray, truth: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """[Y_B | Y_E] (T·n, b+e) and the true torques (T, n) of α sampled at ``RATE`` (no noise yet)."""
     robot, b = excitation.robot, excitation.base.count
-    basis = excitation.trajectory.basis(np.arange(0.0, excitation.problem.trajectory.duration, 1.0 / RATE))
+    basis = excitation.trajectory.basis(np.arange(0.0, excitation.spec.trajectory.duration, 1.0 / RATE))
     Q, QD, QDD = basis.evaluate(alpha)
     Y = np.hstack(
         [robot.regressor_stack(Q, QD, QDD)[:, excitation.base.independent], excitation.effects.columns(QD, QDD)]
@@ -131,7 +132,7 @@ def simulated_robot(config: Path, seed: int) -> tuple:
 
 def blind_runs(blind, seed: int) -> tuple[np.ndarray, np.ndarray]:
     """α of trajectory 1 and of (a)'s trajectory 2, iterations 1 and 2 of the blind sequence (n, 2N+1)."""
-    with Engine(blind, min(default_workers(), blind.problem.optimizer.restarts)) as engine:
+    with Engine(blind, min(default_workers(), blind.spec.optimizer.restarts)) as engine:
         first = run_sequence(blind, 1, seed, engine=engine)
         second = run_sequence(blind, 2, seed, engine=engine, finished=first)[-1].alpha
     return first[0].alpha, second

@@ -71,9 +71,9 @@ def best_second_run(
     group, and that run's coefficients (n, 2N+1) (each group's joints from its own best); ``alphas``:
     run 1's coefficients, then the other starts (n, 2N+1); ``starts`` random starts more per group;
     ``magnitudes`` (e,) the true coefficients' sizes."""
-    duration = model.problem.trajectory.duration
+    duration = model.spec.trajectory.duration
     basis = model.trajectory.basis(np.arange(0.0, duration, 1.0 / RATE))
-    ends = boundary_rows(model.trajectory, duration, model.problem.trajectory.boundary == "rest", False)
+    ends = boundary_rows(model.trajectory, duration, model.spec.trajectory.boundary == "rest", False)
     lower, upper = model.limits.lower, model.limits.upper
 
     def information(alpha: np.ndarray, effects, scale: np.ndarray) -> np.ndarray:

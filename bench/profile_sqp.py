@@ -24,7 +24,7 @@ import numpy as np
 from threadpoolctl import threadpool_info, threadpool_limits
 
 from excite_cli.config_file import load_problem
-from excite_cli.design.excitation import build_excitation
+from excite_cli.design.resolve import build_excitation
 from excite_cli.design.verify import finite_difference_gradient
 from excite_cli.memory import keep_freed_memory
 from excite_cli.search.optimizer import optimize_restart

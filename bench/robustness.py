@@ -46,7 +46,7 @@ import numpy as np
 from excite_cli.config import OptimizerConfig
 from excite_cli.config_file import load_problem
 from excite_cli.criteria import NAMES
-from excite_cli.design.excitation import build_excitation
+from excite_cli.design.resolve import build_excitation
 from excite_cli.search.engine import Engine, default_workers
 from excite_cli.search.kkt import CONVERGED
 from excite_cli.search.sequence import run_sequence

@@ -18,7 +18,7 @@ import time
 from pathlib import Path
 
 from excite_cli.config_file import load_problem
-from excite_cli.design.excitation import build_excitation
+from excite_cli.design.resolve import build_excitation
 from excite_cli.search.engine import Engine, default_workers
 from excite_cli.search.sequence import run_sequence
 

@@ -26,7 +26,7 @@ from threadpoolctl import threadpool_limits
 
 import excite_cli.constraints.lse as lse
 from excite_cli.config_file import load_problem
-from excite_cli.design.excitation import build_excitation
+from excite_cli.design.resolve import build_excitation
 from excite_cli.memory import keep_freed_memory
 from excite_cli.search.kkt import kkt_optimality
 from excite_cli.search.nlp import Evaluations

@@ -20,7 +20,7 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from excite_cli.config_file import load_problem, with_overrides
-from excite_cli.design.excitation import build_excitation
+from excite_cli.design.resolve import build_excitation
 from excite_cli.memory import keep_freed_memory
 from excite_cli.search.restarts import RestartTask
 from excite_cli.search.solvers import METHODS

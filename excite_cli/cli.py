@@ -57,7 +57,9 @@ def optimize(
     if dry_run:
         return say(console.tables.plan(workflows.plan_optimize(problem)))
     with Bars(console.app.busy) as bars:
-        run = workflows.run_optimize(problem, output or Path(problem.output), force, resume, *bars.iterations(problem))
+        run = workflows.run_optimize(
+            problem, output or Path(problem.output), force, resume, *bars.iterations(problem.optimizer)
+        )
     say(
         console.tables.iterations(run.results, problem.optimizer, run.improved),
         f"wrote {run.target} and {', '.join(str(p) for p in run.plots)}",
@@ -134,7 +136,7 @@ def compare_random(
         },
     )
     with Bars(console.app.busy) as bars:
-        progress = bars.iterations(problem)[0] if optimized is None else None
+        progress = bars.iterations(problem.optimizer)[0] if optimized is None else None
         comparison = workflows.run_compare_random(
             problem,
             optimized,

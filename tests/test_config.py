@@ -11,7 +11,7 @@ from typer.testing import CliRunner
 from excite_cli.cli import app
 from excite_cli.config import Problem, effective_yaml, resolve_path
 from excite_cli.config_file import load_problem
-from excite_cli.design.excitation import build_excitation
+from excite_cli.design.resolve import build_excitation
 from excite_cli.errors import ExciteError
 
 runner = CliRunner()

@@ -15,7 +15,7 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, Ti
 from excite_cli.criteria import CRITERIA
 
 if TYPE_CHECKING:  # annotations only: the command line's frame imports this module at start-up
-    from excite_cli.config import Problem
+    from excite_cli.config import OptimizerConfig
     from excite_cli.search.optimizer import ProgressHook
     from excite_cli.search.sequence import IterationResult
 
@@ -62,10 +62,13 @@ class Bars:
             self._live = True
         return self.bar.add_task(description, total=total, status=status)
 
-    def iterations(self, problem: Problem) -> tuple[Callable[[int], ProgressHook], Callable[[IterationResult], None]]:
+    def iterations(
+        self, opts: OptimizerConfig
+    ) -> tuple[Callable[[int], ProgressHook], Callable[[IterationResult], None]]:
         """The hooks of :func:`~excite_cli.runs.run_optimize`: ``progress(k)`` per SLSQP iteration
-        (the objective at the current iterate) and ``done(result)`` per finished iteration."""
-        opts, bar = problem.optimizer, self.bar
+        (the objective at the current iterate) and ``done(result)`` per finished iteration, for the
+        ``optimizer`` section ``opts``."""
+        bar = self.bar
         record = CRITERIA[opts.objective]
         label, shown = record.label, record.shown
         tasks: dict[int, int] = {}

@@ -220,7 +220,7 @@ def verification(v: Verification, tolerance: float) -> list[Table | str]:
 
 def plan(p: Plan) -> list[Table | str]:
     """What ``check`` found: the problem ``optimize`` would run, its constraints and an estimated time."""
-    e, cfg = p.excitation, p.excitation.problem
+    e, cfg = p.excitation, p.excitation.spec
     t = cfg.trajectory
     grid, fine = e.grid_basis.q.shape[0], e.fine_basis.q.shape[0]
     rows = [

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from excite_cli.collision.capsules import capsule_pairs, capsules_from_config
-from excite_cli.config import Problem
+from excite_cli.config import ConstraintsConfig, LimitsConfig
 from excite_cli.constraints import Constraint, JointLimits, SelfCollision, accepted
 from excite_cli.constraints.com_region import com_region_from_config
 from excite_cli.constraints.joint_limits import joint_limit_bounds
@@ -23,7 +23,7 @@ from excite_cli.criteria import criterion_record
 from excite_cli.design.criterion import Criterion, condition_number
 from excite_cli.design.information import excitation_level, parameter_magnitudes
 from excite_cli.design.noise import RowNoise, row_noise
-from excite_cli.design.spec import DesignSpec, needs_collision, resolve
+from excite_cli.design.spec import DesignSpec, needs_collision
 from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.dynamics.effect_columns import EffectColumns
 from excite_cli.dynamics.robot import Robot, load_robot
@@ -41,8 +41,9 @@ class Excitation:
     """A ready-to-optimize excitation problem.
 
     Attributes:
-        spec: the values it was built from (:class:`~excite_cli.design.spec.DesignSpec`): the config,
-            the base parameters, the effect columns, the scaling frame, the measured prior's weights.
+        spec: the values it was built from (:class:`~excite_cli.design.spec.DesignSpec`): the config's
+            sections, the base parameters, the effect columns, the scaling frame, the measured prior's
+            weights.
         robot: the robot (this process's pinocchio and coal objects).
         trajectory: the Fourier parameterization (Eq. 50).
         cost_basis: basis at the T cost samples (regressor rows, Eq. 3).
@@ -62,11 +63,6 @@ class Excitation:
     limits: JointLimits
     constraints: list[Constraint]
     boundary: BoundaryConditions
-
-    @property
-    def problem(self) -> Problem:
-        """The validated config."""
-        return self.spec.problem
 
     @property
     def base(self) -> BaseParameters:
@@ -94,8 +90,8 @@ class Excitation:
         """The criterion of ``objective`` (default ``optimizer.objective``) with C₀ = ``prior`` (m₁, b)
         (Eq. 41), of C (``scaling`` ``none``) or of C L (``urdf``; default ``optimizer.scaling``, else
         the criterion's own, :attr:`~excite_cli.criteria.record.CriterionRecord.scaling`)."""
-        objective = objective or self.problem.optimizer.objective
-        scaling = scaling or self.problem.optimizer.scaling_of(objective)
+        objective = objective or self.spec.optimizer.objective
+        scaling = scaling or self.spec.optimizer.scaling_of(objective)
         return Criterion(
             self.robot,
             self.base,
@@ -126,7 +122,7 @@ class Excitation:
     @property
     def noise(self) -> RowNoise | None:
         """The regressor rows' noise (``noise``, σ_j from a measured prior's report), or None: unweighted."""
-        return row_noise(self.problem.noise, self.robot, self.measured)
+        return row_noise(self.spec.noise, self.robot, self.measured)
 
     @property
     def effect_names(self) -> tuple[str, ...]:
@@ -176,21 +172,6 @@ def home_posture(robot: Robot, limits: JointLimits) -> np.ndarray:
     return np.clip(robot.home, limits.centre[0] - inner, limits.centre[0] + inner)
 
 
-def build_excitation(problem: Problem, base: BaseParameters | None = None, check_home: bool = True) -> Excitation:
-    """Resolve ``problem`` (:func:`~excite_cli.design.spec.resolve`) and build its excitation.
-
-    Args:
-        problem: the validated config.
-        base: the robot's base parameters when already computed; default: computed here.
-        check_home: refuse a home posture that violates a constraint (off: a caller searching for one).
-
-    Raises:
-        ExciteError: see :func:`~excite_cli.design.spec.resolve` and :func:`build_design`.
-    """
-    spec, robot = resolve(problem, base)
-    return build_design(spec, robot, check_home)
-
-
 def build_design(spec: DesignSpec, robot: Robot | None = None, check_home: bool = True) -> Excitation:
     """Set up bases and constraints for ``spec``: what the main process and every worker build.
 
@@ -206,9 +187,8 @@ def build_design(spec: DesignSpec, robot: Robot | None = None, check_home: bool 
             (:func:`joint_limit_bounds`), a bad noise section, a constraint violated at the home
             posture (with ``check_home``).
     """
-    problem = spec.problem
-    robot = robot or load_robot(problem.robot, problem.folder, needs_collision(problem))
-    tcfg = problem.trajectory
+    robot = robot or load_robot(spec.robot, spec.folder, needs_collision(spec.constraints))
+    tcfg = spec.trajectory
     if tcfg.cost_samples * robot.n_rows < spec.columns:
         effect_part = f" and {spec.effects.count} effect columns" if spec.effects else ""
         raise ExciteError(
@@ -217,9 +197,9 @@ def build_design(spec: DesignSpec, robot: Robot | None = None, check_home: bool 
             f"than the robot's {spec.base.count} base parameters{effect_part}; cond(C) would be infinite",
         )
     trajectory = FourierTrajectory(tcfg.harmonics, tcfg.base_frequency)
-    fine_period = tcfg.constraint_period / problem.limits.check_refinement
+    fine_period = tcfg.constraint_period / spec.limits.check_refinement
     grid_basis = trajectory.basis(sample_times(tcfg.duration, tcfg.constraint_period, include_end=True))
-    limits = JointLimits(*joint_limit_bounds(problem.limits, robot), grid_basis)
+    limits = JointLimits(*joint_limit_bounds(spec.limits, robot), grid_basis)
     excitation = Excitation(
         spec=spec,
         robot=robot,
@@ -228,24 +208,26 @@ def build_design(spec: DesignSpec, robot: Robot | None = None, check_home: bool 
         grid_basis=grid_basis,
         fine_basis=trajectory.basis(sample_times(tcfg.duration, fine_period, include_end=True)),
         limits=limits,
-        constraints=_constraints(problem, robot, grid_basis, limits),
+        constraints=_constraints(spec.limits, spec.constraints, robot, grid_basis, limits),
         boundary=boundary_conditions(tcfg, trajectory, limits.coefficient_scale(), home_posture(robot, limits)),
     )
-    row_noise(problem.noise, robot, spec.measured)  # the noise section checked before any work
+    row_noise(spec.noise, robot, spec.measured)  # the noise section checked before any work
     if check_home:
         _check_home_posture(excitation)
     return excitation
 
 
-def _constraints(problem: Problem, robot: Robot, grid_basis: FourierBasis, limits: JointLimits) -> list[Constraint]:
-    """Every constraint of ``problem`` on the constraint grid, the joint limits first."""
-    ccfg = problem.constraints
+def _constraints(
+    lcfg: LimitsConfig, ccfg: ConstraintsConfig, robot: Robot, grid_basis: FourierBasis, limits: JointLimits
+) -> list[Constraint]:
+    """Every constraint of the sections ``limits`` and ``constraints`` on the constraint grid, the joint
+    limits first."""
     constraints: list[Constraint] = [limits]
-    if problem.limits.torque is not None:
-        constraints.append(TorqueLimits(robot, grid_basis, torque_limit(problem.limits.torque, robot)))
-    if problem.limits.min_torque_use is not None:
-        fraction = torque_use_fraction(problem.limits.min_torque_use, robot)
-        limit = torque_limit(problem.limits.torque or "urdf", robot)
+    if lcfg.torque is not None:
+        constraints.append(TorqueLimits(robot, grid_basis, torque_limit(lcfg.torque, robot)))
+    if lcfg.min_torque_use is not None:
+        fraction = torque_use_fraction(lcfg.min_torque_use, robot)
+        limit = torque_limit(lcfg.torque or "urdf", robot)
         constraints.append(TorqueUse(robot, grid_basis, limit, fraction))
     if ccfg.com is not None:
         constraints.append(com_region_from_config(ccfg.com, robot, grid_basis))

@@ -4,9 +4,11 @@ report, how its measured rows weigh (:mod:`~excite_cli.identification.reporting.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
-from excite_cli.config import Problem, resolve_path
+from excite_cli.config import EffectsConfig, resolve_path
 from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.dynamics.effect_columns import EffectColumns, effect_columns
 from excite_cli.dynamics.robot import Robot
@@ -14,14 +16,14 @@ from excite_cli.errors import ExciteError
 from excite_cli.identification.reporting.design_model import MeasuredPrior, read_measured_prior, with_report_model
 
 
-def measured_prior(problem: Problem, robot: Robot) -> MeasuredPrior | None:
-    """How ``sequence.prior`` weighs when it is an identify report (else None).
+def measured_prior(path: str | None, folder: Path | None, robot: Robot) -> MeasuredPrior | None:
+    """How ``sequence.prior`` (``path``, relative to ``folder``) weighs when it is an identify report
+    (else None).
 
     Raises:
         ExciteError: (``sequence.prior``) a report whose joints are not this problem's active joints.
     """
-    path = problem.sequence.prior
-    measured = None if path is None else read_measured_prior(resolve_path(path, problem.folder))
+    measured = None if path is None else read_measured_prior(resolve_path(path, folder))
     if measured is not None and sorted(measured.joints) != sorted(robot.joint_names):
         raise ExciteError(
             "sequence.prior",
@@ -31,17 +33,17 @@ def measured_prior(problem: Problem, robot: Robot) -> MeasuredPrior | None:
     return measured
 
 
-def design_effects(problem: Problem, robot: Robot, base: BaseParameters) -> EffectColumns | None:
-    """The effect columns of ``effects`` that the rigid body's base columns do not already hold (on
-    random states: :meth:`~excite_cli.dynamics.effect_columns.EffectColumns.beside`), or None.
+def design_effects(cfg: EffectsConfig, folder: Path | None, robot: Robot, base: BaseParameters) -> EffectColumns | None:
+    """The effect columns of ``effects`` (``cfg``, its model file relative to ``folder``) that the rigid
+    body's base columns do not already hold (on random states:
+    :meth:`~excite_cli.dynamics.effect_columns.EffectColumns.beside`), or None.
 
     Raises:
         ExciteError: an effect on a joint that is not active (:func:`effect_columns`), an
             ``effects.model`` that is not an identify report of this problem's joints.
     """
-    cfg = problem.effects
     if cfg.model is not None:
-        cfg = with_report_model(cfg, resolve_path(cfg.model, problem.folder), robot.joint_names)
+        cfg = with_report_model(cfg, resolve_path(cfg.model, folder), robot.joint_names)
     effects = effect_columns(cfg, robot.joint_names, robot.n_rows)
     if effects is None:
         return None

@@ -174,7 +174,7 @@ def plan_playback(excitation: Excitation, alpha: np.ndarray, periods: int = 1) -
     if periods < 1:
         raise ExciteError("periods", f"{periods} is out of range", periods, "at least 1")
     home = np.stack([excitation.home, np.zeros_like(excitation.home), np.zeros_like(excitation.home)])
-    trajectory = FourierSegment(excitation.trajectory, alpha, excitation.problem.trajectory.duration)
+    trajectory = FourierSegment(excitation.trajectory, alpha, excitation.spec.trajectory.duration)
     first, last = trajectory.state(0.0), trajectory.state(trajectory.duration)
     limits = excitation.limits
     torque = next((c for c in excitation.constraints if c.bounds_torque), None)

@@ -2,29 +2,51 @@
 
     config ─► resolve(problem) ─► DesignSpec ─► build_design(spec) ─► Excitation
 
-Everything derived from the robot's file and the report files (the base parameters, the effect
-columns, the scaling frame, the measured prior's weights) is computed once, in the main process, and
-held by a frozen, picklable record; the main process and every worker (a local pool or a Dask
-cluster) build their :class:`~excite_cli.design.excitation.Excitation` from that record, so a value
-changed in memory (``dataclasses.replace(spec, scaled_frame=…)``) reaches every process, and no worker
-computes a base of its own. The record's arrays are read-only.
+(:func:`~excite_cli.design.resolve.resolve`, :func:`~excite_cli.design.excitation.build_design`).
+
+The config's sections a design needs (as values) and everything derived from the robot's file and the
+report files (the base parameters, the effect columns, the scaling frame, the measured prior's
+weights) are resolved once, in the main process, and held by a frozen, picklable record; the main
+process and every worker (a local pool or a Dask cluster) build their
+:class:`~excite_cli.design.excitation.Excitation` from that record, so a value changed in memory
+(``dataclasses.replace(spec, scaled_frame=…)``) reaches every process, and no worker computes a base of
+its own. The record's arrays are read-only.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
-from scipy.linalg import block_diag
 
-from excite_cli.config import Problem
-from excite_cli.constraints.joint_limits import joint_limit_bounds
-from excite_cli.design.information import parameter_magnitudes, scaled_frame
-from excite_cli.design.model_columns import design_effects, measured_prior
-from excite_cli.dynamics.base_parameters import BaseParameters, compute_base_parameters
+from excite_cli.config import (
+    ConstraintsConfig,
+    LimitsConfig,
+    NoiseConfig,
+    OptimizerConfig,
+    RobotConfig,
+    SequenceConfig,
+    TrajectoryConfig,
+)
+from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.dynamics.effect_columns import EffectColumns
-from excite_cli.dynamics.robot import Robot, load_robot
 from excite_cli.identification.reporting.design_model import MeasuredPrior
+
+
+@dataclass(frozen=True)
+class ConfigText:
+    """The config a design was resolved from, as a result file stores it.
+
+    Attributes:
+        effective: the validated config as YAML, every default filled in (what the run used).
+        original: the file's own text.
+        path: where the file was read from ("" for a config made in memory).
+    """
+
+    effective: str
+    original: str
+    path: str
 
 
 @dataclass(frozen=True)
@@ -32,7 +54,11 @@ class DesignSpec:
     """What one excitation design is built from, resolved once (:func:`resolve`).
 
     Attributes:
-        problem: the validated config.
+        robot, trajectory, limits, constraints, optimizer, sequence, noise: the config's sections
+            (``noise`` None: every regressor row weighs the same).
+        folder: the config file's folder, which relative paths in it are resolved from (None: the
+            working directory).
+        config: the config's text, as the result file stores it.
         base: the robot's base parameters (Eq. 2).
         effects: the effect columns designed for beside the base columns (``effects``), or None.
         scaled_frame: L (b+e, b+e), read-only: C L is the regressor in a basis that does not depend on
@@ -42,7 +68,15 @@ class DesignSpec:
             (:class:`~excite_cli.identification.reporting.design_model.MeasuredPrior`), or None.
     """
 
-    problem: Problem
+    robot: RobotConfig
+    trajectory: TrajectoryConfig
+    limits: LimitsConfig
+    constraints: ConstraintsConfig
+    optimizer: OptimizerConfig
+    sequence: SequenceConfig
+    noise: NoiseConfig | None
+    folder: Path | None
+    config: ConfigText
     base: BaseParameters
     effects: EffectColumns | None
     scaled_frame: np.ndarray
@@ -59,29 +93,7 @@ class DesignSpec:
         return self.base.count + (self.effects.count if self.effects else 0)
 
 
-def needs_collision(problem: Problem) -> bool:
-    """Whether the robot needs its collision geometry: capsules, the soles' contact points."""
-    ccfg = problem.constraints
+def needs_collision(ccfg: ConstraintsConfig) -> bool:
+    """Whether the robot needs its collision geometry for the constraints ``ccfg``: capsules, the soles'
+    contact points."""
     return bool(ccfg.self_collision or ccfg.environment or ccfg.zmp or (ccfg.com and ccfg.com.support_links))
-
-
-def resolve(problem: Problem, base: BaseParameters | None = None) -> tuple[DesignSpec, Robot]:
-    """The design of ``problem`` as values, and the robot it was resolved on (its pinocchio and coal
-    objects, which :func:`~excite_cli.design.excitation.build_design` reuses in this process).
-
-    Args:
-        problem: the validated config.
-        base: the robot's base parameters when already computed; default: computed here.
-
-    Raises:
-        ExciteError: bad robot, limits, effects or prior input (:func:`load_robot`,
-            :func:`joint_limit_bounds`, :func:`design_effects`, :func:`measured_prior`).
-    """
-    robot = load_robot(problem.robot, problem.folder, needs_collision(problem))
-    base = base or compute_base_parameters(robot)
-    effects = design_effects(problem, robot, base)
-    frame = scaled_frame(base, parameter_magnitudes(robot))
-    if effects is not None:
-        _, upper = joint_limit_bounds(problem.limits, robot)
-        frame = block_diag(frame, np.diag(effects.magnitudes(robot.model.effortLimit[robot.v_idx], upper[1], upper[2])))
-    return DesignSpec(problem, base, effects, frame, measured_prior(problem, robot)), robot

@@ -17,7 +17,8 @@ import pinocchio as pin
 from excite_cli.config import Problem
 from excite_cli.constraints import SelfCollision
 from excite_cli.constraints.world_collision import WorldCollision
-from excite_cli.design.excitation import Excitation, build_excitation
+from excite_cli.design.excitation import Excitation
+from excite_cli.design.resolve import build_excitation
 from excite_cli.drafting.home_posture import home_posture
 from excite_cli.drafting.joints import joint_choice
 from excite_cli.dynamics.urdf_source import apply_joint_ranges, robot_geometry, robot_model

@@ -51,7 +51,7 @@ def plot_result(target: Path, excitation: Excitation, results: Sequence[Iteratio
             lambda q: (skeleton(excitation.robot, q), capsule_segments(excitation.robot, capsules, q)),
             [c.radius for c in capsules],
             excitation.home,
-            world_shapes(excitation.problem.constraints.environment),  # those out of reach too
+            world_shapes(excitation.spec.constraints.environment),  # those out of reach too
         ),
     ]
     if any(r.tracks for r in results):

@@ -53,7 +53,7 @@ class RestartTask:
         return optimize_restart(
             excitation.criterion(self.prior),
             excitation.constraints,
-            excitation.problem.optimizer,
+            excitation.spec.optimizer,
             start,
             excitation.boundary,
             self.index,
@@ -94,7 +94,7 @@ def run_restarts(
         Every start's :class:`RestartResult`, by index (a continued one with its screening's start
         value, iterations and history included).
     """
-    opts = excitation.problem.optimizer
+    opts = excitation.spec.optimizer
     count = opts.screened or opts.restarts
     deadline = time.perf_counter() + opts.time_budget
     runs = _restart_round(excitation, engine, k, seed, prior, range(count), hook, deadline)
@@ -136,7 +136,7 @@ def polish(
         ``runs`` with the polished restart in its place, its iterations and history joined; its stop
         is ``time budget`` when the deadline came before it converged.
     """
-    opts, runs = excitation.problem.optimizer, list(runs)
+    opts, runs = excitation.spec.optimizer, list(runs)
     at = next(i for i, r in enumerate(runs) if r.index == kept)
     for _ in range(opts.polish_rounds):
         current = runs[at]
@@ -164,7 +164,7 @@ def _restart_round(
     deadline: float,
 ) -> list[RestartResult]:
     """The starts ``indices`` of iteration k, screened and continued as :func:`run_restarts` says."""
-    opts = excitation.problem.optimizer
+    opts = excitation.spec.optimizer
     iterations = min(opts.screen_iterations, opts.max_iterations) if opts.screened else None
     tasks = [RestartTask(k, r, seed, prior, None, iterations, _left(deadline)) for r in indices]
     runs = engine.run(tasks, hook, (lambda r: hook(r.index, r.iterations, r.objective)) if hook else None)

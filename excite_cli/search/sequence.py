@@ -257,10 +257,10 @@ def run_sequence(
             raise NoSolution(
                 "optimizer",
                 f"iteration {k}: none of {len(runs)} restarts reached a result within time_budget "
-                f"{excitation.problem.optimizer.time_budget:g} s ({', '.join(failures)})",
+                f"{excitation.spec.optimizer.time_budget:g} s ({', '.join(failures)})",
                 expected="more starts or a longer optimizer.time_budget, or limits that leave the robot room",
             )
-        deadline = start + excitation.problem.optimizer.time_budget
+        deadline = start + excitation.spec.optimizer.time_budget
         runs, best = polish_kept(excitation, engine, k, seed, stacked, runs, deadline, hook)
         result = describe(excitation, k, best.alpha, stacked, time.perf_counter() - start, runs, results, best.index)
         results.append(result)

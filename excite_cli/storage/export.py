@@ -18,8 +18,8 @@ import numpy as np
 
 from excite_cli.atomic import atomic_path
 from excite_cli.config_file import with_overrides
-from excite_cli.design.excitation import build_excitation
 from excite_cli.design.playback import check_motion, plan_playback
+from excite_cli.design.resolve import build_excitation
 from excite_cli.errors import ExciteError
 from excite_cli.storage.formats import ROS_FORMATS, check_format
 from excite_cli.storage.results import problem_of_result, read_alphas

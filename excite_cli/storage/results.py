@@ -14,7 +14,7 @@ import h5py
 import numpy as np
 from pydantic import ValidationError
 
-from excite_cli.config import Problem, effective_yaml
+from excite_cli.config import Problem
 from excite_cli.config_file import parse_yaml
 from excite_cli.design.excitation import Excitation
 from excite_cli.dynamics.base_parameters import BaseParameters
@@ -65,11 +65,14 @@ def write_result(
         ExciteError: the file cannot be written.
     """
     with atomic_h5(path) as f:
-        f.attrs["config"] = effective_yaml(excitation.problem)
-        f.attrs["config_original"] = excitation.problem.source_text
-        f.attrs["config_path"] = str(excitation.problem.source_path or "")
+        config = excitation.spec.config
+        f.attrs["config"], f.attrs["config_original"], f.attrs["config_path"] = (
+            config.effective,
+            config.original,
+            config.path,
+        )
         f.attrs["seed"] = seed
-        f.attrs["objective"] = excitation.problem.optimizer.objective
+        f.attrs["objective"] = excitation.spec.optimizer.objective
         for name, value in (attributes or {}).items():
             f.attrs[name] = value
         _write_robot(f.create_group("robot"), excitation)
@@ -96,8 +99,8 @@ def _write_robot(group: h5py.Group, excitation: Excitation) -> None:
     )
     group.create_dataset("regrouping_matrix", data=base.regrouping).attrs["description"] = "K (b x p): phi_B = K phi"
     group.create_dataset("urdf_base_parameters", data=base.from_standard(robot.urdf_parameters()))
-    group.attrs["urdf"] = excitation.problem.robot.urdf
-    group.attrs["floating_base"] = excitation.problem.robot.floating_base
+    group.attrs["urdf"] = excitation.spec.robot.urdf
+    group.attrs["floating_base"] = excitation.spec.robot.floating_base
     group.attrs["regressor_rows_per_instant"] = robot.n_rows
     if excitation.effects is not None:
         write_strings(group, "effect_names", excitation.effects.names)

@@ -10,7 +10,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from excite_cli.config import Problem
-from excite_cli.design.excitation import Excitation, build_excitation
+from excite_cli.design.excitation import Excitation
+from excite_cli.design.resolve import build_excitation
 from excite_cli.search.engine import default_workers
 from excite_cli.search.kkt import ACTIVE_TOLERANCE
 from excite_cli.search.solvers import criterion_scale

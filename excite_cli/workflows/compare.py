@@ -10,7 +10,8 @@ from typing import Callable, Optional
 import numpy as np
 
 from excite_cli.config import Problem
-from excite_cli.design.excitation import Excitation, build_excitation
+from excite_cli.design.excitation import Excitation
+from excite_cli.design.resolve import build_excitation
 from excite_cli.errors import ExciteError
 from excite_cli.h5 import open_h5, read_strings
 from excite_cli.plots.optimize import plot_comparison

@@ -9,10 +9,11 @@ from typing import Callable, Optional
 import numpy as np
 import yaml
 
-from excite_cli.config import Problem, effective_yaml, resolve_path
+from excite_cli.config import Problem, resolve_path
 from excite_cli.config_file import parse_yaml
-from excite_cli.design.excitation import Excitation, build_excitation
+from excite_cli.design.excitation import Excitation
 from excite_cli.design.information import predicted_std
+from excite_cli.design.resolve import build_excitation
 from excite_cli.errors import ExciteError, FileNotFound, Interrupted, exit_status
 from excite_cli.h5 import open_h5
 from excite_cli.plots.optimize import plot_result
@@ -60,7 +61,7 @@ class OptimizeRun:
             return []
         # C holds s·W·Y per recorded row (s the time rule), and the new runs recorded at the same rate
         # carry (their cost-grid rows)/s² of information: std = s·σ̄·√diag((CᵀC)⁻¹)
-        noise = measured.noise * measured.time_scale(self.excitation.problem.trajectory.cost_period)
+        noise = measured.noise * measured.time_scale(self.excitation.spec.trajectory.cost_period)
         stacked = np.vstack([self.prior, *[r.regressor for r in self.results]])
         before, after = predicted_std(self.prior, noise), predicted_std(stacked, noise)
         names = [*self.excitation.base.names, *self.excitation.effect_names]
@@ -166,7 +167,7 @@ def _resumable(target: Path, excitation: Excitation, prior: Optional[np.ndarray]
     """The iterations of ``target`` if it was made with the same config (see ``RESUMABLE_CHANGES``)."""
     with open_h5(target, "resume") as f:
         stored = parse_yaml(str(f.attrs.get("config", "")), str(target), "resume") or {}
-    current = yaml.safe_load(effective_yaml(excitation.problem))
+    current = yaml.safe_load(excitation.spec.config.effective)
     if not isinstance(stored, dict):
         raise ExciteError("resume", f"{target} has no valid stored config (not an excite optimize result?)", target)
     for dotted in RESUMABLE_CHANGES:
@@ -180,10 +181,9 @@ def _resumable(target: Path, excitation: Excitation, prior: Optional[np.ndarray]
             "resume", f"{target} was made with another config ({', '.join(differing) or 'the whole file'} differ)"
         )
     finished = read_iterations(target, excitation, prior)
-    if len(finished) > excitation.problem.sequence.iterations:
+    if len(finished) > excitation.spec.sequence.iterations:
         raise ExciteError(
             "resume",
-            f"{target} has {len(finished)} iterations, "
-            f"more than the {excitation.problem.sequence.iterations} asked for",
+            f"{target} has {len(finished)} iterations, more than the {excitation.spec.sequence.iterations} asked for",
         )
     return finished

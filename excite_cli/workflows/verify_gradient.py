@@ -10,7 +10,7 @@ import numpy as np
 
 from excite_cli.config import MAX_SEED, Problem
 from excite_cli.criteria import NAMES as OBJECTIVES
-from excite_cli.design.excitation import build_excitation
+from excite_cli.design.resolve import build_excitation
 from excite_cli.design.verify import GradientCheck, check_gradient, constraint_jacobian_error
 from excite_cli.errors import ExciteError
 from excite_cli.storage.results import read_iterations

@@ -78,7 +78,7 @@ def test_validation_table_gives_each_run_its_joints_and_mean():
 def test_a_log_gets_one_line_per_finished_iteration():
     out = io.StringIO()
     with Bars(Console(file=out, width=200, force_terminal=False)) as bars:
-        progress, done = bars.iterations(load_problem(CONFIGS / "smoke.yaml"))
+        progress, done = bars.iterations(load_problem(CONFIGS / "smoke.yaml").optimizer)
         progress(1)(0, 5, -3.0)
         done(_iteration())
     assert "iteration 1: cond(C(i)) 12.3, cond(C) 12.3, 0 s, 200 solver iterations, stop: stalled" in out.getvalue()
@@ -90,7 +90,7 @@ def test_a_log_gets_a_progress_line_every_log_period_while_an_iteration_runs():
     out, now = io.StringIO(), [0.0]
     problem = load_problem(CONFIGS / "smoke.yaml")
     with Bars(Console(file=out, width=200, force_terminal=False), clock=lambda: now[0]) as bars:
-        hook = bars.iterations(problem)[0](1)
+        hook = bars.iterations(problem.optimizer)[0](1)
         for t, it in ((10.0, 5), (29.0, 10), (31.0, 20), (40.0, 25)):
             now[0] = t
             hook(0, it, -3.0)

@@ -12,7 +12,7 @@ from excite_cli.collision.capsules import capsule_frames, segment_ends
 from excite_cli.collision.segments import segment_closest_points
 from excite_cli.config_file import load_problem
 from excite_cli.constraints.self_collision import SelfCollision
-from excite_cli.design.excitation import build_excitation
+from excite_cli.design.resolve import build_excitation
 from excite_cli.design.verify import constraint_jacobian_error
 from excite_cli.errors import ExciteError
 

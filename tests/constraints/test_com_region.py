@@ -5,7 +5,7 @@ from conftest import CONFIGS
 
 from excite_cli.config_file import load_problem
 from excite_cli.constraints.com_region import ComRegion
-from excite_cli.design.excitation import build_excitation
+from excite_cli.design.resolve import build_excitation
 from excite_cli.design.verify import constraint_jacobian_error
 
 

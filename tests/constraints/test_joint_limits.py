@@ -6,7 +6,7 @@ from conftest import small
 
 from excite_cli.constraints.joint_limits import JointLimits
 from excite_cli.constraints.lse import GRID_MARGIN, SHARPNESS
-from excite_cli.design.excitation import build_excitation
+from excite_cli.design.resolve import build_excitation
 from excite_cli.design.verify import constraint_jacobian_error
 
 

@@ -14,7 +14,7 @@ from typer.testing import CliRunner
 from excite_cli.cli import app
 from excite_cli.constraints.lse import GRID_MARGIN
 from excite_cli.constraints.torque_limits import TorqueLimits, TorqueUse
-from excite_cli.design.excitation import build_excitation
+from excite_cli.design.resolve import build_excitation
 from excite_cli.dynamics.urdf_source import example_robot_data_root
 
 runner = CliRunner()

@@ -16,7 +16,7 @@ from excite_cli.collision.geometry import link_points
 from excite_cli.config import EnvironmentConfig
 from excite_cli.config_file import load_problem
 from excite_cli.constraints.world_collision import WorldCollision, distance_bound, world_shapes
-from excite_cli.design.excitation import build_excitation
+from excite_cli.design.resolve import build_excitation
 
 runner = CliRunner()
 #: Shapes around each robot (world frame, m): the floor or table plane, a ball, a post.

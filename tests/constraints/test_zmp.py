@@ -11,7 +11,7 @@ from conftest import CONFIGS
 from excite_cli.config_file import load_problem, with_overrides
 from excite_cli.constraints.support import SupportPolygon
 from excite_cli.constraints.zmp import ZeroMomentPoint, zero_moment_point
-from excite_cli.design.excitation import build_excitation
+from excite_cli.design.resolve import build_excitation
 from excite_cli.design.verify import constraint_jacobian_error
 from excite_cli.errors import ExciteError
 

@@ -9,8 +9,8 @@ from conftest import small
 from excite_cli.config import EffectsConfig, MotorConfig
 from excite_cli.criteria import CRITERIA, NAMES
 from excite_cli.design.criterion import Criterion, condition_number
-from excite_cli.design.excitation import build_excitation
 from excite_cli.design.noise import RowNoise
+from excite_cli.design.resolve import build_excitation
 from excite_cli.design.verify import check_gradient, finite_difference_gradient
 from excite_cli.errors import ExciteWarning
 

@@ -27,9 +27,9 @@ def _report(path, joints, sigma):
 def test_a_rigid_design_has_no_effect_columns_and_a_result_prior_no_weights(optimized):
     problem = load_problem(CONFIGS / "smoke.yaml")
     robot = load_robot(problem.robot, problem.folder)
-    assert design_effects(problem, robot, compute_base_parameters(robot)) is None
+    assert design_effects(problem.effects, problem.folder, robot, compute_base_parameters(robot)) is None
     problem.sequence.prior = str(optimized)  # an optimize result: its rows are the design's own
-    assert measured_prior(problem, robot) is None
+    assert measured_prior(problem.sequence.prior, problem.folder, robot) is None
 
 
 def test_a_report_of_the_problems_joints_weighs_them_and_of_others_is_refused(tmp_path):
@@ -37,11 +37,11 @@ def test_a_report_of_the_problems_joints_weighs_them_and_of_others_is_refused(tm
     robot = load_robot(problem.robot, problem.folder)
     sigma = np.linspace(0.1, 0.7, robot.n_joints)
     problem.sequence.prior = str(_report(tmp_path / "ok.h5", robot.joint_names[::-1], sigma))
-    measured = measured_prior(problem, robot)
+    measured = measured_prior(problem.sequence.prior, problem.folder, robot)
     assert measured.rate == 200.0 and measured.joints == robot.joint_names[::-1]
     problem.sequence.prior = str(_report(tmp_path / "other.h5", ["shoulder_pan_joint"], np.ones(1)))
     with pytest.raises(ExciteError, match=r"sequence\.prior.*identified the joints shoulder_pan_joint"):
-        measured_prior(problem, robot)
+        measured_prior(problem.sequence.prior, problem.folder, robot)
 
 
 def test_predicted_standard_deviations_match_least_squares_on_noisy_data():

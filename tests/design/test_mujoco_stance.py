@@ -9,8 +9,8 @@ from conftest import CONFIGS
 
 from excite_cli.config_file import load_problem
 from excite_cli.constraints.zmp import zero_moment_point
-from excite_cli.design.excitation import build_excitation
 from excite_cli.design.mujoco_stance import TIMESTEP, Stance, play_standing, standing_model
+from excite_cli.design.resolve import build_excitation
 from excite_cli.dynamics.urdf_source import resolve_urdf
 from excite_cli.errors import ExciteError
 

@@ -7,7 +7,7 @@ import pytest
 from conftest import small
 
 from excite_cli.config import NoiseConfig
-from excite_cli.design.excitation import build_excitation
+from excite_cli.design.resolve import build_excitation
 from excite_cli.design.verify import finite_difference_gradient
 from excite_cli.errors import ExciteError
 

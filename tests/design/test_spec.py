@@ -6,11 +6,13 @@ import pickle
 
 import numpy as np
 import pytest
+import yaml
 from conftest import CONFIGS, small
 
 from excite_cli.config_file import load_problem
-from excite_cli.design.excitation import build_design, build_excitation
-from excite_cli.design.spec import resolve
+from excite_cli.design.excitation import build_design
+from excite_cli.design.resolve import build_excitation, resolve
+from excite_cli.design.spec import needs_collision
 
 
 @pytest.fixture(scope="module")
@@ -28,6 +30,21 @@ def test_a_spec_built_in_another_process_is_the_excitation_of_its_config(problem
     assert again.base.names == direct.base.names
     assert again.criterion().value(alpha) == direct.criterion().value(alpha)
     assert [c.name for c in again.constraints] == [c.name for c in direct.constraints]
+    # what the result file stores: the config as run, its own text and where it was read from
+    assert yaml.safe_load(spec.config.effective)["trajectory"]["harmonics"] == 4  # small()'s, not the file's
+    assert spec.config.original == problem.source_text and spec.config.path.endswith("panda_joint_limits.yaml")
+
+
+def test_the_robot_loads_its_collision_geometry_only_for_the_constraints_that_need_it(problem):
+    assert not needs_collision(problem.constraints)  # joint limits only
+    g1 = load_problem(CONFIGS / "g1_arms.yaml").constraints
+    assert needs_collision(g1)  # capsules and the soles' contact points
+    assert needs_collision(
+        g1.model_copy(update={"self_collision": None, "environment": None, "com": None})
+    )  # the ZMP's
+    assert not needs_collision(
+        g1.model_copy(update={"self_collision": None, "environment": None, "com": None, "zmp": None})
+    )
 
 
 def test_the_frame_is_read_only_and_a_frame_changed_in_the_spec_is_the_one_built(problem):

@@ -7,7 +7,7 @@ import pytest
 from conftest import CONFIGS, TESTS
 
 from excite_cli.config_file import load_problem
-from excite_cli.design.excitation import build_excitation
+from excite_cli.design.resolve import build_excitation
 from excite_cli.dynamics.kinematics import BatchKinematics
 
 

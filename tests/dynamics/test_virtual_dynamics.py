@@ -6,7 +6,7 @@ import pinocchio as pin
 import pytest
 from conftest import small
 
-from excite_cli.design.excitation import build_excitation
+from excite_cli.design.resolve import build_excitation
 from excite_cli.dynamics.virtual_dynamics import VirtualDynamics
 
 

@@ -24,7 +24,7 @@ def kept(monkeypatch):
 
 @pytest.fixture(scope="module")
 def results(optimized):
-    from excite_cli.design.excitation import build_excitation
+    from excite_cli.design.resolve import build_excitation
     from excite_cli.storage.results import problem_of_result
 
     excitation = build_excitation(problem_of_result(optimized))

@@ -16,7 +16,7 @@ from typer.testing import CliRunner
 from excite_cli.cli import app
 from excite_cli.config_file import load_problem
 from excite_cli.constraints import accepted
-from excite_cli.design.excitation import build_excitation
+from excite_cli.design.resolve import build_excitation
 from excite_cli.design.verify import finite_difference_gradient
 from excite_cli.search.kkt import (
     ACTIVE_TOLERANCE,
@@ -153,7 +153,7 @@ def test_a_restart_reported_converged_meets_its_tolerance(tmp_path):
     assert run.exit_code == 0, run.output
     assert "Restarts" in run.output and "KKT residual" in run.output
     excitation = build_excitation(load_problem(config))
-    tolerance = excitation.problem.optimizer.optimality_tolerance
+    tolerance = excitation.spec.optimizer.optimality_tolerance
     converged = 0
     with h5py.File(out) as f:
         prior = np.zeros((0, excitation.base.count))

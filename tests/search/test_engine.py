@@ -27,7 +27,8 @@ import excite_cli.search.engine as engine_module
 import excite_cli.search.scheduler as scheduler_module
 from excite_cli.config import OptimizerConfig
 from excite_cli.config_file import load_problem
-from excite_cli.design.excitation import build_design, build_excitation
+from excite_cli.design.excitation import build_design
+from excite_cli.design.resolve import build_excitation
 from excite_cli.errors import ExciteError
 from excite_cli.search.engine import Engine
 from excite_cli.search.optimizer import RestartResult, best_restart
@@ -170,9 +171,8 @@ def test_workers_optimize_in_the_main_process_base(excitation):
         names=[base.names[k] for k in order],
         independent=base.independent[order],
     )
-    problem = excitation.problem.model_copy(deep=True)
-    problem.optimizer.scaling = "none"  # the frame L belongs to the base's order, which this test changes alone
-    other = build_design(dataclasses.replace(excitation.spec, base=shuffled, problem=problem))
+    optimizer = excitation.spec.optimizer.model_copy(update={"scaling": "none"})  # the frame L belongs to the
+    other = build_design(dataclasses.replace(excitation.spec, base=shuffled, optimizer=optimizer))  # base's order
     prior = other.criterion().regressor(other.random_start(np.random.default_rng(3)))
     tasks = [RestartTask(1, r, 5, prior, iterations=5) for r in range(2)]
     with Engine(other, workers=2) as engine:
@@ -228,6 +228,7 @@ def _dask_cluster(port: int) -> Iterator[tuple[str, subprocess.Popen]]:
                 process.wait(20)
 
 
+@pytest.mark.end_to_end
 def test_a_dask_worker_killed_mid_run_gives_the_uninterrupted_result(tmp_path):
     """Real `dask scheduler` and `dask worker` processes; one worker process is killed (SIGKILL) while
     it runs a restart: the scheduler gives the task to a worker again (restarts are pure functions
@@ -286,6 +287,7 @@ def _kill_when(process: subprocess.Popen, ready, kill, deadline_s: float = 180) 
     return False
 
 
+@pytest.mark.end_to_end
 def test_a_cluster_that_loses_every_worker_stops_with_one_line_and_keeps_the_finished_iterations(tmp_path):
     """Real `dask scheduler` and `dask worker` processes; once iteration 1 is written the whole worker
     (its nanny and processes) is killed: the run stops after optimizer.worker_wait seconds without a

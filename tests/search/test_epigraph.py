@@ -8,7 +8,7 @@ import numpy as np
 from conftest import UR5, write_config
 
 from excite_cli.config_file import load_problem
-from excite_cli.design.excitation import build_excitation
+from excite_cli.design.resolve import build_excitation
 from excite_cli.search import nlp
 from excite_cli.search.kkt import CONVERGED, extreme_clusters
 from excite_cli.search.nlp import Epigraph, Evaluations
@@ -52,8 +52,8 @@ def test_a_log_cond_restart_ends_clarke_stationary_at_a_kink(tmp_path):
     Clarke's measure meets it: the restart converged at the non-smooth optimum. (One iteration as
     optimize runs it: its process holds one BLAS thread, so the solver's path is the same anywhere.)"""
     excitation = _small_ur5(tmp_path, "log_cond")
-    excitation.problem.optimizer.restarts = 1
-    tolerance = excitation.problem.optimizer.optimality_tolerance
+    excitation.spec.optimizer.restarts = 1
+    tolerance = excitation.spec.optimizer.optimality_tolerance
     criterion = excitation.criterion()
     iteration = run_sequence(excitation, 1, seed=1)[0]
     result = next(r for r in iteration.restarts if r.index == iteration.kept)

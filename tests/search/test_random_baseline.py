@@ -12,7 +12,7 @@ from typer.testing import CliRunner
 
 from excite_cli.cli import app
 from excite_cli.config_file import load_problem
-from excite_cli.design.excitation import build_excitation
+from excite_cli.design.resolve import build_excitation
 from excite_cli.search.engine import Engine
 from excite_cli.search.random_baseline import DrawTask, draw_pool, greedy_selection, random_candidate
 

@@ -16,7 +16,8 @@ from conftest import UR5, write_config
 from threadpoolctl import threadpool_limits
 
 from excite_cli.config_file import load_problem
-from excite_cli.design.excitation import build_design, build_excitation
+from excite_cli.design.excitation import build_design
+from excite_cli.design.resolve import build_excitation
 from excite_cli.search.engine import Engine
 from excite_cli.search.restarts import RestartTask
 from excite_cli.search.sequence import run_sequence

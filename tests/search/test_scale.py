@@ -8,7 +8,7 @@ import numpy as np
 from conftest import small
 
 from excite_cli.constraints import accepted
-from excite_cli.design.excitation import build_excitation
+from excite_cli.design.resolve import build_excitation
 from excite_cli.search import optimizer, solvers
 from excite_cli.search.kkt import SOLVER_FAILED
 from excite_cli.search.optimizer import own_scale

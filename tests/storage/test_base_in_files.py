@@ -7,7 +7,7 @@ import pytest
 from conftest import CONFIGS
 
 from excite_cli.config_file import load_problem
-from excite_cli.design.excitation import build_excitation
+from excite_cli.design.resolve import build_excitation
 from excite_cli.errors import ExciteError
 from excite_cli.h5 import read_strings, write_strings
 from excite_cli.search.sequence import describe

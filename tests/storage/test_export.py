@@ -9,7 +9,7 @@ import yaml
 from rosbags.typesys import Stores, get_typestore
 
 from excite_cli.config_file import load_problem, with_overrides
-from excite_cli.design.excitation import build_excitation
+from excite_cli.design.resolve import build_excitation
 from excite_cli.errors import ExciteError
 from excite_cli.search.sequence import describe
 from excite_cli.storage.export import Export, columns, export_trajectory, write_export

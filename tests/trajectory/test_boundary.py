@@ -5,7 +5,7 @@ import pytest
 from conftest import CONFIGS, small
 
 from excite_cli.config_file import load_problem
-from excite_cli.design.excitation import build_excitation
+from excite_cli.design.resolve import build_excitation
 from excite_cli.errors import ExciteError
 from excite_cli.trajectory.boundary import BoundaryConditions, boundary_rows
 from excite_cli.trajectory.fourier import FourierTrajectory
@@ -21,7 +21,7 @@ def _excitation(boundary="rest", ends_at_home=False, duration=None, harmonics=4)
 
 
 def _ends(excitation, alpha):
-    T = excitation.problem.trajectory.duration
+    T = excitation.spec.trajectory.duration
     return excitation.trajectory.basis(np.array([0.0, T])).evaluate(alpha)
 
 

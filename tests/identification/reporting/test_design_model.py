@@ -8,7 +8,7 @@ from typer.testing import CliRunner
 
 from excite_cli.cli import app
 from excite_cli.config_file import load_problem
-from excite_cli.design.excitation import build_excitation
+from excite_cli.design.resolve import build_excitation
 from excite_cli.errors import ExciteError
 from excite_cli.h5 import read_strings
 from excite_cli.identification.reporting.design_model import (
@@ -86,8 +86,8 @@ def test_a_second_of_recording_weighs_as_a_second_on_the_cost_grid():
     information matrix equals the cost grid's (both are Riemann sums of ∫ YᵀY dt per second)."""
     excitation = build_excitation(load_problem(CONFIGS / "smoke.yaml"))
     alpha = excitation.random_start(np.random.default_rng(3))
-    period = excitation.problem.trajectory.cost_period
-    duration = excitation.problem.trajectory.duration
+    period = excitation.spec.trajectory.cost_period
+    duration = excitation.spec.trajectory.duration
     fine = excitation.trajectory.basis(np.arange(0.0, duration, period / 7.0))
     Y = excitation.robot.regressor_stack(*fine.evaluate(alpha))[:, excitation.base.independent]
     prior = MeasuredPrior(excitation.robot.joint_names, np.ones(excitation.robot.n_joints), 7.0 / period)
