@@ -3,6 +3,7 @@ sections (:mod:`~excite_cli.config.constraints`) and what every config shares
 (:mod:`~excite_cli.config.base`), validated once at load (pydantic)."""
 
 from excite_cli.config.base import (
+    COULOMB_VELOCITY,
     MAX_FINE,
     MAX_GRID,
     MAX_HARMONICS,
@@ -37,6 +38,7 @@ from excite_cli.config.problem import (
 )
 
 __all__ = [
+    "COULOMB_VELOCITY",
     "MAX_FINE",
     "MAX_GRID",
     "MAX_HARMONICS",

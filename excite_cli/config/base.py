@@ -28,6 +28,9 @@ MAX_SEED = 2**32 - 1
 SCHEDULER_ADDRESS = re.compile(r"^((tcp|tls)://)?(\[[0-9a-fA-F:]+\]|[\w.-]+):\d{1,5}$")
 #: Largest number of local worker processes.
 MAX_WORKERS = 256
+#: v_c [rad/s] of the smooth sign tanh(q̇/v_c) of Coulomb friction, by default in every config that has
+#: one (identify, simulate, the design's effect columns) and in a report that does not store its own.
+COULOMB_VELOCITY = 0.01
 
 
 class FieldProblem(ValueError):

@@ -8,7 +8,7 @@ from typing import Literal, Optional
 
 from pydantic import Field, PositiveFloat, field_validator
 
-from excite_cli.config.base import Section
+from excite_cli.config.base import COULOMB_VELOCITY, Section
 
 #: The effects a joint's columns can hold: linear in their coefficients and in the motion, so the
 #: optimizer can excite them (Coulomb through a smooth sign).
@@ -53,7 +53,7 @@ class EffectsConfig(Section):
     """{joint or '*': [coulomb, viscous, armature, offset]}: each a column on that joint's row."""
     motors: list[MotorConfig] = Field(default_factory=list)
     """Coupled motors, each with its inertia, Coulomb and viscous friction in the motor coordinate."""
-    coulomb_velocity: PositiveFloat = 0.01
+    coulomb_velocity: PositiveFloat = COULOMB_VELOCITY
     """v_c [rad/s] of the smooth sign tanh(q̇/v_c) of Coulomb friction (as identify's default)."""
     model: Optional[str] = None
     """An identify report whose chosen effects are added (its v_c taken); relative to this file."""

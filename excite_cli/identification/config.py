@@ -11,7 +11,7 @@ import numpy as np
 from pydantic import Field, NonNegativeFloat, PositiveFloat, field_validator, model_validator
 from pydantic.json_schema import SkipJsonSchema
 
-from excite_cli.config import Problem, RobotConfig, Section
+from excite_cli.config import COULOMB_VELOCITY, Problem, RobotConfig, Section
 from excite_cli.config.effects import MAX_RATIO
 from excite_cli.identification.effects import EFFECT_NAMES, SHAPE_GRID
 
@@ -250,7 +250,7 @@ class IdentificationConfig(Section):
     """K, time-block folds of the cross-validation."""
     min_improvement: float = Field(0.02, ge=0.0, lt=1.0)
     """Cut [1] of the cross-validated error every effect must buy (a fraction)."""
-    coulomb_velocity: PositiveFloat = 0.01
+    coulomb_velocity: PositiveFloat = COULOMB_VELOCITY
     """v_c of the smooth sign tanh(q̇/v_c) [rad/s]."""
     stribeck_velocity: list[PositiveFloat] = Field(default_factory=lambda: list(SHAPE_GRID), min_length=1)
     """The grid [rad/s] the search picks Stribeck's v_s from (one value fixes it)."""

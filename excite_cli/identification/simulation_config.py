@@ -7,7 +7,7 @@ from typing import Literal, Optional, Union
 
 from pydantic import Field, model_validator
 
-from excite_cli.config import MAX_SEED, Section
+from excite_cli.config import COULOMB_VELOCITY, MAX_SEED, Section
 from excite_cli.identification.config import MAX_RATE, Effect, TransmissionConfig
 
 
@@ -30,7 +30,7 @@ class SimulationConfig(Section):
     """{effect: {joint or '*': coefficient}}: the identification's coefficients [in their units: Nm, Nm·s/rad]."""
     stribeck_velocity: float = Field(0.1, gt=0.0)
     """Stribeck's v_s [rad/s]."""
-    coulomb_velocity: float = Field(0.01, gt=0.0)
+    coulomb_velocity: float = Field(COULOMB_VELOCITY, gt=0.0)
     """v_c of the smooth sign [rad/s]."""
     held_velocity: float = Field(0.02, gt=0.0)
     """Held friction's v_h [rad/s]."""

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from excite_cli.config import EffectsConfig, MotorConfig
+from excite_cli.config import COULOMB_VELOCITY, EffectsConfig, MotorConfig
 from excite_cli.dynamics.effect_columns import MOTOR_KINDS, coefficient_name
 from excite_cli.errors import ExciteError, ExciteWarning
 from excite_cli.h5 import open_h5, read_strings
@@ -61,7 +61,7 @@ def read_report_model(path: Path) -> ReportModel:
         g = f["identification"]
         rows, coupling = g["effects"][()], g["effect_coupling"][()]
         names = read_strings(g, "joint_names")
-        velocity = float(g.attrs.get("coulomb_velocity_rad_s", 0.01))
+        velocity = float(g.attrs.get("coulomb_velocity_rad_s", COULOMB_VELOCITY))
     missing = [name for name in ("effect", "joint") if name not in (rows.dtype.names or ())]
     if missing:
         raise ExciteError("effects.model", f"{path}: /identification/effects has no field '{missing[0]}' (damaged?)")
