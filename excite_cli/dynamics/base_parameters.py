@@ -53,12 +53,21 @@ class BaseParameters:
         regrouping: K, (b, p): φ_B = K φ.
         names: (b,) readable names, e.g. ``Izz_link2 + 0.09·m_link3``.
         independent: (b,) indices of the standard parameters X selects: Y_B = Y[:, independent].
+
+    The arrays are read-only copies: one base is shared by every user in a process, and shipped to
+    every worker.
     """
 
     composition_matrix: np.ndarray
     regrouping: np.ndarray
     names: list[str]
     independent: np.ndarray
+
+    def __post_init__(self) -> None:
+        for name in ("composition_matrix", "regrouping", "independent"):
+            value = np.array(getattr(self, name))
+            value.flags.writeable = False
+            object.__setattr__(self, name, value)
 
     @property
     def count(self) -> int:
