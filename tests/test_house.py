@@ -121,22 +121,8 @@ FLOORS = (
     "cli",
     "__main__",
 )
-ROLE_FOLDERS = {
-    "criteria",
-    "config",
-    "trajectory",
-    "dynamics",
-    "collision",
-    "constraints",
-    "identification",
-    "design",
-    "search",
-    "drafting",
-    "storage",
-    "plots",
-    "workflows",
-    "console",
-}
+#: The role folders: the floors that are folders.
+ROLE_FOLDERS = {name for name in FLOORS if (PACKAGE / name).is_dir()}
 #: Modules outside the role folders: the entry points and what every stage shares.
 TOP_LEVEL = set(FLOORS) - ROLE_FOLDERS
 

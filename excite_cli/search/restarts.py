@@ -65,16 +65,47 @@ class RestartTask:
         )
 
 
-def run_restarts(
-    excitation: Excitation,
-    engine: Engine,
-    k: int,
-    seed: int,
-    prior: np.ndarray,
-    hook: Optional[ProgressHook] = None,
-) -> list[RestartResult]:
-    """The restarts of iteration k: ``optimizer.restarts`` solver runs of ``max_iterations``, each from
-    its own random start.
+@dataclass(frozen=True)
+class RestartContext:
+    """What the restarts of one iteration share.
+
+    Attributes:
+        excitation: the design; engine: where the restarts run.
+        k: the iteration, 1-based; seed: the run's seed (``optimizer.seed``).
+        prior: C₀ (m, b), the rows stacked above the trajectory's regressor (Eq. 41).
+        deadline: the iteration's time budget ends here [s, ``time.perf_counter``].
+        hook: progress (restart index, solver iteration, objective), or None.
+    """
+
+    excitation: Excitation
+    engine: Engine
+    k: int
+    seed: int
+    prior: np.ndarray
+    deadline: float
+    hook: Optional[ProgressHook] = None
+
+    @classmethod
+    def starting(
+        cls, excitation: Excitation, engine: Engine, k: int, seed: int, prior: np.ndarray, hook=None
+    ) -> "RestartContext":
+        """The context of iteration k beginning now: its deadline ``optimizer.time_budget`` seconds away."""
+        return cls(
+            excitation, engine, k, seed, prior, time.perf_counter() + excitation.spec.optimizer.time_budget, hook
+        )
+
+    def task(self, index: int, start=None, iterations=None, scale=None) -> RestartTask:
+        """Restart ``index`` of the iteration (:class:`RestartTask`), its time limit what is left."""
+        return RestartTask(self.k, index, self.seed, self.prior, start, iterations, _left(self.deadline), scale)
+
+    def run(self, tasks: list[RestartTask], hook: Optional[ProgressHook]) -> list[RestartResult]:
+        """``tasks`` on the engine, ``hook`` told of each solver iteration and of each result."""
+        return self.engine.run(tasks, hook, (lambda r: hook(r.index, r.iterations, r.objective)) if hook else None)
+
+
+def run_restarts(context: RestartContext) -> list[RestartResult]:
+    """The restarts of the context's iteration: ``optimizer.restarts`` solver runs of
+    ``max_iterations``, each from its own random start.
 
     With screening (``optimizer.starts`` > ``restarts``), ``starts`` runs of ``screen_iterations``
     first, then the ``restarts`` with the lowest objective among those that succeeded
@@ -82,42 +113,30 @@ def run_restarts(
     the others are kept with the stop reason ``screened out``. Which ones continue depends only on
     the screened results, so it does not depend on where they ran.
 
-    Every solver run stops once ``optimizer.time_budget`` seconds have passed since the iteration
-    began (its time limit is what remains of the budget when its round begins).
+    Every solver run stops at the context's deadline (its time limit is what remains of the budget
+    when its round begins).
 
     When none succeeded, more starts run, as many at a time as the first round, each screened and
-    continued the same way, until one succeeds or ``optimizer.time_budget`` seconds have passed since
-    the iteration began. Each start's seed depends only on its index, so where it succeeds does not
-    depend on the machine (unless the budget ends the search first).
+    continued the same way, until one succeeds or the deadline has passed. Each start's seed depends
+    only on its index, so where it succeeds does not depend on the machine (unless the budget ends the
+    search first).
 
     Returns:
         Every start's :class:`RestartResult`, by index (a continued one with its screening's start
         value, iterations and history included).
     """
-    opts = excitation.spec.optimizer
+    opts = context.excitation.spec.optimizer
     count = opts.screened or opts.restarts
-    deadline = time.perf_counter() + opts.time_budget
-    runs = _restart_round(excitation, engine, k, seed, prior, range(count), hook, deadline)
-    while not any(r.succeeded for r in runs) and time.perf_counter() < deadline:
-        more = range(len(runs), len(runs) + count)
-        runs += _restart_round(excitation, engine, k, seed, prior, more, hook, deadline)
+    runs = _restart_round(context, range(count))
+    while not any(r.succeeded for r in runs) and _left(context.deadline) > 0.0:
+        runs += _restart_round(context, range(len(runs), len(runs) + count))
     return runs
 
 
-def polish(
-    excitation: Excitation,
-    engine: Engine,
-    k: int,
-    seed: int,
-    prior: np.ndarray,
-    runs: list[RestartResult],
-    kept: int,
-    deadline: float,
-    hook: Optional[ProgressHook] = None,
-) -> list[RestartResult]:
+def polish(context: RestartContext, runs: list[RestartResult], kept: int) -> list[RestartResult]:
     """``runs`` with the restart of index ``kept`` continued from its end point until it converges:
     at most ``optimizer.polish_rounds`` solver runs of ``max_iterations`` each, every one from a fresh
-    quasi-Newton matrix, while time is left before ``deadline`` (``time.perf_counter``).
+    quasi-Newton matrix, while time is left before the context's deadline.
 
     A BFGS matrix built along a long path can stop describing the curvature where the path ends:
     SLSQP then takes steps too short to move the objective and stops "stalled" or at its limit short
@@ -127,62 +146,45 @@ def polish(
     iterations, to a lower value. A continuation that fails or ends higher is not kept.
 
     Args:
-        k: the iteration, 1-based; seed: the run's seed; prior: C₀ (m, b) of the iteration.
+        context: the iteration's (its hook told of the polished restart's iterations counted on from
+            where it stopped).
         runs: every restart of the iteration (:func:`run_restarts`); kept: the index of the one to polish.
-        deadline: the iteration's time budget ends here [s, ``time.perf_counter``].
-        hook: progress, the polished restart's iterations counted on from where it stopped.
 
     Returns:
         ``runs`` with the polished restart in its place, its iterations and history joined; its stop
         is ``time budget`` when the deadline came before it converged.
     """
-    opts, runs = excitation.spec.optimizer, list(runs)
+    opts, runs, hook = context.excitation.spec.optimizer, list(runs), context.hook
     at = next(i for i, r in enumerate(runs) if r.index == kept)
     for _ in range(opts.polish_rounds):
         current = runs[at]
-        if current.stop == CONVERGED or _left(deadline) <= 0.0:
+        if current.stop == CONVERGED or _left(context.deadline) <= 0.0:
             break
-        task = RestartTask(k, kept, seed, prior, current.alpha, opts.max_iterations, _left(deadline), current.scale)
+        task = context.task(kept, current.alpha, opts.max_iterations, current.scale)
         shifted = (lambda r, it, value: hook(r, current.iterations + it, value)) if hook else None
-        more = engine.run([task], shifted, (lambda c: shifted(c.index, c.iterations, c.objective)) if hook else None)[0]
+        more = context.run([task], shifted)[0]
         if not more.succeeded or more.objective > current.objective:
             break
         runs[at] = _joined(current, more)
-    if opts.polish_rounds and runs[at].stop != CONVERGED and _left(deadline) <= 0.0:
+    if opts.polish_rounds and runs[at].stop != CONVERGED and _left(context.deadline) <= 0.0:
         runs[at] = replace(runs[at], stop=TIME_BUDGET)  # not polished to the end: the budget decided
     return runs
 
 
-def _restart_round(
-    excitation: Excitation,
-    engine: Engine,
-    k: int,
-    seed: int,
-    prior: np.ndarray,
-    indices: range,
-    hook: Optional[ProgressHook],
-    deadline: float,
-) -> list[RestartResult]:
-    """The starts ``indices`` of iteration k, screened and continued as :func:`run_restarts` says."""
-    opts = excitation.spec.optimizer
+def _restart_round(context: RestartContext, indices: range) -> list[RestartResult]:
+    """The starts ``indices`` of the context's iteration, screened and continued as :func:`run_restarts` says."""
+    opts, hook = context.excitation.spec.optimizer, context.hook
     iterations = min(opts.screen_iterations, opts.max_iterations) if opts.screened else None
-    tasks = [RestartTask(k, r, seed, prior, None, iterations, _left(deadline)) for r in indices]
-    runs = engine.run(tasks, hook, (lambda r: hook(r.index, r.iterations, r.objective)) if hook else None)
+    runs = context.run([context.task(r, iterations=iterations) for r in indices], hook)
     if not opts.screened or iterations >= opts.max_iterations:
         return runs
     chosen = sorted((r for r in runs if r.succeeded), key=lambda r: (r.objective, r.index))[: opts.restarts]
     if not chosen:  # every screened start failed: nothing to continue
         return runs
-    more = [
-        RestartTask(k, r.index, seed, prior, r.alpha, opts.max_iterations - iterations, _left(deadline), r.scale)
-        for r in chosen
-    ]
+    more = [context.task(r.index, r.alpha, opts.max_iterations - iterations, r.scale) for r in chosen]
     shift = indices.stop  # continuations count on their own in the progress
     shifted = (lambda r, it, value: hook(shift + r, it, value)) if hook else None
-    continued = {
-        c.index: c
-        for c in engine.run(more, shifted, (lambda c: shifted(c.index, c.iterations, c.objective)) if hook else None)
-    }
+    continued = {c.index: c for c in context.run(more, shifted)}
     screened = {r.index: r for r in chosen}
     return [
         _joined(screened[r.index], continued[r.index]) if r.index in continued else replace(r, stop="screened out")

@@ -16,7 +16,7 @@ from excite_cli.design.playback import check_motion, plan_playback
 from excite_cli.errors import ExciteError, NoSolution
 from excite_cli.search.engine import Engine
 from excite_cli.search.optimizer import ProgressHook, RestartResult, best_restart
-from excite_cli.search.restarts import polish, run_restarts
+from excite_cli.search.restarts import RestartContext, polish, run_restarts
 from excite_cli.trajectory.similarity import correlation
 
 
@@ -166,24 +166,15 @@ def kept_restart(excitation: Excitation, runs: Sequence[RestartResult]) -> Resta
     return next(playable, ranked[0])
 
 
-def polish_kept(
-    excitation: Excitation,
-    engine: Engine,
-    k: int,
-    seed: int,
-    prior: np.ndarray,
-    runs: list[RestartResult],
-    deadline: float,
-    hook: Optional[ProgressHook] = None,
-) -> tuple[list[RestartResult], RestartResult]:
+def polish_kept(context: RestartContext, runs: list[RestartResult]) -> tuple[list[RestartResult], RestartResult]:
     """``runs`` with the restart the iteration keeps (:func:`kept_restart`) polished
-    (:func:`~excite_cli.search.restarts.polish`, the same arguments), and that restart. A
+    (:func:`~excite_cli.search.restarts.polish`, in the iteration's ``context``), and that restart. A
     polished end point can lose its playable transitions (seen on the G1: the restart polished to KKT
     9.1e-4 could not be played, and the next one was kept as it was, stalled at 4.4e-2); then the
     restart kept next is polished too, each at most once, so the one kept has always been polished."""
     polished: set[int] = set()
-    while (kept := kept_restart(excitation, runs)).index not in polished:
-        runs = polish(excitation, engine, k, seed, prior, runs, kept.index, deadline, hook)
+    while (kept := kept_restart(context.excitation, runs)).index not in polished:
+        runs = polish(context, runs, kept.index)
         polished.add(kept.index)
     return runs, kept
 
@@ -251,7 +242,8 @@ def run_sequence(
     for k in range(len(finished) + 1, iterations + 1):
         start, stacked = time.perf_counter(), stacked_regressors(excitation, prior, results)
         hook = progress(k) if progress else None
-        runs = run_restarts(excitation, engine, k, seed, stacked, hook)
+        context = RestartContext.starting(excitation, engine, k, seed, stacked, hook)
+        runs = run_restarts(context)
         if not any(r.succeeded for r in runs):
             failures = sorted({f"{r.stop} ({r.end})" for r in runs})
             raise NoSolution(
@@ -260,8 +252,7 @@ def run_sequence(
                 f"{excitation.spec.optimizer.time_budget:g} s ({', '.join(failures)})",
                 expected="more starts or a longer optimizer.time_budget, or limits that leave the robot room",
             )
-        deadline = start + excitation.spec.optimizer.time_budget
-        runs, best = polish_kept(excitation, engine, k, seed, stacked, runs, deadline, hook)
+        runs, best = polish_kept(context, runs)
         result = describe(excitation, k, best.alpha, stacked, time.perf_counter() - start, runs, results, best.index)
         results.append(result)
         if on_iteration:

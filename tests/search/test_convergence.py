@@ -195,7 +195,7 @@ def test_the_kept_restart_continues_from_a_fresh_matrix_until_it_converges(tmp_p
     the last converges, its KKT residual recomputed by central differences. A converged restart, or
     polish_rounds 0, is left as it is; one the deadline leaves unpolished says "time budget"."""
     from excite_cli.search.engine import Engine
-    from excite_cli.search.restarts import RestartTask, polish
+    from excite_cli.search.restarts import RestartContext, RestartTask, polish
 
     problem = load_problem(_small_problem(tmp_path, "log_det"))
     opts = problem.optimizer
@@ -207,12 +207,13 @@ def test_the_kept_restart_continues_from_a_fresh_matrix_until_it_converges(tmp_p
     opts.max_iterations = 40  # rounds long enough to learn the curvature: each keeps the run's scale
     deadline = time.perf_counter() + 600.0
     with Engine(excitation) as serial:
-        polished = polish(excitation, serial, 1, 1, prior, [first], 0, deadline)[0]
-        assert polish(excitation, serial, 1, 1, prior, [polished], 0, deadline)[0] is polished
-        late = polish(excitation, serial, 1, 1, prior, [first], 0, time.perf_counter() - 1.0)[0]
+        context = RestartContext(excitation, serial, 1, 1, prior, deadline)
+        polished = polish(context, [first], 0)[0]
+        assert polish(context, [polished], 0)[0] is polished
+        late = polish(RestartContext(excitation, serial, 1, 1, prior, time.perf_counter() - 1.0), [first], 0)[0]
         assert late.stop == TIME_BUDGET and late.iterations == 15  # not polished: the budget decided
         opts.polish_rounds = 0
-        assert polish(excitation, serial, 1, 1, prior, [first], 0, deadline)[0] is first
+        assert polish(context, [first], 0)[0] is first
     assert polished.stop == CONVERGED and polished.objective < first.objective
     assert polished.iterations > 15 and polished.history.shape == (polished.iterations, 2)
     np.testing.assert_array_equal(polished.history[:15], first.history)
@@ -276,16 +277,16 @@ def test_excitation_level_is_the_scaled_standard_regressor_and_does_not_depend_o
 
 def test_screening_continues_the_best_starts_wherever_they_run(ur5_problem):
     from excite_cli.search.engine import Engine
-    from excite_cli.search.restarts import run_restarts
+    from excite_cli.search.restarts import RestartContext, run_restarts
 
     opts = ur5_problem.optimizer
     opts.restarts, opts.starts, opts.screen_iterations, opts.max_iterations = 2, 5, 8, 30
     excitation = build_excitation(ur5_problem)
     prior = np.zeros((0, excitation.base.count))
     with Engine(excitation) as serial:
-        runs = run_restarts(excitation, serial, 1, 3, prior, None)
+        runs = run_restarts(RestartContext.starting(excitation, serial, 1, 3, prior))
     with Engine(excitation, workers=2) as pool:
-        again = run_restarts(excitation, pool, 1, 3, prior, None)
+        again = run_restarts(RestartContext.starting(excitation, pool, 1, 3, prior))
     assert [r.alpha.tobytes() for r in runs] == [r.alpha.tobytes() for r in again]
     assert [r.index for r in runs] == list(range(5))
     out = [r for r in runs if r.stop == "screened out"]
@@ -323,7 +324,7 @@ def test_when_every_restart_fails_more_starts_run_then_the_run_stops(ur5_problem
     sequence stops with NoSolution (exit 1 on the command line) instead of keeping a start."""
     from excite_cli.errors import NoSolution
     from excite_cli.search.engine import Engine
-    from excite_cli.search.restarts import run_restarts
+    from excite_cli.search.restarts import RestartContext, run_restarts
     from excite_cli.search.sequence import run_sequence
 
     ur5_problem.limits.torque, ur5_problem.limits.min_torque_use = "urdf", 0.95
@@ -331,7 +332,7 @@ def test_when_every_restart_fails_more_starts_run_then_the_run_stops(ur5_problem
     opts.restarts, opts.max_iterations, opts.time_budget = 1, 3, 8.0  # a restart: 2-4 s
     excitation = build_excitation(ur5_problem)
     with Engine(excitation) as serial:
-        runs = run_restarts(excitation, serial, 1, 0, np.zeros((0, excitation.base.count)))
+        runs = run_restarts(RestartContext.starting(excitation, serial, 1, 0, np.zeros((0, excitation.base.count))))
         assert len(runs) >= 2 and [r.index for r in runs] == list(range(len(runs)))
         assert not any(r.succeeded for r in runs) and {r.stop for r in runs} == {"infeasible"}
         assert len({r.start_objective for r in runs}) == len(runs)  # each from a start of its own
@@ -340,5 +341,5 @@ def test_when_every_restart_fails_more_starts_run_then_the_run_stops(ur5_problem
     assert raised.value.status == 1
     opts.starts, opts.screen_iterations, opts.time_budget = 2, 2, 0.001  # screened, none to continue
     with Engine(excitation, workers=2) as pool:
-        screened = run_restarts(excitation, pool, 1, 0, np.zeros((0, excitation.base.count)))
+        screened = run_restarts(RestartContext.starting(excitation, pool, 1, 0, np.zeros((0, excitation.base.count))))
     assert [r.index for r in screened] == [0, 1] and not any(r.succeeded for r in screened)

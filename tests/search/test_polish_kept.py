@@ -19,7 +19,7 @@ def test_the_restart_kept_is_one_that_was_polished(monkeypatch):
     ]
     polished = []
 
-    def polish(excitation, engine, k, seed, prior, runs, kept, deadline, hook=None):
+    def polish(context, runs, kept):
         polished.append(kept)
         done = {"objective": runs[kept].objective - 0.5, "alpha": np.full((1, 3), 10.0 + kept), "stop": CONVERGED}
         return [replace(r, **done) if r.index == kept else r for r in runs]
@@ -29,7 +29,7 @@ def test_the_restart_kept_is_one_that_was_polished(monkeypatch):
 
     monkeypatch.setattr(sequence, "polish", polish)
     monkeypatch.setattr(sequence, "transition_checks", transition_checks)
-    out, kept = sequence.polish_kept(None, None, 1, 0, np.zeros((0, 2)), runs, 0.0)
+    out, kept = sequence.polish_kept(sequence.RestartContext(None, None, 1, 0, np.zeros((0, 2)), 0.0), runs)
     assert polished == [0, 1]
     assert kept is sequence.kept_restart(None, out)
     assert kept.index == 1 and kept.stop == CONVERGED and kept.objective == 1.5
