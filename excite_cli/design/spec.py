@@ -51,7 +51,7 @@ class ConfigText:
 
 @dataclass(frozen=True)
 class DesignSpec:
-    """What one excitation design is built from, resolved once (:func:`resolve`).
+    """What one excitation design is built from, resolved once (:func:`~excite_cli.design.resolve.resolve`).
 
     Attributes:
         robot, trajectory, limits, constraints, optimizer, sequence, noise: the config's sections
