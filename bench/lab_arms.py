@@ -28,7 +28,7 @@ from excite_cli.collision.capsules import capsule_pairs, capsules_from_config
 from excite_cli.config import ConstraintsConfig
 from excite_cli.config_file import load_problem
 from excite_cli.dynamics.robot import load_robot
-from excite_cli.storage.export import export_trajectory
+from excite_cli.workflows.export import played_result
 from excite_cli.workflows.optimize import run_optimize
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -44,7 +44,7 @@ def _coal_capsule(a: np.ndarray, b: np.ndarray) -> coal.Transform3s:
 def played_checks(problem, result: Path) -> tuple[float, float, float]:
     """Lowest moving world capsule above the table [m], closest checked capsule pair [m] (coal) and
     largest |τ|/effort over every 1 kHz sample of the exported last iteration of ``result``."""
-    played = export_trajectory(result, rate=1000.0)
+    played = played_result(result, rate=1000.0)
     robot = load_robot(problem.robot, problem.folder, collision=True)
     env = problem.constraints.environment
     table = next(s for s in env.shapes if s.type == "half_space")

@@ -19,11 +19,12 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
+from excite_cli.config_file import result_problem
 from excite_cli.dynamics.robot import Robot
 from excite_cli.identification.effects import Term
 from excite_cli.identification.fitting.least_squares import predict, torque_errors
 from excite_cli.identification.reporting.mjcf_out import urdf_spec, weld_joints
-from excite_cli.storage.results import problem_of_result, read_alphas
+from excite_cli.storage.results import read_alphas
 from excite_cli.trajectory.fourier import FourierTrajectory
 
 #: MuJoCo's step [s] and the steps per controller tick (1 kHz).
@@ -97,7 +98,7 @@ def arm_model(urdf: Path, active: list[str], physics: ArmPhysics):
 def record(mujoco, model, robot: Robot, result: Path, periods: int, seed: int, folder: Path, prefix: str) -> list[Path]:
     """Play every iteration of the optimize ``result`` ``periods`` times in MuJoCo's arm and write the
     recordings ``folder``/``prefix``_k.csv (time, q_<joint>, tau_<joint>; module docstring)."""
-    problem = problem_of_result(result)
+    problem = result_problem(result)
     trajectory = FourierTrajectory(problem.trajectory.harmonics, problem.trajectory.base_frequency)
     rng = np.random.default_rng(seed)
     names = robot.joint_names

@@ -23,11 +23,11 @@ import matplotlib.image
 import numpy as np
 import pinocchio as pin
 
+from excite_cli.config_file import result_problem
 from excite_cli.constraints.world_collision import world_shapes
 from excite_cli.dynamics.robot import load_robot
 from excite_cli.plots.scene import write_scene
-from excite_cli.storage.export import export_trajectory
-from excite_cli.storage.results import problem_of_result
+from excite_cli.workflows.export import played_result
 from excite_cli.workflows.view import run_view
 
 #: Pixels that must change when the robot is drawn (of 1000 × 700).
@@ -51,10 +51,10 @@ def main(result: Path) -> int:
         print("view check skipped: no chromium (make view-check installs it as root)")
         return 0
     scene = run_view(result, output=result.with_name(result.stem + "_view.html"), rate=10.0, force=True)
-    problem = problem_of_result(result)
+    problem = result_problem(result)
     robot = replace(load_robot(problem.robot, problem.folder, collision=True), collision_model=pin.GeometryModel())
     shapes = world_shapes(problem.constraints.environment)  # drawn in both: only the robot's pixels differ
-    played = export_trajectory(result, rate=10.0).q
+    played = played_result(result, rate=10.0).q
     empty = write_scene(result.with_name(result.stem + "_view_empty.html"), robot, played, 10.0, shapes)
     changed = int((np.abs(screenshot(browser, scene) - screenshot(browser, empty)).max(axis=2) > 0.1).sum())
     print(f"{scene}: {changed} pixels show the robot (at least {MIN_PIXELS}); screenshot {scene.with_suffix('.png')}")

@@ -15,8 +15,9 @@ from pathlib import Path
 import yaml
 from pydantic import BaseModel, ValidationError
 
-from excite_cli.config import FieldProblem, Problem
+from excite_cli.config import ConfigFile, FieldProblem, Problem
 from excite_cli.errors import NO_VALUE, ExciteError
+from excite_cli.h5 import open_h5
 from excite_cli.inputs import input_file
 
 #: Largest YAML file read [bytes]; a config or an effects file is a few kB.
@@ -202,10 +203,47 @@ def with_overrides(config: BaseModel, overrides: dict[str, object]) -> BaseModel
         copy = type(config).model_validate(data)
     except ValidationError as error:
         raise _validation_error(None, error) from None
-    for name in ("source_path", "source_text"):
-        if name in type(config).model_fields:
-            setattr(copy, name, getattr(config, name))
+    if isinstance(config, ConfigFile):
+        copy.source_path, copy.source_text = config.source_path, config.source_text
     return copy
+
+
+def result_problem(path: Path) -> Problem:
+    """The optimize config an excite result stores (its attribute ``config``), relative paths resolved
+    from the config's original place (the attribute ``config_path``).
+
+    Raises:
+        ExciteError: missing or unreadable file, or no valid stored config (not an excite result).
+    """
+    with open_h5(path) as f:
+        if "config" not in f.attrs or "iterations" not in f:
+            raise ExciteError(
+                "result", f"{path} is not an excite optimize result (no stored config or /iterations)", path
+            )
+        text, origin = str(f.attrs["config"]), str(f.attrs.get("config_path", ""))
+    try:
+        problem = Problem.model_validate(parse_yaml(text, str(path), "result"))
+    except (ExciteError, ValidationError):
+        raise ExciteError(
+            "result",
+            f"the stored config of {path} is not a valid optimize problem (not an excite optimize result?)",
+            path,
+        ) from None
+    problem.source_path = Path(origin) if origin else None
+    problem.source_text = text
+    return problem
+
+
+def drafted_problem(config: dict, target: Path) -> Problem:
+    """A drafted optimize config ``config`` (as YAML would give it) validated as the file ``target``
+    it will be written to (relative paths are beside it).
+
+    Raises:
+        pydantic.ValidationError: a draft that is not a valid config (a drafting bug, not the user's).
+    """
+    problem = Problem.model_validate(config)
+    problem.source_path = Path(target).resolve()
+    return problem
 
 
 def load_config(path: str | Path, overrides: dict[str, object] | None = None, kind: str = "optimize") -> BaseModel:

@@ -12,8 +12,8 @@ from excite_cli.atomic import atomic_folder, atomic_folders, atomic_path
 from excite_cli.config_file import load_problem
 from excite_cli.errors import CannotWrite, ExciteError, ExciteWarning, FileNotFound, OutputExists
 from excite_cli.h5 import open_h5
-from excite_cli.storage.export import export_trajectory
 from excite_cli.storage.paths import check_target
+from excite_cli.workflows.export import played_result
 
 
 def test_a_config_value_out_of_range_names_its_field_value_and_file(tmp_path):
@@ -27,10 +27,10 @@ def test_a_config_value_out_of_range_names_its_field_value_and_file(tmp_path):
 
 def test_library_errors_name_arguments_not_flags(tmp_path):
     with pytest.raises(FileNotFound) as missing:
-        export_trajectory(tmp_path / "none.h5")
+        played_result(tmp_path / "none.h5")
     assert (missing.value.field, missing.value.value) == ("result", tmp_path / "none.h5")
     with pytest.raises(ExciteError) as rate:
-        export_trajectory(tmp_path / "none.h5", rate=-1.0)
+        played_result(tmp_path / "none.h5", rate=-1.0)
     assert (rate.value.field, rate.value.value) == ("rate", -1.0) and "100000" in rate.value.expected
     (tmp_path / "there.h5").write_bytes(b"")
     with pytest.raises(OutputExists) as exists:

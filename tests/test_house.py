@@ -213,19 +213,33 @@ def test_tests_mirror_the_package_and_every_module_is_tested_in_its_own_folder()
     assert untested == []
 
 
-#: The whole problems, as a module can import them: from their package or their own module.
-_PROBLEMS = {
-    "excite_cli.config.Problem",
-    "excite_cli.config.problem.Problem",
-    "excite_cli.identification.config.IdentifyProblem",
-}
+#: The optimize problem, as a module can import it: from its package or its own module.
+_OPTIMIZE_PROBLEM = {"excite_cli.config.Problem", "excite_cli.config.problem.Problem"}
+#: Where the whole optimize problem may be read: the config and its loader, the commands' workflows,
+#: and the one module that resolves it into the design (``excite_cli.design.spec.DesignSpec``).
+_PROBLEM_READERS = ("excite_cli.config", "excite_cli.config_file", "excite_cli.workflows", "excite_cli.design.resolve")
 
 
-def test_lower_floors_take_sections_and_values_not_whole_problems():
+def test_only_the_config_its_loader_the_workflows_and_the_resolver_read_the_optimize_problem():
+    """No module but the config's own, its loader, the workflows and ``design/resolve.py`` imports the
+    whole optimize ``Problem``: the design, its search and its storage take a ``DesignSpec`` or the
+    sections they use, and a workflow is what reads a config (from a file, a result or a draft) into
+    them."""
+    offenders = [
+        name
+        for name, tree in _modules().items()
+        if name not in _PROBLEM_READERS
+        and not name.startswith(tuple(f"{reader}." for reader in _PROBLEM_READERS))
+        and _OPTIMIZE_PROBLEM & _imports(tree)
+    ]
+    assert offenders == []
+
+
+def test_lower_floors_take_sections_and_values_not_the_identify_problem():
     """Robots, data, constraints, trajectories, the identification's measured, fitting and choice rooms,
-    the design (but the one module that resolves the config into it), the search, the plots and the
-    printed tables are handed the config section or the value they use, never a whole problem (the
-    report and result files store the whole config, so reporting and storage may take it)."""
+    the design, the search, the plots and the printed tables are handed the identify config's section
+    or the value they use, never the whole ``IdentifyProblem`` (the report stores the whole config, so
+    the identification's pipeline and reporting may take it)."""
     lower = (
         "dynamics",
         "collision",
@@ -243,8 +257,7 @@ def test_lower_floors_take_sections_and_values_not_whole_problems():
         name
         for name, tree in _modules().items()
         if name.removeprefix("excite_cli.").startswith(lower)
-        and name != "excite_cli.design.resolve"
-        and _PROBLEMS & _imports(tree)
+        and "excite_cli.identification.config.IdentifyProblem" in _imports(tree)
     ]
     assert offenders == []
 

@@ -9,6 +9,7 @@ from excite_cli.config.base import (
     MAX_HARMONICS,
     MAX_SEED,
     MAX_WORKERS,
+    ConfigFile,
     FieldProblem,
     Fraction,
     PerJoint,
@@ -39,6 +40,7 @@ from excite_cli.config.problem import (
 
 __all__ = [
     "COULOMB_VELOCITY",
+    "ConfigFile",
     "MAX_FINE",
     "MAX_GRID",
     "MAX_HARMONICS",

@@ -11,6 +11,7 @@ from typing import Annotated, Optional, Union
 
 import yaml
 from pydantic import BaseModel, ConfigDict, Field
+from pydantic.json_schema import SkipJsonSchema
 
 PerJoint = Union[float, dict[str, float]]
 #: A fraction in (0, 1).
@@ -47,6 +48,21 @@ class Section(BaseModel):
     docstring is its description in the JSON Schema and the generated config reference."""
 
     model_config = ConfigDict(extra="forbid", allow_inf_nan=False, use_attribute_docstrings=True)
+
+
+class ConfigFile(Section):
+    """A whole config file (optimize, identify): the file it was read from and its text, which the
+    loader sets (neither is in the file)."""
+
+    source_path: SkipJsonSchema[Optional[Path]] = Field(None, exclude=True)
+    """The file it was read from (set by the loader, not in the file)."""
+    source_text: SkipJsonSchema[str] = Field("", exclude=True)
+    """The file's text (set by the loader)."""
+
+    @property
+    def folder(self) -> Optional[Path]:
+        """The config file's folder, which relative paths in it are relative to (None without a file)."""
+        return None if self.source_path is None else self.source_path.parent
 
 
 def resolve_path(path: str, folder: Optional[Path]) -> Path:

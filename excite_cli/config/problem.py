@@ -5,11 +5,9 @@ docstring is its description with its unit (``excite schema``, the config refere
 from __future__ import annotations
 
 import math
-from pathlib import Path
 from typing import Literal, Optional, Union
 
 from pydantic import Field, PositiveFloat, field_serializer, field_validator, model_validator
-from pydantic.json_schema import SkipJsonSchema
 
 from excite_cli.config.base import (
     MAX_FINE,
@@ -18,6 +16,7 @@ from excite_cli.config.base import (
     MAX_SEED,
     MAX_WORKERS,
     SCHEDULER_ADDRESS,
+    ConfigFile,
     FieldProblem,
     Fraction,
     PerJoint,
@@ -206,7 +205,7 @@ class SequenceConfig(Section):
     """HDF5 file of prior data C₀: an excite result or a file with /regressor (rows × b), or none."""
 
 
-class Problem(Section):
+class Problem(ConfigFile):
     """An ``optimize`` problem: the whole YAML file, validated."""
 
     robot: RobotConfig
@@ -229,11 +228,6 @@ class Problem(Section):
     """compare-random's candidates."""
     output: str = "results/excite.h5"
     """Path of the HDF5 result (relative to the working directory)."""
-
-    source_path: SkipJsonSchema[Optional[Path]] = Field(None, exclude=True)
-    """The file it was read from (set by the loader, not in the file)."""
-    source_text: SkipJsonSchema[str] = Field("", exclude=True)
-    """The file's text (set by the loader)."""
 
     @model_validator(mode="after")
     def _grid_fits(self) -> "Problem":
@@ -265,8 +259,3 @@ class Problem(Section):
                 "base period, too little to move in; expected ω × cost_samples × cost_period ≥ π/2",
             )
         return self
-
-    @property
-    def folder(self) -> Optional[Path]:
-        """The config file's folder, which relative paths in it are relative to (None without a file)."""
-        return None if self.source_path is None else self.source_path.parent

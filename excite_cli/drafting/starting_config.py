@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from excite_cli.config import Problem
+from excite_cli.config_file import drafted_problem
 from excite_cli.constraints import SelfCollision
 from excite_cli.constraints.world_collision import WorldCollision
 from excite_cli.design.excitation import Excitation
@@ -155,13 +155,6 @@ TRAJECTORY = {
 OPTIMIZER = {"max_iterations": 400, "restarts": 4, "starts": 16, "screen_iterations": 40}
 
 
-def validated(config: dict, target: Path) -> Problem:
-    """``config`` validated as a :class:`Problem` read from ``target`` (relative paths are beside it)."""
-    problem = Problem.model_validate(config)
-    problem.source_path = Path(target).resolve()
-    return problem
-
-
 def _choose_joints(robot: dict, urdf: Path, joints: list[str] | None, draft: StartingConfig) -> pin.Model:
     """The robot section's joints and ranges (:func:`~excite_cli.drafting.joints.joint_choice`) in
     ``draft``; the file's model, with those ranges."""
@@ -211,7 +204,7 @@ def draft_config(
     draft.config["optimizer"] = dict(OPTIMIZER)
     draft.config["sequence"] = {"iterations": 3}
     draft.config["output"] = f"results/{urdf.stem}.h5"
-    excitation = build_excitation(validated(draft.config, target), check_home=False)
+    excitation = build_excitation(drafted_problem(draft.config, target), check_home=False)
     if not any(isinstance(c, (SelfCollision, WorldCollision)) and c.capsules for c in excitation.constraints):
         draft.config.pop("constraints", None)
         draft.assumptions.pop("constraints.environment", None)
@@ -227,7 +220,7 @@ def draft_config(
     if draft.ignored:
         draft.config["constraints"]["environment"]["ignore_links"] = [link for link, _ in draft.ignored]
     # the same robot: its base parameters need not be computed again
-    excitation = build_excitation(validated(draft.config, target), excitation.base, check_home=False)
+    excitation = build_excitation(drafted_problem(draft.config, target), excitation.base, check_home=False)
     home, why, found = home_posture(excitation, Q, np.random.default_rng(1))
     draft.config["robot"]["home_posture"] = {n: round(float(q), 4) for n, q in zip(active, home)}
     draft.assumptions["robot.home_posture"] = f"searched: {why}" if found else f"FIX FIRST: {why}"

@@ -9,9 +9,8 @@ from typing import Annotated, Literal, Optional, Union
 
 import numpy as np
 from pydantic import Field, NonNegativeFloat, PositiveFloat, field_validator, model_validator
-from pydantic.json_schema import SkipJsonSchema
 
-from excite_cli.config import COULOMB_VELOCITY, Problem, RobotConfig, Section
+from excite_cli.config import COULOMB_VELOCITY, ConfigFile, RobotConfig, Section
 from excite_cli.config.effects import MAX_RATIO
 from excite_cli.identification.effects import EFFECT_NAMES, SHAPE_GRID
 
@@ -277,7 +276,7 @@ class IdentificationConfig(Section):
         return [value] if isinstance(value, (int, float)) else value
 
 
-class IdentifyProblem(Section):
+class IdentifyProblem(ConfigFile):
     """``excite identify`` config: the robot as for ``optimize``, then data, preprocessing, identification."""
 
     robot: RobotConfig
@@ -290,10 +289,3 @@ class IdentifyProblem(Section):
     """The fit and the search for effects the model lacks."""
     output: str = "results/identification.h5"
     """Path of the HDF5 report (relative to the working directory)."""
-
-    source_path: SkipJsonSchema[Optional[Path]] = Field(None, exclude=True)
-    """The file it was read from (set by the loader, not in the file)."""
-    source_text: SkipJsonSchema[str] = Field("", exclude=True)
-    """The file's text (set by the loader)."""
-
-    folder = Problem.folder

@@ -13,16 +13,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
 from excite_cli.atomic import atomic_path
-from excite_cli.config_file import with_overrides
+from excite_cli.design.excitation import Excitation
 from excite_cli.design.playback import check_motion, plan_playback
-from excite_cli.design.resolve import build_excitation
 from excite_cli.errors import ExciteError
 from excite_cli.storage.formats import ROS_FORMATS, check_format
-from excite_cli.storage.results import problem_of_result, read_alphas
 from excite_cli.storage.rosbag import check_goal_size, write_rosbag
 from excite_cli.storage.trajectory_controller import controller_refusals, time_from_start_ns
 
@@ -69,17 +68,23 @@ class Export:
     warnings: tuple[str, ...] = ()
 
 
-def export_trajectory(
-    result: Path, iteration: int | None = None, rate: float = 1000.0, periods: int = 1, speed: float = 1.0
-) -> Export:
-    """Sample iteration ``iteration`` (default: the last) of an ``optimize`` result at ``rate`` [Hz]
-    with the transitions from and to the home posture, played ``speed`` times as fast as optimized,
-    and its feed-forward torques.
+class Played(NamedTuple):
+    """How one iteration of a result is exported: ``result`` (named in the messages), its ``iteration``,
+    the ``rate`` [Hz], the ``periods`` of the trajectory, and the ``speed`` (times the optimized)."""
+
+    result: Path
+    iteration: int
+    rate: float
+    periods: int
+    speed: float
+
+
+def check_playback(rate: float, periods: int, speed: float) -> None:
+    """Refuse an export rate [Hz], period count or speed out of range (before anything is read).
 
     Raises:
-        ExciteError: not an excite result, an iteration it does not have, a rate, speed or period count
-            out of range or together more than ``MAX_SAMPLES`` samples, or samples that violate a
-            constraint that is not advisory (the message names it).
+        ExciteError: (``rate``, ``speed``, ``periods``) a value outside (0, ``MAX_RATE``],
+            [``MIN_SPEED``, ``MAX_SPEED``] or [1, ``MAX_PERIODS``].
     """
     if not (np.isfinite(rate) and 0.0 < rate <= MAX_RATE):
         raise ExciteError("rate", f"{rate:g} Hz is out of range", rate, f"(0, {MAX_RATE:g}] Hz")
@@ -87,16 +92,19 @@ def export_trajectory(
         raise ExciteError("speed", f"{speed:g} is out of range", speed, f"{MIN_SPEED:g} to {MAX_SPEED:g}")
     if not 1 <= periods <= MAX_PERIODS:
         raise ExciteError("periods", f"{periods} is out of range", periods, f"1 to {MAX_PERIODS}")
-    # a copy whose regressor rows are the joints' torques, the feed-forward a robot plays
-    problem = with_overrides(problem_of_result(result), {"robot.base_wrench_rows": False})
-    alphas = dict(read_alphas(result))
-    k = max(alphas) if iteration is None else iteration
-    if k not in alphas:
-        raise ExciteError(
-            "iteration", f"{result} has iterations {sorted(alphas)}, not {k}", k, f"one of {sorted(alphas)}"
-        )
-    excitation = build_excitation(problem)
-    alpha = alphas[k]
+
+
+def export_trajectory(excitation: Excitation, alpha: np.ndarray, how: Played) -> Export:
+    """Sample the trajectory of Fourier coefficients ``alpha`` (n, 2N+1) of ``excitation`` (its regressor
+    rows the joints' torques) as ``how`` says, with the transitions from and to the home posture, and
+    its feed-forward torques. ``how``'s rate, periods and speed are :func:`check_playback`'s.
+
+    Raises:
+        ExciteError: α of another shape than the excitation's, a rate below the trajectory's Nyquist
+            rate, more than ``MAX_SAMPLES`` samples, or samples that violate a constraint that is not
+            advisory (the message names it).
+    """
+    result, k, rate, periods, speed = how
     if alpha.shape != (excitation.robot.n_joints, excitation.trajectory.n_coefficients):
         raise ExciteError(
             "result",

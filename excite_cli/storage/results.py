@@ -12,10 +12,7 @@ from typing import Sequence
 
 import h5py
 import numpy as np
-from pydantic import ValidationError
 
-from excite_cli.config import Problem
-from excite_cli.config_file import parse_yaml
 from excite_cli.design.excitation import Excitation
 from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.errors import ExciteError
@@ -181,31 +178,6 @@ def check_base(f: h5py.File, base: BaseParameters, field: str, path: Path) -> No
         base.column_order(read_strings(f["robot"], "base_parameter_names"), field, path)
 
 
-def problem_of_result(path: Path) -> Problem:
-    """The optimize config stored in a result file (relative paths resolved from its original place).
-
-    Raises:
-        ExciteError: missing or unreadable file, or no valid stored config (not an excite result).
-    """
-    with open_h5(path) as f:
-        if "config" not in f.attrs or "iterations" not in f:
-            raise ExciteError(
-                "result", f"{path} is not an excite optimize result (no stored config or /iterations)", path
-            )
-        text, origin = str(f.attrs["config"]), str(f.attrs.get("config_path", ""))
-    try:
-        problem = Problem.model_validate(parse_yaml(text, str(path), "result"))
-    except (ExciteError, ValidationError):
-        raise ExciteError(
-            "result",
-            f"the stored config of {path} is not a valid optimize problem (not an excite optimize result?)",
-            path,
-        ) from None
-    problem.source_path = Path(origin) if origin else None
-    problem.source_text = text
-    return problem
-
-
 def read_iterations(
     path: Path, excitation: Excitation, prior: np.ndarray | None = None, field: str = "resume"
 ) -> list[IterationResult]:
@@ -253,21 +225,24 @@ def read_table(path: Path, field: str = "result") -> tuple[np.ndarray, float]:
 
 
 def read_alphas(path: Path) -> list[tuple[int, np.ndarray]]:
-    """(k, α (n, 2N+1)) of every iteration of an excite result, in order.
+    """(k, α (n, 2N+1)) of every iteration of an excite result, in order (whether 2N + 1 is its
+    config's, the reader that builds the design checks).
 
     Raises:
         ExciteError: missing or unreadable file, no iteration in it, or coefficients that are not
-            (active joints, 2N + 1) finite numbers (a damaged file).
+            (active joints, 2N + 1) finite numbers of one shape (a damaged file).
     """
-    trajectory = problem_of_result(path).trajectory
     with open_h5(path) as f:
         keys = sorted(f["iterations"].keys(), key=int) if "iterations" in f else []
         if not keys:
             raise ExciteError("result", f"{path} has no finished iteration", path)
         alphas = [(int(k), np.asarray(f["iterations"][k]["alpha"][()], dtype=float)) for k in keys]
         joints = len(read_strings(f["robot"], "joint_names"))
-    shape = (joints, 2 * trajectory.harmonics + 1)
+    shape = alphas[0][1].shape
+    fourier = len(shape) == 2 and shape[0] == joints and shape[1] % 2 == 1
     for k, alpha in alphas:
-        if alpha.shape != shape or not np.all(np.isfinite(alpha)):
-            raise ExciteError("result", f"{path}: iteration {k} has no valid Fourier coefficients {shape}", path)
+        if not fourier or alpha.shape != shape or not np.all(np.isfinite(alpha)):
+            raise ExciteError(
+                "result", f"{path}: iteration {k} has no valid Fourier coefficients ({joints}, 2N + 1)", path
+            )
     return alphas

@@ -4,10 +4,38 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from excite_cli.storage.export import Export, export_trajectory, write_export
+from excite_cli.config_file import result_problem, with_overrides
+from excite_cli.design.resolve import build_excitation
+from excite_cli.errors import ExciteError
+from excite_cli.storage.export import Export, Played, check_playback, export_trajectory, write_export
 from excite_cli.storage.formats import FORMATS, check_format
 from excite_cli.storage.paths import check_target
+from excite_cli.storage.results import read_alphas
 from excite_cli.storage.rosbag import check_bag_target
+
+
+def played_result(
+    result: Path, iteration: int | None = None, rate: float = 1000.0, periods: int = 1, speed: float = 1.0
+) -> Export:
+    """Iteration ``iteration`` (default: the last) of an ``optimize`` result sampled at ``rate`` [Hz]
+    with the transitions from and to the home posture, played ``speed`` times as fast as optimized,
+    and its feed-forward torques (:func:`~excite_cli.storage.export.export_trajectory` on the design
+    the result stores, its regressor rows the joints' torques).
+
+    Raises:
+        ExciteError: not an excite result, an iteration it does not have, a rate, speed or period count
+            out of range (:func:`~excite_cli.storage.export.check_playback`), and as ``export_trajectory``.
+    """
+    check_playback(rate, periods, speed)
+    # a copy whose regressor rows are the joints' torques, the feed-forward a robot plays
+    problem = with_overrides(result_problem(result), {"robot.base_wrench_rows": False})
+    alphas = dict(read_alphas(result))
+    k = max(alphas) if iteration is None else iteration
+    if k not in alphas:
+        raise ExciteError(
+            "iteration", f"{result} has iterations {sorted(alphas)}, not {k}", k, f"one of {sorted(alphas)}"
+        )
+    return export_trajectory(build_excitation(problem), alphas[k], Played(result, k, rate, periods, speed))
 
 
 def run_export(
@@ -21,7 +49,7 @@ def run_export(
     speed: float = 1.0,
     effort: bool = False,
 ) -> tuple[Export, Path]:
-    """:func:`export_trajectory` written by :func:`write_export` to ``output`` (default
+    """:func:`played_result` written by :func:`write_export` to ``output`` (default
     ``<result>_iteration<K>_<rate>Hz.<ending>``, the ending of :data:`FORMATS`, beside the result; a
     bag is a folder of that name without an ending); a given ``output`` is checked first. ``effort``
     puts τ in a ROS 2 trajectory's points (for an effort-controlled joint_trajectory_controller).
@@ -33,7 +61,7 @@ def run_export(
     check = check_bag_target if fmt == "rosbag2" else check_target
     if output is not None:
         check(output, "output", force)
-    export = export_trajectory(result, iteration, rate, periods, speed)
+    export = played_result(result, iteration, rate, periods, speed)
     ending = f".{FORMATS[fmt]}" if FORMATS[fmt] else ""
     faster = f"_speed{speed:g}" if speed != 1.0 else ""
     target = output or result.with_name(f"{result.stem}_iteration{export.iteration}_{rate:g}Hz{faster}{ending}")

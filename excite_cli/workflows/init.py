@@ -13,8 +13,9 @@ import yaml
 
 from excite_cli.atomic import atomic_path
 from excite_cli.config import RobotConfig
+from excite_cli.config_file import drafted_problem
 from excite_cli.drafting.joints import joint_choice
-from excite_cli.drafting.starting_config import StartingConfig, draft_config, validated
+from excite_cli.drafting.starting_config import StartingConfig, draft_config
 from excite_cli.dynamics.mjcf_source import is_mjcf
 from excite_cli.dynamics.urdf_checks import check_urdf
 from excite_cli.dynamics.urdf_source import installed_share, resolve_urdf, robot_model
@@ -182,7 +183,7 @@ def run_init(
     if kind == "optimize":
         draft = draft_config(robot, path, folders, joints, target, collision)
         text = _text(draft, urdf, kind)
-        problem = validated(yaml.safe_load(text), target)
+        problem = drafted_problem(yaml.safe_load(text), target)
         plan = None if draft.problem else plan_optimize(problem)
     else:
         draft = StartingConfig({})

@@ -18,12 +18,13 @@ from pathlib import Path
 import numpy as np
 
 from excite_cli.atomic import atomic_paths
+from excite_cli.config_file import result_problem
 from excite_cli.dynamics.robot import Robot, load_robot
 from excite_cli.errors import ExciteError
 from excite_cli.identification.effects import EFFECTS, effect_columns
 from excite_cli.identification.simulation_config import SimulationConfig
 from excite_cli.storage.paths import check_folder
-from excite_cli.storage.results import problem_of_result, read_alphas
+from excite_cli.storage.results import read_alphas
 from excite_cli.storage.rosbag import check_bag_target, write_joint_states
 from excite_cli.trajectory.fourier import FourierTrajectory
 
@@ -100,11 +101,14 @@ def simulate_runs(
         ExciteError: not a result, an unknown joint or a wrong coefficient count in the effects,
             non-finite effect values, more than MAX_SAMPLES samples per run, files in the way.
     """
-    problem = problem_of_result(result)
+    problem = result_problem(result)
     robot = load_robot(problem.robot, problem.folder, joint_rows_only=True)
     trajectory = FourierTrajectory(problem.trajectory.harmonics, problem.trajectory.base_frequency)
     rng = np.random.default_rng(sim.seed)
     alphas = read_alphas(result)
+    shape = (robot.n_joints, trajectory.n_coefficients)
+    if alphas[0][1].shape != shape:
+        raise ExciteError("result", f"{result} has α of shape {alphas[0][1].shape}, its config needs {shape}")
     bags = sim.recording == "rosbag2"
     names = [f"{prefix}_{k}" + ("" if bags else ".csv") for k, _ in alphas]
     check_folder(out_dir, [] if bags else names, "output_dir", force)

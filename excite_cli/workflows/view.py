@@ -6,13 +6,13 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Optional
 
+from excite_cli.config_file import result_problem
 from excite_cli.constraints.world_collision import world_shapes
 from excite_cli.dynamics.robot import load_robot
 from excite_cli.errors import ExciteError
 from excite_cli.plots.scene import write_scene
-from excite_cli.storage.export import export_trajectory
 from excite_cli.storage.paths import check_target
-from excite_cli.storage.results import problem_of_result
+from excite_cli.workflows.export import played_result
 
 #: Highest frame rate of a scene [Hz] (the file grows with frames × meshes).
 MAX_FRAME_RATE = 120.0
@@ -36,10 +36,10 @@ def run_view(
         raise ExciteError("rate", f"{rate:g} Hz is out of range", rate, f"(0, {MAX_FRAME_RATE:g}] frames per second")
     if output is not None:
         check_target(output, "output", force)
-    played = export_trajectory(result, iteration, rate)
+    played = played_result(result, iteration, rate)
     target = check_target(
         output or result.with_name(f"{result.stem}_iteration{played.iteration}.html"), "output", force
     )
-    problem = problem_of_result(result)
+    problem = result_problem(result)
     robot = load_robot(problem.robot, problem.folder, collision=True)
     return write_scene(target, robot, played.q, rate, world_shapes(problem.constraints.environment))

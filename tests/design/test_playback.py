@@ -15,8 +15,8 @@ from excite_cli.constraints import JointLimits
 from excite_cli.constraints.lse import GRID_MARGIN
 from excite_cli.design.playback import RESOLUTION, Transition, plan_transition
 from excite_cli.dynamics.urdf_source import example_robot_data_root
-from excite_cli.storage.export import export_trajectory
 from excite_cli.storage.rosbag import TOPIC
+from excite_cli.workflows.export import played_result
 
 runner = CliRunner()
 PANDA_URDF = "example-robot-data/robots/panda_description/urdf/panda.urdf"
@@ -113,8 +113,8 @@ def test_export_at_1khz_plays_from_home_to_home_with_rnea_torques(panda_runs, tm
 def test_export_at_half_speed_plays_the_same_path_in_twice_the_time(panda_runs):
     """q_s(t) = q(t/2): the slow file's sample 2k is the fast one's k, with q̇ halved, q̈ quartered and the
     torques RNEA's of those."""
-    fast = export_trajectory(panda_runs["rest"], rate=200.0)
-    slow = export_trajectory(panda_runs["rest"], rate=200.0, speed=0.5)
+    fast = played_result(panda_runs["rest"], rate=200.0)
+    slow = played_result(panda_runs["rest"], rate=200.0, speed=0.5)
     count = min(len(fast.time), (len(slow.time) + 1) // 2)
     np.testing.assert_allclose(slow.time[: 2 * count : 2], 2 * fast.time[:count], atol=1e-12)
     np.testing.assert_allclose(slow.q[: 2 * count : 2], fast.q[:count], atol=1e-12)

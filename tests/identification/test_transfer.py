@@ -12,13 +12,13 @@ from conftest import JOINTS, NOISE, robot_of, write_config
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
-from excite_cli.config_file import load_problem
+from excite_cli.config_file import load_problem, result_problem
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.fitting.least_squares import torque_errors
 from excite_cli.identification.pipeline import run_identification
 from excite_cli.identification.simulation_config import SimulationConfig
 from excite_cli.identification.validate import validate_model
-from excite_cli.storage.results import problem_of_result, read_alphas
+from excite_cli.storage.results import read_alphas
 from excite_cli.trajectory.fourier import FourierTrajectory
 from excite_cli.workflows.simulate import simulate_runs
 
@@ -76,7 +76,7 @@ def test_poorly_exciting_fit_runs_get_the_fit_that_transfers(tmp_path, optimized
     each; validation: a third motion at full amplitude. The robot's bodies are the URDF's scaled by
     0.85–1.15 (a CAD model near the truth), Coulomb friction 0.3 Nm, noise 0.05 Nm. The default is as
     good as the better fit, and keeps the true effects where the least-squares search adds spurious ones."""
-    problem = problem_of_result(optimized)
+    problem = result_problem(optimized)
     robot = robot_of(problem)
     rng = np.random.default_rng(1)
     truth = robot.urdf_parameters() * np.repeat(rng.uniform(0.85, 1.15, robot.urdf_parameters().size // 10), 10)
@@ -119,7 +119,7 @@ def test_a_position_effect_fitted_on_a_narrower_range_is_held_at_its_ends(tmp_pa
     q range: fit runs are two optimized motions at half amplitude about their mean posture,
     validation a third at full amplitude. With the position effects as candidates, the guard (the
     default) holds the fitted term at the ends of the fit range instead of extrapolating it."""
-    problem = problem_of_result(optimized)
+    problem = result_problem(optimized)
     robot = robot_of(problem)
     trajectory = FourierTrajectory(problem.trajectory.harmonics, problem.trajectory.base_frequency)
     time = np.arange(2 * int(trajectory.period * 500) + 1) / 500.0

@@ -24,10 +24,10 @@ def kept(monkeypatch):
 
 @pytest.fixture(scope="module")
 def results(optimized):
+    from excite_cli.config_file import result_problem
     from excite_cli.design.resolve import build_excitation
-    from excite_cli.storage.results import problem_of_result
 
-    excitation = build_excitation(problem_of_result(optimized))
+    excitation = build_excitation(result_problem(optimized))
     return excitation, read_iterations(optimized, excitation)
 
 

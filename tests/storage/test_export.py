@@ -12,10 +12,11 @@ from excite_cli.config_file import load_problem, with_overrides
 from excite_cli.design.resolve import build_excitation
 from excite_cli.errors import ExciteError
 from excite_cli.search.sequence import describe
-from excite_cli.storage.export import Export, columns, export_trajectory, write_export
+from excite_cli.storage.export import Export, columns, write_export
 from excite_cli.storage.formats import FORMATS
 from excite_cli.storage.results import write_result
 from excite_cli.storage.rosbag import MSGTYPE
+from excite_cli.workflows.export import played_result
 
 JOINTS = ["a", "b"]
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"
@@ -134,7 +135,7 @@ def test_a_zmp_closer_to_the_edge_than_its_margin_is_a_warning_not_a_refusal(tmp
     result = describe(strict, 1, alpha, np.zeros((0, strict.columns)))
     target = tmp_path / "g1.h5"
     write_result(target, strict, [result], 0, {"method": "optimized"})
-    played = export_trajectory(target, rate=100.0)
+    played = played_result(target, rate=100.0)
     margin = result.checks["zmp_min_margin_m"]
     assert 0.0 < margin < 0.084 and played.max_violation <= 0.0
     assert len(played.warnings) == 1 and "the robot may tip" in played.warnings[0]

@@ -13,12 +13,12 @@ from conftest import CONFIGS, JOINTS, SHARED, robot_of, write_config
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
-from excite_cli.config_file import load_problem
+from excite_cli.config_file import load_problem, result_problem
 from excite_cli.dynamics.base_parameters import compute_base_parameters
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.fitting.physical import MARGIN, nearest_physical, pseudo_inertia
 from excite_cli.identification.pipeline import run_identification
-from excite_cli.storage.results import problem_of_result, read_alphas
+from excite_cli.storage.results import read_alphas
 from excite_cli.trajectory.fourier import FourierTrajectory
 
 runner = CliRunner()
@@ -154,7 +154,7 @@ def test_simulated_data_consistent_fit_recovers_the_base_parameters(tmp_path, op
 def test_negative_mass_data_stays_physical_with_the_consistent_fit(tmp_path, optimized):  # noqa: F811
     """Torques of a model whose hand body (link 7 with the hand merged) has all parameters negated:
     plain least squares says its mass is negative, the consistent fit keeps every body physical."""
-    problem = problem_of_result(optimized)
+    problem = result_problem(optimized)
     robot = robot_of(problem)
     truth = robot.urdf_parameters()
     truth[60:70] *= -1.0
