@@ -104,6 +104,7 @@ FLOORS = (
     "atomic",
     "h5",
     "criteria",
+    "effects",
     "config",
     "trajectory",
     "dynamics",

@@ -9,10 +9,11 @@ from typing import Literal, Optional
 from pydantic import Field, PositiveFloat, field_validator
 
 from excite_cli.config.base import COULOMB_VELOCITY, Section
+from excite_cli.effects import DESIGNED
 
-#: The effects a joint's columns can hold: linear in their coefficients and in the motion, so the
-#: optimizer can excite them (Coulomb through a smooth sign).
-JointEffect = Literal["coulomb", "viscous", "armature", "offset"]
+#: The effects a joint's columns can hold (:data:`excite_cli.effects.DESIGNED`): linear in their
+#: coefficients, functions of q̇ and q̈ alone, so the optimizer can excite them (Coulomb through a smooth sign).
+JointEffect = Literal[DESIGNED]
 
 
 #: Largest transmission ratio or gear ratio taken as a ratio [1]: beyond it the number is in another unit.

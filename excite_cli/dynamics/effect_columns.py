@@ -7,11 +7,11 @@ included).
 Every column acts in a motor coordinate s = N q, N (n,) a transmission row (a joint's own effect: N = e_j),
 and reaches joint m's row times N_m (τ_m += N_m c f(ṡ, s̈), the motor torque mapped by Nᵀ):
 
-    coulomb f = tanh(ṡ / v_c),  viscous f = ṡ,  armature f = s̈,  offset f = 1.
+    coulomb f = tanh(ṡ / v_c),  viscous f = ṡ,  armature f = s̈,  offset f = 1,
 
-v_c is the config's ``effects.coulomb_velocity`` (default 0.01 rad/s, identify's own): the smooth sign
-identify fits, so the design and the fit see the same column. Its derivative (1 − tanh²)/v_c is what
-the gradient takes (:meth:`EffectColumns.chain`).
+each the column of its record in :data:`excite_cli.effects.EFFECTS` (those a design holds, with the
+derivatives of f in ṡ and s̈ that the gradient takes, :meth:`EffectColumns.chain`), the same column
+identify fits. v_c is the config's ``effects.coulomb_velocity`` (default 0.01 rad/s, identify's own).
 """
 
 from __future__ import annotations
@@ -23,17 +23,9 @@ from typing import Sequence
 import numpy as np
 
 from excite_cli.config import EffectsConfig
+from excite_cli.effects import DESIGNED, EFFECTS, Signals, signals
 from excite_cli.errors import ExciteError, ExciteWarning
 
-#: Coefficient symbol and unit of each effect's column (as identify names them).
-SYMBOLS = {
-    "coulomb": ("Fc", "Nm"),
-    "viscous": ("Fv", "Nm·s/rad"),
-    "armature": ("Ia", "kg·m²"),
-    "offset": ("tau0", "Nm"),
-}
-#: A coupled motor's columns, in order: its rotor inertia, Coulomb and viscous friction (identify's too).
-MOTOR_KINDS = ("armature", "coulomb", "viscous")
 #: A typical effect's torque at the joint's limits, as a fraction of its effort limit (the scaled
 #: criterion's magnitude of an effect coefficient, :meth:`EffectColumns.magnitudes`).
 TYPICAL_SHARE = 0.05
@@ -44,7 +36,7 @@ class EffectColumns:
     """The e effect columns of a design.
 
     Attributes:
-        kinds: (e,) each column's effect (``SYMBOLS``'s keys).
+        kinds: (e,) each column's effect (a name of :data:`~excite_cli.effects.DESIGNED`).
         transmissions: (e, n) each column's transmission row N over the active joints.
         names: (e,) coefficient names, such as ``Fc_elbow_joint`` or ``Ia_motor_wrist_2+wrist_3``.
         coulomb_velocity: v_c [rad/s] of the smooth sign.
@@ -65,18 +57,17 @@ class EffectColumns:
     @property
     def units(self) -> tuple[str, ...]:
         """(e,) the coefficients' units."""
-        return tuple(SYMBOLS[k][1] for k in self.kinds)
+        return tuple(EFFECTS[k].units[0] for k in self.kinds)
 
-    def _motion(self, QD: np.ndarray, QDD: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """ṡ, s̈ (T, e) and tanh(ṡ / v_c) (T, e) from q̇, q̈ (T, n)."""
+    def _motion(self, QD: np.ndarray, QDD: np.ndarray) -> list[Signals]:
+        """Each column's motor coordinate's ṡ, s̈ (T,) from q̇, q̈ (T, n), as :class:`Signals` (no q)."""
         sd, sdd = QD @ self.transmissions.T, QDD @ self.transmissions.T
-        return sd, sdd, np.tanh(sd / self.coulomb_velocity)
+        return [signals(None, sd[:, c], sdd[:, c], self.coulomb_velocity) for c in range(self.count)]
 
     def columns(self, QD: np.ndarray, QDD: np.ndarray) -> np.ndarray:
         """Y_E (T·n_rows, e) at T instants of q̇ [rad/s] and q̈ [rad/s²] (T, n), rows as the base regressor's."""
-        sd, sdd, sign = self._motion(QD, QDD)
-        f = {"coulomb": sign, "viscous": sd, "armature": sdd, "offset": np.ones_like(sd)}
-        values = np.stack([f[kind][:, c] for c, kind in enumerate(self.kinds)], axis=1)  # (T, e)
+        motion = self._motion(QD, QDD)
+        values = np.stack([EFFECTS[kind].columns(s)[0] for kind, s in zip(self.kinds, motion)], axis=1)  # (T, e)
         T, n = QD.shape
         out = np.zeros((T, self.n_rows, self.count))
         out[:, self.n_rows - n :, :] = values[:, None, :] * self.transmissions.T[None, :, :]
@@ -86,15 +77,12 @@ class EffectColumns:
         """The derivative of a function of Y_E in q̇ and q̈ (each (T, n)) from its derivative in Y_E,
         ``gradient`` (T·n_rows, e). No column depends on q."""
         T, n = QD.shape
-        sd, _, sign = self._motion(QD, QDD)
         g = np.einsum(
             "tmc,cm->tc", gradient.reshape(T, self.n_rows, self.count)[:, self.n_rows - n :], self.transmissions
         )
-        kinds = np.array(self.kinds)
-        slope = np.where(kinds == "coulomb", (1.0 - sign**2) / self.coulomb_velocity, (kinds == "viscous") * 1.0)
-        dqd = (g * slope) @ self.transmissions
-        dqdd = (g * (kinds == "armature")) @ self.transmissions
-        return dqd, dqdd
+        slopes = [EFFECTS[kind].slopes(s) for kind, s in zip(self.kinds, self._motion(QD, QDD))]
+        d_velocity, d_acceleration = (np.stack(d, axis=1) for d in zip(*slopes))  # (T, e) each
+        return (g * d_velocity) @ self.transmissions, (g * d_acceleration) @ self.transmissions
 
     def magnitudes(self, effort: np.ndarray, velocity: np.ndarray, acceleration: np.ndarray) -> np.ndarray:
         """(e,) a typical value of each coefficient: the one whose torque at the joints' limits is
@@ -111,7 +99,7 @@ class EffectColumns:
             tau = float(np.mean(torque[moved] / np.abs(row[moved])))
             speed = float(np.max(np.abs(row) * velocity))
             rate = float(np.max(np.abs(row) * acceleration))
-            out[c] = {"coulomb": tau, "offset": tau, "viscous": tau / speed, "armature": tau / rate}[kind]
+            out[c] = tau / (1.0, speed, rate)[EFFECTS[kind].per]
         return out
 
     def subset(self, keep: np.ndarray) -> EffectColumns:
@@ -146,15 +134,17 @@ class EffectColumns:
 
 
 def coefficient_name(kind: str, joints: Sequence[str], motor: bool = False) -> str:
-    """The name of an effect coefficient (a key of ``SYMBOLS``): ``Fc_elbow_joint`` on a joint's own
-    row, ``Ia_motor_wrist_2+wrist_3`` for a motor that turns with the ``joints`` named."""
-    return f"{SYMBOLS[kind][0]}_motor_{'+'.join(joints)}" if motor else f"{SYMBOLS[kind][0]}_{joints[0]}"
+    """The name of an effect coefficient (of a record of :data:`~excite_cli.effects.DESIGNED`):
+    ``Fc_elbow_joint`` on a joint's own row, ``Ia_motor_wrist_2+wrist_3`` for a motor that turns with
+    the ``joints`` named."""
+    symbol = EFFECTS[kind].coefficients[0]
+    return f"{symbol}_motor_{'+'.join(joints)}" if motor else f"{symbol}_{joints[0]}"
 
 
 def effect_columns(cfg: EffectsConfig, joint_names: list[str], n_rows: int) -> EffectColumns | None:
     """The effect columns ``cfg`` asks for over the active joints ``joint_names`` (n), each joint's in
-    ``SYMBOLS``'s order, joints in their order, then each motor's armature, Coulomb and viscous
-    friction; None when it asks for none.
+    :data:`~excite_cli.effects.DESIGNED`'s order, joints in their order, then each motor's columns
+    (its effect's parts: armature, Coulomb and viscous friction); None when it asks for none.
 
     Raises:
         ExciteError: a joint that is not active (``effects.joints``, ``effects.motors``), or a motor whose
@@ -166,7 +156,7 @@ def effect_columns(cfg: EffectsConfig, joint_names: list[str], n_rows: int) -> E
             raise ExciteError("effects.joints", f"'{key}' is not an active joint (or '*' for all)")
     for j, joint in enumerate(joint_names):
         wanted = set(cfg.joints.get("*", [])) | set(cfg.joints.get(joint, []))
-        for kind in (k for k in SYMBOLS if k in wanted):
+        for kind in (k for k in DESIGNED if k in wanted):
             kinds.append(kind)
             rows.append(np.eye(n)[j])
             names.append(coefficient_name(kind, [joint]))
@@ -182,7 +172,7 @@ def effect_columns(cfg: EffectsConfig, joint_names: list[str], n_rows: int) -> E
         row = np.zeros(n)
         for name, ratio in zip(motor.joints, motor.transmission):
             row[joint_names.index(name)] += ratio
-        for kind in MOTOR_KINDS:
+        for kind in EFFECTS["motor"].parts:
             kinds.append(kind)
             rows.append(row)
             names.append(coefficient_name(kind, motor.joints, motor=True))

@@ -12,7 +12,7 @@ from pydantic import Field, NonNegativeFloat, PositiveFloat, field_validator, mo
 
 from excite_cli.config import COULOMB_VELOCITY, ConfigFile, RobotConfig, Section
 from excite_cli.config.effects import MAX_RATIO
-from excite_cli.identification.effects import EFFECT_NAMES, SHAPE_GRID
+from excite_cli.effects import EFFECT_NAMES, SHAPE_GRID
 
 Effect = Literal[EFFECT_NAMES]
 #: The default candidates: every effect. The position-dependent ones pay a higher price

@@ -12,12 +12,13 @@ import numpy as np
 from excite_cli.dynamics.base_parameters import BaseParameters, compute_base_parameters
 from excite_cli.dynamics.robot import Robot, load_robot
 from excite_cli.dynamics.urdf_source import resolve_urdf
+from excite_cli.effects import EFFECTS
 from excite_cli.errors import ExciteError
 from excite_cli.identification.choice.crossval import fold_groups
 from excite_cli.identification.choice.fit_choice import choose_fit
 from excite_cli.identification.choice.selection import Selection, candidate_terms, motor_couplings, select_effects
 from excite_cli.identification.config import IdentifyProblem
-from excite_cli.identification.effects import EFFECTS, Term
+from excite_cli.identification.effects import Term
 from excite_cli.identification.fitting.channels import dead_channels
 from excite_cli.identification.fitting.dataset import Dataset, build_datasets, fit_position_range
 from excite_cli.identification.fitting.least_squares import joint_weights, least_squares, predict, torque_errors

@@ -8,6 +8,7 @@ from typing import Literal, Optional, Union
 from pydantic import Field, model_validator
 
 from excite_cli.config import COULOMB_VELOCITY, MAX_SEED, Section
+from excite_cli.effects import EFFECTS
 from excite_cli.identification.config import MAX_RATE, Effect, TransmissionConfig
 
 
@@ -36,7 +37,7 @@ class SimulationConfig(Section):
     """Held friction's v_h [rad/s]."""
     transmission: Optional[TransmissionConfig] = None
     """Gear ratios and coupling of the motors, or none."""
-    motor_effects: dict[Literal["armature", "coulomb", "viscous"], dict[str, float]] = Field(default_factory=dict)
+    motor_effects: dict[Literal[EFFECTS["motor"].parts], dict[str, float]] = Field(default_factory=dict)
     """{armature|coulomb|viscous: {motor's joint or \"*\": value}}: each motor's own [kg·m², Nm, Nm·s/rad]."""
     motor_side: bool = False
     """Write motor angles and motor torques (m = R q, τ_m = R⁻ᵀ τ)."""

@@ -20,8 +20,9 @@ import numpy as np
 from excite_cli.atomic import atomic_paths
 from excite_cli.config_file import result_problem
 from excite_cli.dynamics.robot import Robot, load_robot
+from excite_cli.effects import EFFECTS
 from excite_cli.errors import ExciteError
-from excite_cli.identification.effects import EFFECTS, effect_columns
+from excite_cli.identification.effects import effect_columns
 from excite_cli.identification.simulation_config import SimulationConfig
 from excite_cli.storage.paths import check_folder
 from excite_cli.storage.results import read_alphas

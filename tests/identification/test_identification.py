@@ -14,9 +14,10 @@ from typer.testing import CliRunner
 
 from excite_cli.cli import app
 from excite_cli.config_file import load_problem
+from excite_cli.effects import EFFECTS
 from excite_cli.h5 import read_strings, write_strings
 from excite_cli.identification.config import IdentifyProblem
-from excite_cli.identification.effects import EFFECTS, effect_columns
+from excite_cli.identification.effects import effect_columns
 from excite_cli.identification.fitting.dataset import run_offset_columns
 from excite_cli.identification.measured.measurements import load_run
 from excite_cli.identification.measured.preprocessing import Filter

@@ -21,7 +21,7 @@ Candidates whose columns lie in the span of the rigid-body model (e.g. the armat
 rotor inertia regroups with a link's) are not separately identifiable and are skipped. Every fit,
 in the folds and the final one, uses the same per-joint weights (WLS: 1/σ_j of the rigid-body fit,
 Gautier 1997) and keeps Coulomb, viscous and armature coefficients ≥ 0 (the consistent fit's bounds,
-:data:`~excite_cli.identification.effects.NONNEGATIVE`), so the reported model is exactly the one the
+:data:`~excite_cli.effects.NONNEGATIVE`), so the reported model is exactly the one the
 search scored and no effect is chosen for a coefficient the reported fit cannot have.
 """
 
@@ -31,10 +31,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from excite_cli.effects import EFFECTS
 from excite_cli.identification.choice.crossval import CrossValidation
 from excite_cli.identification.choice.search import Search, Step, StepwiseSearch, effect_weights
 from excite_cli.identification.config import IdentificationConfig, TransmissionConfig
-from excite_cli.identification.effects import EFFECTS, Term
+from excite_cli.identification.effects import Term
 from excite_cli.identification.fitting.channels import without_dead_rows
 from excite_cli.identification.fitting.dataset import Dataset
 from excite_cli.identification.fitting.least_squares import Fit, joint_weights, least_squares

@@ -5,7 +5,7 @@ Weighted least squares follows Gautier (1997): each joint's rows are weighted by
 residual standard deviation of that joint under ordinary least squares of the rigid-body model,
 fixed for every fit of one identification (the effect selection's and the final one), so the
 reported model is the one that was scored. Coulomb, viscous and armature coefficients are kept ≥ 0
-(:data:`~excite_cli.identification.effects.NONNEGATIVE`, bounded least squares where the plain
+(:data:`~excite_cli.effects.NONNEGATIVE`, bounded least squares where the plain
 solution breaks a bound: :func:`~excite_cli.identification.fitting.normal.solve`); the standard
 deviations are those of the unbounded problem. The estimates' standard deviations come from
 σ² (AᵀWA)⁻¹ (white residuals), or, given AᵀWΣWA from the residuals' spectra

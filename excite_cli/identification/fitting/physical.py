@@ -40,8 +40,8 @@ import cvxpy as cp
 import numpy as np
 import pinocchio as pin
 
+from excite_cli.effects import NONNEGATIVE
 from excite_cli.errors import ExciteError
-from excite_cli.identification.effects import NONNEGATIVE
 from excite_cli.identification.fitting.normal import square_root
 
 #: Length scale ℓ [m] of the inertia parameters in the regularization.

@@ -16,14 +16,12 @@ from pathlib import Path
 import numpy as np
 
 from excite_cli.config import COULOMB_VELOCITY, EffectsConfig, MotorConfig
-from excite_cli.dynamics.effect_columns import MOTOR_KINDS, coefficient_name
+from excite_cli.dynamics.effect_columns import coefficient_name
+from excite_cli.effects import DESIGNED
 from excite_cli.errors import ExciteError, ExciteWarning
 from excite_cli.h5 import open_h5, read_strings
 from excite_cli.identification.effects import Term
 from excite_cli.identification.fitting.dataset import Dataset
-
-#: The report's effects that are design columns (:data:`excite_cli.config.effects.JointEffect`).
-DESIGNED = ("coulomb", "viscous", "armature", "offset")
 
 
 @dataclass(frozen=True)
@@ -219,9 +217,9 @@ class PriorRows:
 def _design_names(term: Term, joints: list[str]) -> list[str] | None:
     """The design's names of ``term``'s columns, or None for an effect a design does not hold (module
     docstring) or a coupled joint effect (the design couples only motors)."""
-    if term.effect == "motor":  # its columns are MOTOR_KINDS', in that order
-        return [coefficient_name(kind, [joints[j] for j in term.joints], motor=True) for kind in MOTOR_KINDS]
-    if term.effect in DESIGNED and term.coupling is None:
+    if term.kind.parts:  # a motor: its columns are its parts', in that order
+        return [coefficient_name(kind, [joints[j] for j in term.joints], motor=True) for kind in term.kind.parts]
+    if term.kind.designed and term.coupling is None:
         return [coefficient_name(term.effect, [joints[term.joint]])]
     return None
 
@@ -248,7 +246,7 @@ def prior_rows(parts: list[Dataset], terms: list[Term], joints: list[str]) -> Pr
             continue
         names += named
         for out, data in zip(columns, parts):
-            if term.effect == "offset":
+            if term.kind.per_run:  # the design's offset: one column of ones, not one per run
                 block = np.zeros((data.tau.size, 1))
                 block[term.joint :: data.n] = 1.0
             else:

@@ -198,12 +198,11 @@ def test_a_coupled_motor_and_an_offset_are_named_and_placed_as_a_design_has_them
     first: the names are those a design of the same model gives (effect_columns), the motor's block
     stands on both joints' rows times their transmission, the offset is ones on its joint's rows."""
     from excite_cli.config import EffectsConfig, MotorConfig
-    from excite_cli.dynamics.effect_columns import MOTOR_KINDS, SYMBOLS, effect_columns
-    from excite_cli.identification.effects import EFFECTS, Term
+    from excite_cli.dynamics.effect_columns import effect_columns
+    from excite_cli.identification.effects import Term
     from excite_cli.identification.fitting.dataset import Dataset
     from excite_cli.identification.reporting.design_model import prior_rows
 
-    assert EFFECTS["motor"].coefficients == tuple(SYMBOLS[kind][0] for kind in MOTOR_KINDS)
     motor, offset = Term("motor", 0, coupling=(1.0, -2.0)), Term("offset", 0)
     cols = np.arange(9.0).reshape(3, 3)
     data = Dataset(
