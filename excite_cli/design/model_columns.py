@@ -13,7 +13,8 @@ from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.dynamics.effect_columns import EffectColumns, effect_columns
 from excite_cli.dynamics.robot import Robot
 from excite_cli.errors import ExciteError
-from excite_cli.identification.reporting.design_model import MeasuredPrior, read_measured_prior, with_report_model
+from excite_cli.identification.reporting.design_model import MeasuredPrior, measured_prior_of, with_report_model
+from excite_cli.identification.reporting.stored_report import read_report
 
 
 def measured_prior(path: str | None, folder: Path | None, robot: Robot) -> MeasuredPrior | None:
@@ -21,10 +22,15 @@ def measured_prior(path: str | None, folder: Path | None, robot: Robot) -> Measu
     (else None).
 
     Raises:
-        ExciteError: (``sequence.prior``) a report whose joints are not this problem's active joints.
+        ExciteError: (``sequence.prior``) a report whose joints are not this problem's active joints, or
+            that no weighing can use (:func:`read_report`, :func:`measured_prior_of`).
     """
-    measured = None if path is None else read_measured_prior(resolve_path(path, folder))
-    if measured is not None and sorted(measured.joints) != sorted(robot.joint_names):
+    found = None if path is None else resolve_path(path, folder)
+    report = None if found is None else read_report(found, "sequence.prior")
+    if report is None:
+        return None
+    measured = measured_prior_of(report, found)
+    if sorted(measured.joints) != sorted(robot.joint_names):
         raise ExciteError(
             "sequence.prior",
             f"{path} identified the joints {', '.join(measured.joints)}; this problem's active joints are "

@@ -13,14 +13,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Optional
 
 import numpy as np
 
 from excite_cli.dynamics.base_parameters import compute_base_parameters
 from excite_cli.dynamics.robot import load_robot
 from excite_cli.errors import ExciteError
-from excite_cli.h5 import open_h5, read_strings
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.effects import Term
 from excite_cli.identification.fitting.dataset import build_datasets
@@ -29,6 +27,7 @@ from excite_cli.identification.measured.gaps import split_at_gaps
 from excite_cli.identification.measured.measurements import load_run
 from excite_cli.identification.measured.payload import payload_parameters
 from excite_cli.identification.measured.preprocessing import preprocess
+from excite_cli.identification.reporting.stored_report import read_identify_report
 
 
 @dataclass(frozen=True)
@@ -41,107 +40,6 @@ class RunError:
     instants: int
 
 
-@dataclass
-class IdentifiedModel:
-    """The model an ``identify`` report holds (the fit it reports: least squares or consistent).
-
-    Attributes:
-        joints: (n,) active joint names; base_names: (b,) base-parameter names.
-        base: (b,) base parameters [SI]; rigid: (b,) the rigid-body-only fit's (for load-dependent terms).
-        terms: (effect, joint name, shape or None, coupling or None) of every effect column, in order.
-        coefficients: effect coefficients, in the order of ``terms``' columns [SI].
-        offset_runs: offset columns (one per fitted run, at least 1).
-        cutoff: low-pass cut-off [Hz]; coulomb_velocity: smoothing velocity of sign(q̇) [rad/s].
-        q_range: (n, 2) [rad] the fit data's q range per joint that guards the position effects
-            (None: a report from before the guard).
-    """
-
-    joints: list[str]
-    base_names: list[str]
-    base: np.ndarray
-    rigid: np.ndarray
-    terms: list[tuple[str, str, Optional[float], Optional[tuple[float, ...]]]]
-    coefficients: np.ndarray
-    offset_runs: int
-    cutoff: float
-    coulomb_velocity: float
-    q_range: np.ndarray | None = None
-
-
-def read_model(path: Path) -> IdentifiedModel:
-    """The model of the ``identify`` report at ``path``, every field it uses checked.
-
-    Raises:
-        ExciteError: missing or unreadable file, not an identify report, a field missing or of
-            another shape than its joints and base parameters give, a value that is not finite, or a
-            cut-off or Coulomb velocity that is not a positive number (the field named).
-    """
-    with open_h5(path, "report") as f:
-        if "identification" not in f or "effects" not in f["identification"]:
-            raise ExciteError("report", f"{path} is not an excite identify report (no /identification/effects)")
-        g = f["identification"]
-        for name, unit in (("cutoff_Hz", "Hz"), ("coulomb_velocity_rad_s", "rad/s")):
-            value = float(g.attrs.get(name, 0.01))
-            if not (np.isfinite(value) and value > 0.0):  # checked like the config field it came from
-                raise ExciteError("report", f"{path}: /identification {name} is {value:g}", value, f"> 0 {unit}")
-        joints, names = read_strings(g, "joint_names"), read_strings(g, "base_parameter_names")
-        rows = g["effects"][()]
-        for field in ("effect", "joint", "value"):
-            if rows.dtype.names is None or field not in rows.dtype.names:
-                raise ExciteError("report", f"{path}: /identification/effects has no field '{field}' (damaged?)")
-        consistent = bool(g["physically_consistent"][()]) if "physically_consistent" in g else False
-        values = rows["value_consistent"] if consistent and "value_consistent" in rows.dtype.names else rows["value"]
-        shapes = rows["shape"] if "shape" in rows.dtype.names else np.full(len(rows), np.nan)
-        coupling = (
-            _checked(g, "effect_coupling", (len(rows), len(joints)), path)
-            if "effect_coupling" in g
-            else np.zeros((len(rows), 1))
-        )
-        terms: list[tuple[str, str, float | None, tuple[float, ...] | None]] = []
-        effects, joint_of = (
-            [v.decode() if isinstance(v, bytes) else str(v) for v in rows[c]] for c in ("effect", "joint")
-        )
-        for effect, joint, shape, weights in zip(effects, joint_of, shapes, coupling):
-            coupled = tuple(float(w) for w in weights) if np.any(weights) else None
-            term = (effect, joint, None if np.isnan(shape) else float(shape), coupled)
-            if term not in terms:
-                terms.append(term)
-        return IdentifiedModel(
-            joints,
-            names,
-            _checked(g, "base_parameters", (len(names),), path),
-            _checked(g, "base_parameters_rigid_only", (len(names),), path),
-            terms,
-            _finite(np.asarray(values, dtype=float), "effects", path),
-            max(1, len(g["offset_runs"][()])) if "offset_runs" in g else 1,
-            float(g.attrs["cutoff_Hz"]),
-            float(g.attrs.get("coulomb_velocity_rad_s", 0.01)),
-            _checked(g, "fit_q_range", (len(joints), 2), path) if "fit_q_range" in g else None,
-        )
-
-
-def _checked(group, name: str, shape: tuple[int, ...], path: Path) -> np.ndarray:
-    """The report's dataset /identification/``name`` as floats of ``shape``, every value finite.
-
-    Raises:
-        ExciteError: missing, of another shape, or not finite (the dataset named).
-    """
-    if name not in group:
-        raise ExciteError("report", f"{path}: /identification/{name} is missing (damaged?)")
-    values = np.asarray(group[name][()], dtype=float)
-    if values.shape != shape:
-        found, wanted = ("x".join(map(str, s)) or "scalar" for s in (values.shape, shape))
-        raise ExciteError("report", f"{path}: /identification/{name} has shape {found}", expected=wanted)
-    return _finite(values, name, path)
-
-
-def _finite(values: np.ndarray, name: str, path: Path) -> np.ndarray:
-    """``values``, refused where one is NaN or infinite (the dataset named)."""
-    if not np.all(np.isfinite(values)):
-        raise ExciteError("report", f"{path}: /identification/{name} holds NaN or infinite values (damaged?)")
-    return values
-
-
 def validate_model(report: Path, problem: IdentifyProblem) -> list[RunError]:
     """Score the model of ``report`` on every run of ``problem`` (their roles are ignored; a run's
     offset is the mean of the report's fitted runs' offsets, a run's known payload is taken out).
@@ -150,7 +48,7 @@ def validate_model(report: Path, problem: IdentifyProblem) -> list[RunError]:
         ExciteError: a report for another robot (joints or base parameters differ), bad data or
             config (as ``identify``).
     """
-    model = read_model(report)
+    model = read_identify_report(report, "report")
     robot = load_robot(problem.robot, problem.folder, joint_rows_only=True, physical=False)
     base = compute_base_parameters(robot)
     if model.joints != robot.joint_names:

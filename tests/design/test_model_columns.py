@@ -4,7 +4,7 @@ checked against the problem's."""
 import h5py
 import numpy as np
 import pytest
-from conftest import CONFIGS
+from conftest import CONFIGS, rows_copy
 
 from excite_cli.config_file import load_problem
 from excite_cli.design.information import predicted_std
@@ -13,12 +13,24 @@ from excite_cli.dynamics.base_parameters import compute_base_parameters
 from excite_cli.dynamics.robot import load_robot
 from excite_cli.errors import ExciteError
 from excite_cli.h5 import write_strings
+from excite_cli.identification.reporting.report_file import write_identification
 
 
-def _report(path, joints, sigma):
-    with h5py.File(path, "w") as f:
-        f.create_dataset("regressor", data=np.zeros((0, 1))).attrs["sample_rate_Hz"] = 200.0
-        g = f.create_group("identification")
+@pytest.fixture(scope="module")
+def report_file(simulated_identification, tmp_path_factory):
+    problem, report, robot, base, rows = simulated_identification
+    path = tmp_path_factory.mktemp("report") / "report.h5"
+    write_identification(path, report, robot, base, problem, rows_copy(rows))
+    return path
+
+
+def _report(source, path, joints, sigma):
+    """A copy of the identify report ``source`` with other joint names and validation errors."""
+    path.write_bytes(source.read_bytes())
+    with h5py.File(path, "a") as f:
+        f["regressor"].attrs["sample_rate_Hz"] = 200.0
+        g = f["identification"]
+        del g["joint_names"], g["rms_after"]
         write_strings(g, "joint_names", joints)
         g["rms_after"] = sigma
     return path
@@ -32,15 +44,16 @@ def test_a_rigid_design_has_no_effect_columns_and_a_result_prior_no_weights(opti
     assert measured_prior(problem.sequence.prior, problem.folder, robot) is None
 
 
-def test_a_report_of_the_problems_joints_weighs_them_and_of_others_is_refused(tmp_path):
+def test_a_report_of_the_problems_joints_weighs_them_and_of_others_is_refused(report_file, tmp_path):
     problem = load_problem(CONFIGS / "smoke.yaml")
     robot = load_robot(problem.robot, problem.folder)
     sigma = np.linspace(0.1, 0.7, robot.n_joints)
-    problem.sequence.prior = str(_report(tmp_path / "ok.h5", robot.joint_names[::-1], sigma))
+    problem.sequence.prior = str(_report(report_file, tmp_path / "ok.h5", robot.joint_names[::-1], sigma))
     measured = measured_prior(problem.sequence.prior, problem.folder, robot)
     assert measured.rate == 200.0 and measured.joints == robot.joint_names[::-1]
-    problem.sequence.prior = str(_report(tmp_path / "other.h5", ["shoulder_pan_joint"], np.ones(1)))
-    with pytest.raises(ExciteError, match=r"sequence\.prior.*identified the joints shoulder_pan_joint"):
+    others = [f"joint_{k}" for k in range(robot.n_joints)]
+    problem.sequence.prior = str(_report(report_file, tmp_path / "other.h5", others, np.ones(robot.n_joints)))
+    with pytest.raises(ExciteError, match=r"sequence\.prior.*identified the joints joint_0"):
         measured_prior(problem.sequence.prior, problem.folder, robot)
 
 

@@ -15,13 +15,13 @@ from pathlib import Path
 
 import numpy as np
 
-from excite_cli.config import COULOMB_VELOCITY, EffectsConfig, MotorConfig
+from excite_cli.config import EffectsConfig, MotorConfig
 from excite_cli.dynamics.effect_columns import coefficient_name
-from excite_cli.effects import DESIGNED
+from excite_cli.effects import DESIGNED, EFFECTS
 from excite_cli.errors import ExciteError, ExciteWarning
-from excite_cli.h5 import open_h5, read_strings
 from excite_cli.identification.effects import Term
 from excite_cli.identification.fitting.dataset import Dataset
+from excite_cli.identification.reporting.stored_report import StoredReport, read_identify_report
 
 
 @dataclass(frozen=True)
@@ -41,50 +41,27 @@ class ReportModel:
     left_out: list[str]
 
 
-def _text(value: object) -> str:
-    return value.decode() if isinstance(value, bytes) else str(value)
-
-
-def read_report_model(path: Path) -> ReportModel:
-    """The model of the identify report at ``path`` (``/identification/effects``, ``effect_coupling``,
-    ``joint_names`` and the attribute ``coulomb_velocity_rad_s``).
-
-    Raises:
-        FileNotFound, ExciteError: (``effects.model``) no readable file, not an identify report, an
-            effects table without its fields, a Coulomb velocity scale that is not positive.
-    """
-    with open_h5(path, "effects.model") as f:
-        if "identification/effects" not in f:
-            raise ExciteError("effects.model", f"{path} is not an identify report (no /identification/effects)")
-        g = f["identification"]
-        rows, coupling = g["effects"][()], g["effect_coupling"][()]
-        names = read_strings(g, "joint_names")
-        velocity = float(g.attrs.get("coulomb_velocity_rad_s", COULOMB_VELOCITY))
-    missing = [name for name in ("effect", "joint") if name not in (rows.dtype.names or ())]
-    if missing:
-        raise ExciteError("effects.model", f"{path}: /identification/effects has no field '{missing[0]}' (damaged?)")
-    if not (np.isfinite(velocity) and velocity > 0):
-        raise ExciteError(
-            "effects.model",
-            f"{path}: its Coulomb velocity scale coulomb_velocity_rad_s is {velocity:g}",
-            velocity,
-            "a positive number of rad/s",
-        )
+def report_model(report: StoredReport) -> ReportModel:
+    """The designable part of the model of ``report``: each joint's effects among ``DESIGNED``, each
+    coupled motor (a motor on one joint's own row: that joint, ratio 1), the others named."""
     joints: dict[str, list[str]] = {}
     motors: list[tuple[list[str], list[float]]] = []
     left_out: list[str] = []
-    for row, weights in zip(rows, coupling):
-        effect, joint = _text(row["effect"]), _text(row["joint"])
-        if effect == "motor":
-            moved = np.flatnonzero(weights)
-            motor = ([names[k] for k in moved], [float(weights[k]) for k in moved])
+    for effect, joint, _, coupling in report.terms:
+        if EFFECTS[effect].parts:  # a motor: its rotor inertia and friction in its coordinate
+            moved = [] if coupling is None else np.flatnonzero(coupling)
+            motor = (
+                ([report.joints[k] for k in moved], [float(coupling[k]) for k in moved])
+                if coupling
+                else ([joint], [1.0])
+            )
             motors += [] if motor in motors else [motor]
         elif effect in DESIGNED:
             kinds = joints.setdefault(joint, [])
             kinds += [] if effect in kinds else [effect]
         elif f"{effect} ({joint})" not in left_out:
             left_out.append(f"{effect} ({joint})")
-    return ReportModel(joints, motors, velocity, left_out)
+    return ReportModel(joints, motors, report.coulomb_velocity, left_out)
 
 
 def with_report_model(cfg: EffectsConfig, path: Path, joint_names: list[str]) -> EffectsConfig:
@@ -95,7 +72,7 @@ def with_report_model(cfg: EffectsConfig, path: Path, joint_names: list[str]) ->
         ExciteError: (``effects.model``) not an identify report, or one whose joints are not all
             active in this problem (a report of another robot or joint set).
     """
-    model = read_report_model(path)
+    model = report_model(read_identify_report(path, "effects.model"))
     unknown = [j for j in [*model.joints, *(j for joints, _ in model.motors for j in joints)] if j not in joint_names]
     if unknown:
         raise ExciteError(
@@ -154,34 +131,24 @@ class MeasuredPrior:
         return float(np.sqrt(1.0 / (cost_period * self.rate)))
 
 
-def read_measured_prior(path: Path) -> MeasuredPrior | None:
-    """The weighing of ``sequence.prior`` when it is an identify report (``/identification/rms_after``,
-    ``/identification/joint_names``, ``/regressor`` attribute ``sample_rate_Hz``); None for anything else
-    (an optimize result, a plain regressor file, or no file: whoever reads the rows says what is wrong).
+def measured_prior_of(report: StoredReport, path: Path) -> MeasuredPrior:
+    """How the rows of ``report`` (read from ``path``, ``sequence.prior``) weigh as prior data: its
+    joints' validation errors (``/identification/rms_after``) and its rows' rate (``/regressor``
+    attribute ``sample_rate_Hz``).
 
     Raises:
         ExciteError: (``sequence.prior``) a report of an earlier version without what weighs its rows, or
             whose errors or sample rate no weighing can use (not finite, negative, all zero, not one per
             joint; a rate that is not positive).
     """
-    if not path.is_file():
-        return None
-    with open_h5(path, "sequence.prior") as f:
-        weighed = "identification/rms_after" in f and "regressor" in f and "sample_rate_Hz" in f["regressor"].attrs
-        if not weighed and "identification" in f:
-            raise ExciteError(
-                "sequence.prior",
-                f"{path} is an identify report of an earlier excite: without /identification/rms_after and the "
-                "regressor's sample_rate_Hz its rows cannot be weighed as its measurements were",
-                path,
-                "a report of this version (identify its runs again)",
-            )
-        if not weighed:
-            return None
-        joints = read_strings(f["identification"], "joint_names")
-        sigma, rate = (
-            np.asarray(f["identification/rms_after"][()], dtype=float),
-            float(f["regressor"].attrs["sample_rate_Hz"]),
+    sigma, rate, joints = report.rms_after, report.rate, report.joints
+    if sigma is None or rate is None:
+        raise ExciteError(
+            "sequence.prior",
+            f"{path} is an identify report of an earlier excite: without /identification/rms_after and the "
+            "regressor's sample_rate_Hz its rows cannot be weighed as its measurements were",
+            path,
+            "a report of this version (identify its runs again)",
         )
     if sigma.shape != (len(joints),) or not np.all(np.isfinite(sigma)) or np.any(sigma < 0) or not np.any(sigma > 0):
         raise ExciteError(

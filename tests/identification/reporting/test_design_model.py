@@ -13,11 +13,12 @@ from excite_cli.errors import ExciteError
 from excite_cli.h5 import read_strings
 from excite_cli.identification.reporting.design_model import (
     MeasuredPrior,
-    read_measured_prior,
-    read_report_model,
+    measured_prior_of,
+    report_model,
     with_report_model,
 )
 from excite_cli.identification.reporting.report_file import write_identification
+from excite_cli.identification.reporting.stored_report import read_identify_report, read_report
 from excite_cli.storage.prior import read_prior
 
 
@@ -33,7 +34,7 @@ def test_the_reports_friction_becomes_the_designs_columns(report_file, simulated
     """The shipped simulated runs hold Coulomb and viscous friction on every joint, which identify finds
     (test_report_file); a design with the report as its model gets exactly those columns."""
     _, report, robot, *_ = simulated_identification
-    model = read_report_model(report_file)
+    model = report_model(read_identify_report(report_file, "effects.model"))
     assert {j: sorted(kinds) for j, kinds in model.joints.items()} == {
         j: ["coulomb", "viscous"] for j in robot.joint_names
     }
@@ -53,7 +54,7 @@ def test_a_report_with_a_coupled_motor_and_a_shaped_effect(report_file, tmp_path
         coupling[1, 5:7] = [1.0, 1.0]
         del f["identification/effects"], f["identification/effect_coupling"]
         f["identification/effects"], f["identification/effect_coupling"] = rows, coupling
-    model = read_report_model(path)
+    model = report_model(read_identify_report(path, "effects.model"))
     assert model.motors == [(["panda_joint6", "panda_joint7"], [1.0, 1.0])]
     assert model.left_out == [f"stribeck ({rows['joint'][0].decode()})"]
 
@@ -111,7 +112,7 @@ def test_optimize_with_the_report_as_prior_weighs_both_the_prior_and_its_own_row
     )
     assert run.exit_code == 0, run.output
     assert "What the new trajectories determine better" in run.output
-    measured = read_measured_prior(report_file)
+    measured = measured_prior_of(read_report(report_file, "sequence.prior"), report_file)
     assert measured is not None and measured.rate > 0
     problem = load_problem(CONFIGS / "smoke.yaml")
     problem.sequence.prior = str(report_file)
@@ -250,7 +251,8 @@ def test_a_damaged_report_as_prior_is_refused_in_one_line(report_file, tmp_path,
     zero ended in LinAlgError, a rate of 0 in ZeroDivisionError, a report of the previous release's
     format was used unweighted in silence)."""
     with pytest.raises(ExciteError, match=message) as error:
-        read_measured_prior(_damaged(report_file, tmp_path, edit))
+        damaged = _damaged(report_file, tmp_path, edit)
+        measured_prior_of(read_report(damaged, "sequence.prior"), damaged)
     assert error.value.field == "sequence.prior"
 
 
@@ -262,10 +264,10 @@ def test_a_damaged_report_as_model_is_refused_in_one_line(report_file, tmp_path)
     renamed = rows.astype([("kind" if n == "effect" else n, rows.dtype[n]) for n in rows.dtype.names])
     no_field = _damaged(report_file, tmp_path, lambda f: _replace(f, "identification/effects", renamed))
     with pytest.raises(ExciteError, match="has no field 'effect'"):
-        read_report_model(no_field)
+        report_model(read_identify_report(no_field, "effects.model"))
     nan = _damaged(
         report_file, tmp_path, lambda f: f["identification"].attrs.__setitem__("coulomb_velocity_rad_s", np.nan)
     )
     with pytest.raises(ExciteError, match="coulomb_velocity_rad_s is nan") as error:
-        read_report_model(nan)
+        report_model(read_identify_report(nan, "effects.model"))
     assert error.value.field == "effects.model"

@@ -1,0 +1,159 @@
+"""An identify report read back: the one reader of the model a report holds, for ``validate`` (its
+model scored on other runs), ``effects.model`` (the next design's effects) and ``sequence.prior`` (how
+its measured rows weigh). The file is opened once and every field a user of it takes is checked,
+its errors named under the field that gave the path."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Optional
+
+import numpy as np
+
+from excite_cli.config import COULOMB_VELOCITY
+from excite_cli.errors import ExciteError
+from excite_cli.h5 import open_h5, read_strings
+
+#: A stored term: (effect, joint name, shape velocity [rad/s] or None, coupling (n,) or None).
+StoredTerm = tuple[str, str, Optional[float], Optional[tuple[float, ...]]]
+
+
+@dataclass(frozen=True)
+class StoredReport:
+    """The model of an identify report (the fit it reports: least squares or consistent) and what
+    weighs its rows as prior data.
+
+    Attributes:
+        joints: (n,) active joint names; base_names: (b,) base-parameter names.
+        base: (b,) base parameters [SI]; rigid: (b,) the rigid-body-only fit's (for load-dependent terms).
+        terms: every effect of its model, in order (a coupled motor once).
+        coefficients: effect coefficients, in the order of ``terms``' columns [SI].
+        offset_runs: offset columns (one per fitted run, at least 1).
+        cutoff: low-pass cut-off [Hz]; coulomb_velocity: v_c of the smooth sign(q̇) [rad/s].
+        q_range: (n, 2) [rad] the fit data's q range per joint that guards the position effects
+            (None: a report from before the guard).
+        rms_after: (n,) [Nm] each joint's RMS error of the reported model on the validation data
+            (``/identification/rms_after``), or None (a report of an earlier excite).
+        rate: its rows' sample rate [Hz] (``/regressor`` attribute ``sample_rate_Hz``), or None (the same).
+    """
+
+    joints: list[str]
+    base_names: list[str]
+    base: np.ndarray
+    rigid: np.ndarray
+    terms: list[StoredTerm]
+    coefficients: np.ndarray
+    offset_runs: int
+    cutoff: float
+    coulomb_velocity: float
+    q_range: np.ndarray | None = None
+    rms_after: np.ndarray | None = None
+    rate: float | None = None
+
+
+def read_report(path: Path, field: str) -> StoredReport | None:
+    """The identify report at ``path``, or None for an HDF5 file that is not one (no /identification:
+    an optimize result, a file of regressor rows).
+
+    Args:
+        field: the config field or argument that named ``path`` (``report``, ``effects.model``,
+            ``sequence.prior``), under which every error is raised.
+
+    Raises:
+        FileNotFound, ExciteError: no readable HDF5 file; a report without its effects table or
+            one of its fields, a dataset of another shape than its joints and base parameters give or
+            not finite, a cut-off or Coulomb velocity scale that is not a positive number.
+    """
+    with open_h5(path, field) as f:
+        if "identification" not in f:
+            return None
+        g = f["identification"]
+        if "effects" not in g:
+            raise ExciteError(field, f"{path} is not an identify report (no /identification/effects)")
+        for name, unit in (("cutoff_Hz", "Hz"), ("coulomb_velocity_rad_s", "rad/s")):
+            value = float(g.attrs.get(name, COULOMB_VELOCITY))
+            if not (np.isfinite(value) and value > 0.0):  # checked like the config field it came from
+                raise ExciteError(field, f"{path}: /identification {name} is {value:g}", value, f"> 0 {unit}")
+        joints, names = read_strings(g, "joint_names"), read_strings(g, "base_parameter_names")
+        rows = g["effects"][()]
+        for column in ("effect", "joint", "value"):
+            if rows.dtype.names is None or column not in rows.dtype.names:
+                raise ExciteError(field, f"{path}: /identification/effects has no field '{column}' (damaged?)")
+        consistent = bool(g["physically_consistent"][()]) if "physically_consistent" in g else False
+        values = rows["value_consistent"] if consistent and "value_consistent" in rows.dtype.names else rows["value"]
+        checked = _Checked(g, path, field)
+        return StoredReport(
+            joints,
+            names,
+            checked("base_parameters", (len(names),)),
+            checked("base_parameters_rigid_only", (len(names),)),
+            _terms(rows, checked("effect_coupling", (len(rows), len(joints))) if "effect_coupling" in g else None),
+            checked.finite(np.asarray(values, dtype=float), "effects"),
+            max(1, len(g["offset_runs"][()])) if "offset_runs" in g else 1,
+            float(g.attrs["cutoff_Hz"]),
+            float(g.attrs.get("coulomb_velocity_rad_s", COULOMB_VELOCITY)),
+            checked("fit_q_range", (len(joints), 2)) if "fit_q_range" in g else None,
+            np.asarray(g["rms_after"][()], dtype=float) if "rms_after" in g else None,
+            float(f["regressor"].attrs["sample_rate_Hz"])
+            if "regressor" in f and "sample_rate_Hz" in f["regressor"].attrs
+            else None,
+        )
+
+
+def _terms(rows: np.ndarray, coupling: np.ndarray | None) -> list[StoredTerm]:
+    """The distinct terms of the effects table ``rows`` (a term has a row per coefficient), each with its
+    row of ``coupling`` (rows, n) where it is not zero."""
+    shapes = rows["shape"] if "shape" in rows.dtype.names else np.full(len(rows), np.nan)
+    coupling = np.zeros((len(rows), 1)) if coupling is None else coupling
+    terms: list[StoredTerm] = []
+    effects, joint_of = ([v.decode() if isinstance(v, bytes) else str(v) for v in rows[c]] for c in ("effect", "joint"))
+    for effect, joint, shape, weights in zip(effects, joint_of, shapes, coupling):
+        coupled = tuple(float(w) for w in weights) if np.any(weights) else None
+        term = (effect, joint, None if np.isnan(shape) else float(shape), coupled)
+        if term not in terms:
+            terms.append(term)
+    return terms
+
+
+@dataclass(frozen=True)
+class _Checked:
+    """The report's datasets /identification/<name> read as floats, checked (errors under ``field``)."""
+
+    group: object
+    path: Path
+    field: str
+
+    def __call__(self, name: str, shape: tuple[int, ...]) -> np.ndarray:
+        """The dataset ``name`` as floats of ``shape``, every value finite.
+
+        Raises:
+            ExciteError: missing, of another shape, or not finite (the dataset named).
+        """
+        if name not in self.group:
+            raise ExciteError(self.field, f"{self.path}: /identification/{name} is missing (damaged?)")
+        values = np.asarray(self.group[name][()], dtype=float)
+        if values.shape != shape:
+            found, wanted = ("x".join(map(str, s)) or "scalar" for s in (values.shape, shape))
+            raise ExciteError(self.field, f"{self.path}: /identification/{name} has shape {found}", expected=wanted)
+        return self.finite(values, name)
+
+    def finite(self, values: np.ndarray, name: str) -> np.ndarray:
+        """``values``, refused where one is NaN or infinite (the dataset named)."""
+        if not np.all(np.isfinite(values)):
+            raise ExciteError(
+                self.field, f"{self.path}: /identification/{name} holds NaN or infinite values (damaged?)"
+            )
+        return values
+
+
+def read_identify_report(path: Path, field: str) -> StoredReport:
+    """:func:`read_report` of a file that must be an identify report.
+
+    Raises:
+        ExciteError: as :func:`read_report`, and a file without /identification (not an identify report).
+    """
+    report = read_report(path, field)
+    if report is None:
+        raise ExciteError(field, f"{path} is not an identify report (no /identification/effects)")
+    return report

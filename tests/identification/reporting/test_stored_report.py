@@ -1,0 +1,39 @@
+"""One reader of an identify report: what it reads back is what the identification reported, a file
+that is not a report is told apart, and its errors carry the field that named the file."""
+
+import h5py
+import numpy as np
+import pytest
+from conftest import rows_copy
+
+from excite_cli.errors import ExciteError
+from excite_cli.identification.reporting.report_file import write_identification
+from excite_cli.identification.reporting.stored_report import read_identify_report, read_report
+
+
+def test_the_report_read_back_is_the_reported_model(simulated_identification, tmp_path):
+    """Joints, base parameters, every effect once with its coefficient, v_c and each joint's validation
+    error: as the pipeline's report holds them."""
+    problem, report, robot, base, rows = simulated_identification
+    path = tmp_path / "report.h5"
+    write_identification(path, report, robot, base, problem, rows_copy(rows))
+    stored = read_identify_report(path, "report")
+    assert stored.joints == robot.joint_names and stored.base_names == base.names
+    assert {(effect, joint) for effect, joint, _, _ in stored.terms} == {
+        (kind, j) for j in robot.joint_names for kind in ("coulomb", "viscous")
+    }
+    assert stored.coefficients.size == len(stored.terms) and np.all(stored.coefficients > 0)
+    assert stored.coulomb_velocity == problem.identification.coulomb_velocity
+    assert stored.rms_after.shape == (robot.n_joints,) and stored.rate > 0
+
+
+def test_a_file_that_is_not_a_report_is_none_or_refused_under_its_field(optimized, tmp_path):
+    assert read_report(optimized, "sequence.prior") is None
+    with pytest.raises(ExciteError, match="is not an identify report") as error:
+        read_identify_report(optimized, "effects.model")
+    assert error.value.field == "effects.model"
+    with h5py.File(tmp_path / "half.h5", "w") as f:
+        f.create_group("identification")
+    with pytest.raises(ExciteError, match="no /identification/effects") as error:
+        read_report(tmp_path / "half.h5", "sequence.prior")
+    assert error.value.field == "sequence.prior"
