@@ -313,3 +313,10 @@ def test_a_constraint_s_kind_is_answered_by_its_class_not_by_its_name():
     names = {c.name for c in _subclasses(Constraint)}
     assert {"joint_limits", "self_collision", "world_collision", "torque_limits"} <= names
     assert _comparisons_with(names, outside="excite_cli.constraints") == []
+
+
+def test_test_modules_have_unique_names():
+    """pytest imports test modules by their file name (no package __init__ in tests/): two test files
+    of one name in different folders fail collection."""
+    names = [p.name for p in TESTS.rglob("test_*.py")]
+    assert sorted(n for n in set(names) if names.count(n) > 1) == []

@@ -6,6 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from excite_cli.storage.export import Export
+from excite_cli.storage.formats import FORMATS
 from excite_cli.storage.rosbag import ACKED_WAIT_MS, PLAY_DELAY_S, TOPIC
 
 
@@ -20,7 +21,8 @@ def export_lines(e: Export, rate: float, target: Path, fmt: str, effort: bool = 
         *[f"warning: {w}" for w in e.warnings],
         f"wrote {target}",
     ]
-    if fmt == "rosbag2":
+    form = FORMATS[fmt]
+    if form.folder:
         lines += [
             f"play it: ros2 bag play {target} --delay {PLAY_DELAY_S:g} --wait-for-all-acked {ACKED_WAIT_MS}  "
             f"(the controller's subscription matched first, the message acknowledged before the player ends; "
@@ -28,7 +30,7 @@ def export_lines(e: Export, rate: float, target: Path, fmt: str, effort: bool = 
             f"record the run meanwhile: ros2 bag record /joint_states -o {target.name}_run_1  "
             "(excite identify reads that bag folder as a data.runs file)",
         ]
-    if fmt in ("ros2", "rosbag2"):
+    if form.controller:
         lines.append(
             "effort: the feed-forward torque, for an effort-controlled joint_trajectory_controller (Jazzy on)"
             if effort

@@ -21,7 +21,7 @@ from excite_cli.atomic import atomic_path
 from excite_cli.design.excitation import Excitation
 from excite_cli.design.playback import check_motion, plan_playback
 from excite_cli.errors import ExciteError
-from excite_cli.storage.formats import ROS_FORMATS, check_format
+from excite_cli.storage.formats import export_format
 from excite_cli.storage.rosbag import check_goal_size, write_rosbag
 from excite_cli.storage.trajectory_controller import controller_refusals, time_from_start_ns
 
@@ -190,37 +190,34 @@ def write_export(path: Path, export: Export, fmt: str = "csv", effort: bool = Fa
             the controller would refuse, a goal longer than one command-line argument holds
             (:func:`~excite_cli.storage.rosbag.check_goal_size`), or a file that cannot be written.
     """
-    check_format(fmt, effort)
-    path = Path(path)
-    if fmt in ROS_FORMATS:
+    form = export_format(fmt, effort)
+    if form.controller:
         _check_controller_accepts(export, effort)
-    if fmt == "rosbag2":
-        motion = (export.q, export.qd, export.qdd, export.tau)
-        return write_rosbag(path, export.joint_names, export.time, motion, effort=effort)
-    goal = ros2_goal(export, effort) if fmt == "ros2" else ""
-    if goal:
-        check_goal_size(goal)
+    return _WRITERS[form.name](Path(path), export, effort)
+
+
+def _write_bag(path: Path, export: Export, effort: bool) -> Path:
+    motion = (export.q, export.qd, export.qdd, export.tau)
+    return write_rosbag(path, export.joint_names, export.time, motion, effort=effort)
+
+
+def _write_goal(path: Path, export: Export, effort: bool) -> Path:
+    goal = ros2_goal(export, effort)
+    check_goal_size(goal)
     with atomic_path(path, "output") as tmp:
-        if fmt == "csv":
-            _write_csv(tmp, export)
-        elif goal:
-            tmp.write_text(goal, encoding="utf-8")
-        else:
-            with open(tmp, "wb") as f:
-                np.savez(
-                    f,
-                    time=export.time,
-                    q=export.q,
-                    qd=export.qd,
-                    qdd=export.qdd,
-                    tau=export.tau,
-                    joint_names=np.array(export.joint_names),
-                    columns=np.array(columns(export.joint_names)),
-                )
+        tmp.write_text(goal, encoding="utf-8")
     return path
 
 
-def _write_csv(path: Path, export: Export) -> None:
+def _write_npz(path: Path, export: Export, effort: bool) -> Path:
+    arrays = {"time": export.time, "q": export.q, "qd": export.qd, "qdd": export.qdd, "tau": export.tau}
+    names = {"joint_names": np.array(export.joint_names), "columns": np.array(columns(export.joint_names))}
+    with atomic_path(path, "output") as tmp, open(tmp, "wb") as f:
+        np.savez(f, **arrays, **names)
+    return path
+
+
+def _write_csv(path: Path, export: Export, effort: bool) -> Path:
     table = np.column_stack([export.time, export.q, export.qd, export.qdd, export.tau])
     comments = [
         f"excite export: iteration {export.iteration}, {export.rate:g} Hz, {export.periods} period(s)",
@@ -228,9 +225,14 @@ def _write_csv(path: Path, export: Export) -> None:
         "tau: feed-forward RNEA torque of the URDF model",
         f"largest constraint violation (normalized, <= 0 satisfied): {export.max_violation:.3g}",
     ]
-    with open(path, "w") as f:
+    with atomic_path(path, "output") as tmp, open(tmp, "w") as f:
         f.write("".join(f"# {line}\n" for line in comments))
         np.savetxt(f, table, delimiter=",", header=",".join(columns(export.joint_names)), comments="", fmt="%.10g")
+    return path
+
+
+#: What writes each format (:data:`~excite_cli.storage.formats.FORMATS`), by its name.
+_WRITERS = {"csv": _write_csv, "npz": _write_npz, "ros2": _write_goal, "rosbag2": _write_bag}
 
 
 def _check_controller_accepts(export: Export, effort: bool) -> None:

@@ -1,25 +1,57 @@
-"""The export's file formats, without what writes them (the command line's help lists them at
-start-up; :mod:`~excite_cli.storage.export` writes them)."""
+"""The export's file formats, one record each, without what writes them (the command line's help lists
+them at start-up; :mod:`~excite_cli.storage.export` writes them)."""
+
+from dataclasses import dataclass
 
 from excite_cli.errors import ExciteError
 
-#: File formats and their file-name endings (``ros2``: a FollowJointTrajectory goal as YAML;
-#: ``rosbag2``: a ROS 2 bag, a folder without an ending).
-FORMATS = {"csv": "csv", "npz": "npz", "ros2": "yaml", "rosbag2": ""}
-#: The formats a ROS 2 joint_trajectory_controller reads (the others are data files).
-ROS_FORMATS = ("ros2", "rosbag2")
+
+@dataclass(frozen=True)
+class ExportFormat:
+    """One file format of ``export``.
+
+    Attributes:
+        name: as ``--format`` takes it.
+        ending: the file-name ending (without the dot; "" for a folder).
+        controller: a ROS 2 joint_trajectory_controller reads it: checked against the controller's
+            rules, τ in its points' effort only when asked (a data file holds τ always).
+        folder: written as a folder (a ROS 2 bag).
+    """
+
+    name: str
+    ending: str
+    controller: bool = False
+    folder: bool = False
+
+    @property
+    def suffix(self) -> str:
+        """The ending with its dot, or "" (a folder)."""
+        return f".{self.ending}" if self.ending else ""
 
 
-def check_format(fmt: str, effort: bool = False) -> None:
-    """That ``fmt`` is one of :data:`FORMATS`, and ``effort`` (τ as a trajectory's effort) asked only of
-    a ROS 2 format (a data file holds τ always).
+#: Every format, by name: CSV, NPZ, a FollowJointTrajectory goal as YAML (``ros2``) and a ROS 2 bag,
+#: a folder without an ending (``rosbag2``).
+FORMATS = {
+    f.name: f
+    for f in (
+        ExportFormat("csv", "csv"),
+        ExportFormat("npz", "npz"),
+        ExportFormat("ros2", "yaml", controller=True),
+        ExportFormat("rosbag2", "", controller=True, folder=True),
+    )
+}
+
+
+def export_format(fmt: str, effort: bool = False) -> ExportFormat:
+    """The format ``fmt`` names, with ``effort`` (τ as a trajectory's effort) asked only of a format a
+    controller reads (a data file holds τ always).
 
     Raises:
         ExciteError: another format, or effort for a data file.
     """
     if fmt not in FORMATS:
         raise ExciteError("format", f"must be one of {', '.join(FORMATS)} (got {fmt!r})")
-    if effort and fmt not in ROS_FORMATS:
-        raise ExciteError(
-            "effort", f"is for the ROS 2 formats; a {fmt} file holds τ always", expected="ros2 or rosbag2"
-        )
+    if effort and not FORMATS[fmt].controller:
+        readers = " or ".join(name for name, f in FORMATS.items() if f.controller)
+        raise ExciteError("effort", f"is for the ROS 2 formats; a {fmt} file holds τ always", expected=readers)
+    return FORMATS[fmt]

@@ -8,7 +8,7 @@ from excite_cli.config_file import result_problem, with_overrides
 from excite_cli.design.resolve import build_excitation
 from excite_cli.errors import ExciteError
 from excite_cli.storage.export import Export, Played, check_playback, export_trajectory, write_export
-from excite_cli.storage.formats import FORMATS, check_format
+from excite_cli.storage.formats import export_format
 from excite_cli.storage.paths import check_target
 from excite_cli.storage.results import read_alphas
 from excite_cli.storage.rosbag import check_bag_target
@@ -50,19 +50,18 @@ def run_export(
     effort: bool = False,
 ) -> tuple[Export, Path]:
     """:func:`played_result` written by :func:`write_export` to ``output`` (default
-    ``<result>_iteration<K>_<rate>Hz.<ending>``, the ending of :data:`FORMATS`, beside the result; a
+    ``<result>_iteration<K>_<rate>Hz.<ending>``, the format's ending, beside the result; a
     bag is a folder of that name without an ending); a given ``output`` is checked first. ``effort``
     puts τ in a ROS 2 trajectory's points (for an effort-controlled joint_trajectory_controller).
 
     Raises:
         ExciteError: see both, and a bad or existing (without ``force``) output path.
     """
-    check_format(fmt, effort)
-    check = check_bag_target if fmt == "rosbag2" else check_target
+    form = export_format(fmt, effort)
+    check = check_bag_target if form.folder else check_target
     if output is not None:
         check(output, "output", force)
     export = played_result(result, iteration, rate, periods, speed)
-    ending = f".{FORMATS[fmt]}" if FORMATS[fmt] else ""
     faster = f"_speed{speed:g}" if speed != 1.0 else ""
-    target = output or result.with_name(f"{result.stem}_iteration{export.iteration}_{rate:g}Hz{faster}{ending}")
+    target = output or result.with_name(f"{result.stem}_iteration{export.iteration}_{rate:g}Hz{faster}{form.suffix}")
     return export, write_export(check(target, "output", force), export, fmt, effort)

@@ -119,9 +119,9 @@ def test_a_trajectory_the_controller_would_refuse_is_not_written(export, tmp_pat
 
 @pytest.mark.parametrize("fmt", list(FORMATS))
 def test_every_format_the_help_lists_is_written_with_its_ending(export, tmp_path, fmt):
-    path = write_export(tmp_path / ("m" + (f".{FORMATS[fmt]}" if FORMATS[fmt] else "")), export, fmt)
+    path = write_export(tmp_path / ("m" + FORMATS[fmt].suffix), export, fmt)
     written = path / "metadata.yaml" if fmt == "rosbag2" else path  # a bag is a folder
-    assert written.is_file() and path.suffix == (f".{FORMATS[fmt]}" if FORMATS[fmt] else "")
+    assert written.is_file() and path.suffix == FORMATS[fmt].suffix
     assert written.stat().st_size > 0
 
 
