@@ -193,6 +193,17 @@ def simulated_identification():
     return (problem, *run_identification(problem))
 
 
+@pytest.fixture(scope="module")
+def report_file(simulated_identification, tmp_path_factory):
+    """The report file of :func:`simulated_identification` (friction found on every joint)."""
+    from excite_cli.identification.reporting.report_file import write_identification
+
+    problem, report, robot, base, rows = simulated_identification
+    path = tmp_path_factory.mktemp("report") / "report.h5"
+    write_identification(path, report, robot, base, problem, rows_copy(rows))
+    return path
+
+
 @contextmanager
 def tcp_server(first_bytes: bytes) -> Iterator[str]:
     """A TCP server on a free local port that sends ``first_bytes`` to whoever connects, then stays

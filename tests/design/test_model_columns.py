@@ -4,7 +4,7 @@ checked against the problem's."""
 import h5py
 import numpy as np
 import pytest
-from conftest import CONFIGS, rows_copy
+from conftest import CONFIGS
 
 from excite_cli.config_file import load_problem
 from excite_cli.design.information import predicted_std
@@ -13,15 +13,6 @@ from excite_cli.dynamics.base_parameters import compute_base_parameters
 from excite_cli.dynamics.robot import load_robot
 from excite_cli.errors import ExciteError
 from excite_cli.h5 import write_strings
-from excite_cli.identification.reporting.report_file import write_identification
-
-
-@pytest.fixture(scope="module")
-def report_file(simulated_identification, tmp_path_factory):
-    problem, report, robot, base, rows = simulated_identification
-    path = tmp_path_factory.mktemp("report") / "report.h5"
-    write_identification(path, report, robot, base, problem, rows_copy(rows))
-    return path
 
 
 def _report(source, path, joints, sigma):

@@ -3,7 +3,7 @@
 import h5py
 import numpy as np
 import pytest
-from conftest import CONFIGS, rows_copy
+from conftest import CONFIGS
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
@@ -17,17 +17,8 @@ from excite_cli.identification.reporting.design_model import (
     report_model,
     with_report_model,
 )
-from excite_cli.identification.reporting.report_file import write_identification
 from excite_cli.identification.reporting.stored_report import read_identify_report, read_report
 from excite_cli.storage.prior import read_prior
-
-
-@pytest.fixture(scope="module")
-def report_file(simulated_identification, tmp_path_factory):
-    problem, report, robot, base, rows = simulated_identification
-    path = tmp_path_factory.mktemp("report") / "report.h5"
-    write_identification(path, report, robot, base, problem, rows_copy(rows))
-    return path
 
 
 def test_the_reports_friction_becomes_the_designs_columns(report_file, simulated_identification):
