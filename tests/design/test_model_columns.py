@@ -12,18 +12,22 @@ from excite_cli.design.model_columns import design_effects, measured_prior
 from excite_cli.dynamics.base_parameters import compute_base_parameters
 from excite_cli.dynamics.robot import load_robot
 from excite_cli.errors import ExciteError
-from excite_cli.h5 import write_strings
+from excite_cli.h5 import read_strings, write_strings
 
 
 def _report(source, path, joints, sigma):
-    """A copy of the identify report ``source`` with other joint names and validation errors."""
+    """A copy of the identify report ``source`` with other joint names (its effects' joints renamed
+    alike, in order) and validation errors."""
     path.write_bytes(source.read_bytes())
     with h5py.File(path, "a") as f:
         f["regressor"].attrs["sample_rate_Hz"] = 200.0
         g = f["identification"]
-        del g["joint_names"], g["rms_after"]
+        renamed = dict(zip(read_strings(g, "joint_names"), joints))
+        rows = g["effects"][()]
+        rows["joint"] = [renamed[j.decode()] for j in rows["joint"]]
+        del g["joint_names"], g["rms_after"], g["effects"]
         write_strings(g, "joint_names", joints)
-        g["rms_after"] = sigma
+        g["rms_after"], g["effects"] = sigma, rows
     return path
 
 

@@ -12,6 +12,7 @@ from typing import Optional
 import numpy as np
 
 from excite_cli.config import COULOMB_VELOCITY
+from excite_cli.effects import EFFECTS
 from excite_cli.errors import ExciteError
 from excite_cli.h5 import open_h5, read_strings
 
@@ -88,7 +89,12 @@ def read_report(path: Path, field: str) -> StoredReport | None:
             names,
             checked("base_parameters", (len(names),)),
             checked("base_parameters_rigid_only", (len(names),)),
-            _terms(rows, checked("effect_coupling", (len(rows), len(joints))) if "effect_coupling" in g else None),
+            _known(
+                _terms(rows, checked("effect_coupling", (len(rows), len(joints))) if "effect_coupling" in g else None),
+                joints,
+                path,
+                field,
+            ),
             checked.finite(np.asarray(values, dtype=float), "effects"),
             max(1, len(g["offset_runs"][()])) if "offset_runs" in g else 1,
             float(g.attrs["cutoff_Hz"]),
@@ -113,6 +119,30 @@ def _terms(rows: np.ndarray, coupling: np.ndarray | None) -> list[StoredTerm]:
         term = (effect, joint, None if np.isnan(shape) else float(shape), coupled)
         if term not in terms:
             terms.append(term)
+    return terms
+
+
+def _known(terms: list[StoredTerm], joints: list[str], path: Path, field: str) -> list[StoredTerm]:
+    """``terms``, every effect one of :data:`~excite_cli.effects.EFFECTS` and every joint's own term on
+    one of the report's ``joints``.
+
+    Raises:
+        ExciteError: (``field``) an effect or a joint the report does not define (damaged, or written
+            by another version of excite).
+    """
+    for effect, joint, _, coupling in terms:
+        if effect not in EFFECTS:
+            raise ExciteError(
+                field,
+                f"{path}: /identification/effects names the effect '{effect}' (damaged, or from another excite?)",
+                effect,
+                f"one of {', '.join(EFFECTS)}",
+            )
+        if coupling is None and joint not in joints:
+            raise ExciteError(
+                field,
+                f"{path}: /identification/effects names the joint '{joint}', not one of its joint_names (damaged?)",
+            )
     return terms
 
 

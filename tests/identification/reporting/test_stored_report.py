@@ -33,3 +33,19 @@ def test_a_file_that_is_not_a_report_is_none_or_refused_under_its_field(optimize
     with pytest.raises(ExciteError, match="no /identification/effects") as error:
         read_report(tmp_path / "half.h5", "sequence.prior")
     assert error.value.field == "sequence.prior"
+
+
+@pytest.mark.parametrize("column, value", [("effect", "friction"), ("joint", "elbow")])
+def test_an_effect_or_joint_the_report_does_not_define_is_refused_naming_it(report_file, tmp_path, column, value):
+    """A damaged effects table (an effect excite does not know, a joint not among the report's) is one
+    message under the field that named the file, not a KeyError later."""
+    path = tmp_path / "edited.h5"
+    path.write_bytes(report_file.read_bytes())
+    with h5py.File(path, "a") as f:
+        rows = f["identification/effects"][()]
+        rows[column][0] = value
+        del f["identification/effects"]
+        f["identification/effects"] = rows
+    with pytest.raises(ExciteError, match=f"names the {column} '{value}'") as error:
+        read_report(path, "effects.model")
+    assert error.value.field == "effects.model"
