@@ -189,7 +189,7 @@ def identify(
     say(console.identification.preprocessing_notes(run.report), console=err)
     say(
         console.identification.identification(run.report),
-        [console.identification.bodies(run.report, run.robot)] if run.report.consistent else [],
+        [console.bodies.consistent_bodies(run.report.consistent, run.robot)] if run.report.consistent else [],
         [console.model_files.urdf_written(run)] if urdf_out else [],
         console.model_files.mjcf_written(run) if mjcf_out else [],
         f"wrote {run.target} and {', '.join(str(p) for p in run.plots)}",

@@ -12,7 +12,8 @@ from pathlib import Path
 TESTS = Path(__file__).resolve().parent
 PACKAGE = TESTS.parent / "excite_cli"
 PRINTING = {"excite_cli.cli"} | {
-    f"excite_cli.console.{m}" for m in ("app", "tables", "identification", "model_files", "progress", "errors")
+    f"excite_cli.console.{m}"
+    for m in ("app", "tables", "identification", "bodies", "model_files", "progress", "errors")
 }
 
 

@@ -8,9 +8,7 @@ import numpy as np
 from rich.table import Table
 
 from excite_cli.console.tables import titled_table
-from excite_cli.dynamics.robot import Robot
 from excite_cli.identification.choice.search import MOVE_SIGNS
-from excite_cli.identification.fitting.physical import body_properties, pseudo_inertia
 from excite_cli.identification.reporting.report import Report
 from excite_cli.identification.validate import RunError
 from excite_cli.workflows.check_identify import IdentifyPlan
@@ -263,38 +261,3 @@ def search(report: Report, runners_up: int = 2) -> list[Table | str]:
         for k, s in enumerate(sel.searches)
     )
     return [steps, f"searches (cross-validated error at their end): {starts}"]
-
-
-def bodies(report: Report, robot: Robot) -> Table:
-    """Identified (physically consistent) bodies beside the URDF's, the active constraints and the rotors."""
-    urdf, fit = robot.urdf_parameters(), report.consistent
-    vector = lambda v: " ".join(f"{x:+.3f}" for x in v)  # noqa: E731
-    rows = []
-    for i, name in enumerate(robot.body_names):
-        m, c, _, moments = body_properties(fit.standard[10 * i : 10 * i + 10])
-        um, uc, _, umoments = body_properties(urdf[10 * i : 10 * i + 10])
-        rows.append(
-            (
-                name,
-                f"{m:.3f} / {um:.3f}",
-                f"{vector(c)} / {vector(uc)}",
-                f"{' '.join(f'{x:.2e}' for x in moments)} / {' '.join(f'{x:.2e}' for x in umoments)}",
-                f"{fit.min_eigenvalues[i]:.1e}",
-            )
-        )
-    plain = [
-        (name, body_properties(fit.unconstrained[10 * i : 10 * i + 10])[0])
-        for i, name in enumerate(robot.body_names)
-        if np.linalg.eigvalsh(pseudo_inertia(fit.unconstrained[10 * i : 10 * i + 10]))[0] <= 0.0
-    ]
-    return titled_table(
-        f"Physically consistent bodies (identified / URDF), solver {fit.status}",
-        ("body", "mass [kg]", "CoM [m]", "principal moments about the CoM [kg m²]", "λmin(J)"),
-        rows,
-        "active: "
-        + (", ".join(fit.active) or "none")
-        + "\nplain least squares (same regularization) is not physical for: "
-        + (", ".join(f"{name} (mass {m:.3f} kg)" for name, m in plain) or "none")
-        + "\nrotor inertias held apart from the bodies (in the regrouped base parameters) [kg m²]: "
-        + (", ".join(f"{j} {a:.4g}" for j, a in zip(fit.rotor_joints, fit.rotors)) or "none"),
-    )

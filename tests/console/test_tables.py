@@ -4,17 +4,20 @@ table, the progress lines of a log, and errors worded as the command's options."
 import io
 
 import numpy as np
-from conftest import CONFIGS
+import pinocchio as pin
+from conftest import CONFIGS, robot_of
 from rich.console import Console
 
 from excite_cli.cli import export, validate
 from excite_cli.config import OptimizerConfig
 from excite_cli.config_file import load_problem
 from excite_cli.console import tables
+from excite_cli.console.bodies import consistent_bodies
 from excite_cli.console.errors import spellings, word
 from excite_cli.console.identification import validation
 from excite_cli.console.progress import Bars
 from excite_cli.errors import ExciteError, OutputExists
+from excite_cli.identification.fitting.physical import ConsistentFit
 from excite_cli.identification.validate import RunError
 from excite_cli.search.kkt import Optimality
 from excite_cli.search.optimizer import RestartResult
@@ -111,3 +114,22 @@ def test_the_command_line_words_fields_as_its_options():
     )
     assert word(ExciteError("limits.velocity", "must be > 0", -1.0), spelled) == "limits.velocity: must be > 0"
     assert word(OutputExists("output", "r.h5"), spelled) == "--output: r.h5 exists; use --force to replace it"
+
+
+def test_the_consistent_bodies_table_gives_the_last_body_with_its_payload_and_the_payload_apart():
+    robot = robot_of(load_problem(CONFIGS / "panda.yaml"))
+    urdf, last = robot.urdf_parameters(), robot.body_names[-1]
+    payload = pin.Inertia(1.25, np.array([0.0, 0.02, 0.1]), 1e-3 * np.eye(3)).toDynamicParameters()
+    standard = urdf.copy()
+    standard[-10:] += payload
+    bodies = len(robot.body_names)
+    fit = ConsistentFit(
+        standard, np.zeros(0), np.zeros(1), np.ones(bodies), [], "optimal", urdf, np.zeros(0), [], np.zeros(1),
+        payload[None], [last],
+    )  # fmt: skip
+    text = _text([consistent_bodies(fit, robot)])
+    assert f"{urdf[-10] + 1.25:.3f} / {urdf[-10]:.3f}" in text  # the last body carries it
+    assert f"on the last bodies (in their masses above): {last} 1.250 kg at +0.000 +0.020 +0.100 m" in text
+    none = ConsistentFit(urdf, np.zeros(0), np.zeros(1), np.ones(bodies), [], "optimal", urdf, np.zeros(0), [],
+                         np.zeros(1), np.zeros((0, 10)), [])  # fmt: skip
+    assert "on the last bodies (in their masses above): none" in _text([consistent_bodies(none, robot)])

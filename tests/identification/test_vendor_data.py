@@ -12,7 +12,7 @@ from typer.testing import CliRunner
 from excite_cli.cli import app
 from excite_cli.config_file import load_problem
 from excite_cli.identification.config import IdentifyProblem
-from excite_cli.identification.fitting.physical import pseudo_inertia
+from excite_cli.identification.fitting.bodies import pseudo_inertia
 from excite_cli.identification.pipeline import run_identification
 from excite_cli.identification.reporting.report_file import write_identification
 from excite_cli.identification.simulation_config import SimulationConfig

@@ -42,6 +42,7 @@ from excite_cli.identification.choice.search import effect_count, objective
 from excite_cli.identification.choice.selection import Selection
 from excite_cli.identification.config import IdentificationConfig
 from excite_cli.identification.effects import Term, coefficient_names
+from excite_cli.identification.fitting.bodies import last_bodies
 from excite_cli.identification.fitting.least_squares import least_squares
 from excite_cli.identification.fitting.physical import ConsistentFit, ConsistentProgram
 
@@ -127,7 +128,8 @@ class FitChoice:
 class ConsistentModel:
     """The physically consistent fit of one model [Y_B, ``terms``] on any normal equations of its
     unknowns (all fit data, or one fold's training data): one compiled program, with a rotor of its
-    own for every joint whose armature regroups with the bodies' and is not one of ``terms``.
+    own for every joint whose armature regroups with the bodies' and is not one of ``terms``, and a
+    payload of its own on every body that carries no other.
 
     Args:
         terms: the model's terms; selection: the fit data's normal equations and the joints' weights.
@@ -142,8 +144,8 @@ class ConsistentModel:
         reference = selection.normal.system(selection.weights, terms)[0]
         R, held = rotor_regrouping(robot, base), {t.joint for t in terms if t.effect == "armature" and not t.coupling}
         rotors = {name: R[:, j] for j, name in enumerate(robot.joint_names) if R[:, j].any() and j not in held}
-        phi = robot.urdf_parameters()
-        self.program = ConsistentProgram(reference, base.regrouping, phi, names, robot.body_names, rotors)
+        phi, carriers = robot.urdf_parameters(), last_bodies(robot.model)
+        self.program = ConsistentProgram(reference, base.regrouping, phi, names, robot.body_names, rotors, carriers)
 
     def fit(self, G: np.ndarray, c: np.ndarray, rows: int, regularization: float) -> ConsistentFit:
         """The SDP of :class:`ConsistentProgram` on the weighted normal equations G, c of ``rows`` rows.

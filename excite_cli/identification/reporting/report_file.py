@@ -15,7 +15,7 @@ from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.dynamics.robot import Robot
 from excite_cli.h5 import atomic_h5, write_parts, write_strings, write_table
 from excite_cli.identification.config import IdentifyProblem
-from excite_cli.identification.fitting.physical import body_properties
+from excite_cli.identification.fitting.bodies import body_properties
 from excite_cli.identification.reporting.design_model import PriorRows
 from excite_cli.identification.reporting.mjcf_check import MujocoCheck, write_mujoco_group
 from excite_cli.identification.reporting.mjcf_out import MjcfModel
@@ -257,8 +257,8 @@ def _write_validation(g: h5py.Group, report: Report) -> None:
 
 
 def _write_consistent(g: h5py.Group, report: Report, robot: Robot) -> None:
-    """The physically consistent fit: standard parameters, rotor inertias, per-body properties beside the
-    URDF's, active constraints, its validation errors."""
+    """The physically consistent fit: standard parameters, rotor inertias, payloads, per-body properties
+    beside the URDF's, active constraints, its validation errors."""
     consistent = report.consistent
     g.create_dataset("standard_parameters", data=consistent.standard).attrs["unit"] = (
         "kg, kg m, kg m^2 (pinocchio order per body)"
@@ -267,6 +267,9 @@ def _write_consistent(g: h5py.Group, report: Report, robot: Robot) -> None:
     g.create_dataset("base_parameters_consistent", data=consistent.base).attrs["description"] = "K phi + R a"
     g.create_dataset("rotor_inertias", data=consistent.rotors).attrs["unit"] = "kg m^2 (a, apart from the bodies)"
     write_strings(g, "rotor_joints", consistent.rotor_joints)
+    payloads = g.create_dataset("payload_parameters", data=consistent.payloads.reshape(-1, 10))
+    payloads.attrs["unit"] = "kg, kg m, kg m^2 (psi on its body, pinocchio order; included in standard_parameters)"
+    write_strings(g, "payload_bodies", consistent.payload_bodies)
     g.attrs["solver_status"] = consistent.status
     write_strings(g, "active_constraints", consistent.active)
     urdf = robot.urdf_parameters()

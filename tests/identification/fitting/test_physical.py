@@ -16,7 +16,8 @@ from excite_cli.cli import app
 from excite_cli.config_file import load_problem, result_problem
 from excite_cli.dynamics.base_parameters import compute_base_parameters
 from excite_cli.identification.config import IdentifyProblem
-from excite_cli.identification.fitting.physical import MARGIN, nearest_physical, pseudo_inertia
+from excite_cli.identification.fitting.bodies import MARGIN, nearest_physical, pseudo_inertia
+from excite_cli.identification.fitting.physical import ConsistentProgram
 from excite_cli.identification.pipeline import run_identification
 from excite_cli.storage.results import read_alphas
 from excite_cli.trajectory.fourier import FourierTrajectory
@@ -64,6 +65,28 @@ def test_nearest_physical_keeps_physical_bodies_and_mends_the_others_keeping_mas
     assert moments[2] <= moments[0] + moments[1]  # the triangle inequality holds again
     # the nearest: the change is no larger than the violation it removes (I_zz − I_xx − I_yy = 0.03)
     assert np.abs(mended.inertia - rod.inertia).max() <= 0.03 + 1e-9
+
+
+def test_what_the_data_cannot_place_goes_to_the_payload_not_the_links():
+    """Two bodies the data see only summed (one base parameter vector φ₁ + φ₂, well measured) and
+    0.5 kg more than the URDF's: held apart as a payload on the second body, it is (almost) all there
+    and the links keep the URDF's masses; without a payload the pull toward the URDF puts it on the
+    heavier link."""
+    first = pin.Inertia.FromBox(2.0, 0.1, 0.2, 0.3).toDynamicParameters()
+    second = pin.Inertia.FromBox(0.5, 0.05, 0.05, 0.1).toDynamicParameters()
+    extra = pin.Inertia(0.5, np.array([0.0, 0.0, 0.1]), 1e-3 * np.eye(3)).toDynamicParameters()
+    K, G = np.hstack([np.eye(10), np.eye(10)]), 1e3 * np.eye(10)
+    c = G @ (first + second + extra)
+    urdf = np.concatenate([first, second])
+    held = ConsistentProgram(G, K, urdf, [], ["link", "flange"], carriers=[1]).solve(G, c, 1, 1e-3)
+    # pulled toward none 1000 × more weakly (per unit of its carrier's scale, 4 × the link's): 98.4 %
+    np.testing.assert_allclose(held.payloads[0][0], extra[0], rtol=0.02)
+    np.testing.assert_allclose(held.standard[0::10], [first[0], second[0] + extra[0]], atol=0.01)
+    np.testing.assert_allclose(held.bodies_base, first + second + extra, atol=1e-4)  # the fit itself
+    assert held.payload_bodies == ["flange"]
+    spread = ConsistentProgram(G, K, urdf, [], ["link", "flange"]).solve(G, c, 1, 1e-3)
+    np.testing.assert_allclose(spread.bodies_base, first + second + extra, atol=1e-4)  # the same fit
+    assert spread.standard[0] - first[0] > 0.4  # the heavier link takes most of it (its scale is larger)
 
 
 @pytest.mark.skipif(not (SHARED / "exciting_traj_1.csv").exists(), reason="shared Panda data not present")
@@ -202,3 +225,35 @@ def test_rotors_that_regroup_with_the_links_stay_out_of_the_bodies(tmp_path, opt
     urdf = robot.urdf_parameters()
     np.testing.assert_allclose(fit.standard[0::10], urdf[0::10], rtol=0.05)
     assert report.relative_consistent.mean() <= 1.3 * report.relative_least_squares.mean()
+
+
+def test_an_undeclared_payload_on_the_flange_is_a_body_of_its_own_and_the_links_keep_their_masses(
+    tmp_path,
+    optimized,  # noqa: F811
+):
+    """Torques of the Panda carrying 1 kg 10 cm beyond the flange, not declared: the payload regroups
+    with the links below it, so the data cannot say which body carries it; the consistent fit holds it
+    apart on the last body (pulled toward none far more weakly than the links toward the URDF), so
+    links 1-6 keep the URDF's masses (the truth) and the last body comes out with the payload's."""
+    problem = result_problem(optimized)
+    robot = robot_of(problem)
+    urdf = robot.urdf_parameters()
+    payload = pin.Inertia(1.0, np.array([0.0, 0.0, 0.1]), np.diag([2e-3, 2e-3, 1e-3])).toDynamicParameters()
+    truth = urdf.copy()
+    truth[-10:] += payload
+    trajectory = FourierTrajectory(problem.trajectory.harmonics, problem.trajectory.base_frequency)
+    rng = np.random.default_rng(1)
+    files = []
+    for k, alpha in read_alphas(optimized):
+        time = np.arange(int(2 * trajectory.period * 500) + 1) / 500.0
+        q, qd, qdd = trajectory.basis(time).evaluate(alpha)
+        tau = np.array([robot.regressor(*x) @ truth for x in zip(q, qd, qdd)]) + rng.normal(0, 0.05, q.shape)
+        header = ",".join(["time"] + [f"q_{j}" for j in JOINTS] + [f"tau_{j}" for j in JOINTS])
+        files.append(f"load_{k}.csv")
+        np.savetxt(tmp_path / files[-1], np.column_stack([time, q, tau]), delimiter=",", header=header, comments="")
+    report, *_ = _identify(tmp_path, files)
+    fit = report.consistent
+    assert fit.payload_bodies == [robot.body_names[-1]]
+    np.testing.assert_allclose(fit.standard[0:60:10], urdf[0:60:10], rtol=0.01)  # links 1-6
+    np.testing.assert_allclose(fit.standard[60], truth[60], rtol=0.02)  # the last body with the payload
+    np.testing.assert_allclose(fit.payloads[0, :4], payload[:4], rtol=0.05, atol=0.005)  # mass and first moment
