@@ -18,6 +18,7 @@ def consistent_bodies(fit: ConsistentFit, robot: Robot) -> Table:
     urdf = robot.urdf_parameters()
     payloads = zip(fit.payload_bodies, fit.payloads)
     vector = lambda v: " ".join(f"{x:+.3f}" for x in v)  # noqa: E731
+    where = lambda p: f" at {vector(p[1:4] / p[0])} m" if p[0] >= 1e-3 else ""  # noqa: E731  (no centre below 1 g)
     rows = []
     for i, name in enumerate(robot.body_names):
         m, c, _, moments = body_properties(fit.standard[10 * i : 10 * i + 10])
@@ -47,5 +48,5 @@ def consistent_bodies(fit: ConsistentFit, robot: Robot) -> Table:
         + "\nrotor inertias held apart from the bodies (in the regrouped base parameters) [kg m²]: "
         + (", ".join(f"{j} {a:.4g}" for j, a in zip(fit.rotor_joints, fit.rotors)) or "none")
         + "\npayloads held apart on the last bodies (in their masses above): "
-        + (", ".join(f"{b} {p[0]:.3f} kg at {vector(p[1:4] / max(p[0], 1e-9))} m" for b, p in payloads) or "none"),
+        + (", ".join(f"{b} {p[0]:.3f} kg{where(p)}" for b, p in payloads) or "none"),
     )

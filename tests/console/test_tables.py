@@ -2,6 +2,7 @@
 table, the progress lines of a log, and errors worded as the command's options."""
 
 import io
+import re
 
 import numpy as np
 import pinocchio as pin
@@ -133,3 +134,8 @@ def test_the_consistent_bodies_table_gives_the_last_body_with_its_payload_and_th
     none = ConsistentFit(urdf, np.zeros(0), np.zeros(1), np.ones(bodies), [], "optimal", urdf, np.zeros(0), [],
                          np.zeros(1), np.zeros((0, 10)), [])  # fmt: skip
     assert "on the last bodies (in their masses above): none" in _text([consistent_bodies(none, robot)])
+    fit = ConsistentFit(
+        standard, np.zeros(0), np.zeros(1), np.ones(bodies), [], "optimal", urdf, np.zeros(0), [], np.zeros(1),
+        1e-5 * payload[None], [last],
+    )  # fmt: skip
+    assert re.search(rf"\(in their masses above\): {last} 0.000 kg\s*$", _text([consistent_bodies(fit, robot)]))
