@@ -122,7 +122,9 @@ class ConsistentProgram:
     """The semidefinite program of the module docstring for one model, compiled once (cvxpy
     parameters) and solved for any normal equations of its unknowns and any λ: the fit on all data
     and each cross-validation fold's refit differ only in G, c and λ. The unknowns are
-    u = column ⊙ [δ; a; ψ; θ], φ = φ_URDF + D δ, column the design's column norms on all fit data.
+    u = column ⊙ [δ; a; θ] with φ + P ψ = φ_URDF + D δ (column: the design's column norms on all fit
+    data), and the payloads ψ = D_P ω: a payload's columns are its carrier's, so the data term sees only
+    their sum and keeps the size of a fit without payloads; ω enters the prior and the constraints.
 
     Args:
         reference: (b + k, b + k) weighted normal equations AᵀW²A of A = [Y_B, E], the base regressor
@@ -151,53 +153,40 @@ class ConsistentProgram:
     ):
         phi_urdf = nearest_physical(phi_urdf)  # unseen parameters stay at φ_URDF: it must be feasible
         self.regrouping, self.phi_urdf, self.names, self.bodies = regrouping, phi_urdf, effect_names, bodies
-        self.scale = body_scales(phi_urdf)
+        self.scale = scale = body_scales(phi_urdf)
+        b, k, p = regrouping.shape[0], len(effect_names), scale.size
         self.rotor_joints, self.carriers = list(rotors or {}), list(carriers or [])
-        b, p = regrouping.shape
         self.rotors = np.column_stack([rotors[j] for j in self.rotor_joints]) if rotors else np.zeros((b, 0))
-        self.first_payload = p + len(self.rotor_joints)  # [δ; a] come before the payloads ψ
-        self.first_effect = self.first_payload + 10 * len(self.carriers)  # and they before the effects θ
+        self.first_effect = p + (r := len(self.rotor_joints))  # [δ; a] come before the effects θ
         self.nonnegative = np.array([name.split()[0] in NONNEGATIVE for name in effect_names], dtype=bool)
-        self.to_unknowns = self._design(len(effect_names))
+        # [Y_B K D, Y_B R, E]: the design in the unknowns [δ; a; θ]
+        self.to_unknowns = np.zeros((b + k, p + r + k))
+        self.to_unknowns[:b, :p] = regrouping * scale
+        self.to_unknowns[:b, p : p + r] = self.rotors
+        self.to_unknowns[b:, p + r :] = np.eye(k)
         column = np.sqrt(np.maximum(np.diag(self.to_unknowns.T @ reference @ self.to_unknowns), 0.0))
         self.unseen = column <= 1e-9 * column.max()
         column[self.unseen] = 1.0
         self.column = column
-        size = column.size
+        self.placing = np.zeros((p, 10 * len(self.carriers)))  # P: each payload's ω onto its carrier's δ
+        for n, body in enumerate(self.carriers):
+            self.placing[10 * body : 10 * body + 10, 10 * n : 10 * n + 10] = np.eye(10)
+        size = p + r + k
         self.R, self.z = cp.Parameter((size, size)), cp.Parameter(size)  # the data term ‖R u − z‖², scaled by 1/M
-        self.weight, self.pinned = cp.Parameter(nonneg=True), cp.Parameter(len(effect_names), nonneg=True)
-        self.u = cp.Variable(size)
-        # √ of each unknown's pull: the bodies toward the URDF, the rotors free, the payloads weakly toward none
-        pulls = (np.ones(p), np.zeros(len(self.rotor_joints)), np.full(10 * len(self.carriers), PAYLOAD_PULL))
-        self.pull = np.sqrt(np.concatenate(pulls))
-        prior = cp.multiply(self.u[: self.first_effect], self.pull / column[: self.first_effect])
-        objective = cp.sum_squares(self.R @ self.u - self.z) + self.weight * cp.sum_squares(prior)
-        self.problem = cp.Problem(cp.Minimize(objective), self._constraints())
+        self.weight, self.pinned = cp.Parameter(nonneg=True), cp.Parameter(k, nonneg=True)
+        self.u, self.omega = cp.Variable(size), cp.Variable(10 * len(self.carriers)) if self.carriers else None
+        own = cp.multiply(self.u[:p], 1.0 / column[:p])  # the links' own D⁻¹(φ − φ_URDF)
+        if self.carriers:
+            own = own - self.placing @ self.omega
+        prior = cp.sum_squares(own) + (PAYLOAD_PULL * cp.sum_squares(self.omega) if self.carriers else 0.0)
+        objective = cp.sum_squares(self.R @ self.u - self.z) + self.weight * prior
+        self.problem = cp.Problem(cp.Minimize(objective), self._constraints(own))
 
-    def _payload_blocks(self) -> list[tuple[slice, slice]]:
-        """Per payload: its carrier's slice of the standard parameters and its slice of the unknowns."""
-        first = self.first_payload
-        return [
-            (slice(10 * i, 10 * i + 10), slice(first + 10 * n, first + 10 * (n + 1)))
-            for n, i in enumerate(self.carriers)
-        ]
-
-    def _design(self, k: int) -> np.ndarray:
-        """[Y_B K D, Y_B R, Y_B K P D_P, E] as a map (b + k, unknowns) from [δ; a; ψ; θ] to [φ_B; θ]."""
-        b, p = self.regrouping.shape
-        out = np.zeros((b + k, self.first_effect + k))
-        out[:b, :p] = self.regrouping * self.scale
-        out[:b, p : self.first_payload] = self.rotors
-        for carrier, unknowns in self._payload_blocks():
-            out[:b, unknowns] = self.regrouping[:, carrier] * self.scale[carrier]
-        out[b:, self.first_effect :] = np.eye(k)
-        return out
-
-    def _constraints(self) -> list:
-        """Every body's pseudo-inertia ⪰ ε_i, every payload's ⪰ 0, a ≥ 0, the non-negative effects,
-        and the effects a fold's data never see pinned at 0."""
-        u, column, scale, p = self.u, self.column, self.scale, self.scale.size
-        phi = self.phi_urdf + cp.multiply(scale, cp.multiply(u[:p], 1.0 / column[:p]))
+    def _constraints(self, own: cp.Expression) -> list:
+        """Every body's own pseudo-inertia ⪰ ε_i (``own``: D⁻¹(φ − φ_URDF)), every payload's ⪰ 0, a ≥ 0,
+        the non-negative effects, and the effects a fold's data never see pinned at 0."""
+        u, scale, p = self.u, self.scale, self.scale.size
+        phi = self.phi_urdf + cp.multiply(scale, own)
         # T J T ⪰ ε T² with T = diag(1/ℓ, 1/ℓ, 1/ℓ, 1)/√m₀: a congruence, same cone, entries of order 1
         T = np.diag([1.0 / LENGTH] * 3 + [1.0])
         out = [
@@ -205,27 +194,17 @@ class ConsistentProgram:
             >> MARGIN * np.diag([1.0] * 3 + [LENGTH**2])
             for i in range(len(self.bodies))
         ]
-        for carrier, unknowns in self._payload_blocks():
-            psi = cp.multiply(scale[carrier] / column[unknowns], u[unknowns])
-            out.append(T @ pseudo_inertia_expression(psi) @ T / scale[carrier.start] >> 0)
+        for n, body in enumerate(self.carriers):
+            psi = cp.multiply(scale[10 * body : 10 * body + 10], self.omega[10 * n : 10 * n + 10])
+            out.append(T @ pseudo_inertia_expression(psi) @ T / scale[10 * body] >> 0)
         if self.rotor_joints:
-            out.append(u[p : self.first_payload] >= 0)
+            out.append(u[p : self.first_effect] >= 0)
         q = self.first_effect
         if self.nonnegative.any():
             out.append(u[q + np.flatnonzero(self.nonnegative)] >= 0)
         if self.names:  # an effect column a fold's data never see (a held-out run's offset) is kept at 0
             out.append(cp.multiply(self.pinned, u[q:]) == 0)
         return out
-
-    def _standard(self, unknowns: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """φ + P ψ (p,) and the payloads ψ (l, 10) of the unknowns [δ; a; ψ; θ] (unscaled by column)."""
-        p = self.scale.size
-        standard = self.phi_urdf + self.scale * unknowns[:p]
-        payloads = np.zeros((len(self.carriers), 10))
-        for n, (carrier, slot) in enumerate(self._payload_blocks()):
-            payloads[n] = self.scale[carrier] * unknowns[slot]
-            standard[carrier] += payloads[n]
-        return standard, payloads
 
     def solve(self, G: np.ndarray, c: np.ndarray, rows: int, regularization: float) -> ConsistentFit:
         """The consistent fit to the weighted normal equations G (b + k, b + k), c (b + k,) of ``rows``
@@ -234,7 +213,7 @@ class ConsistentProgram:
         Raises:
             ExciteError: the solver finds no solution (the message gives its status).
         """
-        b, column = self.regrouping.shape[0], self.column
+        b, p, q, column = self.regrouping.shape[0], self.scale.size, self.first_effect, self.column
         normal = self.to_unknowns.T @ G @ self.to_unknowns / np.outer(column, column)
         right = self.to_unknowns.T @ (c - G[:, :b] @ (self.regrouping @ self.phi_urdf)) / column
         normal[self.unseen, :], normal[:, self.unseen] = 0.0, 0.0
@@ -242,10 +221,12 @@ class ConsistentProgram:
         R, padded = np.zeros_like(normal), np.zeros(normal.shape[0])  # RᵀR = the scaled normal matrix (padded)
         R[: len(A)], padded[: len(z)] = A, z
         self.R.value, self.z.value, self.weight.value = R / np.sqrt(rows), padded / np.sqrt(rows), regularization
-        self.pinned.value = (np.diag(normal)[self.first_effect :] <= 0.0).astype(float)
+        self.pinned.value = (np.diag(normal)[q:] <= 0.0).astype(float)
         problem = _solve(self.problem)
         unknowns = self.u.value / column
-        standard, payloads = self._standard(unknowns)
+        standard = self.phi_urdf + self.scale * unknowns[:p]
+        omega = self.omega.value[: self.placing.shape[1]] if self.carriers else np.zeros(0)
+        payloads = (self.placing * self.scale[:, None]).T @ (self.placing @ omega)
         eigen = np.array([np.linalg.eigvalsh(pseudo_inertia(body))[0] for body in standard.reshape(-1, 10)])
         if np.any(eigen <= 0.0):
             raise ExciteError(
@@ -253,10 +234,7 @@ class ConsistentProgram:
                 f"the SDP ended {problem.status} with a pseudo-inertia "
                 f"that is not positive definite (body {self.bodies[int(np.argmin(eigen))]})",
             )
-        rotors, coefficients = unknowns[self.scale.size : self.first_payload], unknowns[self.first_effect :]
-        prior = np.diag(np.concatenate([self.pull, np.zeros(column.size - self.pull.size)]) / column)[: self.pull.size]
-        stacked = np.vstack([R / np.sqrt(rows), np.sqrt(regularization) * prior])
-        plain = np.linalg.lstsq(stacked, np.concatenate([padded / np.sqrt(rows), np.zeros(len(prior))]), rcond=None)[0]
+        rotors, coefficients = unknowns[p:q], unknowns[q:]
         bodies = self.regrouping @ standard
         return ConsistentFit(
             standard,
@@ -265,13 +243,23 @@ class ConsistentProgram:
             eigen,
             self._active(eigen, coefficients, rotors),
             str(problem.status),
-            self._standard(plain / column)[0],
+            self._unconstrained(R / np.sqrt(rows), padded / np.sqrt(rows), regularization),
             rotors,
             self.rotor_joints,
             bodies,
-            payloads,
+            payloads.reshape(-1, 10),
             [self.bodies[i] for i in self.carriers],
         )
+
+    def _unconstrained(self, R: np.ndarray, z: np.ndarray, regularization: float) -> np.ndarray:
+        """(p,) φ + P ψ of the same problem without the constraints (regularized least squares). For a
+        given carrier's δ the best ω is δ/(1 + μ), which leaves the prior μ/(1 + μ) ‖δ‖² on it."""
+        p, column = self.scale.size, self.column
+        pull = np.where(self.placing.any(axis=1), PAYLOAD_PULL / (1.0 + PAYLOAD_PULL), 1.0)
+        prior = np.zeros((p, column.size))
+        prior[:, :p] = np.diag(np.sqrt(regularization * pull) / column[:p])
+        plain = np.linalg.lstsq(np.vstack([R, prior]), np.concatenate([z, np.zeros(p)]), rcond=None)[0]
+        return self.phi_urdf + self.scale * plain[:p] / column[:p]
 
     def _active(self, eigen: np.ndarray, coefficients: np.ndarray, rotors: np.ndarray) -> list[str]:
         """The constraints at their bound, in words."""
