@@ -407,6 +407,7 @@ def test_unknown_joint_in_declared_effects(tmp_path):
 
 
 @pytest.mark.skipif(not (SHARED / "exciting_traj_1.csv").exists(), reason="shared Panda data not present")
+@pytest.mark.end_to_end
 def test_real_panda_run(tmp_path):
     config = {
         "robot": {"urdf": "panda_description/urdf/panda.urdf", "source": "example-robot-data", "active_joints": JOINTS},
@@ -427,6 +428,7 @@ def test_real_panda_run(tmp_path):
 
 
 @pytest.mark.skipif(not (SHARED / "exciting_traj_1.csv").exists(), reason="shared Panda data not present")
+@pytest.mark.end_to_end
 def test_real_panda_fitted_on_a_short_first_phase_reports_the_fit_that_transfers():
     """Issue 42's analogue of a poorly excited fit run: the first 20 % of the real run fitted, the rest
     validated. Least squares' cross-validated error is the lower one on its search's model, yet it

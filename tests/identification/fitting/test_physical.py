@@ -153,6 +153,24 @@ def _identify(tmp: Path, runs: list[str]):
     return run_identification(load_problem(write_config(tmp, config, "identify.yaml"), IdentifyProblem))
 
 
+def _rigid_runs(tmp: Path, optimized: Path, truth: np.ndarray, periods: int, seed: int, prefix: str) -> list[str]:
+    """One CSV per trajectory of ``optimized``: ``periods`` periods at 500 Hz of the rigid-body torques of
+    the standard parameters ``truth`` (p,) plus 0.05 Nm of white noise; their file names in ``tmp``."""
+    problem = result_problem(optimized)
+    robot = robot_of(problem)
+    trajectory = FourierTrajectory(problem.trajectory.harmonics, problem.trajectory.base_frequency)
+    rng = np.random.default_rng(seed)
+    files = []
+    for k, alpha in read_alphas(optimized):
+        time = np.arange(int(periods * trajectory.period * 500) + 1) / 500.0
+        q, qd, qdd = trajectory.basis(time).evaluate(alpha)
+        tau = np.array([robot.regressor(*x) @ truth for x in zip(q, qd, qdd)]) + rng.normal(0, 0.05, q.shape)
+        header = ",".join(["time"] + [f"q_{j}" for j in JOINTS] + [f"tau_{j}" for j in JOINTS])
+        files.append(f"{prefix}_{k}.csv")
+        np.savetxt(tmp / files[-1], np.column_stack([time, q, tau]), delimiter=",", header=header, comments="")
+    return files
+
+
 def test_simulated_data_consistent_fit_recovers_the_base_parameters(tmp_path, optimized):  # noqa: F811
     sim = {
         "sample_rate": 500,
@@ -177,21 +195,10 @@ def test_simulated_data_consistent_fit_recovers_the_base_parameters(tmp_path, op
 def test_negative_mass_data_stays_physical_with_the_consistent_fit(tmp_path, optimized):  # noqa: F811
     """Torques of a model whose hand body (link 7 with the hand merged) has all parameters negated:
     plain least squares says its mass is negative, the consistent fit keeps every body physical."""
-    problem = result_problem(optimized)
-    robot = robot_of(problem)
+    robot = robot_of(result_problem(optimized))
     truth = robot.urdf_parameters()
     truth[60:70] *= -1.0
-    trajectory = FourierTrajectory(problem.trajectory.harmonics, problem.trajectory.base_frequency)
-    rng = np.random.default_rng(0)
-    files = []
-    for k, alpha in read_alphas(optimized):
-        time = np.arange(int(4 * trajectory.period * 500) + 1) / 500.0
-        q, qd, qdd = trajectory.basis(time).evaluate(alpha)
-        tau = np.array([robot.regressor(*x) @ truth for x in zip(q, qd, qdd)]) + rng.normal(0, 0.05, q.shape)
-        header = ",".join(["time"] + [f"q_{j}" for j in JOINTS] + [f"tau_{j}" for j in JOINTS])
-        files.append(f"neg_{k}.csv")
-        np.savetxt(tmp_path / files[-1], np.column_stack([time, q, tau]), delimiter=",", header=header, comments="")
-    report, *_ = _identify(tmp_path, files)
+    report, *_ = _identify(tmp_path, _rigid_runs(tmp_path, optimized, truth, 4, 0, "neg"))
     plain, consistent = report.consistent.unconstrained, report.consistent.standard
     assert plain[60] < 0  # plain least squares: a negative mass of the hand body
     assert np.all(consistent[0::10] > 0) and np.all(_eigenvalues(consistent) > 0)
@@ -235,23 +242,12 @@ def test_an_undeclared_payload_on_the_flange_is_a_body_of_its_own_and_the_links_
     with the links below it, so the data cannot say which body carries it; the consistent fit holds it
     apart on the last body (pulled toward none far more weakly than the links toward the URDF), so
     links 1-6 keep the URDF's masses (the truth) and the last body comes out with the payload's."""
-    problem = result_problem(optimized)
-    robot = robot_of(problem)
+    robot = robot_of(result_problem(optimized))
     urdf = robot.urdf_parameters()
     payload = pin.Inertia(1.0, np.array([0.0, 0.0, 0.1]), np.diag([2e-3, 2e-3, 1e-3])).toDynamicParameters()
     truth = urdf.copy()
     truth[-10:] += payload
-    trajectory = FourierTrajectory(problem.trajectory.harmonics, problem.trajectory.base_frequency)
-    rng = np.random.default_rng(1)
-    files = []
-    for k, alpha in read_alphas(optimized):
-        time = np.arange(int(2 * trajectory.period * 500) + 1) / 500.0
-        q, qd, qdd = trajectory.basis(time).evaluate(alpha)
-        tau = np.array([robot.regressor(*x) @ truth for x in zip(q, qd, qdd)]) + rng.normal(0, 0.05, q.shape)
-        header = ",".join(["time"] + [f"q_{j}" for j in JOINTS] + [f"tau_{j}" for j in JOINTS])
-        files.append(f"load_{k}.csv")
-        np.savetxt(tmp_path / files[-1], np.column_stack([time, q, tau]), delimiter=",", header=header, comments="")
-    report, *_ = _identify(tmp_path, files)
+    report, *_ = _identify(tmp_path, _rigid_runs(tmp_path, optimized, truth, 2, 1, "load"))
     fit = report.consistent
     assert fit.payload_bodies == [robot.body_names[-1]]
     np.testing.assert_allclose(fit.standard[0:60:10], urdf[0:60:10], rtol=0.01)  # links 1-6

@@ -52,7 +52,7 @@ def test_the_identified_urdf_loads_and_reproduces_the_consistent_torques(simulat
     write_urdf(source, target, robot, report.consistent.standard, effects, "test")
     model = pin.buildModelFromUrdf(str(target))
     assert model.nq >= robot.n_joints
-    phi = report.consistent.base
+    phi = report.consistent.bodies_base  # what a URDF holds: the rotors are comments in it
 
     def identified(q, qd, qdd):
         return robot.regressor(q, qd, qdd) @ base.composition_matrix @ phi
