@@ -171,6 +171,7 @@ class ConsistentProgram:
         self.placing = np.zeros((p, 10 * len(self.carriers)))  # P: each payload's ω onto its carrier's δ
         for n, body in enumerate(self.carriers):
             self.placing[10 * body : 10 * body + 10, 10 * n : 10 * n + 10] = np.eye(10)
+        self.payload_scale = self.placing.T @ scale  # D_P: each payload scaled like its carrier, ψ = D_P ω
         size = p + r + k
         self.R, self.z = cp.Parameter((size, size)), cp.Parameter(size)  # the data term ‖R u − z‖², scaled by 1/M
         self.weight, self.pinned = cp.Parameter(nonneg=True), cp.Parameter(k, nonneg=True)
@@ -195,7 +196,7 @@ class ConsistentProgram:
             for i in range(len(self.bodies))
         ]
         for n, body in enumerate(self.carriers):
-            psi = cp.multiply(scale[10 * body : 10 * body + 10], self.omega[10 * n : 10 * n + 10])
+            psi = cp.multiply(self.payload_scale, self.omega)[10 * n : 10 * n + 10]
             out.append(T @ pseudo_inertia_expression(psi) @ T / scale[10 * body] >> 0)
         if self.rotor_joints:
             out.append(u[p : self.first_effect] >= 0)
@@ -225,8 +226,7 @@ class ConsistentProgram:
         problem = _solve(self.problem)
         unknowns = self.u.value / column
         standard = self.phi_urdf + self.scale * unknowns[:p]
-        omega = self.omega.value[: self.placing.shape[1]] if self.carriers else np.zeros(0)
-        payloads = (self.placing * self.scale[:, None]).T @ (self.placing @ omega)
+        payloads = self.payload_scale * (self.omega.value if self.carriers else np.zeros(0))
         eigen = np.array([np.linalg.eigvalsh(pseudo_inertia(body))[0] for body in standard.reshape(-1, 10)])
         if np.any(eigen <= 0.0):
             raise ExciteError(
