@@ -16,7 +16,7 @@ def consistent_bodies(fit: ConsistentFit, robot: Robot) -> Table:
     """Identified (physically consistent) bodies beside the URDF's, the active constraints, the rotors and
     the payloads."""
     urdf = robot.urdf_parameters()
-    payloads = zip(fit.payload_bodies, fit.payloads)
+    payloads, rotors = zip(fit.payload_bodies, fit.payloads), zip(fit.rotor_joints, fit.rotors, fit.own_columns)
     vector = lambda v: " ".join(f"{x:+.3f}" for x in v)  # noqa: E731
     where = lambda p: f" at {vector(p[1:4] / p[0])} m" if p[0] >= 1e-3 else ""  # noqa: E731  (no centre below 1 g)
     rows = []
@@ -45,8 +45,8 @@ def consistent_bodies(fit: ConsistentFit, robot: Robot) -> Table:
         + (", ".join(fit.active) or "none")
         + "\nplain least squares (same regularization) is not physical for: "
         + (", ".join(f"{name} (mass {m:.3f} kg)" for name, m in plain) or "none")
-        + "\nrotor inertias held apart from the bodies (in the regrouped base parameters) [kg m²]: "
-        + (", ".join(f"{j} {a:.4g}" for j, a in zip(fit.rotor_joints, fit.rotors)) or "none")
+        + "\nrotor inertias held apart from the bodies [kg m²] (regrouped: in the base parameters with a link's): "
+        + (", ".join(f"{j} {a:.4g}{'' if o else ' regrouped'}" for j, a, o in rotors) or "none")
         + "\npayloads held apart on the last bodies (in their masses above): "
         + (", ".join(f"{b} {p[0]:.3f} kg{where(p)}" for b, p in payloads) or "none"),
     )

@@ -151,7 +151,7 @@ def models(report: Report) -> list[Table]:
         rows.append(
             (
                 label + (" (chosen)" if k == choice.model else ""),
-                f"{model.effects:.4g}",
+                f"{choice.effects(k, best):.4g}",
                 f"{choice.cv[k, 0]:.2f}" if choice.names[0] == "least squares" else "",
                 choice.names[best],
                 f"{choice.cv[k, best]:.2f}",
@@ -161,7 +161,8 @@ def models(report: Report) -> list[Table]:
     return [
         titled_table(
             "Models and fits scored together: J = log CV + effects × log(1 + min_improvement) (least squares: "
-            "+ log(1 + least_squares_margin)), the lowest wins",
+            "+ log(1 + least_squares_margin); a consistent fit's effects leave out armature, it holds every "
+            "rotor), the lowest wins",
             ("model", "effects", "least squares CV [%]", "best fit", "its CV [%]", "J"),
             rows,
         )

@@ -133,3 +133,11 @@ def coefficient_names(term: Term, offset_runs: list[str]) -> list[str]:
     if term.kind.per_run and len(offset_runs) > 1:
         return [f"{names[0]}[{label}]" for label in offset_runs]
     return list(names)
+
+
+def rotor_terms(n: int, terms: list[Term]) -> list[Term]:
+    """The armature of each of the ``n`` joints that no uncoupled term of ``terms`` already holds (an
+    ``armature`` or a joint's own ``motor``): the rotors the physically consistent fit keeps as bodies
+    of their own (:mod:`~excite_cli.identification.choice.fit_choice`) beside the model's effects."""
+    held = {t.joint for t in terms if t.coupling is None and "armature" in (t.effect, *t.kind.parts)}
+    return [Term("armature", j) for j in range(n) if j not in held]

@@ -14,11 +14,12 @@ from excite_cli.dynamics.robot import Robot, load_robot
 from excite_cli.dynamics.urdf_source import resolve_urdf
 from excite_cli.effects import EFFECTS
 from excite_cli.errors import ExciteError
+from excite_cli.identification.choice.consistent_model import consistent_model
 from excite_cli.identification.choice.crossval import fold_groups
 from excite_cli.identification.choice.fit_choice import choose_fit
 from excite_cli.identification.choice.selection import Selection, candidate_terms, motor_couplings, select_effects
 from excite_cli.identification.config import IdentifyProblem
-from excite_cli.identification.effects import Term
+from excite_cli.identification.effects import Term, rotor_terms
 from excite_cli.identification.fitting.channels import dead_channels
 from excite_cli.identification.fitting.dataset import Dataset, build_datasets, fit_position_range
 from excite_cli.identification.fitting.least_squares import joint_weights, least_squares, predict, torque_errors
@@ -190,7 +191,8 @@ def run_identification(
     cfg = problem.identification
     couplings = motor_couplings(problem.data.transmission, cfg.coupling_ratios, robot.n_joints)
     candidates = candidate_terms(cfg, robot.n_joints, couplings)
-    data = prepare_data(problem, robot, base, declared + [t for t in candidates if t not in declared])
+    terms = declared + [t for t in candidates + rotor_terms(robot.n_joints, []) if t not in declared]
+    data = prepare_data(problem, robot, base, list(dict.fromkeys(terms)))  # with the consistent fit's rotors
     fit_data, val_data = data.fit, data.validation
     selection = select_effects(
         fit_data,
@@ -211,16 +213,15 @@ def run_identification(
     measured = val_data.tau.reshape(-1, val_data.n)
     before = predict(val_data, selection.rigid.x, [])
     plain = predict(val_data, selection.fit.x, selection.terms)
-    consistent = None
+    consistent, kept = None, selection.terms
     if choice.consistent is not None:
-        consistent = predict(
-            val_data, np.concatenate([choice.consistent.base, choice.consistent.effects]), selection.terms
-        )
+        kept, x = consistent_model(choice.consistent, selection.terms, robot.joint_names)
+        consistent = predict(val_data, x, kept)
     after = consistent if choice.is_consistent else plain
     rms_after, rms_torque, _ = torque_errors(measured, after)
     ladder = error_ladder(val_data, selection, robot.joint_names, ~data.silent | data.silent.all())
     for d in (fit_data, val_data):  # the candidates not chosen are no longer needed: released before the report
-        for t in [t for t in d.blocks if t not in selection.terms]:
+        for t in [t for t in d.blocks if t not in kept]:
             del d.blocks[t]
     trim_freed_memory()
     report = Report(

@@ -117,7 +117,7 @@ def test_the_command_line_words_fields_as_its_options():
     assert word(OutputExists("output", "r.h5"), spelled) == "--output: r.h5 exists; use --force to replace it"
 
 
-def test_the_consistent_bodies_table_gives_the_last_body_with_its_payload_and_the_payload_apart():
+def test_the_consistent_bodies_table_gives_the_last_body_with_its_payload_the_payload_and_the_rotors_apart():
     robot = robot_of(load_problem(CONFIGS / "panda.yaml"))
     urdf, last = robot.urdf_parameters(), robot.body_names[-1]
     payload = pin.Inertia(1.25, np.array([0.0, 0.02, 0.1]), 1e-3 * np.eye(3)).toDynamicParameters()
@@ -125,17 +125,18 @@ def test_the_consistent_bodies_table_gives_the_last_body_with_its_payload_and_th
     standard[-10:] += payload
     bodies = len(robot.body_names)
     fit = ConsistentFit(
-        standard, np.zeros(0), np.zeros(1), np.ones(bodies), [], "optimal", urdf, np.zeros(0), [], np.zeros(1),
-        payload[None], [last],
+        standard, np.zeros(0), np.zeros(1), np.ones(bodies), [], "optimal", urdf, np.array([0.3, 0.05]),
+        ["panda_joint1", "panda_joint4"], np.zeros(1), payload[None], [last], np.array([False, True]),
     )  # fmt: skip
     text = _text([consistent_bodies(fit, robot)])
+    assert "with a link's): panda_joint1 0.3 regrouped, panda_joint4 0.05" in " ".join(text.split())  # wrapped
     assert f"{urdf[-10] + 1.25:.3f} / {urdf[-10]:.3f}" in text  # the last body carries it
     assert f"on the last bodies (in their masses above): {last} 1.250 kg at +0.000 +0.020 +0.100 m" in text
     none = ConsistentFit(urdf, np.zeros(0), np.zeros(1), np.ones(bodies), [], "optimal", urdf, np.zeros(0), [],
-                         np.zeros(1), np.zeros((0, 10)), [])  # fmt: skip
+                         np.zeros(1), np.zeros((0, 10)), [], np.zeros(0, dtype=bool))  # fmt: skip
     assert "on the last bodies (in their masses above): none" in _text([consistent_bodies(none, robot)])
     fit = ConsistentFit(
         standard, np.zeros(0), np.zeros(1), np.ones(bodies), [], "optimal", urdf, np.zeros(0), [], np.zeros(1),
-        1e-5 * payload[None], [last],
+        1e-5 * payload[None], [last], np.zeros(0, dtype=bool),
     )  # fmt: skip
     assert re.search(rf"\(in their masses above\): {last} 0.000 kg\s*$", _text([consistent_bodies(fit, robot)]))

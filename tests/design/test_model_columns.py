@@ -16,8 +16,8 @@ from excite_cli.h5 import read_strings, write_strings
 
 
 def _report(source, path, joints, sigma):
-    """A copy of the identify report ``source`` with other joint names (its effects' joints renamed
-    alike, in order) and validation errors."""
+    """A copy of the identify report ``source`` with other joint names (its effects' and rotors' joints
+    renamed alike, in order) and validation errors."""
     path.write_bytes(source.read_bytes())
     with h5py.File(path, "a") as f:
         f["regressor"].attrs["sample_rate_Hz"] = 200.0
@@ -25,8 +25,10 @@ def _report(source, path, joints, sigma):
         renamed = dict(zip(read_strings(g, "joint_names"), joints))
         rows = g["effects"][()]
         rows["joint"] = [renamed[j.decode()] for j in rows["joint"]]
-        del g["joint_names"], g["rms_after"], g["effects"]
+        rotors = [renamed[j] for j in read_strings(g, "rotor_joints")]
+        del g["joint_names"], g["rms_after"], g["effects"], g["rotor_joints"]
         write_strings(g, "joint_names", joints)
+        write_strings(g, "rotor_joints", rotors)
         g["rms_after"], g["effects"] = sigma, rows
     return path
 

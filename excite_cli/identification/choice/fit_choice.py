@@ -16,14 +16,18 @@ search's own objective
     J(M, fit) = log CV(M, fit) + p(M) · log(1 + min_improvement) [+ log(1 + least_squares_margin)],
 
 p(M) the effects M adds beyond the declared ones: least squares (its CV error is the search's) and
-the consistent fit at every λ of ``identification.regularization``, refitted on each fold's
-training normal equations. Least squares pays the bracketed price when a consistent fit is a
-candidate: it must cut the CV error of the consistent fit by the fraction ``least_squares_margin``
-(default 0.5) to be chosen. The folds see motion next to the fit's (a neighbouring time block of the
-same few seconds); least squares is free to use base-parameter directions such motion barely
-excites, which its CV error does not charge and a new motion does: fitted on the first 20 % of the
-real Panda run, least squares scored 6.89 % CV against 9.23 % and predicted the rest of the run at
-9.89 % against 7.61 % (docs/figures.md, "Which fit transfers"). The pair with the lowest J wins
+the consistent fit at every λ of ``identification.regularization``, refitted on each fold's training
+normal equations. A consistent fit holds every joint's rotor
+(:mod:`~excite_cli.identification.choice.consistent_model`), so a model's armature terms change
+nothing in it and are not in its p(M): models that differ only by them tie, and the first compared
+(the kept search's end) is kept with the effects the search found. Least squares pays the bracketed
+price when a consistent fit is a candidate: it must cut the CV error of the consistent fit by the
+fraction ``least_squares_margin`` (default 0.5) to be chosen. The folds see motion next to the fit's
+(a neighbouring time block of the same few seconds); least squares is free to use base-parameter
+directions such motion barely excites, which its CV error does not charge and a new motion does:
+fitted on the first 20 % of the real Panda run, least squares scored 6.89 % CV against 9.23 % and
+predicted the rest of the run at 9.89 % against 7.61 % (docs/figures.md, "Which fit transfers"). The
+pair with the lowest J wins
 (``fit: auto``); ``fit: least_squares``
 or ``consistent`` restricts the fits (least squares alone keeps the search's model), and a single
 pair is not cross-validated. The reported model, its validation error and the identified URDF are
@@ -36,15 +40,15 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from excite_cli.dynamics.base_parameters import BaseParameters, rotor_regrouping
+from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.dynamics.robot import Robot
+from excite_cli.identification.choice.consistent_model import ConsistentModel
 from excite_cli.identification.choice.search import effect_count, objective
 from excite_cli.identification.choice.selection import Selection
 from excite_cli.identification.config import IdentificationConfig
-from excite_cli.identification.effects import Term, coefficient_names
-from excite_cli.identification.fitting.bodies import last_bodies
+from excite_cli.identification.effects import Term
 from excite_cli.identification.fitting.least_squares import least_squares
-from excite_cli.identification.fitting.physical import ConsistentFit, ConsistentProgram
+from excite_cli.identification.fitting.physical import ConsistentFit
 
 #: The name of the least-squares candidate.
 LEAST_SQUARES = "least squares"
@@ -53,14 +57,17 @@ LEAST_SQUARES = "least squares"
 @dataclass(frozen=True)
 class Model:
     """A model scored with the fits: the search it comes from, whether it is that search's start or
-    end, its terms and the number of effects it adds beyond the declared ones (p, a coupled one
-    counting as several: :func:`~excite_cli.identification.choice.selection.effect_count`)."""
+    end, its terms, the number of effects it adds beyond the declared ones (p, a coupled one
+    counting as several: :func:`~excite_cli.identification.choice.selection.effect_count`) and how
+    many of those are a joint's armature, which a consistent fit holds anyway (its rotors:
+    :mod:`~excite_cli.identification.choice.consistent_model`) and which there add nothing to pay for."""
 
     search: int
     start: str
     at_start: bool
     terms: list[Term]
     effects: float
+    rotors: int = 0
 
     @property
     def label(self) -> str:
@@ -115,6 +122,12 @@ class FitChoice:
         """(f,) CV error [%] of the winning model under each fit."""
         return self.cv[self.model]
 
+    def effects(self, model: int, fit: int) -> float:
+        """p of J: the effects ``models[model]`` adds, counted under the fit ``names[fit]`` (a consistent
+        fit does not count armature: module docstring)."""
+        m = self.models[model]
+        return m.effects - (m.rotors if self.names[fit] != LEAST_SQUARES else 0)
+
     @property
     def lead(self) -> float:
         """How much lower the winner's CV error is than the next best fit's of the same model [% points]
@@ -123,42 +136,6 @@ class FitChoice:
         if others.size == 0 or np.all(np.isnan(others)):
             return float("nan")
         return float(np.nanmin(others) - self.cv_error[self.chosen])
-
-
-class ConsistentModel:
-    """The physically consistent fit of one model [Y_B, ``terms``] on any normal equations of its
-    unknowns (all fit data, or one fold's training data): one compiled program, with a rotor of its
-    own for every joint whose armature regroups with the bodies' and is not one of ``terms``, and a
-    payload of its own on every body that carries no other.
-
-    Args:
-        terms: the model's terms; selection: the fit data's normal equations and the joints' weights.
-        robot, base: the URDF's parameters, bodies and regrouping K.
-        offset_runs: the labels of the fitted runs, which name the offsets' columns.
-    """
-
-    def __init__(
-        self, terms: list[Term], selection: Selection, robot: Robot, base: BaseParameters, offset_runs: list[str]
-    ):
-        names = [f"{name} {t.where(robot.joint_names)}" for t in terms for name in coefficient_names(t, offset_runs)]
-        reference = selection.normal.system(selection.weights, terms)[0]
-        R, held = rotor_regrouping(robot, base), {t.joint for t in terms if t.effect == "armature" and not t.coupling}
-        rotors = {name: R[:, j] for j, name in enumerate(robot.joint_names) if R[:, j].any() and j not in held}
-        phi, carriers = robot.urdf_parameters(), last_bodies(robot.model)
-        self.program = ConsistentProgram(reference, base.regrouping, phi, names, robot.body_names, rotors, carriers)
-
-    def fit(self, G: np.ndarray, c: np.ndarray, rows: int, regularization: float) -> ConsistentFit:
-        """The SDP of :class:`ConsistentProgram` on the weighted normal equations G, c of ``rows`` rows.
-
-        Raises:
-            ExciteError: the semidefinite program has no solution.
-        """
-        return self.program.solve(G, c, rows, regularization)
-
-    def coefficients(self, G: np.ndarray, c: np.ndarray, rows: int, regularization: float) -> np.ndarray:
-        """(b + k,) the fit's base parameters and effect coefficients, in the model's unknowns."""
-        fit = self.fit(G, c, rows, regularization)
-        return np.concatenate([fit.base, fit.effects])
 
 
 def candidates(cfg: IdentificationConfig) -> list[float | None]:
@@ -176,23 +153,33 @@ def compared_models(selection: Selection) -> list[Model]:
         for at_start, terms in ((False, search.terms), (True, search.initial)):
             if all(set(terms) != set(m.terms) for m in out):
                 p = effect_count(list(terms), selection.declared, selection.effect_weights)
-                out.append(Model(k, search.start, at_start, list(terms), p))
+                rotors = len(terms[selection.declared :]) - len(_without_rotors(terms[selection.declared :]))
+                out.append(Model(k, search.start, at_start, list(terms), p, rotors))
     return out
 
 
-def _scores(selection: Selection, model: Model, lams: list[float | None], consistent: ConsistentModel | None):
-    """(f,) CV error [%] of ``model`` under each fit of ``lams`` (the search's own for least squares)."""
-    search, cv = selection.searches[model.search], selection.cross_validation
+def _without_rotors(terms: list[Term]) -> frozenset[Term]:
+    """``terms`` but a joint's own armature: what tells apart consistent fits (they hold every rotor)."""
+    return frozenset(t for t in terms if t.effect != "armature" or t.coupling is not None)
+
+
+def _scores(selection: Selection, model: Model, lams: list[float | None], programs: dict, known: dict) -> np.ndarray:
+    """(f,) CV error [%] of ``model`` under each fit of ``lams`` (the search's own for least squares);
+    a consistent fit's once per set of terms without rotors (``programs``, ``known``: its scores)."""
+    search, cv, key = selection.searches[model.search], selection.cross_validation, _without_rotors(model.terms)
     out = []
     for lam in lams:
         if lam is None:
             out.append(search.initial_error if model.at_start else search.cv_error)
             continue
+        if (key, lam) not in known:
+            consistent = programs[key]
 
-        def refit(k: int, lam: float = lam) -> np.ndarray:
-            return consistent.coefficients(*cv.training_system(k, model.terms), lam)
+            def refit(k: int, lam: float = lam) -> np.ndarray:
+                return consistent.coefficients(*cv.training_system(k, consistent.terms), lam)
 
-        out.append(cv.error(model.terms, refit)[0])
+            known[key, lam] = cv.error(consistent.terms, refit)[0]
+        out.append(known[key, lam])
     return np.array(out)
 
 
@@ -242,11 +229,15 @@ def choose_fit(
     models = compared_models(selection)
     single = len(models) * len(lams) == 1 and lams[0] is not None  # nothing to compare
     scored = any(lam is not None for lam in lams) and not single
-    programs = [ConsistentModel(m.terms, selection, robot, base, offset_runs) if scored else None for m in models]
-    cv = np.full((len(models), len(lams)), np.nan)
+    programs: dict[frozenset, ConsistentModel] = {}
+    for m in models if scored else []:  # one program per set of terms without rotors: the first model's
+        if _without_rotors(m.terms) not in programs:
+            programs[_without_rotors(m.terms)] = ConsistentModel(m.terms, selection, robot, base, offset_runs)
+    cv, known = np.full((len(models), len(lams)), np.nan), {}
     if not single:
-        cv = np.array([_scores(selection, m, lams, p) for m, p in zip(models, programs)])
-    J = objective(cv, [[m.effects] for m in models], selection.min_improvement)
+        cv = np.array([_scores(selection, m, lams, programs, known) for m in models])
+    p = [[m.effects - (m.rotors if lam is not None else 0) for lam in lams] for m in models]  # FitChoice.effects
+    J = objective(cv, p, selection.min_improvement)
     if any(lam is not None for lam in lams):  # least squares pays its margin (module docstring)
         J = J + np.log1p(np.array([0.0 if lam is not None else cfg.least_squares_margin for lam in lams]))
     win, chosen = (0, 0) if single else np.unravel_index(int(np.nanargmin(J)), J.shape)
@@ -255,8 +246,10 @@ def choose_fit(
     lam = lams[best] if best is not None else (cfg.regularization[0] if consistent_beside else None)
     fit = None
     if lam is not None:
-        program = programs[win] or ConsistentModel(models[win].terms, selection, robot, base, offset_runs)
-        G, c, _ = selection.normal.system(selection.weights, models[win].terms)
+        program = programs.get(_without_rotors(models[win].terms))
+        if program is None or program.model != models[win].terms:
+            program = ConsistentModel(models[win].terms, selection, robot, base, offset_runs)
+        G, c, _ = selection.normal.system(selection.weights, program.terms)
         fit = program.fit(G, c, selection.normal.rows, lam)
     choice = FitChoice(
         models=models,

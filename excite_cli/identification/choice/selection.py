@@ -35,7 +35,7 @@ from excite_cli.effects import EFFECTS
 from excite_cli.identification.choice.crossval import CrossValidation
 from excite_cli.identification.choice.search import Search, Step, StepwiseSearch, effect_weights
 from excite_cli.identification.config import IdentificationConfig, TransmissionConfig
-from excite_cli.identification.effects import Term
+from excite_cli.identification.effects import Term, rotor_terms
 from excite_cli.identification.fitting.channels import without_dead_rows
 from excite_cli.identification.fitting.dataset import Dataset
 from excite_cli.identification.fitting.least_squares import Fit, joint_weights, least_squares
@@ -68,7 +68,8 @@ class Selection:
         cross_validation: the folds every model was scored on, for scoring other fits of the model.
         min_improvement: the price of an effect (a fraction); effect_weights: the effects a coupled
             and a position-dependent one count as (:func:`effect_count`).
-        normal: the fit data's normal equations (every candidate), for refitting other models.
+        normal: the fit data's normal equations (every candidate and every joint's armature: the rotors of
+            :mod:`~excite_cli.identification.choice.consistent_model`), for refitting other models.
     """
 
     terms: list[Term]
@@ -176,14 +177,15 @@ def select_effects(
     """
     n = fit_data.n
     candidates = [t for t in candidate_terms(cfg, n, couplings) if t not in declared and t in fit_data.blocks]
-    total = NormalEquations(fit_data, declared + candidates)
+    # the rotors the consistent fit holds beside any model (consistent_model): in every system, never candidates
+    rotors = [t for t in rotor_terms(n, []) if t in fit_data.blocks and t not in declared + candidates]
+    total = NormalEquations(fit_data, declared + candidates + rotors)
     weights = without_dead_rows(total, joint_weights(total, cfg.method == "wls"), scored)
     model = total.system(weights, declared)[0].shape[0]
     absorbed = [t for t in candidates if outside_fraction(total.system(weights, declared + [t])[0], model) < ABSORBED]
     candidates = [t for t in candidates if t not in absorbed]
-    cv = CrossValidation(
-        fit_data, declared + candidates, weights, cfg.folds, margin, recordings, fitted_offsets, scored
-    )
+    keys = declared + candidates + [t for t in total.size if t not in declared + candidates]
+    cv = CrossValidation(fit_data, keys, weights, cfg.folds, margin, recordings, fitted_offsets, scored)
     search = StepwiseSearch(cv, candidates, declared, cfg)
     searches, seen = [], []
     for name, effects in STARTS.items():

@@ -24,7 +24,8 @@ links the same way):
   first joints). Least squares cannot tell a rotor from the link inertia it regroups with; without
   a, the consistent fit must put a geared joint's rotor into the links' inertias, pulled toward the
   URDF, and bend the bodies (a simulated Panda with 0.3 kg·m² on joints 1 and 2: link 3's mass 39 %
-  low). The prior does not pull a.
+  low). The prior does not pull a. The other joints' rotors are effect columns of their own, kept ≥ 0
+  like a (:mod:`~excite_cli.identification.choice.consistent_model`).
 - The payloads ψ_l: a body of its own (10 parameters, a positive semidefinite pseudo-inertia: none
   at all is allowed) on each body that carries no other (a tool or load on the flange; P places it
   on its carrier), scaled like its carrier (D_P) and pulled toward none μ = ``PAYLOAD_PULL`` times
@@ -76,6 +77,10 @@ class ConsistentFit:
         base: (b,) base parameters K φ + R a (Eq. 2; the bodies and the rotors regrouped with them).
         rotors: (r,) rotor inertias a [kg·m²] of the joints ``rotor_joints`` (module docstring).
         rotor_joints: (r,) the joints whose rotors are held apart from the bodies.
+        own_columns: (r,) bool, the rotors outside ``base``: a joint whose armature does not regroup
+            with the bodies has a column of its own, a_j q̈_j on joint j's row (the model's effects lack
+            it; :mod:`~excite_cli.identification.choice.consistent_model`); the others are in ``base``
+            through R.
         bodies_base: (b,) the bodies' part of ``base``, K (φ + P ψ) (what a URDF of ``standard`` has).
         payloads: (l, 10) each payload's parameters ψ_l in its carrier's frame (module docstring).
         payload_bodies: (l,) the bodies that carry them.
@@ -99,6 +104,7 @@ class ConsistentFit:
     bodies_base: np.ndarray
     payloads: np.ndarray
     payload_bodies: list[str]
+    own_columns: np.ndarray
 
 
 def _solve(problem: cp.Problem) -> cp.Problem:
@@ -249,6 +255,7 @@ class ConsistentProgram:
             bodies,
             payloads.reshape(-1, 10),
             [self.bodies[i] for i in self.carriers],
+            np.zeros(len(self.rotor_joints), dtype=bool),
         )
 
     def _unconstrained(self, R: np.ndarray, z: np.ndarray, regularization: float) -> np.ndarray:

@@ -43,11 +43,12 @@ class ReportModel:
 
 def report_model(report: StoredReport) -> ReportModel:
     """The designable part of the model of ``report``: each joint's effects among ``DESIGNED``, each
-    coupled motor (a motor on one joint's own row: that joint, ratio 1), the others named."""
+    coupled motor (a motor on one joint's own row: that joint, ratio 1), the others named; the
+    consistent fit's rotors that the effect search did not choose are bodies, not effects to design for."""
     joints: dict[str, list[str]] = {}
     motors: list[tuple[list[str], list[float]]] = []
     left_out: list[str] = []
-    for effect, joint, _, coupling in report.terms:
+    for effect, joint, _, coupling in report.terms[: len(report.terms) - report.rotors]:
         if EFFECTS[effect].parts:  # a motor: its rotor inertia and friction in its coordinate
             moved = [] if coupling is None else np.flatnonzero(coupling)
             motor = (

@@ -25,6 +25,7 @@ import numpy as np
 from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.dynamics.robot import Robot
 from excite_cli.errors import ExciteError
+from excite_cli.identification.choice.consistent_model import consistent_model
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.effects import effect_columns
 from excite_cli.identification.fitting.dataset import fit_instants
@@ -179,11 +180,13 @@ def check_mjcf(
 
 
 def _split(report: Report):
-    """The consistent fit's terms in order and {term: its coefficients (k,)}."""
-    terms, values, k = list(report.selection.terms), {}, 0
+    """The consistent fit's terms in order (its rotors with columns of their own last) and {term: its
+    coefficients (k,)}."""
+    terms, x = consistent_model(report.consistent, report.selection.terms, report.joints)
+    values, k = {}, len(report.base_names)
     for t in terms:
         width = report.validation.blocks[t].shape[1]
-        values[t] = report.consistent.effects[k : k + width]
+        values[t] = x[k : k + width]
         k += width
     return terms, values
 

@@ -199,14 +199,19 @@ def _write_fits(g: h5py.Group, report: Report) -> None:
         units="cv_error in % of the chosen model on the selection's folds (NaN: the only pair, not cross-validated)",
         chosen=choice.chosen,
     )
-    rows = zip(choice.labels, choice.models, choice.cv, choice.objective)
+    rows = [
+        (label, choice.effects(k, f), name, choice.cv[k, f], choice.objective[k, f])
+        for k, label in enumerate(choice.labels)
+        for f, name in enumerate(choice.names)
+    ]
     write_table(
         g,
         "models",
-        [(label, m.effects, name, cv, J) for label, m, cvs, Js in rows for name, cv, J in zip(choice.names, cvs, Js)],
-        "model:str effects:i4 fit:str cv_error:f8 objective:f8",
+        rows,
+        "model:str effects:f8 fit:str cv_error:f8 objective:f8",
         units="cv_error in %; objective J = log CV + effects × log(1 + min_improvement) "
-        "(+ log(1 + least_squares_margin) for least squares); the lowest wins",
+        "(+ log(1 + least_squares_margin) for least squares; a consistent fit's effects leave out armature); "
+        "the lowest wins",
         chosen=choice.model * len(choice.names) + choice.chosen,
     )
     g.attrs["model"] = choice.labels[choice.model]
@@ -267,26 +272,18 @@ def _write_consistent(g: h5py.Group, report: Report, robot: Robot) -> None:
     g.create_dataset("base_parameters_consistent", data=consistent.base).attrs["description"] = "K phi + R a"
     g.create_dataset("rotor_inertias", data=consistent.rotors).attrs["unit"] = "kg m^2 (a, apart from the bodies)"
     write_strings(g, "rotor_joints", consistent.rotor_joints)
-    payloads = g.create_dataset("payload_parameters", data=consistent.payloads.reshape(-1, 10))
-    payloads.attrs["unit"] = "kg, kg m, kg m^2 (psi on its body, pinocchio order; included in standard_parameters)"
+    g.create_dataset("rotor_own_columns", data=consistent.own_columns).attrs["description"] = "not in K phi + R a"
+    g.create_dataset("payload_parameters", data=consistent.payloads.reshape(-1, 10)).attrs["unit"] = (
+        "kg, kg m, kg m^2 (psi on its body, pinocchio order; included in standard_parameters)"
+    )
     write_strings(g, "payload_bodies", consistent.payload_bodies)
     g.attrs["solver_status"] = consistent.status
     write_strings(g, "active_constraints", consistent.active)
-    urdf = robot.urdf_parameters()
-    bodies = np.zeros(
-        len(robot.body_names),
-        dtype=[
-            ("body", STR),
-            ("mass", "f8"),
-            ("com", "f8", 3),
-            ("principal_moments", "f8", 3),
-            ("inertia_com", "f8", (3, 3)),
-            ("urdf_mass", "f8"),
-            ("urdf_com", "f8", 3),
-            ("urdf_principal_moments", "f8", 3),
-            ("pseudo_inertia_min_eigenvalue", "f8"),
-        ],
-    )
+    urdf, vector, inertia = robot.urdf_parameters(), ("f8", 3), ("f8", (3, 3))
+    fields = [("body", STR), ("mass", "f8"), ("com", *vector), ("principal_moments", *vector)]
+    fields += [("inertia_com", *inertia), ("urdf_mass", "f8"), ("urdf_com", *vector)]
+    fields += [("urdf_principal_moments", *vector), ("pseudo_inertia_min_eigenvalue", "f8")]
+    bodies = np.zeros(len(robot.body_names), dtype=fields)
     for i, row in enumerate(bodies):
         m, c, I, moments = body_properties(consistent.standard[10 * i : 10 * i + 10])
         um, uc, _, umoments = body_properties(urdf[10 * i : 10 * i + 10])

@@ -37,6 +37,9 @@ class StoredReport:
         rms_after: (n,) [Nm] each joint's RMS error of the reported model on the validation data
             (``/identification/rms_after``), or None (a report of an earlier excite).
         rate: its rows' sample rate [Hz] (``/regressor`` attribute ``sample_rate_Hz``), or None (the same).
+        rotors: the last ``rotors`` of ``terms`` are the consistent fit's rotors with columns of their own
+            (armature the effect search did not choose:
+            :mod:`~excite_cli.identification.choice.consistent_model`), part of what it predicts.
     """
 
     joints: list[str]
@@ -51,6 +54,7 @@ class StoredReport:
     q_range: np.ndarray | None = None
     rms_after: np.ndarray | None = None
     rate: float | None = None
+    rotors: int = 0
 
 
 def read_report(path: Path, field: str) -> StoredReport | None:
@@ -84,18 +88,15 @@ def read_report(path: Path, field: str) -> StoredReport | None:
         consistent = bool(g["physically_consistent"][()]) if "physically_consistent" in g else False
         values = rows["value_consistent"] if consistent and "value_consistent" in rows.dtype.names else rows["value"]
         checked = _Checked(g, path, field)
+        coupling = checked("effect_coupling", (len(rows), len(joints))) if "effect_coupling" in g else None
+        rotors, inertias = _own_rotors(g) if consistent else ([], np.zeros(0))
         return StoredReport(
             joints,
             names,
             checked("base_parameters", (len(names),)),
             checked("base_parameters_rigid_only", (len(names),)),
-            _known(
-                _terms(rows, checked("effect_coupling", (len(rows), len(joints))) if "effect_coupling" in g else None),
-                joints,
-                path,
-                field,
-            ),
-            checked.finite(np.asarray(values, dtype=float), "effects"),
+            _known(_terms(rows, coupling) + rotors, joints, path, field),
+            checked.finite(np.concatenate([np.asarray(values, dtype=float), inertias]), "effects"),
             max(1, len(g["offset_runs"][()])) if "offset_runs" in g else 1,
             float(g.attrs["cutoff_Hz"]),
             float(g.attrs.get("coulomb_velocity_rad_s", COULOMB_VELOCITY)),
@@ -104,6 +105,7 @@ def read_report(path: Path, field: str) -> StoredReport | None:
             float(f["regressor"].attrs["sample_rate_Hz"])
             if "regressor" in f and "sample_rate_Hz" in f["regressor"].attrs
             else None,
+            len(rotors),
         )
 
 
@@ -120,6 +122,17 @@ def _terms(rows: np.ndarray, coupling: np.ndarray | None) -> list[StoredTerm]:
         if term not in terms:
             terms.append(term)
     return terms
+
+
+def _own_rotors(g) -> tuple[list[StoredTerm], np.ndarray]:
+    """The consistent fit's rotors with columns of their own (/identification/``rotor_own_columns``: not
+    in its base parameters) as armature terms, and their inertias [kg m²] (none in a report of an
+    earlier excite)."""
+    if "rotor_own_columns" not in g:
+        return [], np.zeros(0)
+    own = np.asarray(g["rotor_own_columns"][()], dtype=bool)
+    joints = [j for j, o in zip(read_strings(g, "rotor_joints"), own) if o]
+    return [("armature", j, None, None) for j in joints], np.asarray(g["rotor_inertias"][()], dtype=float)[own]
 
 
 def _known(terms: list[StoredTerm], joints: list[str], path: Path, field: str) -> list[StoredTerm]:

@@ -106,6 +106,7 @@ def test_real_panda_consistent_fit_and_its_urdf(tmp_path):
         assert g["physically_consistent"][()] == chosen.startswith("consistent")
         standard, base_parameters = g["standard_parameters"][()], g["base_parameters_consistent"][()]
         rotors = dict(zip([j.decode() for j in g["rotor_joints"][()]], g["rotor_inertias"][()]))
+        own = dict(zip(rotors, g["rotor_own_columns"][()]))
         consistent, unconstrained = g["relative_consistent"][()].mean(), g["relative_least_squares"][()].mean()
         models, fits = g["models"][()], g["fits"][()]
         winner, model = models[g["models"].attrs["chosen"]], g.attrs["model"]
@@ -120,9 +121,12 @@ def test_real_panda_consistent_fit_and_its_urdf(tmp_path):
     assert consistent <= unconstrained + 1.0
     # the written URDF, loaded by pinocchio on its own, with the rotors held apart from its bodies
     # (armature I_a q̈ on their joints), against the identified rigid-body torques at the held-out
-    # blocks' measured states (blocks 2 and 4 of 4)
-    assert set(rotors) <= {"panda_joint1", "panda_joint2"} and all(a >= 0 for a in rotors.values())
-    armature = np.array([rotors.get(f"panda_joint{k}", 0.0) for k in range(1, 8)])
+    # blocks' measured states (blocks 2 and 4 of 4): every joint has a rotor, joints 1-2's in the
+    # base parameters, the others' columns of their own
+    assert list(rotors) == [f"panda_joint{k}" for k in range(1, 8)] and all(a >= 0 for a in rotors.values())
+    assert [j for j, o in own.items() if not o] == ["panda_joint1", "panda_joint2"]
+    armature = np.array([rotors[f"panda_joint{k}"] for k in range(1, 8)])
+    own_armature = np.array([rotors[j] if o else 0.0 for j, o in own.items()])
     data = np.genfromtxt(SHARED / "exciting_traj_1.csv", delimiter=",", names=True)
     t = data["time"]
     quarter = np.floor(4 * (t - t[0]) / (t[-1] - t[0] + 1e-9)).astype(int)
@@ -137,7 +141,8 @@ def test_real_panda_consistent_fit_and_its_urdf(tmp_path):
     for r in rows:
         tau = pin.rnea(written, written_data, np.r_[q[r], 0, 0], np.r_[qd[r], 0, 0], np.r_[qdd[r], 0, 0])[:7]
         tau += armature * qdd[r]
-        assert np.allclose(tau, robot.regressor(q[r], qd[r], qdd[r]) @ X @ base_parameters, atol=1e-6)
+        identified = robot.regressor(q[r], qd[r], qdd[r]) @ X @ base_parameters + own_armature * qdd[r]
+        assert np.allclose(tau, identified, atol=1e-6)
     assert "from the physically consistent fit" in run.output and "rigid-body torques to" in run.output
 
 
@@ -227,8 +232,9 @@ def test_rotors_that_regroup_with_the_links_stay_out_of_the_bodies(tmp_path, opt
     assert result.exit_code == 0, result.output
     report, robot, base, _ = _identify(tmp_path, [f"run_{k}.csv" for k in (1, 2, 3)])
     fit = report.consistent
-    assert fit.rotor_joints == ["panda_joint1", "panda_joint2"]
-    np.testing.assert_allclose(fit.rotors, [0.3, 0.3], rtol=0.05)
+    assert fit.rotor_joints == JOINTS and list(fit.own_columns) == [False] * 2 + [True] * 5
+    np.testing.assert_allclose(fit.rotors[:2], [0.3, 0.3], rtol=0.05)
+    assert np.all(fit.rotors[2:] <= 2e-3)  # none in the data
     urdf = robot.urdf_parameters()
     np.testing.assert_allclose(fit.standard[0::10], urdf[0::10], rtol=0.05)
     assert report.relative_consistent.mean() <= 1.3 * report.relative_least_squares.mean()

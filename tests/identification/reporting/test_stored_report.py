@@ -6,19 +6,29 @@ import numpy as np
 import pytest
 
 from excite_cli.errors import ExciteError
+from excite_cli.identification.effects import Term
+from excite_cli.identification.fitting.least_squares import predict
 from excite_cli.identification.reporting.stored_report import read_identify_report, read_report
 
 
 def test_the_report_read_back_is_the_reported_model(simulated_identification, report_file):
-    """Joints, base parameters, every effect once with its coefficient, v_c and each joint's validation
-    error: as the pipeline's report holds them."""
-    problem, _, robot, base, _ = simulated_identification
+    """Joints, base parameters, every effect once with its coefficient, the consistent fit's rotors with
+    columns of their own after them, v_c and each joint's validation error: as the pipeline's report
+    holds them, predicting its validation torques."""
+    problem, report, robot, base, _ = simulated_identification
     stored = read_identify_report(report_file, "report")
     assert stored.joints == robot.joint_names and stored.base_names == base.names
-    assert {(effect, joint) for effect, joint, _, _ in stored.terms} == {
+    effects, rotors = stored.terms[: -stored.rotors], stored.terms[-stored.rotors :]
+    assert {(effect, joint) for effect, joint, _, _ in effects} == {
         (kind, j) for j in robot.joint_names for kind in ("coulomb", "viscous")
     }
-    assert stored.coefficients.size == len(stored.terms) and np.all(stored.coefficients > 0)
+    assert report.fit_choice.is_consistent and stored.rotors == 5  # joints 1-2's rotors regroup into the base
+    assert [(e, j) for e, j, _, _ in rotors] == [("armature", j) for j in robot.joint_names[2:]]
+    assert stored.coefficients.size == len(stored.terms) and np.all(stored.coefficients[: len(effects)] > 0)
+    assert np.all(stored.coefficients[len(effects) :] >= 0)
+    terms = [Term(e, robot.joint_names.index(j)) for e, j, _, _ in stored.terms]
+    x = np.concatenate([stored.base, stored.coefficients])
+    np.testing.assert_allclose(predict(report.validation, x, terms), report.predicted_after, atol=1e-9)
     assert stored.coulomb_velocity == problem.identification.coulomb_velocity
     assert stored.rms_after.shape == (robot.n_joints,) and stored.rate > 0
 
