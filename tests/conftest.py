@@ -89,6 +89,19 @@ def write_config(tmp_path: Path, data: dict, name: str = "problem.yaml") -> Path
     return path
 
 
+def panda_runs_config(runs: list[str], **identification) -> dict:
+    """An identify config of the Panda's simulated runs ``runs`` (CSV files of ``excite simulate``), each
+    fitted and validated on alternate time blocks, with ``identification`` settings."""
+    return {
+        "robot": {"urdf": "panda_description/urdf/panda.urdf", "source": "example-robot-data", "active_joints": JOINTS},
+        "data": {
+            "runs": [{"file": f, "role": "blocks"} for f in runs],
+            "columns": {"q": [f"q_{j}" for j in JOINTS], "tau": [f"tau_{j}" for j in JOINTS]},
+        },
+        "identification": identification,
+    }
+
+
 def assert_refused(folder: Path, argv: list[str], expected: str) -> str:
     """``excite argv`` exits with status 2 and one line starting ``error:`` that contains
     ``expected``, prints no traceback, and writes or changes no file under ``folder``; that line."""

@@ -9,7 +9,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 import yaml
-from conftest import CONFIGS, JOINTS, NOISE, SHARED, TESTS, robot_of, write_config
+from conftest import CONFIGS, JOINTS, NOISE, SHARED, TESTS, panda_runs_config, robot_of, write_config
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
@@ -107,15 +107,11 @@ def _simulate(
         app, ["simulate", str(optimized), str(write_config(tmp, sim, "effects.yaml")), "-o", str(tmp), "--force"]
     )
     assert result.exit_code == 0, result.output
+    identification = {**(settings or {}), **({"candidates": candidates} if candidates is not None else {})}
     config = {
-        "robot": {"urdf": "panda_description/urdf/panda.urdf", "source": "example-robot-data", "active_joints": JOINTS},
-        "data": {
-            "runs": [{"file": f"run_{k}.csv", "role": "blocks"} for k in (1, 2, 3)],
-            "columns": {"q": [f"q_{j}" for j in JOINTS], "tau": [f"tau_{j}" for j in JOINTS]},
-        },
+        **panda_runs_config([f"run_{k}.csv" for k in (1, 2, 3)], **identification),
         "output": str(tmp / "ident.h5"),
     }
-    config["identification"] = {**(settings or {}), **({"candidates": candidates} if candidates is not None else {})}
     return load_problem(write_config(tmp, config, "identify.yaml"), IdentifyProblem)
 
 

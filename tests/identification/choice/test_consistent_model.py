@@ -1,7 +1,7 @@
 """Every joint's rotor is a body of the consistent fit, whether or not the effect search added it."""
 
 import numpy as np
-from conftest import JOINTS, write_config
+from conftest import panda_runs_config, write_config
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
@@ -30,14 +30,7 @@ def test_a_rotor_the_search_cannot_add_is_held_apart_and_the_links_keep_their_ma
         app, ["simulate", str(optimized), str(write_config(tmp_path, sim, "effects.yaml")), "-o", str(tmp_path)]
     )
     assert result.exit_code == 0, result.output
-    config = {
-        "robot": {"urdf": "panda_description/urdf/panda.urdf", "source": "example-robot-data", "active_joints": JOINTS},
-        "data": {
-            "runs": [{"file": f"run_{k}.csv", "role": "blocks"} for k in (1, 2, 3)],
-            "columns": {"q": [f"q_{j}" for j in JOINTS], "tau": [f"tau_{j}" for j in JOINTS]},
-        },
-        "identification": {"fit": "consistent", "candidates": ["coulomb", "viscous"]},
-    }
+    config = panda_runs_config([f"run_{k}.csv" for k in (1, 2, 3)], fit="consistent", candidates=["coulomb", "viscous"])
     problem = load_problem(write_config(tmp_path, config, "identify.yaml"), IdentifyProblem)
     report, robot, _, _ = run_identification(problem)
     fit = report.consistent

@@ -9,7 +9,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 import yaml
-from conftest import CONFIGS, JOINTS, SHARED, robot_of, write_config
+from conftest import CONFIGS, JOINTS, SHARED, panda_runs_config, robot_of, write_config
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
@@ -147,14 +147,7 @@ def test_real_panda_consistent_fit_and_its_urdf(tmp_path):
 
 
 def _identify(tmp: Path, runs: list[str]):
-    config = {
-        "robot": {"urdf": "panda_description/urdf/panda.urdf", "source": "example-robot-data", "active_joints": JOINTS},
-        "data": {
-            "runs": [{"file": f, "role": "blocks"} for f in runs],
-            "columns": {"q": [f"q_{j}" for j in JOINTS], "tau": [f"tau_{j}" for j in JOINTS]},
-        },
-        "identification": {"fit": "consistent"},
-    }
+    config = panda_runs_config(runs, fit="consistent")
     return run_identification(load_problem(write_config(tmp, config, "identify.yaml"), IdentifyProblem))
 
 
