@@ -69,8 +69,10 @@ class ConsistentModel:
         """
         fit = self.program.solve(G, c, rows, regularization)
         k = fit.effects.size - len(self.own)  # each armature term has one column
+        bound = {f"Ia {self.joints[t.joint]} ≥ 0": f"rotor of {self.joints[t.joint]} ≥ 0" for t in self.own}
         return replace(
             fit,
+            active=[bound.get(a, a) for a in fit.active],  # named as the rotors through R are
             effects=fit.effects[:k],
             rotors=np.concatenate([fit.rotors, fit.effects[k:]]),
             rotor_joints=fit.rotor_joints + [self.joints[t.joint] for t in self.own],

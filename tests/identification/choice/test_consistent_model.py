@@ -39,6 +39,7 @@ def test_a_rotor_the_search_cannot_add_is_held_apart_and_the_links_keep_their_ma
     assert rotors["panda_joint4"][1] and not rotors["panda_joint1"][1]  # a column of its own; joint 1's regroups
     np.testing.assert_allclose(rotors["panda_joint4"][0], 0.2, rtol=0.05)
     assert all(a <= 2e-3 for j, (a, _) in rotors.items() if j != "panda_joint4")
+    assert "rotor of panda_joint4 ≥ 0" not in fit.active and not any(a.startswith("Ia ") for a in fit.active)
     np.testing.assert_allclose(fit.standard[0::10], robot.urdf_parameters()[0::10], rtol=0.01)
     assert report.mean(report.relative_consistent) < 0.8 * report.mean(report.relative_least_squares)
     # what it predicts with: the model's terms, then its rotor columns, the coefficients in their order
