@@ -69,6 +69,10 @@ class Model:
     effects: float
     rotors: int = 0
 
+    def counted(self, consistent: bool) -> float:
+        """p of J under a least-squares or a consistent fit (which does not count armature)."""
+        return self.effects - (self.rotors if consistent else 0)
+
     @property
     def label(self) -> str:
         """e.g. ``end of 'Coulomb on every joint'``."""
@@ -125,8 +129,7 @@ class FitChoice:
     def effects(self, model: int, fit: int) -> float:
         """p of J: the effects ``models[model]`` adds, counted under the fit ``names[fit]`` (a consistent
         fit does not count armature: module docstring)."""
-        m = self.models[model]
-        return m.effects - (m.rotors if self.names[fit] != LEAST_SQUARES else 0)
+        return self.models[model].counted(self.names[fit] != LEAST_SQUARES)
 
     @property
     def lead(self) -> float:
@@ -236,8 +239,7 @@ def choose_fit(
     cv, known = np.full((len(models), len(lams)), np.nan), {}
     if not single:
         cv = np.array([_scores(selection, m, lams, programs, known) for m in models])
-    p = [[m.effects - (m.rotors if lam is not None else 0) for lam in lams] for m in models]  # FitChoice.effects
-    J = objective(cv, p, selection.min_improvement)
+    J = objective(cv, [[m.counted(lam is not None) for lam in lams] for m in models], selection.min_improvement)
     if any(lam is not None for lam in lams):  # least squares pays its margin (module docstring)
         J = J + np.log1p(np.array([0.0 if lam is not None else cfg.least_squares_margin for lam in lams]))
     win, chosen = (0, 0) if single else np.unravel_index(int(np.nanargmin(J)), J.shape)
