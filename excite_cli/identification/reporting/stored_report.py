@@ -89,7 +89,7 @@ def read_report(path: Path, field: str) -> StoredReport | None:
         values = rows["value_consistent"] if consistent and "value_consistent" in rows.dtype.names else rows["value"]
         checked = _Checked(g, path, field)
         coupling = checked("effect_coupling", (len(rows), len(joints))) if "effect_coupling" in g else None
-        rotors, inertias = _own_rotors(g) if consistent else ([], np.zeros(0))
+        rotors, inertias = _own_rotors(g, checked) if consistent else ([], np.zeros(0))
         return StoredReport(
             joints,
             names,
@@ -124,15 +124,24 @@ def _terms(rows: np.ndarray, coupling: np.ndarray | None) -> list[StoredTerm]:
     return terms
 
 
-def _own_rotors(g) -> tuple[list[StoredTerm], np.ndarray]:
+def _own_rotors(g, checked: _Checked) -> tuple[list[StoredTerm], np.ndarray]:
     """The consistent fit's rotors with columns of their own (/identification/``rotor_own_columns``: not
     in its base parameters) as armature terms, and their inertias [kg m²] (none in a report of an
-    earlier excite)."""
+    earlier excite).
+
+    Raises:
+        ExciteError: ``rotor_inertias`` or ``rotor_joints`` missing or of another length (damaged).
+    """
     if "rotor_own_columns" not in g:
         return [], np.zeros(0)
-    own = np.asarray(g["rotor_own_columns"][()], dtype=bool)
-    joints = [j for j, o in zip(read_strings(g, "rotor_joints"), own) if o]
-    return [("armature", j, None, None) for j in joints], np.asarray(g["rotor_inertias"][()], dtype=float)[own]
+    own = np.asarray(g["rotor_own_columns"][()], dtype=bool).ravel()
+    inertias = checked("rotor_inertias", own.shape)
+    joints = read_strings(g, "rotor_joints") if "rotor_joints" in g else []
+    if len(joints) != own.size:
+        raise ExciteError(
+            checked.field, f"{checked.path}: /identification/rotor_joints names {len(joints)} of {own.size} rotors"
+        )
+    return [("armature", j, None, None) for j, o in zip(joints, own) if o], inertias[own]
 
 
 def _known(terms: list[StoredTerm], joints: list[str], path: Path, field: str) -> list[StoredTerm]:

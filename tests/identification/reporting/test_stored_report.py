@@ -59,3 +59,17 @@ def test_an_effect_or_joint_the_report_does_not_define_is_refused_naming_it(repo
     with pytest.raises(ExciteError, match=f"names the {column} '{value}'") as error:
         read_report(path, "effects.model")
     assert error.value.field == "effects.model"
+
+
+@pytest.mark.parametrize("damage, expected", [("rotor_joints", "names 0 of 7 rotors"), ("rotor_inertias", "missing")])
+def test_a_damaged_rotor_list_is_refused_naming_it(report_file, tmp_path, damage, expected):
+    """The consistent fit's rotors read back (a report whose reported fit is consistent) without their
+    names or inertias: one message under the field that named the file, not a KeyError."""
+    path = tmp_path / "edited.h5"
+    path.write_bytes(report_file.read_bytes())
+    with h5py.File(path, "a") as f:
+        assert f["identification/physically_consistent"][()] and f["identification/rotor_own_columns"][()].size == 7
+        del f[f"identification/{damage}"]
+    with pytest.raises(ExciteError, match=expected) as error:
+        read_report(path, "report")
+    assert error.value.field == "report"
