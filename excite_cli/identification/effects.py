@@ -138,6 +138,6 @@ def coefficient_names(term: Term, offset_runs: list[str]) -> list[str]:
 def rotor_terms(n: int, terms: list[Term]) -> list[Term]:
     """The armature of each of the ``n`` joints that no uncoupled term of ``terms`` already holds (an
     ``armature`` or a joint's own ``motor``): the rotors the physically consistent fit keeps as bodies
-    of their own (:mod:`~excite_cli.identification.choice.fit_choice`) beside the model's effects."""
+    of their own (:mod:`~excite_cli.identification.choice.consistent_model`) beside the model's effects."""
     held = {t.joint for t in terms if t.coupling is None and "armature" in (t.effect, *t.kind.parts)}
     return [Term("armature", j) for j in range(n) if j not in held]
