@@ -89,6 +89,15 @@ def write_config(tmp_path: Path, data: dict, name: str = "problem.yaml") -> Path
     return path
 
 
+def smoke_config(folder: Path) -> dict:
+    """The smoke problem (configs/smoke.yaml) with its output in ``folder``: a run or a refusal never
+    meets the checkout's own results/smoke.h5 (which the smoke run of .ci/run writes, so that an
+    "output exists" refusal came first in a checkout that had run it)."""
+    data = yaml.safe_load((CONFIGS / "smoke.yaml").read_text())
+    data["output"] = str(folder / "out.h5")
+    return data
+
+
 def panda_runs_config(runs: list[str], **identification) -> dict:
     """An identify config of the Panda's simulated runs ``runs`` (CSV files of ``excite simulate``), each
     fitted and validated on alternate time blocks, with ``identification`` settings."""

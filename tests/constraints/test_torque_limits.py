@@ -8,7 +8,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 import yaml
-from conftest import CONFIGS, assert_refused, constraint_jacobian_error, exported_motion, small
+from conftest import CONFIGS, assert_refused, constraint_jacobian_error, exported_motion, small, smoke_config
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
@@ -69,7 +69,7 @@ def test_an_exported_motion_keeps_every_torque_within_its_limit(tmp_path):
 
 
 def test_a_home_posture_beyond_the_torque_limits_stops_before_optimizing(tmp_path):
-    config = yaml.safe_load((CONFIGS / "smoke.yaml").read_text())
+    config = smoke_config(tmp_path)
     config["limits"]["torque"] = 0.01  # gravity alone needs more on the shoulder
     (tmp_path / "weak.yaml").write_text(yaml.safe_dump(config))
     line = assert_refused(
@@ -83,7 +83,7 @@ def test_a_home_posture_beyond_the_torque_limits_stops_before_optimizing(tmp_pat
     [({"panda_joint9": 10.0}, "'panda_joint9' is not an active joint"), (-1.0, "limits.torque"), ("max", "torque")],
 )
 def test_a_torque_limit_that_cannot_be_is_refused(tmp_path, torque, expected):
-    config = yaml.safe_load((CONFIGS / "smoke.yaml").read_text())
+    config = smoke_config(tmp_path)
     config["limits"]["torque"] = torque
     (tmp_path / "bad.yaml").write_text(yaml.safe_dump(config))
     assert_refused(tmp_path, ["optimize", str(tmp_path / "bad.yaml")], expected)
@@ -158,7 +158,7 @@ def test_a_minimum_torque_use_no_motion_can_reach_stops_the_run_and_writes_no_re
     ],
 )
 def test_a_minimum_torque_use_that_cannot_be_is_refused(tmp_path, use, expected):
-    config = yaml.safe_load((CONFIGS / "smoke.yaml").read_text())
+    config = smoke_config(tmp_path)
     config["limits"]["min_torque_use"] = use
     (tmp_path / "bad.yaml").write_text(yaml.safe_dump(config))
     assert_refused(tmp_path, ["optimize", str(tmp_path / "bad.yaml")], expected)

@@ -7,7 +7,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 import yaml
-from conftest import CONFIGS, assert_refused, constraint_jacobian_error, exported_motion, robot_of, small
+from conftest import CONFIGS, assert_refused, constraint_jacobian_error, exported_motion, robot_of, small, smoke_config
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
@@ -144,7 +144,7 @@ def test_capsules_no_active_joint_moves_are_left_out(panda_problem):
 
 
 def test_a_home_posture_inside_the_world_stops_before_optimizing_naming_link_and_shape(tmp_path):
-    config = yaml.safe_load((CONFIGS / "smoke.yaml").read_text())
+    config = smoke_config(tmp_path)
     config["constraints"] = {
         "environment": {"shapes": [{"name": "shelf", "type": "half_space", "point": [0, 0, 0.5], "normal": [0, 0, 1]}]}
     }
@@ -163,7 +163,7 @@ def test_a_home_posture_inside_the_world_stops_before_optimizing_naming_link_and
     ],
 )
 def test_a_world_shape_that_cannot_be_is_refused(tmp_path, shape, expected):
-    config = yaml.safe_load((CONFIGS / "smoke.yaml").read_text())
+    config = smoke_config(tmp_path)
     config["constraints"] = {"environment": {"shapes": [shape]}}
     (tmp_path / "bad.yaml").write_text(yaml.safe_dump(config))
     assert_refused(tmp_path, ["optimize", str(tmp_path / "bad.yaml")], expected)
