@@ -21,11 +21,10 @@ from typing import Callable, Optional, Sequence
 import numpy as np
 
 from excite_cli.config import OptimizerConfig
-from excite_cli.constraints import Constraint, accepted, farthest_accepted
-from excite_cli.constraints.lse import GRID_MARGIN
+from excite_cli.constraints import Constraint, accepted
 from excite_cli.design.criterion import Criterion
-from excite_cli.search.kkt import INFEASIBLE, SOLVER_FAILED, Optimality, stop_reason
-from excite_cli.search.nlp import BISECTIONS, Epigraph, Evaluations, project, repair
+from excite_cli.search.kkt import INFEASIBLE, SOLVER_FAILED, Optimality, stationary, stop_reason, until_done
+from excite_cli.search.nlp import Epigraph, Evaluations, onto_fine_grid, project, repair
 from excite_cli.search.solvers import SolverRun, criterion_scale, solve
 from excite_cli.trajectory.boundary import BoundaryConditions
 from excite_cli.trajectory.fourier import FourierBasis
@@ -36,8 +35,6 @@ ProgressHook = Callable[[int, int, float], None]
 #: (:func:`_solve_recovering`); the factor on the criterion's scale after a failure, and on the
 #: solver's tolerance after its own test.
 RECOVERIES, RECOVERY_SCALE, RECOVERY_TOLERANCE = 2, 0.5, 1e-3
-#: The solver's iterates between two Clarke tests of a non-smooth criterion (each a small SDP).
-NONSMOOTH_EVERY = 10
 
 
 @dataclass(frozen=True)
@@ -62,6 +59,8 @@ class RestartResult:
             the start and ``objective`` inf).
         scale: the factor [1] the solver's criterion was multiplied by
             (:attr:`~excite_cli.search.solvers.SolverRun.scale`), which a continuation keeps.
+        margins: per constraint, the margin [1] of the problem ``optimality`` belongs to, which a
+            continuation keeps (:attr:`~excite_cli.search.nlp.Evaluations.margins`).
     """
 
     index: int
@@ -76,6 +75,7 @@ class RestartResult:
     stop: str = ""
     end: str = ""
     scale: Optional[float] = None
+    margins: tuple[float, ...] = ()
 
     @property
     def succeeded(self) -> bool:
@@ -93,41 +93,6 @@ def best_restart(results: Sequence[RestartResult]) -> RestartResult:
     return min(candidates, key=lambda r: (r.objective, r.index))
 
 
-def _until_done(
-    problem: Evaluations, on_iterate: Callable[[np.ndarray], None], tolerance: float, deadline: float
-) -> Callable[[np.ndarray], None]:
-    """The solver's callback: ``on_iterate(z)``, then StopIteration (which every solver honours) once
-    the iterate is inside every aggregated constraint (up to the aggregation's margin) and its KKT
-    residual is at most ``tolerance``, or ``deadline`` (``time.perf_counter``) has passed.
-
-    Every iterate is tested: near a KKT point SLSQP's iterates move at the scale of its steps, and
-    the residual with them (active aggregates of β = 300 turn their gradients fast), between 5e-4
-    and 2e-2 at an objective still to 1e-5 on the G1; tested every 10th iterate, a restart ran on
-    for hundreds of iterations past points that met the tolerance. The test costs a non-negative
-    least squares on the active set (0.6 ms there): the gradient and Jacobian it needs at the
-    iterate are those the solver asks for next. Where the criterion is non-smooth (an extreme
-    singular value multiple), the Clarke test (:mod:`~excite_cli.search.kkt`, 0.2 s on
-    the G1) runs every ``NONSMOOTH_EVERY``-th iterate."""
-
-    count = iter(range(1 << 62))
-
-    def callback(z: np.ndarray) -> None:
-        on_iterate(z)
-        if time.perf_counter() > deadline:
-            raise StopIteration
-        nonsmooth = next(count) % NONSMOOTH_EVERY == 0  # the Clarke test (a small SDP) every so often
-        if _stationary(problem, z, tolerance, nonsmooth):
-            raise StopIteration
-
-    return callback
-
-
-def _stationary(problem: Evaluations, z: np.ndarray, tolerance: float, nonsmooth: bool = True) -> bool:
-    """Whether z (n_z,) is inside every aggregated constraint (up to the aggregation's margin) with a
-    KKT residual (or Clarke's, ``nonsmooth``) of at most ``tolerance``."""
-    return problem.constraint_values(z).max() <= GRID_MARGIN and problem.kkt(z, nonsmooth).residual <= tolerance
-
-
 def _solve_recovering(
     options: OptimizerConfig,
     nlp: Evaluations | Epigraph,
@@ -138,7 +103,7 @@ def _solve_recovering(
 ) -> SolverRun:
     """:func:`~excite_cli.search.solvers.solve`, run again (up to ``RECOVERIES`` times, a fresh
     quasi-Newton matrix each, for the iterations left; they add up) where it ended neither at its
-    limit nor at the KKT test of :func:`_until_done`:
+    limit nor at the KKT test of :func:`~excite_cli.search.kkt.until_done`:
 
     - it failed on its own (SLSQP's "More than 3*n iterations in LSQ subproblem" or "Positive
       directional derivative for linesearch", IPOPT's restoration): from the best iterate inside
@@ -162,7 +127,7 @@ def _solve_recovering(
     run = solve(options.method, nlp, variables(z0), iterations, tolerance, on_iterate, scale)
     done = run.iterations
     for _ in range(RECOVERIES):
-        short = run.failed or not _stationary(problem, run.z[: z0.size], options.optimality_tolerance)
+        short = run.failed or not stationary(problem, run.z[: z0.size], options.optimality_tolerance)
         if run.limit or done >= iterations or not short:
             break
         if run.failed:
@@ -203,11 +168,12 @@ def optimize_restart(
     fine_basis: Optional[FourierBasis] = None,
     time_limit: Optional[float] = None,
     scale: Optional[float] = None,
+    margins: Sequence[float] = (),
 ) -> RestartResult:
     """Minimize the criterion over α with ``options.method`` from one feasible start.
 
     The solver stops at its own convergence test, at ``max_iterations``, or, tested at every
-    iterate (:func:`_until_done`), at an iterate inside the constraints that meets
+    iterate (:func:`~excite_cli.search.kkt.until_done`), at an iterate inside the constraints that meets
     ``options.optimality_tolerance`` (the KKT residual the result is judged by) or once ``time_limit``
     has passed.
 
@@ -218,8 +184,9 @@ def optimize_restart(
     (:func:`~excite_cli.search.nlp.project`; if the projection fails,
     :func:`~excite_cli.search.nlp.repair`); each is confirmed by every constraint's exact grid check.
     The one kept is confirmed on ``fine_basis`` too, the re-check its result is judged by (the grid
-    margin covers the overshoot between grid instants, but not always): where that check fails, it
-    is moved towards the start until the check holds (bisection, as in :func:`~excite_cli.search.nlp.repair`).
+    margin covers the overshoot between grid instants, but not always): where that check fails, the
+    constraints it rejects get a margin of their own and the point is projected onto that problem,
+    or else moved towards the start (:func:`~excite_cli.search.nlp.onto_fine_grid`).
 
     Args:
         criterion: the criterion (value and gradient).
@@ -235,10 +202,11 @@ def optimize_restart(
         time_limit: wall time [s] after which the solver stops (default: none).
         scale: the criterion's scale for the solver, that of the restart this one continues
             (default: set at the start, :func:`~excite_cli.search.solvers.solve`).
+        margins: the constraints' margins of the restart this one continues (default: none).
     """
     begin = time.perf_counter()
     start_value = criterion.value(start)
-    problem = Evaluations(criterion, constraints, boundary, start_value)
+    problem = Evaluations(criterion, constraints, boundary, start_value, margins)
     history: list[tuple[float, float]] = []
 
     def on_iterate(z: np.ndarray) -> None:
@@ -248,13 +216,13 @@ def optimize_restart(
 
     deadline = begin + (np.inf if time_limit is None else time_limit)
     z0 = boundary.to_variables(start)
-    until_done = _until_done(problem, on_iterate, options.optimality_tolerance, deadline)
+    done = until_done(problem, on_iterate, options.optimality_tolerance, deadline)
     # a criterion of the extreme singular values is solved in its epigraph form (smooth where it is not)
     nlp = Epigraph(problem) if criterion.objective.extremes else problem
     if scale is None and not isinstance(nlp, Epigraph):  # the epigraph's criterion is its bounds' weights
         scale = own_scale(criterion, boundary, start)
     run = _solve_recovering(
-        options, nlp, z0, max_iterations or options.max_iterations, lambda w: until_done(w[: z0.size]), scale
+        options, nlp, z0, max_iterations or options.max_iterations, lambda w: done(w[: z0.size]), scale
     )
     run = replace(run, z=run.z[: z0.size])
     out_of_time = time.perf_counter() > deadline
@@ -276,7 +244,7 @@ def optimize_restart(
     # only a constraint that needs motion rejects the start: when no end point meets it, none is kept
     value, _, end, alpha = min(scored, key=lambda item: item[:2]) if scored else (np.inf, 0, "none", start)
     if scored and fine_basis is not None and not accepted(constraints, alpha, fine_basis):
-        alpha = start + farthest_accepted(constraints, start, alpha, BISECTIONS, fine_basis) * (alpha - start)
+        problem, alpha, end = onto_fine_grid(problem, alpha, start, fine_basis)
         value = criterion.value(alpha)
     optimality = problem.optimality(alpha)
     history_values = [f for f, _ in history]
@@ -295,4 +263,5 @@ def optimize_restart(
         stop,
         end,
         run.scale,
+        problem.margins,
     )

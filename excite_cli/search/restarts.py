@@ -31,7 +31,8 @@ class RestartTask:
         iterations: solver iterations (default ``optimizer.max_iterations``).
         time_limit: wall time [s] after which its solver stops (default: none).
         scale: the criterion's scale of the run it continues (:attr:`RestartResult.scale`), or None
-            for a start of its own.
+            for a start of its own; margins: the constraints' margins of the run it continues
+            (:attr:`RestartResult.margins`).
     """
 
     iteration: int
@@ -42,6 +43,7 @@ class RestartTask:
     iterations: Optional[int] = None
     time_limit: Optional[float] = None
     scale: Optional[float] = None
+    margins: tuple[float, ...] = ()
 
     def rng(self) -> np.random.Generator:
         """The restart's own random generator."""
@@ -62,6 +64,7 @@ class RestartTask:
             excitation.fine_basis,
             self.time_limit,
             self.scale,
+            self.margins,
         )
 
 
@@ -94,9 +97,10 @@ class RestartContext:
             excitation, engine, k, seed, prior, time.perf_counter() + excitation.spec.optimizer.time_budget, hook
         )
 
-    def task(self, index: int, start=None, iterations=None, scale=None) -> RestartTask:
+    def task(self, index: int, start=None, iterations=None, scale=None, margins=()) -> RestartTask:
         """Restart ``index`` of the iteration (:class:`RestartTask`), its time limit what is left."""
-        return RestartTask(self.k, index, self.seed, self.prior, start, iterations, _left(self.deadline), scale)
+        left = _left(self.deadline)
+        return RestartTask(self.k, index, self.seed, self.prior, start, iterations, left, scale, margins)
 
     def run(self, tasks: list[RestartTask], hook: Optional[ProgressHook]) -> list[RestartResult]:
         """``tasks`` on the engine, ``hook`` told of each solver iteration and of each result."""
@@ -160,7 +164,7 @@ def polish(context: RestartContext, runs: list[RestartResult], kept: int) -> lis
         current = runs[at]
         if current.stop == CONVERGED or _left(context.deadline) <= 0.0:
             break
-        task = context.task(kept, current.alpha, opts.max_iterations, current.scale)
+        task = context.task(kept, current.alpha, opts.max_iterations, current.scale, current.margins)
         shifted = (lambda r, it, value: hook(r, current.iterations + it, value)) if hook else None
         more = context.run([task], shifted)[0]
         if not more.succeeded or more.objective > current.objective:
@@ -181,7 +185,7 @@ def _restart_round(context: RestartContext, indices: range) -> list[RestartResul
     chosen = sorted((r for r in runs if r.succeeded), key=lambda r: (r.objective, r.index))[: opts.restarts]
     if not chosen:  # every screened start failed: nothing to continue
         return runs
-    more = [context.task(r.index, r.alpha, opts.max_iterations - iterations, r.scale) for r in chosen]
+    more = [context.task(r.index, r.alpha, opts.max_iterations - iterations, r.scale, r.margins) for r in chosen]
     shift = indices.stop  # continuations count on their own in the progress
     shifted = (lambda r, it, value: hook(shift + r, it, value)) if hook else None
     continued = {c.index: c for c in context.run(more, shifted)}
