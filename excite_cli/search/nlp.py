@@ -31,7 +31,8 @@ PROJECTION_ITERATIONS = 60
 #: Singular values at each extreme the epigraph form bounds (one solver constraint each).
 EPIGRAPH_SIZE = CLUSTER_SIZE
 #: A bound's gradient is computed (a pass of RNEA derivatives) where its log σ is within this [1] of
-#: its extreme; a farther one is inactive by more than that, and its row of the Jacobian is zero.
+#: its extreme, and for the next singular value beyond them on each side whatever its distance (the
+#: first a step raising the cluster would bring into it); a farther one's row of the Jacobian is zero.
 EPIGRAPH_BAND = 0.05
 #: Projections with a larger margin (2, 4, 8 × the overshoot) before a point the fine check rejects
 #: is moved towards the start (:func:`onto_fine_grid`).
@@ -188,7 +189,9 @@ class Epigraph:
                 signs.append(np.full(count, 1.0 if side == 0 else -1.0))
             indices, sides, signs = np.concatenate(indices), np.concatenate(sides), np.concatenate(signs)
             extreme = np.where(signs > 0, logs[-1], logs[0])
-            near = np.unique(indices[np.abs(logs[indices] - extreme) <= EPIGRAPH_BAND])
+            inside = (np.abs(logs[indices] - extreme) <= EPIGRAPH_BAND).reshape(len(self.sides), count)
+            reach = np.minimum(inside.sum(axis=1) + 1, count)  # the cluster (a prefix) and the next one
+            near = np.unique(indices[(np.arange(count) < reach[:, None]).ravel()])
             gradients = np.zeros((indices.size, z.size))
             if near.size:
                 _, alpha_gradients = self.problem.criterion.log_singular_values(self.problem.boundary.to_alpha(z), near)

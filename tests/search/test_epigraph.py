@@ -64,3 +64,33 @@ def test_a_log_cond_restart_ends_clarke_stationary_at_a_kink(tmp_path):
     z = excitation.boundary.to_variables(result.alpha)
     assert evaluations.kkt(z, nonsmooth=False).residual > 10 * tolerance
     assert evaluations.kkt(z).residual <= tolerance
+
+
+def test_the_next_singular_value_beyond_each_cluster_has_its_gradient(tmp_path):
+    """With the band as shipped, the bounds of the singular values within it of their extreme and of
+    the next one beyond them on each side carry their gradients (against central differences: the
+    first a step raising the cluster would bring into it); the rows farther out are zero."""
+    excitation = _small_ur5(tmp_path, "log_cond")
+    criterion = excitation.criterion()
+    alpha = excitation.random_start(np.random.default_rng(2))
+    epigraph = Epigraph(Evaluations(criterion, excitation.constraints, excitation.boundary, criterion.value(alpha)))
+    z = excitation.boundary.to_variables(alpha)
+    w = epigraph.start(z)
+    logs = np.log(criterion.singular_values(alpha))
+    count = nlp.EPIGRAPH_SIZE
+    bounds = epigraph.constraint_jacobian(w)[-2 * count :, : z.size].reshape(2, count, z.size)
+    for side, order in enumerate((logs[::-1][:count], logs[:count])):
+        reach = int(np.sum(np.abs(order - order[0]) <= nlp.EPIGRAPH_BAND)) + 1
+        assert reach < count  # a random start: the band does not hold every bound
+        for k in range(count):
+            if k >= reach:
+                assert not bounds[side, k].any(), (side, k)
+                continue
+            index = logs.size - 1 - k if side == 0 else k
+            sign = 1.0 if side == 0 else -1.0
+
+            def log_sigma(y, index=index):
+                return np.log(criterion.singular_values(excitation.boundary.to_alpha(y))[index])
+
+            fd = np.array([(log_sigma(z + 1e-6 * e) - log_sigma(z - 1e-6 * e)) / 2e-6 for e in np.eye(z.size)])
+            assert np.allclose(bounds[side, k], sign * fd, rtol=1e-5, atol=1e-6 * np.abs(fd).max()), (side, k)
