@@ -4,7 +4,7 @@ result exported at 1 kHz (transitions in and out, one period) and checked at eve
 the lab config's table, capsules and effort limits, with pinocchio (forward kinematics, RNEA) and
 coal, outside the optimizer's code.
 
-Run: `.venv/bin/python bench/lab_arms.py [CONFIG ...]` (about 12 minutes on 2 cores for both).
+Run: `.venv/bin/python bench/lab_arms.py [CONFIG ...]` (about 3 minutes on 2 cores for both).
 Prints a table.
 """
 
