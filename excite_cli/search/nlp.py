@@ -152,8 +152,10 @@ class Epigraph:
 
     (an extreme weighed zero has no t). At a solution t_max = log σ_max and t_min = log σ_min, the
     objective is w_max log σ_max + w_min log σ_min (log cond; cond is its exponential, with the same
-    minimizers), and its KKT conditions are Clarke's for the criterion: the bounds' multipliers weigh
-    the singular values' gradients (Overton 1992). The solver sees this problem; everything else z.
+    minimizers), and its KKT conditions are Clarke's for the criterion with the weights S of a multiple
+    singular value's subdifferential diagonal in the current singular vectors: the bounds' multipliers
+    weigh the singular values' own gradients, not their cross terms (Overton 1992). The solver sees
+    this problem; everything else z (its end is judged by Clarke's full test, kkt.clarke_optimality).
     """
 
     def __init__(self, problem: Evaluations):
