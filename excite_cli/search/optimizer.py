@@ -4,9 +4,10 @@ The solver (``optimizer.method``, :mod:`excite_cli.search.solvers`) works on the
 (boundary conditions met exactly, preconditioned); the criterion and every constraint supply
 analytic gradients; a criterion of the extreme singular values (cond, log cond, E-optimality) is
 solved in its epigraph form (:class:`~excite_cli.search.nlp.Epigraph`), smooth where the
-criterion has a kink at its optimum. Quasi-Newton iterates of this problem approach the constraint boundary from
-outside (on the G1 problem SLSQP's iterates stay up to 3 cm outside the CoM region for most of
-the run), so a restart ends at the feasible point nearest to the solver's last iterate
+criterion has a kink at its optimum (a continuation of a restart that stalled in that form runs on
+its smoothing, :mod:`~excite_cli.search.smoothing`). Quasi-Newton iterates of this problem approach
+the constraint boundary from outside (on the G1 problem SLSQP's iterates stay up to 3 cm outside the
+CoM region for most of the run), so a restart ends at the feasible point nearest to the solver's last iterate
 (:func:`~excite_cli.search.nlp.project`): what the restart found is then judged by a point
 every constraint accepts, with its first-order optimality (:mod:`excite_cli.search.kkt`)
 and an honest stop reason.
@@ -25,6 +26,7 @@ from excite_cli.constraints import Constraint, accepted
 from excite_cli.design.criterion import Criterion
 from excite_cli.search.kkt import INFEASIBLE, SOLVER_FAILED, Optimality, stationary, stop_reason, until_done
 from excite_cli.search.nlp import Epigraph, Evaluations, onto_fine_grid, project, repair
+from excite_cli.search.smoothing import Smoothed
 from excite_cli.search.solvers import SolverRun, criterion_scale, solve
 from excite_cli.trajectory.boundary import BoundaryConditions
 from excite_cli.trajectory.fourier import FourierBasis
@@ -95,7 +97,7 @@ def best_restart(results: Sequence[RestartResult]) -> RestartResult:
 
 def _solve_recovering(
     options: OptimizerConfig,
-    nlp: Evaluations | Epigraph,
+    nlp: Evaluations | Epigraph | Smoothed,
     z0: np.ndarray,
     iterations: int,
     on_iterate: Callable[[np.ndarray], None],
@@ -121,7 +123,7 @@ def _solve_recovering(
     def variables(z: np.ndarray) -> np.ndarray:  # the epigraph's bounds start at their extremes
         return nlp.start(z) if isinstance(nlp, Epigraph) else z
 
-    problem = nlp.problem if isinstance(nlp, Epigraph) else nlp
+    problem = nlp if isinstance(nlp, Evaluations) else nlp.problem
 
     tolerance = options.tolerance
     run = solve(options.method, nlp, variables(z0), iterations, tolerance, on_iterate, scale)
@@ -169,6 +171,7 @@ def optimize_restart(
     time_limit: Optional[float] = None,
     scale: Optional[float] = None,
     margins: Sequence[float] = (),
+    smoothed: bool = False,
 ) -> RestartResult:
     """Minimize the criterion over α with ``options.method`` from one feasible start.
 
@@ -203,6 +206,9 @@ def optimize_restart(
         scale: the criterion's scale for the solver, that of the restart this one continues
             (default: set at the start, :func:`~excite_cli.search.solvers.solve`).
         margins: the constraints' margins of the restart this one continues (default: none).
+        smoothed: a criterion of the extreme singular values is solved on its smoothing
+            (:class:`~excite_cli.search.smoothing.Smoothed`) rather than in its epigraph form: the
+            continuation of a restart that stalled in that form.
     """
     begin = time.perf_counter()
     start_value = criterion.value(start)
@@ -218,8 +224,8 @@ def optimize_restart(
     z0 = boundary.to_variables(start)
     done = until_done(problem, on_iterate, options.optimality_tolerance, deadline)
     # a criterion of the extreme singular values is solved in its epigraph form (smooth where it is not)
-    nlp = Epigraph(problem) if criterion.objective.extremes else problem
-    if scale is None and not isinstance(nlp, Epigraph):  # the epigraph's criterion is its bounds' weights
+    nlp = (Smoothed if smoothed else Epigraph)(problem) if criterion.objective.extremes else problem
+    if scale is None and isinstance(nlp, Evaluations):  # the epigraph's criterion is its bounds' weights
         scale = own_scale(criterion, boundary, start)
     run = _solve_recovering(
         options, nlp, z0, max_iterations or options.max_iterations, lambda w: done(w[: z0.size]), scale
@@ -236,13 +242,17 @@ def optimize_restart(
         ends.append(("bisection", repair(constraints, boundary.to_alpha(run.z), start, boundary)))
     if problem.best_inside is not None:
         ends.append(("inside", problem.best_inside))
+    # judged by the criterion the solver minimized: a smoothing's start (a stalled end) can be lower in
+    # the criterion itself by what the smoothing costs (excite_cli.search.restarts._smoothed_round weighs that)
+    judge = (lambda a: nlp.value(boundary.to_variables(a))) if isinstance(nlp, Smoothed) else criterion.value
     scored = [
-        (criterion.value(alpha), k, name, alpha)
+        (judge(alpha), k, name, alpha)
         for k, (name, alpha) in enumerate(ends)
         if name == "projected" or accepted(constraints, alpha)
     ]  # the projection is already accepted
     # only a constraint that needs motion rejects the start: when no end point meets it, none is kept
-    value, _, end, alpha = min(scored, key=lambda item: item[:2]) if scored else (np.inf, 0, "none", start)
+    _, _, end, alpha = min(scored, key=lambda item: item[:2]) if scored else (np.inf, 0, "none", start)
+    value = criterion.value(alpha) if scored else np.inf
     if scored and fine_basis is not None and not accepted(constraints, alpha, fine_basis):
         problem, alpha, end = onto_fine_grid(problem, alpha, start, fine_basis)
         value = criterion.value(alpha)

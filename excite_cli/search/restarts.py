@@ -11,8 +11,9 @@ import numpy as np
 
 from excite_cli.design.excitation import Excitation
 from excite_cli.search.engine import Engine
-from excite_cli.search.kkt import CONVERGED, TIME_BUDGET
+from excite_cli.search.kkt import CONVERGED, STALLED, TIME_BUDGET
 from excite_cli.search.optimizer import ProgressHook, RestartResult, optimize_restart
+from excite_cli.search.smoothing import log_criterion, smoothing_bound
 
 
 @dataclass(frozen=True)
@@ -33,6 +34,8 @@ class RestartTask:
         scale: the criterion's scale of the run it continues (:attr:`RestartResult.scale`), or None
             for a start of its own; margins: the constraints' margins of the run it continues
             (:attr:`RestartResult.margins`).
+        smoothed: a criterion of the extreme singular values is solved on its smoothing (the
+            continuation of a restart that stalled in its epigraph form, :func:`polish`).
     """
 
     iteration: int
@@ -44,6 +47,7 @@ class RestartTask:
     time_limit: Optional[float] = None
     scale: Optional[float] = None
     margins: tuple[float, ...] = ()
+    smoothed: bool = False
 
     def rng(self) -> np.random.Generator:
         """The restart's own random generator."""
@@ -65,6 +69,7 @@ class RestartTask:
             self.time_limit,
             self.scale,
             self.margins,
+            self.smoothed,
         )
 
 
@@ -97,10 +102,10 @@ class RestartContext:
             excitation, engine, k, seed, prior, time.perf_counter() + excitation.spec.optimizer.time_budget, hook
         )
 
-    def task(self, index: int, start=None, iterations=None, scale=None, margins=()) -> RestartTask:
+    def task(self, index: int, start=None, iterations=None, scale=None, margins=(), smoothed=False) -> RestartTask:
         """Restart ``index`` of the iteration (:class:`RestartTask`), its time limit what is left."""
         left = _left(self.deadline)
-        return RestartTask(self.k, index, self.seed, self.prior, start, iterations, left, scale, margins)
+        return RestartTask(self.k, index, self.seed, self.prior, start, iterations, left, scale, margins, smoothed)
 
     def run(self, tasks: list[RestartTask], hook: Optional[ProgressHook]) -> list[RestartResult]:
         """``tasks`` on the engine, ``hook`` told of each solver iteration and of each result."""
@@ -170,9 +175,34 @@ def polish(context: RestartContext, runs: list[RestartResult], kept: int) -> lis
         if not more.succeeded or more.objective > current.objective:
             break
         runs[at] = _joined(current, more)
+    if opts.polish_rounds and runs[at].stop == STALLED and _left(context.deadline) > 0.0:
+        runs[at] = _smoothed_round(context, runs[at])
     if opts.polish_rounds and runs[at].stop != CONVERGED and _left(context.deadline) <= 0.0:
         runs[at] = replace(runs[at], stop=TIME_BUDGET)  # not polished to the end: the budget decided
     return runs
+
+
+def _smoothed_round(context: RestartContext, current: RestartResult) -> RestartResult:
+    """``current``, a kept restart of a criterion of the extreme singular values that stalled in its
+    epigraph form, continued on the criterion's smoothing for ``max_iterations``
+    (:mod:`~excite_cli.search.smoothing`); the continuation is kept when it is lower, or when it
+    converged (Clarke's test of the criterion itself) higher by no more than the smoothing can cost
+    (:func:`~excite_cli.search.smoothing.smoothing_bound` at ``current``). Any other criterion:
+    ``current``."""
+    criterion = context.excitation.criterion(context.prior)
+    if not criterion.objective.extremes:
+        return current
+    opts, hook = context.excitation.spec.optimizer, context.hook
+    task = context.task(current.index, current.alpha, opts.max_iterations, current.scale, current.margins, True)
+    shifted = (lambda r, it, value: hook(r, current.iterations + it, value)) if hook else None
+    more = context.run([task], shifted)[0]
+    rise = log_criterion(criterion, more.alpha) - log_criterion(criterion, current.alpha)
+    bound = smoothing_bound(criterion, current.alpha)
+    if more.succeeded and (rise <= 0.0 or (more.stop == CONVERGED and rise <= bound)):
+        return replace(
+            _joined(current, more), message=f"stalled in epigraph form, then on its smoothing: {more.message}"
+        )
+    return current
 
 
 def _restart_round(context: RestartContext, indices: range) -> list[RestartResult]:
