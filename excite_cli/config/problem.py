@@ -153,8 +153,7 @@ class OptimizerConfig(Section):
     screen_iterations: int = Field(30, ge=1, le=100_000)
     """Solver iterations of each screened start."""
     polish_rounds: int = Field(3, ge=0, le=100)
-    """Runs of max_iterations the kept restart continues by, each from a fresh quasi-Newton matrix, until converged;
-    cond, log_cond and sigma_min still stalled after them run one more, on the criterion's smoothing."""
+    """Runs of max_iterations the kept restart continues by until converged (stalled cond, sigma_min: +1 smoothed)."""
     time_budget: float = Field(1800.0, gt=0.0, le=604_800.0)
     """Wall time [s] an iteration may spend, a safety net: its solver runs stop there (stop: time budget)."""
     workers: Optional[int] = Field(None, ge=1, le=MAX_WORKERS)

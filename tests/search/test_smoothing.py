@@ -87,3 +87,19 @@ def test_a_restart_that_stalled_in_epigraph_form_converges_on_the_smoothing():
     assert accepted(excitation.constraints, polished.alpha, excitation.fine_basis)
     rise = log_criterion(criterion, polished.alpha) - log_criterion(criterion, stalled_alpha)
     assert rise <= smoothing_bound(criterion, stalled_alpha)
+
+
+def test_the_smoothing_is_finite_where_the_regressor_loses_rank(tmp_path):
+    """Without motion (the start's constant terms only) the inertial columns vanish: the smoothing
+    floors σ as the criterion does (RANK_FLOOR σ_max), so its value and gradient stay finite and
+    within the bound of the criterion's own floored value."""
+    excitation = _small_ur5(tmp_path, "log_cond")
+    criterion = excitation.criterion()
+    alpha = excitation.random_start(np.random.default_rng(0))
+    alpha[:, 1:] = 0.0
+    assert criterion.singular_values(alpha)[0] <= 1e-12 * criterion.singular_values(alpha)[-1]
+    smoothed = Smoothed(Evaluations(criterion, excitation.constraints, excitation.boundary, 0.0))
+    z = excitation.boundary.to_variables(alpha)
+    assert np.isfinite(smoothed.value(z)) and np.isfinite(smoothed.gradient(z)).all()
+    gap = smoothed.value(z) - log_criterion(criterion, alpha)
+    assert -1e-9 <= gap <= smoothing_bound(criterion, alpha) + 1e-9
