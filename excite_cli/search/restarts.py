@@ -152,7 +152,9 @@ def polish(context: RestartContext, runs: list[RestartResult], kept: int) -> lis
     of the KKT tolerance. Started again from the same point with the identity (Nocedal & Wright,
     Numerical Optimization, 2nd ed., Sec. 6.1, on restarting quasi-Newton methods), it converges:
     on the Panda (iteration 2, seed 0) a restart stalled at KKT 5.1e-2 converged in 70 more
-    iterations, to a lower value. A continuation that fails or ends higher is not kept.
+    iterations, to a lower value. A continuation that fails or ends higher is not kept. A criterion of
+    the extreme singular values still stalled after the rounds runs one more, on its smoothing
+    (:func:`_smoothed_round`).
 
     Args:
         context: the iteration's (its hook told of the polished restart's iterations counted on from
