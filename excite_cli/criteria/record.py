@@ -68,6 +68,12 @@ class CriterionRecord:
         return math.exp(value) if self.exponentiate else value
 
     @property
+    def weighed_extremes(self) -> list[tuple[int, float]]:
+        """(side, w) of each extreme of ``extremes`` with a non-zero weight: side 0 the largest singular
+        value (w_max), 1 the smallest (w_min); empty for a smooth criterion."""
+        return [(side, weight) for side, weight in enumerate(self.extremes) if weight]
+
+    @property
     def label(self) -> str:
         """The name tables put above that figure."""
         return self.shown_as or self.name

@@ -160,7 +160,7 @@ class Epigraph:
 
     def __init__(self, problem: Evaluations):
         self.problem = problem
-        self.sides = [(side, weight) for side, weight in enumerate(problem.criterion.objective.extremes) if weight]
+        self.sides = problem.criterion.objective.weighed_extremes
 
     def start(self, z: np.ndarray) -> np.ndarray:
         """w (n_z + sides,) at z (n_z,): each t at its extreme log σ."""

@@ -44,7 +44,7 @@ class Smoothed:
     def __init__(self, problem: Evaluations, mu: float = SMOOTHING):
         self.problem, self.mu = problem, mu
         self.constraint_values, self.constraint_jacobian = problem.constraint_values, problem.constraint_jacobian
-        self.sides = [(side, w) for side, w in enumerate(problem.criterion.objective.extremes) if w]
+        self.sides = problem.criterion.objective.weighed_extremes
 
     def value(self, z: np.ndarray) -> float:
         return self._value_and_gradient(z)[0]
@@ -56,13 +56,14 @@ class Smoothed:
         def compute():
             alpha, criterion = self.problem.boundary.to_alpha(z), self.problem.criterion
             logs = _log_sigma(criterion, alpha)
-            value, gradient = 0.0, np.zeros(alpha.size)
-            for side, weight in self.sides:
-                sign, members = _band(logs, side, self.mu)
-                value += weight * sign * self.mu * logsumexp(sign * logs[members] / self.mu)
-                p = softmax(sign * logs[members] / self.mu)
-                _, gradients = criterion.log_singular_values(alpha, members)
-                gradient += weight * (p @ gradients.reshape(members.size, -1))
+            bands = [(weight, *_band(logs, side, self.mu)) for side, weight in self.sides]
+            members = np.concatenate([band for *_, band in bands])  # every extreme's gradients in one call
+            gradients = criterion.log_singular_values(alpha, members)[1].reshape(members.size, -1)
+            value, gradient, row = 0.0, np.zeros(alpha.size), 0
+            for weight, sign, band in bands:
+                value += weight * sign * self.mu * logsumexp(sign * logs[band] / self.mu)
+                gradient += weight * (softmax(sign * logs[band] / self.mu) @ gradients[row : row + band.size])
+                row += band.size
             return float(value), self.problem.boundary.chain(gradient)
 
         return once(self, "smoothed", z, compute)
@@ -90,5 +91,5 @@ def log_criterion(criterion: Criterion, alpha: np.ndarray) -> float:
 def smoothing_bound(criterion: Criterion, alpha: np.ndarray, mu: float = SMOOTHING) -> float:
     """μ Σ_c |w_c| log |B_c| at α (n, 2N+1): how much f_μ exceeds the (log) criterion there at most."""
     logs = _log_sigma(criterion, alpha)
-    sides = [(side, w) for side, w in enumerate(criterion.objective.extremes) if w]
+    sides = criterion.objective.weighed_extremes
     return float(sum(abs(w) * mu * np.log(_band(logs, side, mu)[1].size) for side, w in sides))
