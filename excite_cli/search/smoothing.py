@@ -47,9 +47,11 @@ class Smoothed:
         self.sides = problem.criterion.objective.weighed_extremes
 
     def value(self, z: np.ndarray) -> float:
+        """f_μ at z (n_z,) [1, of log σ]."""
         return self._value_and_gradient(z)[0]
 
     def gradient(self, z: np.ndarray) -> np.ndarray:
+        """∇f_μ in z (n_z,): Σ_c w_c Σ_i p_i ∇log σ_i, chained into the optimizer's variables."""
         return self._value_and_gradient(z)[1]
 
     def _value_and_gradient(self, z: np.ndarray) -> tuple[float, np.ndarray]:
