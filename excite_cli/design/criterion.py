@@ -179,6 +179,12 @@ class Criterion:
         """σ (b,) of C (of C L with the frame), ascending, from the eigenvalues of CᵀC."""
         return np.sqrt(np.maximum(np.linalg.eigvalsh(self._gram(self._motion(alpha)[3])), 0.0))
 
+    def floored_singular_values(self, alpha: np.ndarray) -> np.ndarray:
+        """σ (b,) as :meth:`singular_values`, floored as the criterion floors them
+        (:data:`~excite_cli.criteria.record.RANK_FLOOR` σ_max): rank loss gives finite logs."""
+        sigma = self.singular_values(alpha)
+        return np.maximum(sigma, max(RANK_FLOOR * sigma[-1], np.finfo(float).tiny))
+
     def log_singular_values(self, alpha: np.ndarray, indices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """log σ_i (k,) of C (of C L with the frame) for the singular values ``indices`` (k,) (ascending
         order), and their gradients in α (k, n, 2N+1): ∂ log σ_i = v_iᵀ Cᵀ∂C v_i / λ_i (Eq. 17's terms one

@@ -11,7 +11,6 @@ import numpy as np
 from scipy.optimize import minimize
 
 from excite_cli.constraints import Constraint, accepted, farthest_accepted
-from excite_cli.criteria.record import RANK_FLOOR
 from excite_cli.design.criterion import Criterion
 from excite_cli.memo import once
 from excite_cli.search.kkt import (
@@ -168,8 +167,7 @@ class Epigraph:
         return np.concatenate([z, [logs[-1] if side == 0 else logs[0] for side, _ in self.sides]])
 
     def _singular_values(self, z: np.ndarray) -> np.ndarray:
-        sigma = self.problem.criterion.singular_values(self.problem.boundary.to_alpha(z))
-        return np.maximum(sigma, max(RANK_FLOOR * sigma[-1], np.finfo(float).tiny))  # as the criterion floors σ
+        return self.problem.criterion.floored_singular_values(self.problem.boundary.to_alpha(z))
 
     def value(self, w: np.ndarray) -> float:
         return float(sum(weight * t for (_, weight), t in zip(self.sides, w[-len(self.sides) :])))

@@ -25,7 +25,6 @@ from __future__ import annotations
 import numpy as np
 from scipy.special import logsumexp, softmax
 
-from excite_cli.criteria.record import RANK_FLOOR
 from excite_cli.design.criterion import Criterion
 from excite_cli.memo import once
 from excite_cli.search.nlp import Evaluations
@@ -57,7 +56,7 @@ class Smoothed:
     def _value_and_gradient(self, z: np.ndarray) -> tuple[float, np.ndarray]:
         def compute():
             alpha, criterion = self.problem.boundary.to_alpha(z), self.problem.criterion
-            logs = _log_sigma(criterion, alpha)
+            logs = np.log(criterion.floored_singular_values(alpha))
             bands = [(weight, *_band(logs, side, self.mu)) for side, weight in self.sides]
             members = np.concatenate([band for *_, band in bands])  # every extreme's gradients in one call
             gradients = criterion.log_singular_values(alpha, members)[1].reshape(members.size, -1)
@@ -69,13 +68,6 @@ class Smoothed:
             return float(value), self.problem.boundary.chain(gradient)
 
         return once(self, "smoothed", z, compute)
-
-
-def _log_sigma(criterion: Criterion, alpha: np.ndarray) -> np.ndarray:
-    """log σ (b,) at α (n, 2N+1), ascending, σ floored as the criterion floors it
-    (:data:`~excite_cli.criteria.record.RANK_FLOOR` σ_max: rank loss gives finite values)."""
-    sigma = criterion.singular_values(alpha)
-    return np.log(np.maximum(sigma, max(RANK_FLOOR * sigma[-1], np.finfo(float).tiny)))
 
 
 def _band(logs: np.ndarray, side: int, mu: float) -> tuple[float, np.ndarray]:
@@ -92,6 +84,6 @@ def log_criterion(criterion: Criterion, alpha: np.ndarray) -> float:
 
 def smoothing_bound(criterion: Criterion, alpha: np.ndarray, mu: float = SMOOTHING) -> float:
     """μ Σ_c |w_c| log |B_c| at α (n, 2N+1): how much f_μ exceeds the (log) criterion there at most."""
-    logs = _log_sigma(criterion, alpha)
+    logs = np.log(criterion.floored_singular_values(alpha))
     sides = criterion.objective.weighed_extremes
     return float(sum(abs(w) * mu * np.log(_band(logs, side, mu)[1].size) for side, w in sides))
