@@ -42,6 +42,8 @@ class ZmpConfig(Section):
     """The links whose lowest collision points touch the ground (the soles' contact points)."""
     margin: float = Field(0.02, ge=0.0)
     """Distance [m] the ZMP keeps from every edge of the support polygon."""
+    friction: float = Field(0.5, gt=0.0, le=10.0)
+    """Friction coefficient μ [1] of the soles: the held joints' feed-forward keeps forces in ‖f_xy‖ ≤ μ f_z."""
 
 
 class CapsuleConfig(Section):

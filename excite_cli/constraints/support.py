@@ -70,17 +70,27 @@ class SupportPolygon:
         return (self.offsets - points @ self.normals.T).min(axis=1)
 
 
+def sole_points(robot: Robot, links: list[str], height: float, field: str) -> list[np.ndarray]:
+    """Each of ``links``' collision-geometry points (k_i, 3) [m, world frame] within ``height`` [m] of
+    the lowest point of them all, at the home posture (the robot standing on them): its sole's contact
+    points, possibly none.
+
+    Raises:
+        ExciteError: (``field``) a link without collision geometry.
+    """
+    points = [world_points(robot, link, robot.home, field) for link in links]
+    lowest = min(p[:, 2].min() for p in points)
+    return [p[p[:, 2] <= lowest + height] for p in points]
+
+
 def support_polygon(robot: Robot, links: list[str], height: float, field: str) -> SupportPolygon:
-    """The hull of the collision-geometry points of ``links`` within ``height`` [m] of their lowest
-    point, at the home posture (the robot standing on them).
+    """The hull of the soles' contact points of ``links`` (:func:`sole_points`) on the ground plane.
 
     Raises:
         ExciteError: (``field``) a link without collision geometry, or soles spanning no area.
     """
-    points = np.vstack([world_points(robot, link, robot.home, field) for link in links])
-    lowest = points[:, 2].min()
-    sole = points[points[:, 2] <= lowest + height, :2]
+    sole = np.vstack(sole_points(robot, links, height, field))
     try:
-        return SupportPolygon.from_points(sole, lowest)
+        return SupportPolygon.from_points(sole[:, :2], sole[:, 2].min())
     except (QhullError, ValueError):  # degenerate input (too few, collinear or coincident points)
         raise ExciteError(field, "the soles of these links span no area") from None
