@@ -5,6 +5,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
+
 from excite_cli.storage.export import Export
 from excite_cli.storage.formats import FORMATS
 from excite_cli.storage.rosbag import ACKED_WAIT_MS, PLAY_DELAY_S, TOPIC
@@ -18,10 +20,19 @@ def export_lines(e: Export, rate: float, target: Path, fmt: str, effort: bool = 
         f"{e.time.size} samples at {rate:g} Hz{faster}; every constraint holds: largest normalized violation "
         f"{e.max_violation:+.2e} (≤ 0 satisfied), closest: {e.worst}",
         *[f"predicted (feet flat, legs rigid): {p}" for p in e.predictions],
+        *held_lines(e),
         *[f"warning: {w}" for w in e.warnings],
         f"wrote {target}",
     ]
     form = FORMATS[fmt]
+    if e.held and form.controller:
+        lines.append(
+            f"held joints ({len(e.held.joint_names)}): in the trajectory, held still with their feed-forward as "
+            "effort, for one effort-controlled controller over the whole body"
+            if effort
+            else "held joints: not in the trajectory (--effort puts them in with their feed-forward); "
+            "their torques are in the csv and npz formats"
+        )
     if form.folder:
         lines += [
             f"play it: ros2 bag play {target} --delay {PLAY_DELAY_S:g} --wait-for-all-acked {ACKED_WAIT_MS}  "
@@ -38,3 +49,18 @@ def export_lines(e: Export, rate: float, target: Path, fmt: str, effort: bool = 
             "(--effort adds the feed-forward torque, for an effort-controlled one)"
         )
     return lines
+
+
+def held_lines(e: Export) -> list[str]:
+    """For a standing robot: the held joints' feed-forward, its largest torque against its effort limit."""
+    if not e.held:
+        return []
+    k, share = e.held.peak()
+    name, peak, limit = e.held.joint_names[k], np.abs(e.held.tau[:, k]).max(), e.held.effort[k]
+    against = (
+        f"{100 * share:.0f} % of its effort limit {limit:g} Nm" if np.isfinite(limit) and limit > 0 else "no limit"
+    )
+    return [
+        f"held joints ({len(e.held.joint_names)}): feed-forward that keeps the base and them still, feet flat; "
+        f"largest share {name} {peak:.1f} Nm ({against})"
+    ]

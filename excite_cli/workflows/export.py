@@ -5,9 +5,11 @@ from __future__ import annotations
 from pathlib import Path
 
 from excite_cli.config_file import result_problem, with_overrides
+from excite_cli.design.held_joints import held_joints
 from excite_cli.design.resolve import build_excitation
 from excite_cli.errors import ExciteError
-from excite_cli.storage.export import Export, Played, check_playback, export_trajectory, write_export
+from excite_cli.storage.export import Export, Played, check_playback, export_trajectory
+from excite_cli.storage.export_files import write_export
 from excite_cli.storage.formats import export_format
 from excite_cli.storage.paths import check_target
 from excite_cli.storage.results import read_alphas
@@ -20,11 +22,13 @@ def played_result(
     """Iteration ``iteration`` (default: the last) of an ``optimize`` result sampled at ``rate`` [Hz]
     with the transitions from and to the home posture, played ``speed`` times as fast as optimized,
     and its feed-forward torques (:func:`~excite_cli.storage.export.export_trajectory` on the design
-    the result stores, its regressor rows the joints' torques).
+    the result stores, its regressor rows the joints' torques), the held joints' too for a standing
+    robot (:func:`~excite_cli.design.held_joints.held_joints`).
 
     Raises:
         ExciteError: not an excite result, an iteration it does not have, a rate, speed or period count
-            out of range (:func:`~excite_cli.storage.export.check_playback`), and as ``export_trajectory``.
+            out of range (:func:`~excite_cli.storage.export.check_playback`), and as ``export_trajectory``
+            and ``held_joints``.
     """
     check_playback(rate, periods, speed)
     # a copy whose regressor rows are the joints' torques, the feed-forward a robot plays
@@ -35,7 +39,9 @@ def played_result(
         raise ExciteError(
             "iteration", f"{result} has iterations {sorted(alphas)}, not {k}", k, f"one of {sorted(alphas)}"
         )
-    return export_trajectory(build_excitation(problem), alphas[k], Played(result, k, rate, periods, speed))
+    excitation = build_excitation(problem)
+    held = held_joints(problem.robot, problem.folder, problem.constraints, excitation.robot)
+    return export_trajectory(excitation, alphas[k], Played(result, k, rate, periods, speed), held)
 
 
 def run_export(

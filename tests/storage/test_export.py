@@ -9,10 +9,12 @@ import yaml
 from rosbags.typesys import Stores, get_typestore
 
 from excite_cli.config_file import load_problem, with_overrides
+from excite_cli.design.held_joints import HeldTorques, held_joints
 from excite_cli.design.resolve import build_excitation
 from excite_cli.errors import ExciteError
 from excite_cli.search.sequence import describe
-from excite_cli.storage.export import Export, columns, write_export
+from excite_cli.storage.export import Export, Played, export_trajectory
+from excite_cli.storage.export_files import columns, write_export
 from excite_cli.storage.formats import FORMATS
 from excite_cli.storage.results import write_result
 from excite_cli.storage.rosbag import MSGTYPE
@@ -140,3 +142,53 @@ def test_a_zmp_closer_to_the_edge_than_its_margin_is_a_warning_not_a_refusal(tmp
     assert 0.0 < margin < 0.084 and played.max_violation <= 0.0
     assert len(played.warnings) == 1 and "the robot may tip" in played.warnings[0]
     assert played.predictions[0].startswith("constraints.zmp: ZMP ")
+
+
+@pytest.fixture
+def standing(export):
+    """The fixture's motion with two held joints, held at 0.1 and −0.2 rad."""
+    tau = np.column_stack([np.linspace(1.0, 2.0, 5), np.linspace(-3.0, -1.0, 5)])
+    forces, points = np.zeros((5, 4, 3)), np.zeros((4, 3))
+    held = HeldTorques(("knee", "hip"), np.array([0.1, -0.2]), tau, forces, points, np.array([50.0, 0.0]), 0)
+    return replace(export, held=held)
+
+
+def test_a_standing_robot_s_held_joints_are_columns_and_arrays_beside_the_active_joints(standing, tmp_path):
+    path = write_export(tmp_path / "m.csv", standing, "csv")
+    header = [line for line in path.read_text().splitlines() if line.startswith("#")]
+    assert header[-1].endswith("knee at 0.1 rad, hip at -0.2 rad")
+    table = np.genfromtxt(path, delimiter=",", names=True, skip_header=5)
+    assert list(table.dtype.names) == columns(JOINTS) + ["tau_knee_Nm", "tau_hip_Nm"]
+    np.testing.assert_allclose(table["tau_hip_Nm"], standing.held.tau[:, 1], rtol=1e-9)
+    archive = np.load(write_export(tmp_path / "m.npz", standing, "npz"))
+    assert archive["held_joint_names"].tolist() == ["knee", "hip"]
+    np.testing.assert_array_equal(archive["tau_held"], standing.held.tau)
+    np.testing.assert_array_equal(archive["held_positions"], [0.1, -0.2])
+
+
+def test_held_joints_reach_an_effort_controller_s_trajectory_and_stay_out_of_a_position_controller_s(
+    standing, tmp_path
+):
+    """With effort, one trajectory over the whole body: the held joints at their values, at rest, their
+    feed-forward as effort, which the controller's rules accept; without, the active joints only (a
+    controller refuses a joint it does not command)."""
+    points = yaml.safe_load(write_export(tmp_path / "e.yaml", standing, "ros2", True).read_text())["trajectory"]
+    assert points["joint_names"] == JOINTS + ["knee", "hip"]
+    last = points["points"][-1]
+    np.testing.assert_allclose(last["positions"][2:], [0.1, -0.2])
+    np.testing.assert_allclose(last["velocities"][2:] + last["accelerations"][2:], 0.0)
+    np.testing.assert_allclose(last["effort"], np.r_[standing.tau[-1], standing.held.tau[-1]])
+    plain = yaml.safe_load(write_export(tmp_path / "p.yaml", standing, "ros2").read_text())["trajectory"]
+    assert plain["joint_names"] == JOINTS
+
+
+def test_a_held_joint_s_feed_forward_above_its_effort_limit_is_refused(tmp_path):
+    problem = load_problem(CONFIGS / "g1_arms.yaml")
+    excitation = build_excitation(problem)
+    held = held_joints(problem.robot, problem.folder, problem.constraints, excitation.robot)
+    alpha = excitation.random_start(np.random.default_rng(2))
+    how = Played(tmp_path / "g1.h5", 1, 50.0, 1, 1.0)
+    assert export_trajectory(excitation, alpha, how, held).held.peak()[1] < 1.0
+    held.effort = held.effort / 20.0
+    with pytest.raises(ExciteError, match="of the held joint 'waist_pitch_joint' to keep the robot still, above its"):
+        export_trajectory(excitation, alpha, how, held)

@@ -9,7 +9,8 @@ import yaml
 from rosbags.highlevel import AnyReader
 from rosbags.typesys import Stores, get_typestore
 
-from excite_cli.storage.export import Export, write_export
+from excite_cli.storage.export import Export
+from excite_cli.storage.export_files import write_export
 from excite_cli.storage.trajectory_controller import controller_refusals
 
 JOINTS = ["shoulder", "elbow", "wrist"]
