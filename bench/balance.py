@@ -24,7 +24,8 @@ frequency and damping ratio of its centre of mass's free swing over 5.9 s) and a
 stance and speed.
 
     .venv/bin/python bench/balance.py [--config configs/g1_arms.yaml] [--seeds 0 1 2] [--result R.h5]
-        [--results-dir DIR] [--stances welded pd1000/40 ...] [--stabilizer 2 1] [--joint-losses 0.5 0.01 0.1]
+        [--results-dir DIR] [--workers W] [--stances welded pd1000/40 ...] [--stabilizer 2 1]
+        [--joint-losses 0.5 0.01 0.1]
 
 With --result the iterations of that result are played instead of optimizing; --results-dir keeps the
 optimized results (and plays those already there). The stabilizer's gains were chosen on the push
@@ -71,7 +72,9 @@ STANCES = (
 MENAGERIE_G1_JOINTS = (0.5, 0.01, 0.1)
 
 
-def results(config: Path, seeds: list[int], given: Path | None, folder: Path) -> dict[int, dict[int, np.ndarray]]:
+def results(
+    config: Path, seeds: list[int], given: Path | None, folder: Path, workers: int | None = None
+) -> dict[int, dict[int, np.ndarray]]:
     """{seed: {iteration: α}}: of ``given``, or of each seed's result in ``folder``, optimized there
     where it is not yet."""
     if given is not None:
@@ -79,7 +82,7 @@ def results(config: Path, seeds: list[int], given: Path | None, folder: Path) ->
     found = {}
     for seed in seeds:
         problem = load_problem(config)
-        problem.optimizer.seed = seed
+        problem.optimizer.seed, problem.optimizer.workers = seed, workers or problem.optimizer.workers
         target = folder / f"{config.stem}_seed{seed}.h5"
         if not target.exists():
             run_optimize(problem, target, force=True)
@@ -147,6 +150,7 @@ def main() -> None:
     parser.add_argument("--joint-losses", type=float, nargs=3, default=list(MENAGERIE_G1_JOINTS))
     parser.add_argument("--result", type=Path, help="play this result's iterations instead of optimizing")
     parser.add_argument("--results-dir", type=Path, help="keep the optimized results here (and reuse them)")
+    parser.add_argument("--workers", type=int, help="optimizer processes (default: the config's, else every core)")
     args = parser.parse_args()
     problem, excitation, zmp, urdf, locked = setup(args.config)
     joints, robot = excitation.robot.joint_names, excitation.robot
@@ -157,7 +161,7 @@ def main() -> None:
     models = [standing_model(urdf, joints, locked, links, s, losses) for s in stances]
     print(f"joints: damping {losses[0]:g} Nm·s/rad, armature {losses[1]:g} kg·m², frictionloss {losses[2]:g} Nm")
     with tempfile.TemporaryDirectory() as folder:
-        alphas = results(args.config, args.seeds, args.result, args.results_dir or Path(folder))
+        alphas = results(args.config, args.seeds, args.result, args.results_dir or Path(folder), args.workers)
     summary: dict[tuple[str, float], list[tuple[float, float, bool]]] = {}
     for seed, iterations in alphas.items():
         for k, alpha in sorted(iterations.items()):
