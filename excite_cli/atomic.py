@@ -1,6 +1,10 @@
 """Files written whole or not at all: every file excite writes (HDF5, PNG, HTML, CSV, URDF) goes
 through a temporary ``.<name>.partial`` beside ``<path>`` moved onto its path only when it is complete, and the folders
-made for it are removed again when nothing was written; a folder written as one (a ROS 2 bag) the same way."""
+made for it are removed again when nothing was written; a folder written as one (a ROS 2 bag) the same way.
+A path that is a symbolic link is written through: the file it points to is replaced, never the link.
+Every file and folder excite writes carries :data:`MARK` (an HDF5 attribute, a PNG text chunk, a
+comment line, a bag's custom data), so that ``force`` replaces only what excite wrote
+(:func:`~excite_cli.storage.paths.written_by_excite`)."""
 
 from __future__ import annotations
 
@@ -11,7 +15,24 @@ from contextlib import contextmanager, suppress
 from pathlib import Path
 from typing import Iterator, Sequence
 
+from excite_cli import __version__
 from excite_cli.errors import CannotWrite, ExciteWarning
+
+#: What every file and folder excite writes says of itself (with its version; in a text file also the
+#: command that wrote it).
+MARK_PREFIX = "written by excite"
+MARK = f"{MARK_PREFIX} {__version__}"
+
+
+def through_links(path: Path) -> Path:
+    """``path``, or the file a symbolic link there points to (followed to its end), which a write
+    replaces instead of the link.
+
+    Raises:
+        RuntimeError: a loop of symbolic links.
+    """
+    path = Path(path)
+    return path.resolve() if path.is_symlink() else path
 
 
 def partial_path(path: Path) -> Path:
@@ -69,7 +90,7 @@ def atomic_paths(paths: Sequence[Path], field: str = "output") -> Iterator[list[
     Raises:
         CannotWrite: a file cannot be written (``OSError`` in the block or in a move).
     """
-    paths = [Path(p) for p in paths]
+    paths = [through_links(p) for p in paths]
     tmps = [partial_path(p) for p in paths]  # hidden: a killed run's is not in the way
     for tmp in tmps:
         remove_stale(tmp)

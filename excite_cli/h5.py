@@ -15,7 +15,7 @@ from typing import Iterator, Sequence
 import h5py
 import numpy as np
 
-from excite_cli.atomic import atomic_bytes
+from excite_cli.atomic import MARK, atomic_bytes
 from excite_cli.errors import ExciteError
 from excite_cli.inputs import input_file
 from excite_cli.kernels import describe
@@ -38,6 +38,7 @@ def atomic_h5(path: Path, field: str = "output") -> Iterator[h5py.File]:
     """
     buffer = io.BytesIO()
     with h5py.File(buffer, "w") as f:
+        f.attrs["written_by"] = MARK
         f.attrs["created"] = datetime.now(timezone.utc).isoformat(timespec="seconds")
         for name, version in package_versions().items():
             f.attrs[f"version_{name}"] = version

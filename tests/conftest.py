@@ -114,7 +114,7 @@ def panda_runs_config(runs: list[str], **identification) -> dict:
 def assert_refused(folder: Path, argv: list[str], expected: str) -> str:
     """``excite argv`` exits with status 2 and one line starting ``error:`` that contains
     ``expected``, prints no traceback, and writes or changes no file under ``folder``; that line."""
-    before = {p: p.stat().st_mtime_ns for p in folder.rglob("*")}
+    before = {p: p.lstat().st_mtime_ns for p in folder.rglob("*")}  # a link itself, not what it points to
     result = CliRunner().invoke(app, argv, env={"COLUMNS": "400"})
     assert isinstance(result.exception, SystemExit), repr(result.exception)
     assert result.exit_code == 2, result.output
@@ -122,7 +122,7 @@ def assert_refused(folder: Path, argv: list[str], expected: str) -> str:
     assert len(lines) == 1 and lines[0].startswith("error:"), result.output
     assert expected in lines[0], lines[0]
     assert "Traceback" not in result.output
-    after = {p: p.stat().st_mtime_ns for p in folder.rglob("*")}
+    after = {p: p.lstat().st_mtime_ns for p in folder.rglob("*")}
     assert after == before, f"files written or changed: {sorted(set(after) ^ set(before))}"
     return lines[0]
 

@@ -8,6 +8,7 @@ import resource
 import shutil
 import subprocess
 import sys
+from contextlib import chdir
 from pathlib import Path
 
 import h5py
@@ -17,6 +18,8 @@ import scipy.io
 import yaml
 from conftest import assert_refused, pendulum_config, tcp_server
 from numpy.lib import recfunctions as rf
+from rosbags.rosbag2 import Writer
+from rosbags.typesys import Stores, get_typestore
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
@@ -719,3 +722,63 @@ def test_a_prior_regressor_of_three_dimensions_is_named_by_its_shape(pendulum_ru
     config = {**yaml.safe_load((folder / "pendulum.yaml").read_text()), "output": "new.h5"}
     (folder / "prior3.yaml").write_text(yaml.safe_dump({**config, "sequence": {"iterations": 1, "prior": "prior3.h5"}}))
     assert_refused(folder, ["optimize", str(folder / "prior3.yaml")], "has regressor rows of shape 2x3x3")
+
+
+# --- what excite did not write is never replaced (issue 85) ------------------------------------------
+
+
+def _recording(folder: Path) -> Path:
+    """A bag as ``ros2 bag record /joint_states`` writes one (no mark of excite's): 3 messages."""
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    types = store.types
+    with Writer(folder, version=8) as writer:
+        connection = writer.add_connection("/joint_states", "sensor_msgs/msg/JointState", typestore=store)
+        for k in range(3):
+            stamp = types["builtin_interfaces/msg/Time"](sec=k, nanosec=0)
+            message = types["sensor_msgs/msg/JointState"](
+                header=types["std_msgs/msg/Header"](stamp=stamp, frame_id=""),
+                name=["hinge"],
+                position=np.zeros(1),
+                velocity=np.zeros(0),
+                effort=np.ones(1),
+            )
+            writer.write(connection, k * 10**9, store.serialize_cdr(message, "sensor_msgs/msg/JointState"))
+    return folder
+
+
+@pytest.mark.parametrize("force", [[], ["--force"]])
+def test_a_lab_s_recording_at_an_output_is_never_replaced(pendulum_run, tmp_path, force):
+    """Every writer with a recording excite did not write in the way: export's bag and file, simulate's
+    bags and CSV runs, identify's report behind a dangling symbolic link; refused with and without
+    --force, the recording untouched."""
+    folder = _copy(pendulum_run, tmp_path / "run")
+    _recording(folder / "fit")
+    (folder / "bags").mkdir()
+    _recording(folder / "bags" / "run_1")
+    (folder / "csv").mkdir()
+    (folder / "csv" / "run_1.csv").write_text("time,q_hinge,tau_hinge\n0,0,0\n")
+    (folder / "play.csv").write_text("time,q_hinge,tau_hinge\n0,0,0\n")
+    simulate = ["simulate", "out.h5", "effects.yaml"]
+    bags = yaml.safe_load((folder / "effects.yaml").read_text()) | {"recording": "rosbag2"}
+    (folder / "bag_effects.yaml").write_text(yaml.safe_dump(bags))
+    cases = [
+        (["export", "out.h5", "--format", "rosbag2", "-o", "fit"], "fit"),
+        (["export", "out.h5", "-o", "play.csv"], "play.csv"),
+        (["simulate", "out.h5", "bag_effects.yaml", "-o", "bags"], "run_1"),
+        ([*simulate, "-o", "csv"], "run_1.csv"),
+    ]
+    for argv, named in cases:
+        with chdir(folder):
+            assert_refused(folder, argv + force, named)
+    if not force:  # a dangling link: refused, not replaced by a file (with --force it is written through)
+        (folder / "rep.h5").symlink_to(folder / "elsewhere" / "rep.h5")
+        with chdir(folder):
+            result = runner.invoke(app, ["identify", "id.yaml", "-o", "rep.h5"])
+        assert result.exit_code == 2 and "rep.h5 exists" in result.output
+        assert (folder / "rep.h5").is_symlink() and not (folder / "elsewhere").exists()
+
+
+def test_a_symbolic_link_loop_at_an_output_is_one_line(tmp_path):
+    (tmp_path / "a.yaml").symlink_to(tmp_path / "b.yaml")
+    (tmp_path / "b.yaml").symlink_to(tmp_path / "a.yaml")
+    assert_refused(tmp_path, ["init", "ur_description/urdf/ur3_robot.urdf", "-o", str(tmp_path / "a.yaml")], "loop")

@@ -10,7 +10,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from excite_cli.atomic import atomic_bytes  # noqa: E402
+from excite_cli.atomic import MARK, atomic_bytes  # noqa: E402
 
 
 def save_figure(fig: plt.Figure, path: Path, dpi: int) -> Path:
@@ -21,7 +21,7 @@ def save_figure(fig: plt.Figure, path: Path, dpi: int) -> Path:
     """
     buffer = io.BytesIO()
     try:
-        fig.savefig(buffer, format="png", dpi=dpi)
+        fig.savefig(buffer, format="png", dpi=dpi, metadata={"Software": MARK})
     finally:
         plt.close(fig)
     return atomic_bytes(path, buffer.getvalue(), "output")

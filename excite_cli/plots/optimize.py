@@ -1,5 +1,5 @@
-"""PNG figures: joint trajectories with their limits, the condition-number table, constraint tracks,
-posture strips, the random-baseline comparison and identification residuals."""
+"""The PNG figures of an optimize result: joint trajectories with their limits, the condition-number table,
+constraint tracks and posture strips."""
 
 from __future__ import annotations
 
@@ -26,10 +26,16 @@ from excite_cli.plots.skeleton import capsule_segments, skeleton  # noqa: E402
 from excite_cli.search.sequence import IterationResult  # noqa: E402
 
 
+def figure_paths(target: Path) -> list[Path]:
+    """The figures of an ``optimize`` result at ``target``: ``<stem>_trajectories.png``, ``_cond.png``,
+    ``_postures.png`` and, with balance or collision constraints, ``_constraints.png``."""
+    stem = Path(target).with_suffix("")
+    return [stem.with_name(stem.name + f"_{name}.png") for name in ("trajectories", "cond", "postures", "constraints")]
+
+
 def plot_result(target: Path, excitation: Excitation, results: Sequence[IterationResult]) -> list[Path]:
-    """The PNG figures of an ``optimize`` result beside ``target`` (``<stem>_trajectories.png``,
-    ``_cond.png``, ``_postures.png`` and, with balance or collision constraints, ``_constraints.png``)."""
-    stem = target.with_suffix("")
+    """The PNG figures of an ``optimize`` result beside ``target`` (:func:`figure_paths`)."""
+    trajectories, cond, postures, tracks = figure_paths(target)
     com = next((c for c in excitation.constraints if isinstance(c, ComRegion)), None)
     zmp = next((c for c in excitation.constraints if isinstance(c, ZeroMomentPoint)), None)
     collision = next((c for c in excitation.constraints if isinstance(c, SelfCollision)), None)
@@ -38,15 +44,15 @@ def plot_result(target: Path, excitation: Excitation, results: Sequence[Iteratio
     limits = excitation.limits
     plots = [
         plot_trajectories(
-            stem.with_name(stem.name + "_trajectories.png"),
+            trajectories,
             excitation.robot.joint_names,
             results,
             limits.lower,
             limits.upper,
         ),
-        plot_condition_numbers(stem.with_name(stem.name + "_cond.png"), results),
+        plot_condition_numbers(cond, results),
         plot_postures(
-            stem.with_name(stem.name + "_postures.png"),
+            postures,
             results,
             lambda q: (skeleton(excitation.robot, q), capsule_segments(excitation.robot, capsules, q)),
             [c.radius for c in capsules],
@@ -57,7 +63,7 @@ def plot_result(target: Path, excitation: Excitation, results: Sequence[Iteratio
     if any(r.tracks for r in results):
         plots.append(
             plot_constraint_tracks(
-                stem.with_name(stem.name + "_constraints.png"),
+                tracks,
                 results,
                 centre=com.centre if com else None,
                 radius=com.radius if com else None,
@@ -272,26 +278,5 @@ def plot_constraint_tracks(
                     ax.legend(fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1.0))
                 continue
             ax.legend(fontsize=7)
-    fig.tight_layout()
-    return save_figure(fig, path, 110)
-
-
-def plot_comparison(path: Path, random_table, optimized_table) -> Path:
-    """Bars of cond(C⁽ⁱ⁾) and cond(C) per motion index, random selection (Table II) beside the
-    optimized trajectories (Table I); log scale; written to ``path`` (PNG)."""
-    fig, axes = plt.subplots(1, 2, figsize=(9, 3.8))
-    for ax, column, title in zip(axes, ("cond_own", "cond_stacked"), ("cond(C⁽ⁱ⁾)", "cond(C) stacked")):
-        k = np.asarray(random_table["iteration"])
-        ax.bar(k - 0.2, random_table[column], width=0.4, label="random + selection")
-        if optimized_table is not None:
-            ax.bar(
-                np.asarray(optimized_table["iteration"]) + 0.2, optimized_table[column], width=0.4, label="optimized"
-            )
-        ax.set_yscale("log")
-        ax.set_xticks(k)
-        ax.set_xlabel("motion index")
-        ax.set_title(title)
-        ax.grid(alpha=0.3, axis="y")
-        ax.legend(fontsize=8)
     fig.tight_layout()
     return save_figure(fig, path, 110)

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from excite_cli.atomic import atomic_bytes
+from excite_cli.atomic import MARK, atomic_bytes
 from excite_cli.constraints.world_collision import WorldShape
 from excite_cli.dynamics.robot import Robot
 from excite_cli.errors import ExciteError
@@ -65,7 +65,7 @@ def write_scene(path: Path, robot: Robot, q: np.ndarray, rate: float, shapes: li
     finally:
         viewer.window.server_proc.kill()
         viewer.window.server_proc.wait()
-    return atomic_bytes(path, html.encode("utf-8"))
+    return atomic_bytes(path, f"<!-- {MARK} view -->\n{html}".encode("utf-8"))
 
 
 def _draw_shape(node, shape: WorldShape) -> None:

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from excite_cli.atomic import atomic_path
+from excite_cli.atomic import MARK, atomic_path
 from excite_cli.errors import ExciteError
 from excite_cli.storage.export import Export
 from excite_cli.storage.formats import export_format
@@ -91,6 +91,7 @@ def _write_npz(path: Path, export: Export, effort: bool) -> Path:
     arrays = {"time": export.time, "q": export.q, "qd": export.qd, "qdd": export.qdd, "tau": export.tau}
     held = export.held.joint_names if export.held else ()
     names = {"joint_names": np.array(export.joint_names), "columns": np.array(columns(export.joint_names, held))}
+    names["written_by"] = np.array(f"{MARK} export")
     if export.held:
         arrays |= {"held_positions": export.held.positions, "tau_held": export.held.tau}
         names["held_joint_names"] = np.array(held)

@@ -1,19 +1,54 @@
 """Output paths, checked before any computation, so a bad path fails in a second rather than after
-a run, and an existing result is never replaced by accident; a lock beside an output, so two runs
-never write it at once."""
+a run, and an existing result is never replaced by accident, nor anything excite did not write, even
+with ``force``; a lock beside an output, so two runs never write it at once."""
 
 from __future__ import annotations
 
 import fcntl
 import os
+import re
 import tempfile
 import warnings
+import zipfile
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Iterator
 
-from excite_cli.atomic import new_folders, partial_path, remove_stale
+from excite_cli.atomic import MARK_PREFIX, new_folders, partial_path, remove_stale
 from excite_cli.errors import CannotWrite, ExciteError, ExciteWarning, OutputExists
+
+#: How much of a file's start is read for its mark [bytes].
+MARK_WINDOW = 4096
+#: A text file excite wrote: the mark (:data:`~excite_cli.atomic.MARK`) or, in the files of versions before
+#: it, the comment naming the command in its first lines (``# excite export: ...``, ``<!-- excite identify``).
+TEXT_MARK = re.compile(rf"{MARK_PREFIX}|^(# |<!-- )excite (export|identify|init)\b", re.MULTILINE)
+
+
+def written_by_excite(path: Path) -> bool:
+    """Whether excite wrote the file at ``path``, by the mark it leaves (:data:`~excite_cli.atomic.MARK`):
+    an HDF5 file's ``written_by`` attribute (or the ``version_excite`` attribute of earlier versions), a
+    PNG's ``Software`` text chunk (or matplotlib's, which wrote excite's plots before the mark), an NPZ's
+    ``written_by`` array, or a text file's first or last 4 KiB (CSV, YAML, JSON, URDF, MJCF, HTML; a
+    simulated run's CSV ends with its mark, so that its header is its first row as a recording's). A
+    file that cannot be read is not excite's."""
+    try:
+        with open(path, "rb") as f:
+            head = f.read(MARK_WINDOW)
+            f.seek(max(0, os.fstat(f.fileno()).st_size - MARK_WINDOW))
+            tail = f.read(MARK_WINDOW)
+        if head.startswith(b"\x89HDF"):
+            import h5py  # only for an HDF5 file in the way
+
+            with h5py.File(path, "r") as f:
+                return str(f.attrs.get("written_by", "")).startswith(MARK_PREFIX) or "version_excite" in f.attrs
+        if head.startswith(b"\x89PNG"):
+            return re.search(rb"Software\x00(" + MARK_PREFIX.encode() + rb"|Matplotlib)", head) is not None
+        if head.startswith(b"PK"):
+            with zipfile.ZipFile(path) as archive:
+                return "written_by.npy" in archive.namelist()
+        return any(TEXT_MARK.search(part.decode("utf-8", errors="replace")) for part in (head, tail))
+    except (OSError, ValueError, zipfile.BadZipFile):
+        return False
 
 
 def check_target(path: Path, field: str, force: bool = False, exists_ok: bool = False) -> Path:
@@ -22,24 +57,41 @@ def check_target(path: Path, field: str, force: bool = False, exists_ok: bool = 
     Args:
         path: the file to write (its folder is created later, when the result is written).
         field: the argument or config field that named it, for the messages (e.g. ``output``).
-        force: replacing an existing file is allowed.
+        force: replacing an existing file excite wrote (:func:`written_by_excite`) is allowed, and
+            writing through a symbolic link at ``path`` (the file it points to is written).
         exists_ok: an existing file is expected (a result to resume).
 
     Returns:
         ``path``.
 
     Raises:
-        OutputExists: the file exists and neither ``force`` nor ``exists_ok``.
-        ExciteError: ``path`` is a folder or not a regular file (a device, a FIFO), a file is in the
-            way of its folder, or its nearest existing folder is not writable.
+        OutputExists: the file exists, or a symbolic link is there, and neither ``force`` nor ``exists_ok``.
+        ExciteError: ``path`` is a folder or not a regular file (a device, a FIFO), a file excite did not
+            write (with ``force``), a loop of symbolic links, a file is in the way of its folder, or its
+            nearest existing folder is not writable.
     """
     path = Path(path)
+    if path.is_symlink():
+        try:
+            target = path.resolve()  # the file it points to is what is written
+        except (RuntimeError, OSError):
+            raise ExciteError(field, f"{path} is a loop of symbolic links", path, "a file name") from None
+        if not (force or exists_ok):
+            raise OutputExists(field, path)
+        path = target
     if path.is_dir():
         raise ExciteError(field, f"{path} is a folder", path, "a file name")
     if path.exists() and not path.is_file():  # a device, FIFO or socket is never replaced, even with --force
         raise ExciteError(field, f"{path} is not a regular file", path, "a file name")
     if path.exists() and not (force or exists_ok):
         raise OutputExists(field, path)
+    if path.exists() and force and not exists_ok and not written_by_excite(path):
+        raise ExciteError(
+            field,
+            f"{path} exists and excite did not write it (it holds no mark of excite's); not replaced",
+            path,
+            "another path, or remove that file yourself",
+        )
     folder = path.parent
     while not folder.exists():
         folder = folder.parent

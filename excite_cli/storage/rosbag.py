@@ -26,7 +26,7 @@ import yaml
 from rosbags.rosbag2 import Writer, WriterError
 from rosbags.typesys import Stores, get_typestore
 
-from excite_cli.atomic import atomic_folder, atomic_folders
+from excite_cli.atomic import MARK, MARK_PREFIX, atomic_folder, atomic_folders
 from excite_cli.errors import CannotWrite, ExciteError, OutputExists
 from excite_cli.storage.paths import check_target
 from excite_cli.storage.trajectory_controller import time_from_start_ns
@@ -44,6 +44,9 @@ ACKED_WAIT_MS = 5000
 JOINT_STATES = "/joint_states"
 #: Stamp of a simulated run's first sample [ns] (2026-01-01, Unix time: a recording's clock).
 START = 1_767_225_600 * 10**9
+#: The key of the bag's metadata ``custom_data`` (rosbag2 metadata version 6 on) under which excite marks
+#: the bags it writes (:data:`~excite_cli.atomic.MARK`): ``ros2 bag record`` writes no such key.
+CUSTOM_DATA_KEY = "written_by"
 #: Longest single command-line argument on Linux [bytes] (``MAX_ARG_STRLEN``, 32 pages of 4 KiB).
 MAX_ARGUMENT = 131_072
 
@@ -65,31 +68,40 @@ def check_goal_size(text: str) -> None:
         )
 
 
-def is_rosbag2_folder(folder: Path) -> bool:
+def is_rosbag2_folder(folder: Path, excite: bool = False) -> bool:
     """Whether ``folder`` is a ROS 2 bag and nothing else: its ``metadata.yaml`` parses as rosbag2's
     (``rosbag2_bagfile_information`` with ``relative_file_paths``, the rosbag2 metadata format) and the
     folder holds no file or folder but that metadata and the files it lists (what excite, or ``ros2 bag
-    record``, wrote there). A folder holding anything else is a user's, however its files are named."""
+    record``, wrote there). A folder holding anything else is a user's, however its files are named.
+    With ``excite``: and excite wrote it (its ``custom_data`` holds :data:`CUSTOM_DATA_KEY` with excite's
+    mark), not ``ros2 bag record`` (a lab's recording)."""
     try:
         info = yaml.safe_load((folder / "metadata.yaml").read_text(encoding="utf-8"))["rosbag2_bagfile_information"]
         listed = {str(name) for name in info["relative_file_paths"]}
-    except (OSError, UnicodeDecodeError, yaml.YAMLError, KeyError, TypeError):
+        mark = str((info.get("custom_data") or {}).get(CUSTOM_DATA_KEY, ""))
+    except (OSError, UnicodeDecodeError, yaml.YAMLError, KeyError, TypeError, AttributeError):
         return False
-    return {entry.name for entry in folder.iterdir()} <= listed | {"metadata.yaml"}
+    only_the_bag = {entry.name for entry in folder.iterdir()} <= listed | {"metadata.yaml"}
+    return only_the_bag and (not excite or mark.startswith(MARK_PREFIX))
 
 
 def check_bag_target(folder: Path, field: str, force: bool) -> Path:
-    """``folder`` may receive a bag: it does not exist, or with ``force`` it is a ROS 2 bag and nothing
-    else (:func:`is_rosbag2_folder`), which is replaced; never another folder or a file.
+    """``folder`` may receive a bag: it does not exist, or with ``force`` it is a bag excite wrote and
+    nothing else (:func:`is_rosbag2_folder`), which is replaced; never a lab's recording, another folder
+    or a file.
 
     Raises:
-        OutputExists: it exists, without ``force``.
-        ExciteError: it is a file, a folder that is not only a bag, or cannot be written
-            (:func:`~excite_cli.storage.paths.check_target`).
+        OutputExists: it exists (or a symbolic link is there), without ``force``.
+        ExciteError: it is a file, a folder that is not only a bag excite wrote, a symbolic link, or
+            cannot be written (:func:`~excite_cli.storage.paths.check_target`).
     """
     folder = Path(folder)
-    if folder.exists() and not force:
+    if (folder.exists() or folder.is_symlink()) and not force:
         raise OutputExists(field, folder)
+    if folder.is_symlink():
+        raise ExciteError(
+            field, f"{folder} is a symbolic link; a bag is not written through it", folder, "a new folder"
+        )
     if folder.exists() and not (folder.is_dir() and is_rosbag2_folder(folder)):
         raise ExciteError(
             field,
@@ -97,6 +109,13 @@ def check_bag_target(folder: Path, field: str, force: bool) -> Path:
             "not replaced",
             folder,
             "a new folder",
+        )
+    if folder.exists() and not is_rosbag2_folder(folder, excite=True):
+        raise ExciteError(
+            field,
+            f"{folder} is a ROS 2 bag excite did not write (a recording); not replaced",
+            folder,
+            "a new folder (or remove it yourself)",
         )
     check_target(folder / "metadata.yaml", field, force=True)  # its folder (or the nearest one there is) writable
     return folder
@@ -149,6 +168,7 @@ def _fill_bag(staging: Path, folder: Path, topic: str, msgtype: str, messages) -
     typestore = get_typestore(Stores.ROS2_HUMBLE)
     try:
         with Writer(staging, version=8) as writer:
+            writer.set_custom_data(CUSTOM_DATA_KEY, MARK)
             connection = writer.add_connection(topic, msgtype, typestore=typestore)
             for ns, message in messages(typestore.types):
                 writer.write(connection, ns, typestore.serialize_cdr(message, msgtype))

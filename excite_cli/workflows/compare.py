@@ -14,7 +14,7 @@ from excite_cli.design.excitation import Excitation
 from excite_cli.design.resolve import build_excitation
 from excite_cli.errors import ExciteError
 from excite_cli.h5 import open_h5, read_strings
-from excite_cli.plots.optimize import plot_comparison
+from excite_cli.plots.comparison import plot_comparison
 from excite_cli.search.optimizer import ProgressHook
 from excite_cli.search.random_baseline import draw_pool, greedy_selection, pool_convergence
 from excite_cli.search.sequence import describe, stacked_regressors
@@ -71,6 +71,7 @@ def run_compare_random(
     """
     base = Path(problem.output)
     target = check_target(target or base.with_name(base.stem + "_random.h5"), "output", force)
+    figure = check_target(target.with_suffix("").with_name(target.stem + "_comparison.png"), "output", force=True)
     excitation = build_excitation(problem)
     with output_lock(target, "output"), engine_for(problem, excitation) as engine:
         if optimized is None:  # run here: its table is in memory
@@ -121,9 +122,7 @@ def run_compare_random(
     sizes = sorted(
         {s for s in (count, 10, 30, 100, 300, 1000, 3000, len(drawn.alphas)) if count <= s <= len(drawn.alphas)}
     )
-    plot = plot_comparison(
-        target.with_suffix("").with_name(target.stem + "_comparison.png"), random_table, optimized_table
-    )
+    plot = plot_comparison(figure, random_table, optimized_table)
     return Comparison(
         random_table,
         optimized_table,

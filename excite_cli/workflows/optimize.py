@@ -16,7 +16,7 @@ from excite_cli.design.information import predicted_std
 from excite_cli.design.resolve import build_excitation
 from excite_cli.errors import ExciteError, FileNotFound, Interrupted, exit_status
 from excite_cli.h5 import open_h5
-from excite_cli.plots.optimize import plot_result
+from excite_cli.plots.optimize import figure_paths, plot_result
 from excite_cli.search.engine import Engine, default_workers
 from excite_cli.search.optimizer import ProgressHook
 from excite_cli.search.sequence import IterationResult, run_sequence
@@ -117,6 +117,8 @@ def run_optimize(
         Interrupted: Ctrl-C or SIGTERM; the finished iterations are in ``target``, the workers stopped.
     """
     check_target(target, "output", force, exists_ok=resume)
+    for figure in figure_paths(target):  # written over only where excite wrote them
+        check_target(figure, "output", force=True)
     if resume and not target.is_file():
         raise FileNotFound("resume", target, "result to continue")
     excitation = build_excitation(problem)

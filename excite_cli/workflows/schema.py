@@ -9,7 +9,7 @@ from pathlib import Path
 
 from pydantic import BaseModel
 
-from excite_cli.atomic import atomic_paths
+from excite_cli.atomic import MARK_PREFIX, atomic_paths
 from excite_cli.config import Problem
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.simulation_config import SimulationConfig
@@ -31,7 +31,8 @@ def config_schema(kind: str) -> dict:
         KeyError: an unknown kind.
     """
     schema = KINDS[kind].model_json_schema()
-    return {"$schema": "https://json-schema.org/draft/2020-12/schema", **schema, "title": TITLES[kind]}
+    schema = {"$schema": "https://json-schema.org/draft/2020-12/schema", **schema, "title": TITLES[kind]}
+    return {**schema, "$comment": f"{MARK_PREFIX} schema"}
 
 
 def run_schema(folder: Path, force: bool = False) -> list[Path]:

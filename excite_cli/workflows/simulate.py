@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from excite_cli.atomic import atomic_paths
+from excite_cli.atomic import MARK, atomic_paths
 from excite_cli.config_file import result_problem
 from excite_cli.dynamics.robot import Robot, load_robot
 from excite_cli.effects import EFFECTS
@@ -152,5 +152,7 @@ def simulate_runs(
         return write_joint_states(written, robot.joint_names, runs)
     with atomic_paths(written, "output_dir") as tmps:
         for tmp, table in zip(tmps, tables.values()):
-            np.savetxt(tmp, table, delimiter=",", header=",".join(header), comments="", fmt="%.10g")
+            with open(tmp, "w") as f:  # the header row first, as a recording's; the mark last
+                np.savetxt(f, table, delimiter=",", header=",".join(header), comments="", fmt="%.10g")
+                f.write(f"# {MARK} simulate: a simulated run\n")
     return written

@@ -4,6 +4,7 @@ to save_figure is kept and its lines read back against the results and reports t
 import numpy as np
 import pytest
 
+import excite_cli.plots.comparison as comparison_plots
 import excite_cli.plots.identification as identification_plots
 import excite_cli.plots.optimize as optimize_plots
 from excite_cli.config import EnvironmentConfig
@@ -17,7 +18,7 @@ from excite_cli.storage.results import read_iterations
 def kept(monkeypatch):
     """The figures the plot functions save, kept open instead of written."""
     figures = []
-    for module in (optimize_plots, identification_plots):
+    for module in (optimize_plots, identification_plots, comparison_plots):
         monkeypatch.setattr(module, "save_figure", lambda fig, path, dpi: figures.append(fig) or path)
     return figures
 
@@ -48,6 +49,15 @@ def test_table_one_chart_draws_each_iteration_s_condition_numbers(kept, results,
     np.testing.assert_array_equal(own.get_ydata(), [r.cond_own for r in iterations])
     np.testing.assert_array_equal(stacked.get_ydata(), [r.cond_stacked for r in iterations])
     np.testing.assert_array_equal(stacked.get_xdata(), [1, 2, 3])
+
+
+def test_the_comparison_draws_random_selection_beside_the_optimized_motions(kept, tmp_path):
+    random_table = {"iteration": [1, 2], "cond_own": [600.0, 700.0], "cond_stacked": [600.0, 500.0]}
+    optimized = {"iteration": [1, 2], "cond_own": [60.0, 70.0], "cond_stacked": [60.0, 50.0]}
+    comparison_plots.plot_comparison(tmp_path / "c.png", random_table, optimized)
+    own, stacked = kept[0].axes
+    assert [b.get_height() for b in stacked.patches] == [600.0, 500.0, 60.0, 50.0]
+    assert [b.get_height() for b in own.patches] == [600.0, 700.0, 60.0, 70.0]
 
 
 def test_trajectory_plot_draws_q_of_every_joint_and_its_limits(kept, results, tmp_path):

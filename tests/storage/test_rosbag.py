@@ -1,14 +1,18 @@
 """The exported motion as a ROS 2 bag: read back with rosbags as ros2 bag play reads it, written
-whole or not at all, replacing only a folder that holds a bag and nothing else."""
+whole or not at all, replacing only a folder that holds a bag excite wrote and nothing else (never a
+lab's recording, which ``ros2 bag record`` writes without excite's mark)."""
 
 import numpy as np
 import pytest
+import yaml
 from rosbags.highlevel import AnyReader
+from rosbags.rosbag2 import Writer
 from rosbags.typesys import Stores, get_typestore
 
 from excite_cli.errors import CannotWrite, ExciteError, OutputExists
 from excite_cli.identification.measured.bags import read_bag
 from excite_cli.storage.rosbag import (
+    CUSTOM_DATA_KEY,
     JOINT_STATES,
     MSGTYPE,
     START,
@@ -150,3 +154,38 @@ def test_a_set_of_recorded_bags_replaces_the_earlier_set_whole_or_not_at_all(tmp
         write_joint_states(folders, JOINTS, [(TIME, 3 * Q, MOTION[3]), (TIME, 4 * Q, MOTION[3])])
     assert {f: {p.name: p.read_bytes() for p in f.iterdir()} for f in folders} == before
     assert sorted(p.name for p in (tmp_path / "bags").iterdir()) == ["run_1", "run_2"]
+
+
+def _recording(folder):
+    """A bag as ``ros2 bag record /joint_states`` writes it (no custom data of excite's): 3 messages."""
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    types = store.types
+    with Writer(folder, version=8) as writer:
+        connection = writer.add_connection(JOINT_STATES, "sensor_msgs/msg/JointState", typestore=store)
+        for k in range(3):
+            header = types["std_msgs/msg/Header"](
+                stamp=types["builtin_interfaces/msg/Time"](sec=k, nanosec=0), frame_id=""
+            )
+            message = types["sensor_msgs/msg/JointState"](
+                header=header, name=JOINTS, position=np.zeros(2), velocity=np.zeros(0), effort=np.ones(2)
+            )
+            writer.write(connection, k * 10**9, store.serialize_cdr(message, "sensor_msgs/msg/JointState"))
+    return folder
+
+
+def test_a_lab_s_recording_is_never_replaced_and_excite_s_own_bags_carry_its_mark(tmp_path):
+    recording = _recording(tmp_path / "fit")
+    before = {p.name: p.read_bytes() for p in recording.iterdir()}
+    for force in (False, True):
+        with pytest.raises((OutputExists, ExciteError), match="fit"):
+            check_bag_target(recording, "output", force)
+    with pytest.raises(ExciteError, match="a ROS 2 bag excite did not write"):
+        check_bag_target(recording, "output", True)
+    assert {p.name: p.read_bytes() for p in recording.iterdir()} == before
+    for ours in (_bag(tmp_path / "bag"), *write_joint_states([tmp_path / "run_1"], JOINTS, [(TIME, Q, Q)])):
+        metadata = yaml.safe_load((ours / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
+        assert metadata["custom_data"][CUSTOM_DATA_KEY].startswith("written by excite")
+        check_bag_target(ours, "output", True)
+    (tmp_path / "link").symlink_to(recording)
+    with pytest.raises(ExciteError, match="symbolic link"):
+        check_bag_target(tmp_path / "link", "output", True)

@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from excite_cli.atomic import atomic_path
+from excite_cli.atomic import MARK, atomic_path
 from excite_cli.dynamics.mjcf_source import is_mjcf
 from excite_cli.dynamics.robot import Robot
 from excite_cli.dynamics.urdf_meshes import mesh_path
@@ -263,5 +263,5 @@ def write_mjcf(
     except ValueError as exc:
         raise ExciteError("mjcf_out", f"MuJoCo refuses the identified model: {exc}") from None
     with atomic_path(Path(target), "mjcf_out") as tmp:
-        Path(tmp).write_text(spec.to_xml(), encoding="utf-8")
+        Path(tmp).write_text(f"<!-- {MARK} identify -->\n{spec.to_xml()}", encoding="utf-8")
     return model
