@@ -19,6 +19,7 @@ from excite_cli.identification.choice.selection import candidate_terms, motor_co
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.measured.gaps import Gap, find_gaps
 from excite_cli.identification.measured.measurements import check_against_limits, load_run
+from excite_cli.identification.measured.payload import payload_parameters
 from excite_cli.identification.pipeline import declared_terms
 from excite_cli.workflows.check import Plan, plan_optimize
 
@@ -60,15 +61,17 @@ def plan_identify(problem: IdentifyProblem) -> IdentifyPlan:
 
     Raises:
         ExciteError: what ``identify`` would refuse before fitting: the robot (:func:`load_robot`),
-            a declared effect on a joint that is not active, a run (:func:`load_run`,
-            :func:`check_against_limits`).
+            a declared effect on a joint that is not active, a payload's frame the robot does not have
+            (:func:`payload_parameters`), a run (:func:`load_run`, :func:`check_against_limits`).
     """
     robot = load_robot(problem.robot, problem.folder, joint_rows_only=True, physical=False)
     cfg = problem.identification
     declared = declared_terms(problem, robot)
     couplings = motor_couplings(problem.data.transmission, cfg.coupling_ratios, robot.n_joints)
     runs = []
-    for config in problem.data.runs:
+    for k, config in enumerate(problem.data.runs):
+        if config.payload:  # its frame, as identify reads it before anything else
+            payload_parameters(robot, config.payload, f"data.runs[{k}].payload")
         run = load_run(config, problem.data, robot.joint_names, problem.folder)
         check_against_limits(run, robot.joint_names, robot.lower, robot.upper, robot.velocity_limit)
         signals = ("q",) + tuple(s for s in ("qd", "qdd") if getattr(run, s) is not None) + ("tau",)

@@ -16,6 +16,7 @@ from excite_cli.identification.reporting.mjcf_check import MujocoCheck, check_mj
 from excite_cli.identification.reporting.mjcf_out import MjcfModel, write_mjcf
 from excite_cli.identification.reporting.report import Report
 from excite_cli.identification.reporting.report_file import write_identification
+from excite_cli.identification.reporting.urdf_out import check_urdf_source
 from excite_cli.plots.identification import plot_identification, plot_ladder
 from excite_cli.storage.paths import check_target, output_lock
 
@@ -85,7 +86,11 @@ def run_identify(
     """
     check_target(target, "output", force)
     plots = [target.with_name(target.stem + suffix) for suffix in ("_residuals.png", "_ladder.png")]
+    for figure in plots:  # written over only where excite wrote them
+        check_target(figure, "output", force=True)
     _check_model_paths(target, plots, {"urdf_out": urdf_out, "mjcf_out": mjcf_out}, force)
+    if urdf_out is not None:  # before the fit, not after it
+        check_urdf_source(resolve_urdf(problem.robot, problem.folder)[0])
     with output_lock(target, "output"):
         report, robot, base, rows = run_identification(
             problem, consistent_beside=urdf_out is not None or mjcf_out is not None

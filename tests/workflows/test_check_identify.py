@@ -53,6 +53,25 @@ def test_check_refuses_what_identify_would_refuse(identify_config, tmp_path):
     config["data"]["columns"]["tau"] = ["tau_elbow"]
     (identify_config.parent / "bad.yaml").write_text(yaml.safe_dump(config))
     assert_refused(tmp_path, ["check", str(identify_config.parent / "bad.yaml")], "no column 'tau_elbow'")
+    config = yaml.safe_load(identify_config.read_text())
+    config["data"]["runs"][0]["payload"] = {"mass": 1.0, "frame": "gripper"}  # identify refused it at once
+    (identify_config.parent / "payload.yaml").write_text(yaml.safe_dump(config))
+    expected = "data.runs[0].payload.frame: 'gripper' is not a frame of the robot's model"
+    assert_refused(tmp_path, ["check", str(identify_config.parent / "payload.yaml")], expected)
+    config["data"]["runs"][0]["payload"] = {"mass": 1e30}  # the SDP ended infeasible, naming the fit
+    (identify_config.parent / "payload.yaml").write_text(yaml.safe_dump(config))
+    assert_refused(tmp_path, ["check", str(identify_config.parent / "payload.yaml")], "data.runs.0.payload.mass")
+    urdf_out = str(tmp_path / "model.urdf")
+    mjcf = identify_config.parent / "arm.xml"
+    mjcf.write_text(
+        '<mujoco model="arm"><compiler angle="radian"/><worldbody><body name="arm"><joint name="hinge" '
+        'type="hinge" axis="0 1 0" range="-2 2"/><geom type="sphere" size="0.1" mass="1"/></body></worldbody></mujoco>'
+    )
+    config = yaml.safe_load(identify_config.read_text())
+    config["robot"]["urdf"] = "arm.xml"
+    (identify_config.parent / "mjcf.yaml").write_text(yaml.safe_dump(config))
+    argv = ["identify", str(identify_config.parent / "mjcf.yaml"), "-o", str(tmp_path / "r.h5"), "--urdf-out", urdf_out]
+    assert_refused(tmp_path, argv, "--urdf-out: the robot's file arm.xml is an MJCF")  # before the fit, not after
     assert_refused(tmp_path, ["check", str(identify_config), "-k", "2"], "--iterations: applies to an optimize config")
 
 

@@ -21,6 +21,7 @@ import pinocchio as pin
 
 from excite_cli.atomic import atomic_path
 from excite_cli.config import RobotConfig
+from excite_cli.dynamics.mjcf_source import is_mjcf
 from excite_cli.dynamics.robot import Robot, load_robot
 from excite_cli.errors import ExciteError
 
@@ -65,6 +66,17 @@ def merged_links(robot: Robot) -> dict[str, list[str]]:
     return out
 
 
+def check_urdf_source(source: Path) -> None:
+    """That a URDF copy of the robot's file ``source`` can be written: it is a URDF, not an MJCF.
+
+    Raises:
+        ExciteError: (``urdf_out``) an MJCF.
+    """
+    if is_mjcf(source):
+        problem = f"the robot's file {source.name} is an MJCF: a URDF copy of it cannot be written"
+        raise ExciteError("urdf_out", problem, expected="the identified model as MJCF (mjcf_out)")
+
+
 def write_urdf(
     source: Path,
     target: Path,
@@ -92,9 +104,7 @@ def write_urdf(
     except (ET.ParseError, OSError) as exc:
         raise ExciteError("robot.urdf", f"cannot parse {source}: {exc}") from None
     root = tree.getroot()
-    if root.tag == "mujoco":
-        problem = f"the robot's file {source.name} is an MJCF: a URDF copy of it cannot be written"
-        raise ExciteError("urdf_out", problem, expected="the identified model as MJCF (mjcf_out)")
+    check_urdf_source(source)
     links = {link.get("name"): link for link in root.findall("link")}
     joints = {joint.get("name"): joint for joint in root.findall("joint")}
     for i, (body, merged) in enumerate(merged_links(robot).items()):
