@@ -177,6 +177,11 @@ class OptimizerConfig(Section):
         return value
 
 
+#: The noise a design may be for: σ [Nm] (a nano-newton-metre to a mega-newton-metre) and ρ [1] (0 to
+#: ten times the torque), so that the rows' weights and their squares stay finite.
+NOISE_RANGES = {"absolute": (1e-9, 1e6, " Nm"), "relative": (0.0, 10.0, "")}
+
+
 class NoiseConfig(Section):
     """The torque noise the design is for (:mod:`excite_cli.design.noise`): per joint an absolute
     part σ [Nm] and a part ρ [1] relative to the torque; each regressor row weighs 1/√(σ_j² + ρ_j² τ_j(t)²)."""
@@ -185,6 +190,16 @@ class NoiseConfig(Section):
     """σ_j [Nm], one value or {joint: Nm}: the torque reading's own noise (an identify report as prior gives its)."""
     relative: PerJoint = 0.0
     """ρ_j [1], one value or {joint: value}: noise growing with the torque, as a motor current's (0.02: 2 %)."""
+
+    @model_validator(mode="after")
+    def _in_range(self) -> "NoiseConfig":
+        for name, (low, high, unit) in NOISE_RANGES.items():
+            given = getattr(self, name)
+            for joint, value in given.items() if isinstance(given, dict) else [(None, given)]:
+                if not low <= value <= high:
+                    at = f" for joint '{joint}'" if joint else ""
+                    raise ValueError(f"{name}: {value:g}{at} is out of range; expected {low:g} to {high:g}{unit}")
+        return self
 
 
 class RandomBaselineConfig(Section):

@@ -148,10 +148,16 @@ class JointLimits(Constraint):
 
 
 def per_joint(
-    field: str, value: PerJoint | None, default: np.ndarray, robot: Robot, zero_allowed: bool = False
+    field: str,
+    value: PerJoint | None,
+    default: np.ndarray,
+    robot: Robot,
+    zero_allowed: bool = False,
+    noun: str | None = None,
 ) -> np.ndarray:
     """(n,) positive limits of the config field ``field`` from a scalar, a {joint: value} map (the
     others from ``default``) or None (all from ``default``); with ``zero_allowed``, ≥ 0 (a margin).
+    ``noun`` names the value in the messages (default: limit, or margin with ``zero_allowed``).
 
     Raises:
         ExciteError: an unknown joint, or a joint left without a positive (or, with ``zero_allowed``,
@@ -165,10 +171,15 @@ def per_joint(
             out[robot.joint_names.index(name)] = v
     elif value is not None:
         out[:] = value
+    given = value if isinstance(value, dict) else {}
     for name, v in zip(robot.joint_names, out):
         if not np.isfinite(v) or v < 0 or (v == 0 and not zero_allowed):
-            source = "the robot's file has none" if value is None else f"got {v:g}"
-            kind = "non-negative finite margin" if zero_allowed else "positive finite limit"
+            if value is None or (given and name not in given and np.isnan(v)):
+                source = "the robot's file has none" if value is None else "none given for it, and no default"
+            else:
+                source = f"got {v:g}"
+            noun = noun or ("margin" if zero_allowed else "limit")
+            kind = f"non-negative finite {noun}" if zero_allowed else f"positive finite {noun}"
             expected = f"{field}: {{{name}: value}}"
             raise ExciteError(field, f"joint '{name}' needs a {kind} ({source})", expected=expected)
     return out

@@ -79,8 +79,8 @@ def row_noise(cfg: NoiseConfig | None, robot: Robot, measured: MeasuredPrior | N
         by_joint = dict(zip(measured.joints, measured.floored))
         sigma = np.array([by_joint[j] for j in robot.joint_names])
     else:
-        sigma = per_joint("noise.absolute", cfg.absolute, np.full(n, np.nan), robot)
-    rho = np.zeros(n) if cfg is None else per_joint("noise.relative", cfg.relative, np.zeros(n), robot, True)
+        sigma = per_joint("noise.absolute", cfg.absolute, np.full(n, np.nan), robot, noun="noise [Nm]")
+    rho = np.zeros(n) if cfg is None else per_joint("noise.relative", cfg.relative, np.zeros(n), robot, True, "noise")
     scale = measured.noise if measured is not None else float(np.exp(np.log(sigma).mean()))
     return RowNoise(
         sigma=np.concatenate([np.full(rows - n, scale), sigma]),

@@ -67,15 +67,23 @@ class ColumnsConfig(Section):
         return self
 
 
+#: The heaviest payload a run may declare [kg] (the heaviest industrial arms carry about 2 t).
+MAX_PAYLOAD = 10_000.0
+#: The farthest a payload's centre of mass may lie from its link [m], and its largest moment of inertia [kg·m²].
+MAX_REACH, MAX_INERTIA = 100.0, 1e6
+Reach = Annotated[float, Field(ge=-MAX_REACH, le=MAX_REACH)]
+Moment = Annotated[float, Field(ge=-MAX_INERTIA, le=MAX_INERTIA)]
+
+
 class PayloadConfig(Section):
     """A known payload of a run: mass [kg], centre of mass [m] and inertia about it [kg·m²]
     (Ixx, Ixy, Iyy, Ixz, Iyz, Izz) in ``frame`` (default: the link of the last active joint)."""
 
-    mass: float = Field(gt=0.0)
+    mass: float = Field(gt=0.0, le=MAX_PAYLOAD)
     """Mass [kg]."""
-    com: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    com: tuple[Reach, Reach, Reach] = (0.0, 0.0, 0.0)
     """Centre of mass [m] in `frame`."""
-    inertia: tuple[float, float, float, float, float, float] = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    inertia: tuple[Moment, Moment, Moment, Moment, Moment, Moment] = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     """Inertia about the CoM [kg·m²]: Ixx, Ixy, Iyy, Ixz, Iyz, Izz in `frame`."""
     frame: Optional[str] = None
     """The link it is fixed to (default: the link of the last active joint)."""

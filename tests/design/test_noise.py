@@ -2,6 +2,8 @@
 inverse dynamics of the URDF at the motion, the criterion's gradient (through the weights too)
 against finite differences, and the noise section's bad values named."""
 
+import re
+
 import numpy as np
 import pytest
 from conftest import small
@@ -65,9 +67,11 @@ def test_gradient_through_weights_that_move_with_the_torque_matches_finite_diffe
 @pytest.mark.parametrize(
     "noise, expected",
     [
-        ({"absolute": 0.0}, "noise.absolute: joint 'panda_joint1' needs a positive finite limit"),
-        ({"relative": -0.1}, "noise.relative: joint 'panda_joint1' needs a non-negative finite margin"),
         ({"absolute": {"elbow": 0.1}}, "noise.absolute: 'elbow' is not an active joint"),
+        (  # noise given for one joint: the others are named, not called a limit of NaN
+            {"absolute": {"panda_joint1": 0.1}},
+            "noise.absolute: joint 'panda_joint2' needs a positive finite noise [Nm] (none given for it",
+        ),
     ],
 )
 def test_a_noise_that_cannot_be_is_named(panda_problem, noise, expected):
@@ -76,3 +80,20 @@ def test_a_noise_that_cannot_be_is_named(panda_problem, noise, expected):
     with pytest.raises(ExciteError) as raised:
         build_excitation(problem)
     assert raised.value.describe().startswith(expected)
+
+
+@pytest.mark.parametrize(
+    "noise, expected",
+    [
+        ({"absolute": 1e300}, "absolute: 1e+300 is out of range; expected 1e-09 to 1e+06 Nm"),
+        ({"absolute": 1e-300}, "absolute: 1e-300 is out of range"),
+        ({"absolute": 0.0}, "absolute: 0 is out of range"),
+        ({"relative": 1e300}, "relative: 1e+300 is out of range; expected 0 to 10"),
+        ({"relative": -0.1}, "relative: -0.1 is out of range"),
+        ({"relative": {"panda_joint2": 20.0}}, "relative: 20 for joint 'panda_joint2' is out of range"),
+    ],
+)
+def test_a_noise_out_of_range_is_refused_where_it_is_read(noise, expected):
+    """A number no sensor has (its weights' squares would overflow: numpy's warnings, then a traceback)."""
+    with pytest.raises(ValueError, match=re.escape(expected)):
+        NoiseConfig(**noise)

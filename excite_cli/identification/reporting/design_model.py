@@ -92,6 +92,12 @@ def with_report_model(cfg: EffectsConfig, path: Path, joint_names: list[str]) ->
     return cfg.model_copy(update={"joints": joints, "motors": motors, "coulomb_velocity": model.coulomb_velocity})
 
 
+#: The largest joint error a report may give as prior data [Nm] (the noise a design may be for).
+LARGEST_ERROR = 1e6
+#: The highest sample rate a report's rows may have [Hz].
+HIGHEST_RATE = 1e6
+
+
 @dataclass(frozen=True)
 class MeasuredPrior:
     """How an identify report's rows weigh as prior data C₀ (Eq. 41) of the next design, as
@@ -157,9 +163,20 @@ def measured_prior_of(report: StoredReport, path: Path) -> MeasuredPrior:
             f"{path}: /identification/rms_after must hold each of its {len(joints)} joints' error, finite, not "
             "negative and not all zero (damaged?)",
         )
-    if not (np.isfinite(rate) and rate > 0):
+    if sigma.max() > LARGEST_ERROR:
+        j = int(np.argmax(sigma))
         raise ExciteError(
-            "sequence.prior", f"{path}: its sample rate sample_rate_Hz is {rate:g}", rate, "a positive rate [Hz]"
+            "sequence.prior",
+            f"{path}: /identification/rms_after gives joint '{joints[j]}' an error of {sigma[j]:g} Nm (damaged?)",
+            sigma[j],
+            f"at most {LARGEST_ERROR:g} Nm",
+        )
+    if not (np.isfinite(rate) and 0 < rate <= HIGHEST_RATE):
+        raise ExciteError(
+            "sequence.prior",
+            f"{path}: its sample rate sample_rate_Hz is {rate:g}",
+            rate,
+            f"a positive rate up to {HIGHEST_RATE:g} Hz",
         )
     return MeasuredPrior(joints, sigma, rate)
 

@@ -232,6 +232,8 @@ def _replace(f, name, value):
         (lambda f: _replace(f, "identification/rms_after", np.zeros(7)), "rms_after must hold"),
         (lambda f: _replace(f, "identification/rms_after", np.full(7, np.nan)), "rms_after must hold"),
         (lambda f: _replace(f, "identification/rms_after", np.ones(3)), "rms_after must hold"),
+        (lambda f: _replace(f, "identification/rms_after", np.r_[1e300, np.ones(6)]), "an error of 1e.300 Nm"),
+        (lambda f: f["regressor"].attrs.__setitem__("sample_rate_Hz", 1e300), "sample_rate_Hz is 1e.300"),
         (lambda f: f["regressor"].attrs.__setitem__("sample_rate_Hz", 0.0), "sample_rate_Hz is 0"),
         (lambda f: f["identification/rms_after"].parent.pop("rms_after"), "report of an earlier excite"),
         (lambda f: f["regressor"].attrs.__delitem__("sample_rate_Hz"), "report of an earlier excite"),
