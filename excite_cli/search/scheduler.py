@@ -40,16 +40,22 @@ def check_scheduler(address: str, timeout: float = CONNECT_TIMEOUT) -> None:
     (``protocol.loads``) to a dict. The client allocates whatever another server's first bytes happen
     to say (3 EiB was seen) and fails on bytes it cannot unpack, so the whole message is read here
     within ``timeout`` seconds in all (a server that trickles a byte at a time is cut off at the bound)
-    and decoded by distributed itself. ``tls://`` and in-process addresses are left to Dask.
+    and decoded by distributed itself. A ``tls://`` address needs the client's certificates in Dask's
+    own configuration (``distributed.comm.tls``: its CA file and the client's certificate and key,
+    distributed's ``Security``), from which Dask's client takes its TLS context; with them it is left to
+    Dask, without them refused.
 
     Raises:
         ExciteError: (``optimizer.scheduler``) distributed is not installed (:func:`require_distributed`),
-            nothing listens there, the server's first message is not
+            a ``tls://`` address without the certificates Dask needs for it, nothing listens there, the
+            server's first message is not
             whole within ``timeout`` [s], announces more than :data:`HANDSHAKE_BYTES`, or is no Dask
             handshake.
     """
     require_distributed()
     scheme, _, rest = address.rpartition("://")
+    if scheme == "tls":
+        _check_tls(address)
     if scheme not in ("", "tcp"):
         return
     host, _, port = rest.rpartition(":")
@@ -76,6 +82,28 @@ def check_scheduler(address: str, timeout: float = CONNECT_TIMEOUT) -> None:
         address,
         "the address of a Dask scheduler (dask scheduler prints it)",
     )
+
+
+def _check_tls(address: str) -> None:
+    """That Dask's configuration gives its client a TLS context for ``address`` (a ``tls://`` one).
+
+    Raises:
+        ExciteError: (``optimizer.scheduler``) it does not (Dask would fail with a bare ``TypeError``).
+    """
+    from distributed.security import Security
+
+    try:
+        context = Security().get_connection_args("client").get("ssl_context")
+    except Exception as exc:  # certificate files that do not exist or do not parse
+        raise ExciteError("optimizer.scheduler", f"Dask's TLS configuration cannot be used: {exc}") from None
+    if context is None:
+        raise ExciteError(
+            "optimizer.scheduler",
+            f"{address} is a TLS address, and Dask's configuration gives its client no certificates",
+            address,
+            "distributed.comm.tls.ca-file, .client.cert and .client.key set in Dask's configuration "
+            "(or DASK_DISTRIBUTED__COMM__TLS__CA_FILE and the like), or a tcp:// address",
+        )
 
 
 def _receive(connection: socket.socket, count: int, deadline: float) -> bytes:

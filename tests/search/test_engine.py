@@ -347,3 +347,11 @@ def test_a_local_worker_process_killed_mid_run_is_one_line(tmp_path):
         if run.poll() is None:
             run.kill()
     _assert_stopped_keeping_iterations(run, stderr, "--workers: a worker process died during the run", out)
+
+
+def test_a_tls_address_without_dask_s_certificates_is_one_line():
+    """Dask's client ends in a bare TypeError ("TLS expects a ssl_context argument") without them."""
+    with pytest.raises(
+        ExciteError, match="is a TLS address, and Dask's configuration gives its client no certificates"
+    ):
+        scheduler_module.check_scheduler("tls://127.0.0.1:1", timeout=0.5)
