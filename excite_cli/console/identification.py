@@ -35,7 +35,7 @@ def plan(p: IdentifyPlan) -> list[Table | str]:
             f"{r.rate:.4g}",
             ", ".join(r.signals),
             str(r.dropped),
-            "; ".join(f"{g.length:.3g} s after {g.start:.3f} s" for g in r.gaps) or "none",
+            "; ".join(f"{g.length:.3g} s at {g.into:.3f} s" for g in r.gaps) or "none",
         )
         for r in p.runs
     ]

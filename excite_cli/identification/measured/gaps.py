@@ -20,7 +20,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from excite_cli.errors import ExciteWarning
+from excite_cli.errors import ExciteError, ExciteWarning
 from excite_cli.identification.measured.measurements import Run
 
 #: A step between two samples longer than this many median sample periods, and than MIN_GAP_S, is a gap.
@@ -34,12 +34,14 @@ MIN_PIECE_S = 2.0
 
 @dataclass(frozen=True)
 class Gap:
-    """A gap in a run: it starts at ``start`` [s] (the last sample before it) and lasts ``length`` [s];
-    ``index`` is the sample after it."""
+    """A gap in a run: it starts at ``start`` [s] (the last sample before it, on the recording's clock)
+    and lasts ``length`` [s]; ``index`` is the sample after it; ``into`` [s] is ``start`` from the run's
+    first sample (what the messages say: a bag's clock is the epoch)."""
 
     start: float
     length: float
     index: int
+    into: float = 0.0
 
 
 def find_gaps(time: np.ndarray) -> list[Gap]:
@@ -49,7 +51,7 @@ def find_gaps(time: np.ndarray) -> list[Gap]:
     if steps.size == 0:
         return []
     at = np.flatnonzero(steps > max(GAP_PERIODS * np.median(steps), MIN_GAP_S))
-    return [Gap(float(time[k]), float(steps[k]), int(k + 1)) for k in at]
+    return [Gap(float(time[k]), float(steps[k]), int(k + 1), float(time[k] - time[0])) for k in at]
 
 
 def split_at_gaps(run: Run, quiet: bool = False) -> list[Run]:
@@ -59,18 +61,19 @@ def split_at_gaps(run: Run, quiet: bool = False) -> list[Run]:
     ``[run]`` itself when it has none.
 
     Raises:
-        Nothing: a run whose every piece is too short comes back whole, for preprocessing to refuse
-        by its length.
+        ExciteError: (``data.runs``) every piece of the run is shorter than :data:`MIN_PIECE_S`: nothing
+            of it can be filtered without interpolating across its gaps, which are named.
     """
     gaps = find_gaps(run.time)
     if not gaps:
         return [run]
     bounds = [0] + [g.index for g in gaps] + [run.time.size]
     pieces, short = [], []
+    said = "; ".join(f"{g.length:.3f} s at {g.into:.3f} s" for g in gaps)
     for lo, hi in zip(bounds[:-1], bounds[1:]):
         t0, t1 = float(run.time[lo]), float(run.time[hi - 1])
         if t1 - t0 < MIN_PIECE_S:
-            short.append(f"{t0:.3f}–{t1:.3f} s")
+            short.append(f"{t0 - run.time[0]:.3f}–{t1 - run.time[0]:.3f} s")
             continue
         pick = slice(lo, hi)
         pieces.append(
@@ -85,9 +88,16 @@ def split_at_gaps(run: Run, quiet: bool = False) -> list[Run]:
                 dropped=run.dropped if not pieces else 0,
             )
         )
-    if not pieces or quiet:
-        return pieces or [run]
-    said = "; ".join(f"{g.length:.3f} s after {g.start:.3f} s" for g in gaps)
+    if not pieces:
+        raise ExciteError(
+            "data.runs",
+            f"{run.name}: {len(gaps)} gap(s) in the recording ({said}) leave no piece of at least "
+            f"{MIN_PIECE_S:g} s to filter (pieces {', '.join(short)}); excite never interpolates across a gap",
+            run.name,
+            "a recording with fewer gaps, or its pieces as runs of their own if they are long enough",
+        )
+    if quiet:
+        return pieces
     left = f"; left out, too short to filter (under {MIN_PIECE_S:g} s): {', '.join(short)}" if short else ""
     warnings.warn(
         f"{run.name}: {len(gaps)} gap(s) in the recording ({said}): cut there into {len(pieces)} piece(s), "

@@ -11,7 +11,7 @@ import yaml
 from conftest import CONFIGS
 
 from excite_cli.config_file import load_problem
-from excite_cli.errors import ExciteWarning
+from excite_cli.errors import ExciteError, ExciteWarning
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.measured.gaps import MIN_PIECE_S, find_gaps, split_at_gaps
 from excite_cli.identification.measured.measurements import Run
@@ -44,7 +44,7 @@ def test_a_run_is_cut_at_its_gaps_and_a_piece_too_short_to_filter_is_left_out_an
     assert [p.dropped for p in pieces] == [3, 0]  # counted once
     np.testing.assert_array_equal(pieces[1].tau, 2 * np.sin(pieces[1].time)[:, None])
     [message] = [str(w.message) for w in said]
-    assert "2 gap(s) in the recording (2.010 s after 2.990 s; 1.010 s after 5.990 s)" in message
+    assert "2 gap(s) in the recording (2.010 s at 2.990 s; 1.010 s at 5.990 s)" in message
     assert "left out, too short to filter (under 2 s): 5.000–5.990 s" in message
     with warnings.catch_warnings():
         warnings.simplefilter("error")
@@ -52,6 +52,19 @@ def test_a_run_is_cut_at_its_gaps_and_a_piece_too_short_to_filter_is_left_out_an
         [same] = split_at_gaps(whole)
         assert same is whole  # no gap: as it is, unsaid
         assert len(split_at_gaps(_run(time), quiet=True)) == 2  # read again: not said twice
+
+
+def test_a_recording_whose_every_piece_is_too_short_is_refused_by_its_gaps_on_its_own_clock():
+    """Pieces of 1.5 s between 0.5 s gaps, on a bag's clock (epoch seconds): refused, never
+    interpolated across, each gap placed from the recording's start."""
+    time = 1_795_600_000.0 + np.concatenate(
+        [np.arange(0, 1.5, 0.005), np.arange(2, 3.5, 0.005), np.arange(4, 5.5, 0.005)]
+    )
+    with pytest.raises(
+        ExciteError,
+        match=r"rec.csv: 2 gap\(s\) in the recording \(0.505 s at 1.495 s; 0.505 s at 3.495 s\) leave no piece",
+    ):
+        split_at_gaps(_run(time))
 
 
 def test_a_2_s_gap_identifies_the_friction_as_the_whole_recording_does(tmp_path, simulated_identification):
@@ -71,7 +84,7 @@ def test_a_2_s_gap_identifies_the_friction_as_the_whole_recording_does(tmp_path,
     (tmp_path / "configs").mkdir()
     (tmp_path / "configs" / "gap.yaml").write_text(yaml.safe_dump(config))
     problem = load_problem(tmp_path / "configs" / "gap.yaml", IdentifyProblem)
-    with pytest.warns(ExciteWarning, match=r"run_1\.csv: 1 gap\(s\) in the recording \(2\.00\d s after"):
+    with pytest.warns(ExciteWarning, match=r"run_1\.csv: 1 gap\(s\) in the recording \(2\.00\d s at"):
         report = run_identification(problem)[0]
     assert report.run_names == [r.label for r in problem.data.runs]  # the pieces are one run (one offset each)
     whole = simulated_identification[1]
