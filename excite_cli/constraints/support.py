@@ -76,8 +76,16 @@ def sole_points(robot: Robot, links: list[str], height: float, field: str) -> li
     points, possibly none.
 
     Raises:
-        ExciteError: (``field``) a link without collision geometry.
+        ExciteError: (``field``) a link without collision geometry, or one an active joint moves (a
+            hand: soles stand still).
     """
+    active = {robot.model.getJointId(name): name for name in robot.joint_names}
+    for link in links:
+        frame = robot.model.getFrameId(link)
+        chain = robot.model.supports[robot.model.frames[frame].parentJoint] if frame < robot.model.nframes else []
+        moving = [active[j] for j in chain if j in active]
+        if moving:
+            raise ExciteError(field, f"'{link}' is moved by the active joint '{moving[0]}'; a sole stands still", link)
     points = [world_points(robot, link, robot.home, field) for link in links]
     lowest = min(p[:, 2].min() for p in points)
     return [p[p[:, 2] <= lowest + height] for p in points]

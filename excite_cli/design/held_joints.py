@@ -90,8 +90,7 @@ class HeldJoints:
         field: the config field that names ``links``, for the messages.
 
     Raises:
-        ExciteError: (``field``) a support link an active joint moves, or contact points that cannot
-            carry a wrench (on one line).
+        ExciteError: (``field``) contact points that cannot carry a wrench (on one line).
     """
 
     def __init__(
@@ -106,12 +105,6 @@ class HeldJoints:
     ):
         self.full, self.data, self.friction = full, full.createData(), float(friction)
         active = [full.getJointId(name) for name in robot.joint_names]
-        for link in links:
-            moving = [
-                full.names[j] for j in full.supports[full.frames[full.getFrameId(link)].parentJoint] if j in active
-            ]
-            if moving:
-                raise ExciteError(field, f"'{link}' is moved by the active joint '{moving[0]}'; a sole stands still")
         self.q_idx = np.array([full.idx_qs[j] for j in active])
         self.v_idx = np.array([full.idx_vs[j] for j in active])
         held = [j for j in range(2, full.njoints) if j not in active]

@@ -44,8 +44,10 @@ def mjcf_model(path: Path, floating: bool = False) -> pin.Model:
     """pinocchio's model of the MJCF at ``path``, with a free-flyer root joint when ``floating``.
 
     Raises:
-        ExciteError: (``robot.urdf``) a file pinocchio's MJCF parser refuses, in one line.
+        ExciteError: (``robot.urdf``) a file with ``<include>`` elements (:func:`check_includes`), or one
+            pinocchio's MJCF parser refuses, in one line.
     """
+    check_includes(path)
     try:
         with warnings.catch_warnings():  # the root-joint overload is deprecated for one returning constraints
             warnings.simplefilter("ignore", DeprecationWarning)
@@ -59,17 +61,46 @@ def mjcf_model(path: Path, floating: bool = False) -> pin.Model:
     return built[0] if isinstance(built, tuple) else built
 
 
+def check_includes(path: Path) -> None:
+    """That the MJCF at ``path`` is one file: pinocchio's MJCF reader does not follow ``<include
+    file="...">`` (MuJoCo pastes the included file's elements in its place, the path taken from the
+    including file's folder), so what an include holds (a whole arm) would be left out without a word.
+
+    Raises:
+        ExciteError: (``robot.urdf``) an include of a file that does not exist, or any include, named.
+    """
+    try:
+        includes = [e.get("file", "") for e in ElementTree.parse(path).getroot().iter("include")]
+    except (ElementTree.ParseError, OSError):
+        return  # pinocchio's reader names what it cannot read
+    for name in includes:
+        if not (path.parent / name).is_file():
+            raise ExciteError("robot.urdf", f"{path.name} includes {name}, which does not exist", name)
+    if includes:
+        raise ExciteError(
+            "robot.urdf",
+            f"{path.name} includes {', '.join(includes)} (<include>), which pinocchio's MJCF reader does not "
+            "follow: their bodies and joints would be left out",
+            includes[0],
+            "the model as one file (MuJoCo writes one: mujoco.MjSpec.from_file(path).to_xml())",
+        )
+
+
 def mjcf_geometry(model: pin.Model, path: Path) -> pin.GeometryModel:
     """The collision geometry of the MJCF at ``path`` (its geoms, meshes found as MuJoCo finds them) for
-    ``model``.
+    ``model``, less the geoms of ``<worldbody>`` itself (a floor, walls: the world's, not the robot's;
+    pinocchio's reduced models also lose their frame).
 
     Raises:
         ExciteError: (``robot.urdf``) a mesh pinocchio or coal cannot find or read.
     """
     try:
-        return pin.buildGeomFromMJCF(model, str(path), pin.COLLISION)
+        geometry = pin.buildGeomFromMJCF(model, str(path), pin.COLLISION)
     except (RuntimeError, ValueError, IndexError) as exc:
         raise _pinocchio_error(path, exc) from None
+    for name in [o.name for o in geometry.geometryObjects if o.parentJoint == 0 and o.parentFrame == 0]:
+        geometry.removeGeometryObject(name)
+    return geometry
 
 
 def mjcf_couplings(path: Path) -> dict[str, tuple[str, str]]:

@@ -87,6 +87,15 @@ def test_a_margin_wider_than_the_polygon_is_refused(g1):
     assert error.value.field == "constraints.zmp.margin"
 
 
+def test_hands_as_soles_are_refused_by_their_field_not_the_margin():
+    """Links the arms move cannot be what the robot stands on (the error blamed the margin)."""
+    hands = ["left_wrist_yaw_link", "right_wrist_yaw_link"]
+    problem = with_overrides(load_problem(CONFIGS / "g1_arms.yaml"), {"constraints.zmp.support_links": hands})
+    with pytest.raises(ExciteError, match="'left_wrist_yaw_link' is moved by the active joint") as error:
+        build_excitation(problem)
+    assert error.value.field == "constraints.zmp.support_links"
+
+
 def test_a_robot_without_a_floating_base_is_refused(g1):
     problem = load_problem(CONFIGS / "g1_arms.yaml")
     problem = with_overrides(problem, {"robot.floating_base": False, "constraints.com": None})

@@ -98,3 +98,25 @@ def test_joints_the_parser_would_drop_are_refused(tmp_path):
     path = panda_mjcf(tmp_path, frames=True)
     with pytest.raises(ExciteError, match="leaves out joint.s. panda_finger_joint1, panda_finger_joint2 of panda.xml"):
         load_robot(RobotConfig(urdf=str(path), active_joints=JOINTS))
+
+
+ON_A_FLOOR = """<mujoco model="arm"><compiler angle="radian"/>{include}<worldbody>
+  <geom name="floor" type="plane" size="2 2 0.1"/>
+  <body name="link1" pos="0 0 0.1"><joint name="j1" type="hinge" axis="0 0 1" range="-2 2"/>
+    <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.03" mass="1"/></body>
+</worldbody></mujoco>"""
+
+
+def test_a_floor_in_the_worldbody_is_the_world_s_and_an_include_is_named(tmp_path):
+    """A floor geom directly in <worldbody> ended init in an IndexError (pinocchio's reduced model
+    loses its frame); an <include> was ignored in silence (a 3-joint arm drafted as 2 joints)."""
+    (tmp_path / "arm.xml").write_text(ON_A_FLOOR.format(include=""))
+    robot = load_robot(RobotConfig(urdf=str(tmp_path / "arm.xml"), active_joints=["j1"]), collision=True)
+    assert [robot.model.frames[o.parentFrame].name for o in robot.collision_model.geometryObjects] == ["link1"]
+    (tmp_path / "top.xml").write_text(ON_A_FLOOR.format(include='<include file="hand.xml"/>'))
+    config = RobotConfig(urdf=str(tmp_path / "top.xml"), active_joints=["j1"])
+    with pytest.raises(ExciteError, match="top.xml includes hand.xml, which does not exist"):
+        load_robot(config)
+    (tmp_path / "hand.xml").write_text("<mujoco><worldbody/></mujoco>")
+    with pytest.raises(ExciteError, match=r"top.xml includes hand.xml \(<include>\), which pinocchio's MJCF reader"):
+        load_robot(config)
