@@ -207,9 +207,14 @@ def export(
     effort: bool = console.app.EFFORT,
     force: bool = FORCE,
     output: Optional[Path] = typer.Option(None, "--output", "-o", help="File to write (default: beside the result)."),
+    approach: Optional[float] = typer.Option(
+        None, "--approach", help="Seconds a ROS 2 trajectory gives to reach home first (default: from anywhere)."
+    ),
 ) -> None:
     """Write a trajectory as a robot plays it: home → P periods → home, at the controller's rate, with torques."""
-    exported, target = workflows.run_export(result, iteration, rate, periods, fmt, output, force, speed, effort)
+    exported, target = workflows.run_export(
+        result, iteration, rate, periods, fmt, output, force, speed, effort, approach
+    )
     say(console.export_lines.export_lines(exported, rate, target, fmt, effort))
 
 

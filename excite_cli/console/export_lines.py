@@ -43,6 +43,11 @@ def export_lines(e: Export, rate: float, target: Path, fmt: str, effort: bool = 
         ]
     if form.controller:
         lines.append(
+            f"first point (home, at rest) at {e.approach:g} s: the controller moves the robot there from where it "
+            "stands in that time (from anywhere in its joint range within the velocity and acceleration limits; "
+            "--approach sets it)"
+        )
+        lines.append(
             "effort: the feed-forward torque, for an effort-controlled joint_trajectory_controller (Jazzy on)"
             if effort
             else "positions, velocities and accelerations: what every joint_trajectory_controller accepts "

@@ -88,6 +88,27 @@ class Transition:
         return q, qd, qdd
 
 
+def approach_duration(excitation: Excitation) -> float:
+    """[s] How long a controller takes to bring the robot from wherever it stands in its joint range
+    (the robot's file's) to the home posture at rest without exceeding the problem's velocity and
+    acceleration limits, on the quintic a joint_trajectory_controller interpolates from its current
+    state to a point with positions, velocities and accelerations (its spline interpolation): the
+    rest-to-rest bound max_j(15 Δ_j / (8 v_j), (10 Δ_j / (√3 a_j))^½) with Δ_j the farthest joint j
+    can stand from home, rounded up to ``RESOLUTION``."""
+    robot, limits = excitation.robot, excitation.limits
+    lower, upper = robot.lower, robot.upper
+    delta = np.maximum(upper - robot.home, robot.home - lower)
+    within = np.maximum(limits.upper[0] - robot.home, robot.home - limits.lower[0])  # a joint without a range
+    delta = np.where(np.isfinite(delta), delta, within)
+    velocity = np.minimum(-limits.lower[1], limits.upper[1])
+    acceleration = np.minimum(-limits.lower[2], limits.upper[2])
+    bound = max(
+        float(np.max(15.0 * delta / (8.0 * velocity))),
+        float(np.max(np.sqrt(10.0 * delta / (np.sqrt(3.0) * acceleration)))),
+    )
+    return round(float(np.ceil(bound / RESOLUTION - 1e-9) * RESOLUTION), 6)
+
+
 def plan_transition(
     start: np.ndarray, end: np.ndarray, limits: JointLimits, name: str, torque: Constraint | None = None
 ) -> Transition | None:

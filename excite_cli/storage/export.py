@@ -22,7 +22,7 @@ import numpy as np
 
 from excite_cli.design.excitation import Excitation
 from excite_cli.design.held_joints import HeldJoints, HeldTorques
-from excite_cli.design.playback import check_motion, plan_playback
+from excite_cli.design.playback import approach_duration, check_motion, plan_playback
 from excite_cli.errors import ExciteError
 
 #: Highest export rate accepted [Hz] (memory grows with rate × duration).
@@ -31,6 +31,8 @@ MAX_RATE = 100_000.0
 MAX_PERIODS = 1000
 #: Fastest and slowest playback accepted (times the optimized speed).
 MAX_SPEED, MIN_SPEED = 10.0, 0.01
+#: Longest approach accepted [s].
+MAX_APPROACH = 600.0
 #: Most samples in one file (about 1.3 GB of CSV with 7 joints).
 MAX_SAMPLES = 20_000_000
 
@@ -51,6 +53,9 @@ class Export:
         warnings: the advisory constraints the samples violate, and the samples whose held-joint
             feed-forward found no contact forces inside the friction cones, in words.
         held: a standing robot's held joints and their feed-forward at the samples, or None.
+        approach: [s] what a controller's trajectory waits before its first point (the home posture at
+            rest), its time to bring the robot there from where it stands; the ROS 2 formats start
+            their points' ``time_from_start`` there (:func:`~excite_cli.design.playback.approach_duration`).
     """
 
     joint_names: list[str]
@@ -69,17 +74,20 @@ class Export:
     predictions: tuple[str, ...] = ()
     warnings: tuple[str, ...] = ()
     held: HeldTorques | None = None
+    approach: float = 0.0
 
 
 class Played(NamedTuple):
     """How one iteration of a result is exported: ``result`` (named in the messages), its ``iteration``,
-    the ``rate`` [Hz], the ``periods`` of the trajectory, and the ``speed`` (times the optimized)."""
+    the ``rate`` [Hz], the ``periods`` of the trajectory, the ``speed`` (times the optimized) and the
+    ``approach`` [s] before the first point (None: :func:`~excite_cli.design.playback.approach_duration`)."""
 
     result: Path
     iteration: int
     rate: float
     periods: int
     speed: float
+    approach: float | None = None
 
 
 def check_playback(rate: float, periods: int, speed: float) -> None:
@@ -108,7 +116,9 @@ def export_trajectory(excitation: Excitation, alpha: np.ndarray, how: Played, he
             rate, more than ``MAX_SAMPLES`` samples, samples that violate a constraint that is not
             advisory (the message names it), or a held joint's feed-forward above its URDF effort limit.
     """
-    result, k, rate, periods, speed = how
+    result, k, rate, periods, speed, approach = how
+    if approach is not None and not (np.isfinite(approach) and 0.0 <= approach <= MAX_APPROACH):
+        raise ExciteError("approach", f"{approach:g} s is out of range", approach, f"0 to {MAX_APPROACH:g} s")
     if alpha.shape != (excitation.robot.n_joints, excitation.trajectory.n_coefficients):
         raise ExciteError(
             "result",
@@ -173,6 +183,7 @@ def export_trajectory(excitation: Excitation, alpha: np.ndarray, how: Played, he
         )
         + _slipping(stance),
         held=stance,
+        approach=approach_duration(excitation) if approach is None else float(approach),
     )
 
 

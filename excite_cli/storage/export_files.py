@@ -1,6 +1,9 @@
 """The files ``excite export`` writes from a played motion (:class:`~excite_cli.storage.export.Export`):
 CSV and NPZ for any controller, a ROS 2 FollowJointTrajectory goal and a ROS 2 bag for ros2_control's
-joint_trajectory_controller, all written atomically.
+joint_trajectory_controller, all written atomically. The ROS 2 formats' first point (the home posture at
+rest) is at ``time_from_start`` = the export's approach, not 0: the controller samples a first point
+whose time is not in the future at once (``trajectory.cpp``), a step from wherever the robot stands;
+given time, it interpolates there from its current state. The CSV and NPZ keep time 0 at home.
 
 A standing robot's export also holds the held joints' feed-forward
 (:mod:`~excite_cli.design.held_joints`): CSV columns ``tau_<joint>_Nm`` after the active joints'
@@ -76,7 +79,7 @@ def controller_motion(export: Export, effort: bool) -> tuple[list[str], tuple[np
 
 def _write_bag(path: Path, export: Export, effort: bool) -> Path:
     names, motion = controller_motion(export, effort)
-    return write_rosbag(path, names, export.time, motion, effort=effort)
+    return write_rosbag(path, names, export.time + export.approach, motion, effort=effort)
 
 
 def _write_goal(path: Path, export: Export, effort: bool) -> Path:
@@ -132,9 +135,8 @@ def _check_controller_accepts(export: Export, effort: bool) -> None:
         ExciteError: its first refusal, in the controller's words.
     """
     names, (q, qd, qdd, tau) = controller_motion(export, effort)
-    refusals = controller_refusals(
-        names, time_from_start_ns(export.time), q, qd, qdd, tau if effort else None, effort_interface=effort
-    )
+    time_ns = time_from_start_ns(export.time + export.approach)
+    refusals = controller_refusals(names, time_ns, q, qd, qdd, tau if effort else None, effort_interface=effort)
     if refusals:
         raise ExciteError("format", f"joint_trajectory_controller would refuse the trajectory: {refusals[0]}")
 
@@ -152,7 +154,7 @@ def ros2_goal(export: Export, effort: bool = False) -> str:
         return "[" + ", ".join(f"{x:.10g}" for x in row) + "]"
 
     names, (q, qd, qdd, tau) = controller_motion(export, effort)
-    nanoseconds = time_from_start_ns(export.time)
+    nanoseconds = time_from_start_ns(export.time + export.approach)
     lines = [
         f"# excite export: iteration {export.iteration}, {export.rate:g} Hz, {export.periods} period(s)",
         "trajectory:",

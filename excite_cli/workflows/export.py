@@ -17,13 +17,19 @@ from excite_cli.storage.rosbag import check_bag_target
 
 
 def played_result(
-    result: Path, iteration: int | None = None, rate: float = 1000.0, periods: int = 1, speed: float = 1.0
+    result: Path,
+    iteration: int | None = None,
+    rate: float = 1000.0,
+    periods: int = 1,
+    speed: float = 1.0,
+    approach: float | None = None,
 ) -> Export:
     """Iteration ``iteration`` (default: the last) of an ``optimize`` result sampled at ``rate`` [Hz]
     with the transitions from and to the home posture, played ``speed`` times as fast as optimized,
     and its feed-forward torques (:func:`~excite_cli.storage.export.export_trajectory` on the design
     the result stores, its regressor rows the joints' torques), the held joints' too for a standing
-    robot (:func:`~excite_cli.design.held_joints.held_joints`).
+    robot (:func:`~excite_cli.design.held_joints.held_joints`); ``approach`` [s] before a controller's
+    first point (default: :func:`~excite_cli.design.playback.approach_duration`).
 
     Raises:
         ExciteError: not an excite result, an iteration it does not have, a rate, speed or period count
@@ -41,7 +47,7 @@ def played_result(
         )
     excitation = build_excitation(problem)
     held = held_joints(problem.robot, problem.folder, problem.constraints, excitation.robot)
-    return export_trajectory(excitation, alphas[k], Played(result, k, rate, periods, speed), held)
+    return export_trajectory(excitation, alphas[k], Played(result, k, rate, periods, speed, approach), held)
 
 
 def run_export(
@@ -54,6 +60,7 @@ def run_export(
     force: bool = False,
     speed: float = 1.0,
     effort: bool = False,
+    approach: float | None = None,
 ) -> tuple[Export, Path]:
     """:func:`played_result` written by :func:`write_export` to ``output`` (default
     ``<result>_iteration<K>_<rate>Hz.<ending>``, the format's ending, beside the result; a
@@ -67,7 +74,7 @@ def run_export(
     check = check_bag_target if form.folder else check_target
     if output is not None:
         check(output, "output", force)
-    export = played_result(result, iteration, rate, periods, speed)
+    export = played_result(result, iteration, rate, periods, speed, approach)
     faster = f"_speed{speed:g}" if speed != 1.0 else ""
     target = output or result.with_name(f"{result.stem}_iteration{export.iteration}_{rate:g}Hz{faster}{form.suffix}")
     return export, write_export(check(target, "output", force), export, fmt, effort)

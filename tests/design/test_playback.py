@@ -11,9 +11,11 @@ from rosbags.typesys import Stores, get_typestore
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
+from excite_cli.config_file import result_problem
 from excite_cli.constraints import JointLimits
 from excite_cli.constraints.lse import GRID_MARGIN
-from excite_cli.design.playback import RESOLUTION, Transition, plan_transition
+from excite_cli.design.playback import RESOLUTION, Transition, approach_duration, plan_transition
+from excite_cli.design.resolve import build_excitation
 from excite_cli.dynamics.urdf_source import example_robot_data_root
 from excite_cli.storage.rosbag import TOPIC
 from excite_cli.workflows.export import played_result
@@ -186,7 +188,28 @@ def test_a_rosbag2_export_plays_the_samples_of_the_csv(panda_runs, tmp_path):
     np.testing.assert_allclose([p.positions for p in message.points], q, rtol=1e-9, atol=1e-9)
     np.testing.assert_allclose([p.effort for p in message.points], tau, rtol=1e-9, atol=1e-8)
     stamps = [p.time_from_start.sec + 1e-9 * p.time_from_start.nanosec for p in message.points]
-    np.testing.assert_allclose(stamps, time, atol=1e-9)
+    approach = approach_duration(build_excitation(result_problem(panda_runs["rest"])))
+    np.testing.assert_allclose(stamps, time + approach, atol=1e-9)  # the first point after the approach
+    assert f"first point (home, at rest) at {approach:g} s" in result.output
+
+
+def test_the_approach_brings_the_robot_home_from_anywhere_in_its_range_within_the_limits(panda_runs):
+    """The controller samples a first point at time 0 at once (joint_trajectory_controller's
+    trajectory.cpp): a step from where the robot stands. Given the approach, its quintic from rest
+    anywhere in the joint range to home at rest keeps the config's velocity and acceleration limits,
+    sampled here (s ∈ [0, 1], 10 s³ − 15 s⁴ + 6 s⁵), and a tenth less would not."""
+    excitation = build_excitation(result_problem(panda_runs["rest"]))
+    approach, robot, limits = approach_duration(excitation), excitation.robot, excitation.limits
+    farthest = np.maximum(robot.upper - robot.home, robot.home - robot.lower)
+    s = np.linspace(0.0, 1.0, 20001)[:, None]
+
+    def peaks(duration):
+        speed = farthest * (30 * s**2 - 60 * s**3 + 30 * s**4) / duration
+        acceleration = farthest * (60 * s - 180 * s**2 + 120 * s**3) / duration**2
+        return np.abs(speed).max(axis=0) / limits.upper[1], np.abs(acceleration).max(axis=0) / limits.upper[2]
+
+    assert max(peaks(approach)[0].max(), peaks(approach)[1].max()) <= 1.0 + 1e-9
+    assert max(peaks(0.9 * approach)[0].max(), peaks(0.9 * approach)[1].max()) > 1.0
 
 
 def _csv(path):
