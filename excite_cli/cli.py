@@ -174,9 +174,7 @@ def identify(
     config: Path = typer.Argument(..., help="Identification YAML: robot, data, preprocessing, identification."),
     output: Optional[Path] = typer.Option(None, "--output", "-o", help="HDF5 report (overrides config 'output')."),
     fit: Optional[str] = typer.Option(
-        None,
-        "--fit",
-        help="auto (the one the cross-validation prefers), least_squares or consistent (identification.fit).",
+        None, "--fit", help="auto (the cross-validation's choice), least_squares or consistent (identification.fit)."
     ),
     urdf_out: Optional[Path] = typer.Option(None, "--urdf-out", help="Write the identified URDF (consistent fit)."),
     mjcf_out: Optional[Path] = typer.Option(None, "--mjcf-out", help="Write the identified MJCF, checked by MuJoCo."),
@@ -207,9 +205,7 @@ def export(
     effort: bool = console.app.EFFORT,
     force: bool = FORCE,
     output: Optional[Path] = typer.Option(None, "--output", "-o", help="File to write (default: beside the result)."),
-    approach: Optional[float] = typer.Option(
-        None, "--approach", help="Seconds a ROS 2 trajectory gives to reach home first (default: from anywhere)."
-    ),
+    approach: Optional[float] = console.app.APPROACH,
 ) -> None:
     """Write a trajectory as a robot plays it: home → P periods → home, at the controller's rate, with torques."""
     exported, target = workflows.run_export(
