@@ -55,17 +55,21 @@ def word(error: ExciteError, spelled: dict[str, str], config: Optional[Path] = N
 @contextmanager
 def printed_warnings(console: Console) -> Iterator[None]:
     """Every :class:`~excite_cli.errors.ExciteWarning` raised in the block printed on ``console`` as
-    one line ``warning: ...`` (each time, not once per place); other warnings as Python shows them, but
-    numpy's floating-point ones (an overflow, a division by zero), which the block does not show: what
+    one line ``warning: ...``, once per message (a base computed by two steps of a command warns
+    once); other warnings as Python shows them, but numpy's floating-point ones (an overflow, a division by zero), which the block does not show: what
     such a number reaches is refused by the range checks with its field, not as numpy's line."""
     import numpy as np  # here, not at start-up: a command's, which computes with it anyway
 
     with warnings.catch_warnings(), np.errstate(all="ignore"):
         warnings.simplefilter("always", ExciteWarning)
         python_way = warnings.showwarning
+        said: set[str] = set()
 
         def show(message, category, *args, **kwargs) -> None:
             if issubclass(category, ExciteWarning):
+                if str(message) in said:
+                    return
+                said.add(str(message))
                 console.print(f"[bold yellow]warning:[/] {escape(str(message))}", highlight=False, soft_wrap=True)
             else:
                 python_way(message, category, *args, **kwargs)

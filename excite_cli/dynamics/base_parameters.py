@@ -22,6 +22,7 @@ is a function of the robot, not of the machine, nor of the order of the rows or 
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from typing import Sequence
 
@@ -29,7 +30,8 @@ import numpy as np
 import scipy.linalg
 
 from excite_cli.dynamics.robot import Robot
-from excite_cli.errors import ExciteError
+from excite_cli.dynamics.urdf_rounding import ROUNDING_FACTOR
+from excite_cli.errors import ExciteError, ExciteWarning
 
 #: A residual column norm below this fraction of the first pivot's is rank loss.
 RANK_TOLERANCE = 1e-9
@@ -94,18 +96,18 @@ class BaseParameters:
         raise ExciteError(field, f"{source} was made for another problem: other base parameters ({detail})")
 
 
-def pivoted_columns(W: np.ndarray, order: np.ndarray) -> list[int]:
+def pivoted_columns(W: np.ndarray, order: np.ndarray, tolerance: float = RANK_TOLERANCE) -> list[int]:
     """Independent columns of W (m, p) in pivot order: Gram-Schmidt (twice per step, so the residuals
     stay orthogonal to the chosen columns) taking at each step the column of largest residual norm;
     norms within ``TIE_TOLERANCE`` of it are a tie, won by the lowest ``order`` (p,) rank.
 
-    Stops at the first residual norm below ``RANK_TOLERANCE`` times the first pivot's.
+    Stops at the first residual norm below ``tolerance`` times the first pivot's.
     """
     residual = np.array(W, dtype=float, copy=True)
     norms = np.sqrt(np.einsum("ij,ij->j", residual, residual))
     if norms.size == 0 or norms.max() == 0.0:
         return []
-    floor = RANK_TOLERANCE * norms.max()
+    floor = tolerance * norms.max()
     chosen: list[int] = []
     units = np.zeros((W.shape[0], 0))
     for _ in range(min(W.shape)):
@@ -141,17 +143,20 @@ def _name(row: np.ndarray, names: list[str], lead: int, order: np.ndarray) -> st
     return " ".join(parts)
 
 
-def base_from_regressor(W: np.ndarray, names: list[str], order: np.ndarray | None = None) -> BaseParameters:
+def base_from_regressor(
+    W: np.ndarray, names: list[str], order: np.ndarray | None = None, tolerance: float = RANK_TOLERANCE
+) -> BaseParameters:
     """Base parameters of the standard regressor rows W (m, p) whose columns are the parameters
     ``names`` (p,), ties broken by ``order`` (p,), each column's rank in the robot's parameter order
-    (default: the columns' own order; module docstring).
+    (default: the columns' own order; module docstring); residual norms below ``tolerance`` times the
+    largest are rank loss.
 
     Raises:
         ExciteError: no parameter is excited by the rows (b = 0).
     """
     p = W.shape[1]
     order = np.arange(p) if order is None else np.asarray(order)
-    independent = np.array(pivoted_columns(W, order), dtype=int)
+    independent = np.array(pivoted_columns(W, order, tolerance), dtype=int)
     if independent.size == 0:
         raise ExciteError("robot.active_joints", "no inertial parameter affects the selected regressor rows")
     b = independent.size
@@ -167,7 +172,9 @@ def base_from_regressor(W: np.ndarray, names: list[str], order: np.ndarray | Non
 
 
 def compute_base_parameters(robot: Robot, seed: int = 0, samples: int | None = None) -> BaseParameters:
-    """Numerical base parameters of ``robot`` from a regressor of random states (:func:`base_from_regressor`).
+    """Numerical base parameters of ``robot`` from a regressor of random states (:func:`base_from_regressor`),
+    at the rank tolerance of the URDF's rounding (:mod:`excite_cli.dynamics.urdf_rounding`): the
+    directions it drops are said in an :class:`~excite_cli.errors.ExciteWarning`.
 
     The same on every processor, BLAS library and thread count: compute it once and pass it on.
 
@@ -182,7 +189,20 @@ def compute_base_parameters(robot: Robot, seed: int = 0, samples: int | None = N
     Raises:
         ExciteError: no parameter is excited by the regressor rows (b = 0).
     """
-    return base_from_regressor(robot.regressor_stack(*_random_states(robot, seed, samples)), robot.parameter_names)
+    W = robot.regressor_stack(*_random_states(robot, seed, samples))
+    tolerance = max(RANK_TOLERANCE, ROUNDING_FACTOR * robot.angle_rounding)
+    base = base_from_regressor(W, robot.parameter_names, tolerance=tolerance)
+    if tolerance > RANK_TOLERANCE:
+        dropped = len(pivoted_columns(W, np.arange(W.shape[1]))) - base.count
+        if dropped:
+            warnings.warn(
+                f"robot: {dropped} direction(s) of the regressor below {tolerance:.2g} of the largest are not base "
+                f"parameters ({base.count} are): the URDF writes right angles rounded (by up to "
+                f"{robot.angle_rounding:.2g} rad), and what they add no motion excites above the rounding",
+                ExciteWarning,
+                stacklevel=2,
+            )
+    return base
 
 
 def _random_states(robot: Robot, seed: int, samples: int | None = None) -> tuple[np.ndarray, ...]:

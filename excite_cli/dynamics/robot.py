@@ -20,6 +20,7 @@ from excite_cli.config import RobotConfig
 from excite_cli.dynamics.mjcf_source import check_mjcf, is_mjcf
 from excite_cli.dynamics.urdf_checks import check_urdf
 from excite_cli.dynamics.urdf_meshes import package_folders
+from excite_cli.dynamics.urdf_rounding import angle_rounding
 from excite_cli.dynamics.urdf_source import apply_joint_ranges, resolve_urdf, robot_geometry, robot_model
 from excite_cli.errors import ExciteError
 
@@ -53,6 +54,8 @@ class Robot:
         links: (parent, child) names of consecutive joint frames (moving, locked or fixed) of the
             full URDF tree, for drawing the robot (the reduced model's frames keep no parent for
             locked joints).
+        angle_rounding: largest rounding [rad] of a right (or 15°) angle in the URDF
+            (:func:`~excite_cli.dynamics.urdf_rounding.angle_rounding`; 0 for an MJCF).
     """
 
     model: pin.Model
@@ -69,6 +72,7 @@ class Robot:
     collision_model: pin.GeometryModel | None = None
     links: list[tuple[str, str]] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
+    angle_rounding: float = 0.0
     data: pin.Data = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
@@ -285,4 +289,5 @@ def load_robot(
         collision_model=geometry,
         links=joint_frame_links(full),
         warnings=[f"{p} in {path.name}: kept as the identification's reference only" for p in problems],
+        angle_rounding=0.0 if mjcf else angle_rounding(path),
     )

@@ -3,6 +3,7 @@ table, the progress lines of a log, and errors worded as the command's options."
 
 import io
 import re
+import warnings
 
 import numpy as np
 import pinocchio as pin
@@ -14,15 +15,23 @@ from excite_cli.config import OptimizerConfig
 from excite_cli.config_file import load_problem
 from excite_cli.console import tables
 from excite_cli.console.bodies import consistent_bodies
-from excite_cli.console.errors import spellings, word
+from excite_cli.console.errors import printed_warnings, spellings, word
 from excite_cli.console.identification import validation
 from excite_cli.console.progress import Bars
-from excite_cli.errors import ExciteError, OutputExists
+from excite_cli.errors import ExciteError, ExciteWarning, OutputExists
 from excite_cli.identification.fitting.physical import ConsistentFit
 from excite_cli.identification.validate import RunError
 from excite_cli.search.kkt import Optimality
 from excite_cli.search.optimizer import RestartResult
 from excite_cli.search.sequence import IterationResult
+
+
+def test_each_warning_is_printed_once_however_often_a_command_raises_it():
+    console = Console(record=True, width=300, file=io.StringIO())
+    with printed_warnings(console):
+        for message in ("robot: 2 directions dropped", "limits: too fast", "robot: 2 directions dropped"):
+            warnings.warn(message, ExciteWarning)
+    assert console.export_text().splitlines() == ["warning: robot: 2 directions dropped", "warning: limits: too fast"]
 
 
 def _text(renderables) -> str:
