@@ -56,8 +56,9 @@ def word(error: ExciteError, spelled: dict[str, str], config: Optional[Path] = N
 def printed_warnings(console: Console) -> Iterator[None]:
     """Every :class:`~excite_cli.errors.ExciteWarning` raised in the block printed on ``console`` as
     one line ``warning: ...``, once per message (a base computed by two steps of a command warns
-    once); other warnings as Python shows them, but numpy's floating-point ones (an overflow, a division by zero), which the block does not show: what
-    such a number reaches is refused by the range checks with its field, not as numpy's line."""
+    once); other warnings as Python shows them, but numpy's floating-point ones (an overflow, a
+    division by zero), which the block does not show: what such a number reaches is refused by the
+    range checks with its field, not as numpy's line."""
     import numpy as np  # here, not at start-up: a command's, which computes with it anyway
 
     with warnings.catch_warnings(), np.errstate(all="ignore"):

@@ -35,6 +35,7 @@ def plan(p: IdentifyPlan) -> list[Table | str]:
             f"{r.rate:.4g}",
             ", ".join(r.signals),
             str(r.dropped),
+            str(r.missing),
             "; ".join(f"{g.length:.3g} s at {g.into:.3f} s" for g in r.gaps) or "none",
         )
         for r in p.runs
@@ -43,7 +44,7 @@ def plan(p: IdentifyPlan) -> list[Table | str]:
         f"robot: {len(p.joints)} active joints ({', '.join(p.joints)}), {p.base_parameters} base parameters",
         titled_table(
             "Runs, read as identify reads them",
-            ("run", "role", "samples", "s", "Hz", "signals", "dropped", "gaps (cut there)"),
+            ("run", "role", "samples", "s", "Hz", "signals", "dropped", "missing", "gaps (cut there)"),
             rows,
         ),
         f"fit: {cfg.method}, {cfg.fit}; declared effects: {', '.join(p.declared) or 'none'}; "

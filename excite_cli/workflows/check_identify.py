@@ -17,7 +17,7 @@ from excite_cli.dynamics.robot import load_robot
 from excite_cli.errors import ExciteError
 from excite_cli.identification.choice.selection import candidate_terms, motor_couplings
 from excite_cli.identification.config import IdentifyProblem
-from excite_cli.identification.measured.gaps import Gap, find_gaps
+from excite_cli.identification.measured.gaps import Gap, find_gaps, missing_messages
 from excite_cli.identification.measured.measurements import check_against_limits, load_run
 from excite_cli.identification.measured.payload import payload_parameters
 from excite_cli.identification.pipeline import declared_terms
@@ -28,8 +28,9 @@ from excite_cli.workflows.check import Plan, plan_optimize
 class RunSummary:
     """One measured run as ``identify`` reads it: its label (file and crop), role, samples, duration
     [s], median sample rate [Hz], the signals found (``q``, ``qd`` or ``qdd`` when recorded, ``tau``),
-    the rows left out (``data.bad_rows: drop``) and its gaps (where identify cuts the run, never
-    interpolating across: :func:`~excite_cli.identification.measured.gaps.find_gaps`)."""
+    the rows left out (``data.bad_rows: drop``), its gaps (where identify cuts the run, never
+    interpolating across: :func:`~excite_cli.identification.measured.gaps.find_gaps`) and the single
+    messages missing between them (:func:`~excite_cli.identification.measured.gaps.missing_messages`)."""
 
     label: str
     role: str
@@ -39,6 +40,7 @@ class RunSummary:
     signals: tuple[str, ...]
     dropped: int
     gaps: tuple[Gap, ...] = ()
+    missing: int = 0
 
 
 @dataclass
@@ -80,7 +82,15 @@ def plan_identify(problem: IdentifyProblem) -> IdentifyPlan:
         seconds = float(run.time[-1] - run.time[0])
         runs.append(
             RunSummary(
-                config.label, run.role, run.time.size, seconds, rate, signals, run.dropped, tuple(find_gaps(run.time))
+                config.label,
+                run.role,
+                run.time.size,
+                seconds,
+                rate,
+                signals,
+                run.dropped,
+                tuple(find_gaps(run.time)),
+                missing_messages(run.time),
             )
         )
     return IdentifyPlan(

@@ -54,6 +54,17 @@ def find_gaps(time: np.ndarray) -> list[Gap]:
     return [Gap(float(time[k]), float(steps[k]), int(k + 1), float(time[k] - time[0])) for k in at]
 
 
+def missing_messages(time: np.ndarray) -> int:
+    """Messages missing between the time stamps (T,) [s], outside gaps: each step of k median periods
+    (rounded; k ≥ 2, shorter than a gap: :func:`find_gaps`) lacks k − 1 (a sample the resampling bridges)."""
+    steps = np.diff(time)
+    if steps.size == 0:
+        return 0
+    period = np.median(steps)
+    short = steps[steps <= max(GAP_PERIODS * period, MIN_GAP_S)]
+    return int(np.sum(np.maximum(np.rint(short / period) - 1, 0)))
+
+
 def split_at_gaps(run: Run, quiet: bool = False) -> list[Run]:
     """``run`` cut at its gaps (:func:`find_gaps`) into pieces named ``<name> [t0–t1 s]``, each gap
     and each piece left out (shorter than :data:`MIN_PIECE_S`) named in an

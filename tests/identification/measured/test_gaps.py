@@ -12,9 +12,10 @@ from conftest import CONFIGS
 
 from excite_cli.config_file import load_problem
 from excite_cli.errors import ExciteError, ExciteWarning
-from excite_cli.identification.config import IdentifyProblem
-from excite_cli.identification.measured.gaps import MIN_PIECE_S, find_gaps, split_at_gaps
+from excite_cli.identification.config import IdentifyProblem, PreprocessingConfig
+from excite_cli.identification.measured.gaps import MIN_PIECE_S, find_gaps, missing_messages, split_at_gaps
 from excite_cli.identification.measured.measurements import Run
+from excite_cli.identification.measured.preprocessing import choose_cutoff, preprocess
 from excite_cli.identification.pipeline import run_identification
 
 DATA = Path(__file__).resolve().parents[3] / "data" / "panda_simulated"
@@ -34,6 +35,38 @@ def test_jitter_and_dropped_messages_are_no_gaps_but_a_stall_is():
     stalled = np.concatenate([time[time < 4.0], time[time > 4.5]])
     [gap] = find_gaps(stalled)
     assert gap.start == pytest.approx(4.0, abs=0.003) and gap.length == pytest.approx(0.5, abs=0.005)
+
+
+def test_single_missing_messages_are_counted_and_are_no_gap():
+    """A 40 s, 500 Hz recording with 200 single messages missing (and one missing three in a row)."""
+    rng = np.random.default_rng(1)
+    time = np.arange(20_000) / 500.0 + rng.uniform(-0.0002, 0.0002, 20_000)
+    lost = rng.choice(np.arange(10, 19_990, 50), 200, replace=False)
+    time = np.delete(time, lost)
+    assert find_gaps(time) == [] and missing_messages(time) == 200
+    assert missing_messages(np.delete(time, [5001, 5002, 5003])) == 203
+
+
+def _rows(time: np.ndarray, q: np.ndarray) -> int:
+    """Regressor rows identify keeps of a fit run (every piece between gaps filtered on its own)."""
+    cfg = PreprocessingConfig()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ExciteWarning)
+        pieces = split_at_gaps(Run("rec.csv", "fit", time, q, None, None, q.copy()))
+    cutoff, _ = choose_cutoff(pieces, cfg)
+    return sum(preprocess(p, cfg, cutoff).filter.kept(p.time.size) for p in pieces)
+
+
+def test_a_gap_costs_the_gap_and_the_filter_s_edges_not_a_fifth_of_the_rows():
+    """A 0.5 s gap in the middle of a 40 s, 500 Hz recording costs 4.4 % of the rows (≤ 5 %): the gap
+    and two edges of 3 cut-off periods; the decimation step of each piece is the whole run's (500 Hz
+    to 200 Hz rounded 2 or 3 by the last digits of each piece's rate: 20 % more or fewer rows)."""
+    time = np.arange(20_000) / 500.0
+    rng = np.random.default_rng(0)
+    q = np.column_stack([np.sin(2 * np.pi * 0.1 * k * time + rng.uniform(0, 6)) / k for k in range(1, 6)])
+    keep = ~((time > 20.0) & (time < 20.5))
+    whole, gapped = _rows(time, q), _rows(time[keep], q[keep])
+    assert 0.03 < 1.0 - gapped / whole <= 0.05
 
 
 def test_a_run_is_cut_at_its_gaps_and_a_piece_too_short_to_filter_is_left_out_and_said():
