@@ -89,7 +89,10 @@ def _limits(model: pin.Model, active: list[str], draft: StartingConfig) -> dict:
         draft.assumptions["limits.torque"] = f"none: {', '.join(idle)} move(s) no mass in the file (no <inertial>?)"
     elif all(0 < model.effortLimit[model.idx_vs[i]] < math.inf for i in ids):
         limits["torque"] = "urdf"
-        draft.assumptions["limits.torque"] = "the URDF's effort limits"
+        draft.assumptions["limits.torque"] = "the file's effort limits (an MJCF's: its actuators' force ranges × gear)"
+    else:
+        unbounded = [n for n, i in zip(active, ids) if not 0 < model.effortLimit[model.idx_vs[i]] < math.inf]
+        draft.assumptions["limits.torque"] = f"none: the file bounds no torque of {', '.join(unbounded)} (unchecked)"
     return limits
 
 

@@ -1,12 +1,25 @@
-"""A robot described in MJCF (MuJoCo's XML, as MuJoCo Menagerie ships robots), read by pinocchio's own
-MJCF parser: joints and their ranges (in MuJoCo's angle unit: degrees unless ``<compiler
-angle="radian">``), inertias (from the geoms where a body has no ``<inertial>``, as MuJoCo computes
-them), effort limits from ``actuatorfrcrange``, and the collision geometry from the geoms.
+"""A robot described in MJCF (MuJoCo's XML, as MuJoCo Menagerie ships robots) as MuJoCo reads it:
+compiled by MuJoCo's own compiler (``<include>``, ``<default>`` classes, ``<frame>`` elements, angle
+units, inertias from geoms, all resolved as MuJoCo resolves them), then handed to pinocchio body by
+body.
 
-What the parser leaves out is refused rather than dropped: a joint of the file missing from the model
-(pinocchio skips bodies nested in a ``<frame>`` element, so a whole gripper can vanish with its mass).
-An equality constraint that couples two joints (``<equality><joint joint1 joint2>``: joint1 follows
-joint2) is a coupling the model does not represent, checked as a URDF ``<mimic>`` is
+From the compiled ``mjModel``: each body's placement in its parent (``body_pos``, ``body_quat``),
+its joints (hinge: revolute, slide: prismatic, ball: spherical, each through its ``jnt_pos`` along
+``jnt_axis``; a body without a joint is welded to its parent's), its inertia (``body_mass`` at
+``body_ipos``, principal moments ``body_inertia`` in ``body_iquat``), the joint ranges
+(``jnt_range`` where ``jnt_limited``), the armature (``dof_armature``), and the joint torque limits
+from the actuators (MuJoCo's actuation model, mujoco.readthedocs.io "Actuation model": a joint
+transmission's torque is ``gear`` × the actuator force; the force is clamped to ``forcerange`` when
+``forcelimited``; a ``motor``'s force is its control, clamped to ``ctrlrange``; ``actuatorfrcrange``
+bounds the sum at the joint). A free joint of a root body is the floating base
+(``robot.floating_base``), or welded where the base is. Geoms that collide (``contype`` or
+``conaffinity``) of the robot's bodies are the collision geometry; those of ``<worldbody>`` itself
+(a floor) are the world's.
+
+The file's joint ``damping`` and ``frictionloss`` are not the rigid body's: they are said in a
+warning (identify finds them as viscous and Coulomb friction), not built in. An equality constraint
+that couples two joints (``<equality><joint joint1 joint2>``: joint1 follows joint2) is a coupling
+the model does not represent, checked as a URDF ``<mimic>`` is
 (:func:`~excite_cli.dynamics.urdf_checks.check_couplings`). MJCF has no velocity limits and a hinge
 may have no range: ``limits.velocity`` and ``robot.joint_ranges`` give them
 (:mod:`~excite_cli.constraints.joint_limits` asks, naming the joint).
@@ -14,17 +27,23 @@ may have no range: ``limits.velocity`` and ``robot.joint_ranges`` give them
 
 from __future__ import annotations
 
+import functools
 import warnings
 from pathlib import Path
 from xml.etree import ElementTree
 
+import coal
+import numpy as np
 import pinocchio as pin
 
 from excite_cli.dynamics.urdf_checks import check_couplings
-from excite_cli.errors import ExciteError
+from excite_cli.errors import ExciteError, ExciteWarning
 
 #: The name of the free-flyer root joint of a floating base.
 ROOT_JOINT = "root_joint"
+FREE, BALL, SLIDE, HINGE = 0, 1, 2, 3  # mjtJoint
+SPHERE, CAPSULE, ELLIPSOID, CYLINDER, BOX, MESH = 2, 3, 4, 5, 6, 7  # mjtGeom
+MOTOR_GAIN, NO_BIAS, JOINT_TRANSMISSION, JOINT_EQUALITY = 0, 0, 0, 2  # mjtGain fixed, mjtBias none, mjtTrn, mjtEq
 
 
 def is_mjcf(path: Path) -> bool:
@@ -36,104 +55,222 @@ def is_mjcf(path: Path) -> bool:
         return False
 
 
-def _pinocchio_error(path: Path, exc: Exception) -> ExciteError:
-    return ExciteError("robot.urdf", f"pinocchio cannot read the MJCF {path.name}: {' '.join(str(exc).split())[:300]}")
+@functools.lru_cache(maxsize=8)
+def _compiled(path: str, mtime: float):
+    try:
+        import mujoco
+    except ImportError:
+        raise ExciteError(
+            "robot.urdf",
+            f"{Path(path).name} is an MJCF, which excite reads with MuJoCo's compiler: MuJoCo is not installed",
+            expected="pip install 'excite-cli[mujoco]' (make install has it)",
+        ) from None
+    try:
+        return mujoco.MjModel.from_xml_path(path)
+    except ValueError as exc:
+        problem = f"MuJoCo cannot compile {Path(path).name}: {' '.join(str(exc).split())[:300]}"
+        raise ExciteError("robot.urdf", problem) from None
+
+
+def compiled(path: Path):
+    """MuJoCo's ``MjModel`` of the MJCF at ``path`` (cached while the file is unchanged).
+
+    Raises:
+        ExciteError: (``robot.urdf``) MuJoCo is not installed, or its compiler refuses the file (a
+            missing include is named by MuJoCo's message).
+    """
+    return _compiled(str(Path(path).resolve()), Path(path).stat().st_mtime)
+
+
+def _name(mj, kind: str, index: int) -> str:
+    return getattr(mj, kind)(index).name or f"{kind}{index}"
+
+
+def _placement(quat: np.ndarray, pos: np.ndarray) -> pin.SE3:
+    return pin.SE3(pin.Quaternion(*quat).matrix(), np.array(pos, dtype=float))
+
+
+def _joint_model(kind: int, axis: np.ndarray):
+    unit = {tuple(np.eye(3)[k]): k for k in range(3)}.get(tuple(np.round(axis, 12)))
+    if kind == HINGE:
+        return (
+            (pin.JointModelRX, pin.JointModelRY, pin.JointModelRZ)[unit]()
+            if unit is not None
+            else (pin.JointModelRevoluteUnaligned(*axis))
+        )
+    if kind == SLIDE:
+        return (
+            (pin.JointModelPX, pin.JointModelPY, pin.JointModelPZ)[unit]()
+            if unit is not None
+            else (pin.JointModelPrismaticUnaligned(*axis))
+        )
+    return pin.JointModelSpherical()
+
+
+def _add_joints(mj, model: pin.Model, b: int, parent: tuple[int, pin.SE3], floating: bool) -> tuple[int, pin.SE3]:
+    """Body ``b``'s joints added after ``parent`` (joint id, body placement in it); its own (joint id,
+    placement of the body frame in that joint)."""
+    joint, placement = parent
+    joints = range(mj.body_jntadr[b], mj.body_jntadr[b] + mj.body_jntnum[b])
+    if any(mj.jnt_type[j] == FREE for j in joints):
+        if mj.body_parentid[b] != 0 or mj.body_jntnum[b] > 1:
+            raise ExciteError("robot.urdf", f"body '{_name(mj, 'body', b)}' has a free joint but is not a root body")
+        if floating:
+            return model.addJoint(0, pin.JointModelFreeFlyer(), pin.SE3.Identity(), ROOT_JOINT), pin.SE3.Identity()
+        return 0, pin.SE3.Identity()
+    here = placement * _placement(mj.body_quat[b], mj.body_pos[b])
+    last = np.zeros(3)
+    for j in joints:
+        offset = here * pin.SE3(np.eye(3), mj.jnt_pos[j] - last)
+        joint = model.addJoint(joint, _joint_model(mj.jnt_type[j], mj.jnt_axis[j]), offset, _name(mj, "joint", j))
+        model.addJointFrame(joint, -1)
+        here, last = pin.SE3.Identity(), mj.jnt_pos[j].copy()
+    return joint, here * pin.SE3(np.eye(3), -last)
+
+
+def _limits(mj, model: pin.Model, j: int, torques: dict[str, float]) -> None:
+    """Joint ``j``'s range, armature, torque limit (``torques``, else inf) and velocity limit (MJCF has
+    none: inf) on ``model``."""
+    name = _name(mj, "joint", j)
+    jid = model.getJointId(name)
+    q, v, nv = model.idx_qs[jid], model.idx_vs[jid], model.nvs[jid]
+    if mj.jnt_type[j] in (HINGE, SLIDE):
+        low, high = mj.jnt_range[j] if mj.jnt_limited[j] else (-np.inf, np.inf)
+        model.lowerPositionLimit[q], model.upperPositionLimit[q] = low, high
+    dofs = slice(mj.jnt_dofadr[j], mj.jnt_dofadr[j] + nv)
+    model.armature[v : v + nv] = mj.dof_armature[dofs]
+    model.velocityLimit[v : v + nv] = np.inf
+    model.effortLimit[v : v + nv] = torques.get(name, np.inf)
 
 
 def mjcf_model(path: Path, floating: bool = False) -> pin.Model:
-    """pinocchio's model of the MJCF at ``path``, with a free-flyer root joint when ``floating``.
+    """pinocchio's model of the MJCF at ``path`` as MuJoCo compiles it (module docstring), with a
+    free-flyer root joint ``root_joint`` when ``floating``.
 
     Raises:
-        ExciteError: (``robot.urdf``) a file with ``<include>`` elements (:func:`check_includes`), or one
-            pinocchio's MJCF parser refuses, in one line.
+        ExciteError: (``robot.urdf``) see :func:`compiled`; a free joint below the root.
     """
-    check_includes(path)
-    try:
-        with warnings.catch_warnings():  # the root-joint overload is deprecated for one returning constraints
-            warnings.simplefilter("ignore", DeprecationWarning)
-            built = (
-                pin.buildModelFromMJCF(str(path), pin.JointModelFreeFlyer(), ROOT_JOINT)
-                if floating
-                else pin.buildModelFromMJCF(str(path))
-            )
-    except (RuntimeError, ValueError, IndexError) as exc:
-        raise _pinocchio_error(path, exc) from None
-    return built[0] if isinstance(built, tuple) else built
-
-
-def check_includes(path: Path) -> None:
-    """That the MJCF at ``path`` is one file: pinocchio's MJCF reader does not follow ``<include
-    file="...">`` (MuJoCo pastes the included file's elements in its place, the path taken from the
-    including file's folder), so what an include holds (a whole arm) would be left out without a word.
-
-    Raises:
-        ExciteError: (``robot.urdf``) an include of a file that does not exist, or any include, named.
-    """
-    try:
-        includes = [e.get("file", "") for e in ElementTree.parse(path).getroot().iter("include")]
-    except (ElementTree.ParseError, OSError):
-        return  # pinocchio's reader names what it cannot read
-    for name in includes:
-        if not (path.parent / name).is_file():
-            raise ExciteError("robot.urdf", f"{path.name} includes {name}, which does not exist", name)
-    if includes:
-        raise ExciteError(
-            "robot.urdf",
-            f"{path.name} includes {', '.join(includes)} (<include>), which pinocchio's MJCF reader does not "
-            "follow: their bodies and joints would be left out",
-            includes[0],
-            "the model as one file (MuJoCo writes one: mujoco.MjSpec.from_file(path).to_xml())",
+    mj = compiled(path)
+    model = pin.Model()
+    model.name = Path(path).stem
+    placed: dict[int, tuple[int, pin.SE3]] = {0: (0, pin.SE3.Identity())}
+    for b in range(1, mj.nbody):
+        joint, placement = _add_joints(mj, model, b, placed[mj.body_parentid[b]], floating)
+        placed[b] = (joint, placement)
+        inertia = pin.Inertia(
+            float(mj.body_mass[b]),
+            np.array(mj.body_ipos[b], dtype=float),
+            (R := pin.Quaternion(*mj.body_iquat[b]).matrix()) @ np.diag(mj.body_inertia[b]) @ R.T,
         )
+        model.appendBodyToJoint(joint, inertia, placement)
+        model.addBodyFrame(_name(mj, "body", b), joint, placement, -1)
+    torques = joint_torque_limits(mj)
+    for j in range(mj.njnt):
+        if mj.jnt_type[j] != FREE:
+            _limits(mj, model, j, torques)
+    _say_losses(mj, Path(path).name)
+    return model
 
 
-def mjcf_geometry(model: pin.Model, path: Path) -> pin.GeometryModel:
-    """The collision geometry of the MJCF at ``path`` (its geoms, meshes found as MuJoCo finds them) for
-    ``model``, less the geoms of ``<worldbody>`` itself (a floor, walls: the world's, not the robot's;
-    pinocchio's reduced models also lose their frame).
-
-    Raises:
-        ExciteError: (``robot.urdf``) a mesh pinocchio or coal cannot find or read.
-    """
-    try:
-        geometry = pin.buildGeomFromMJCF(model, str(path), pin.COLLISION)
-    except (RuntimeError, ValueError, IndexError) as exc:
-        raise _pinocchio_error(path, exc) from None
-    for name in [o.name for o in geometry.geometryObjects if o.parentJoint == 0 and o.parentFrame == 0]:
-        geometry.removeGeometryObject(name)
-    return geometry
+def joint_torque_limits(mj) -> dict[str, float]:
+    """{joint: largest torque [N·m] (force [N] of a slide)} the actuators of a joint transmission can
+    give (module docstring); joints without a bounded actuator are left out (their torque unchecked)."""
+    limits: dict[str, float] = {}
+    for a in range(mj.nu):
+        if mj.actuator_trntype[a] != JOINT_TRANSMISSION:
+            continue
+        gear, bounds = abs(mj.actuator_gear[a][0]), []
+        if mj.actuator_forcelimited[a]:
+            bounds.append(np.abs(mj.actuator_forcerange[a]).max())
+        motor = mj.actuator_gaintype[a] == MOTOR_GAIN and mj.actuator_biastype[a] == NO_BIAS
+        if motor and mj.actuator_ctrllimited[a]:
+            bounds.append(abs(mj.actuator_gainprm[a][0]) * np.abs(mj.actuator_ctrlrange[a]).max())
+        if bounds:
+            name = _name(mj, "joint", mj.actuator_trnid[a][0])
+            limits[name] = limits.get(name, 0.0) + gear * min(bounds)
+    for j in range(mj.njnt):
+        if mj.jnt_actfrclimited[j]:
+            name = _name(mj, "joint", j)
+            limits[name] = min(limits.get(name, np.inf), float(np.abs(mj.jnt_actfrcrange[j]).max()))
+    return {k: float(v) for k, v in limits.items()}
 
 
 def mjcf_couplings(path: Path) -> dict[str, tuple[str, str]]:
     """{follower: (leader, how)} of the MJCF's joint equality constraints (``joint1`` follows
     ``joint2``; ``how``: the polynomial's coefficients in words)."""
-    root = ElementTree.parse(path).getroot()
+    mj = compiled(path)
     out = {}
-    for equality in root.iter("equality"):
-        for joint in equality.iter("joint"):
-            if joint.get("joint1") and joint.get("joint2"):
-                out[joint.get("joint1")] = (joint.get("joint2"), f"polycoef {joint.get('polycoef', '0 1 0 0 0')}")
+    for e in range(mj.neq):
+        if mj.eq_type[e] == JOINT_EQUALITY and mj.eq_obj2id[e] >= 0:
+            coefficients = " ".join(f"{c:g}" for c in mj.eq_data[e][:5])
+            out[_name(mj, "joint", mj.eq_obj1id[e])] = (_name(mj, "joint", mj.eq_obj2id[e]), f"polycoef {coefficients}")
     return out
 
 
-def check_mjcf(path: Path, model: pin.Model, active: list[str], locked: list[str] = ()) -> None:
-    """Every joint of the MJCF at ``path`` is in pinocchio's ``model`` of it, and the ``active`` and
-    ``locked`` joints respect its joint couplings (:func:`mjcf_couplings`, checked as a URDF's
-    ``<mimic>``).
+def _say_losses(mj, file_name: str) -> None:
+    """One warning naming the joints whose damping or frictionloss the file gives (module docstring)."""
+    said = []
+    for what, values, unit in (("damping", mj.dof_damping, "N·m·s/rad"), ("frictionloss", mj.dof_frictionloss, "N·m")):
+        joints = [f"{_name(mj, 'joint', mj.dof_jntid[d])} {values[d]:.3g}" for d in range(mj.nv) if values[d] > 0]
+        if joints:
+            said.append(f"{what} [{unit}] ({', '.join(joints)})")
+    if said:
+        warnings.warn(
+            f"robot.urdf: {file_name} gives joint {' and '.join(said)}, which excite's model (rigid bodies and "
+            "armature) leaves out: identify finds them as viscous and Coulomb friction",
+            ExciteWarning,
+            stacklevel=3,
+        )
+
+
+def _shape(mj, g: int):
+    size, kind = mj.geom_size[g], mj.geom_type[g]
+    if kind == SPHERE:
+        return coal.Sphere(size[0])
+    if kind == CAPSULE:
+        return coal.Capsule(size[0], 2 * size[1])
+    if kind == CYLINDER:
+        return coal.Cylinder(size[0], 2 * size[1])
+    if kind == BOX:
+        return coal.Box(*(2 * size))
+    if kind == ELLIPSOID:
+        return coal.Ellipsoid(*size)
+    if kind == MESH:
+        m = mj.geom_dataid[g]
+        vertices = mj.mesh_vert[mj.mesh_vertadr[m] : mj.mesh_vertadr[m] + mj.mesh_vertnum[m]]
+        faces = mj.mesh_face[mj.mesh_faceadr[m] : mj.mesh_faceadr[m] + mj.mesh_facenum[m]]
+        mesh = coal.BVHModelOBBRSS()
+        mesh.beginModel(len(faces), len(vertices))
+        mesh.addVertices(np.asarray(vertices, dtype=float))
+        mesh.addTriangles(np.asarray(faces, dtype=np.int64))
+        mesh.endModel()
+        return mesh
+    return None  # a plane or height field on a body: not a shape the robot's collisions take
+
+
+def mjcf_geometry(model: pin.Model, path: Path) -> pin.GeometryModel:
+    """The colliding geoms of the MJCF's bodies (not ``<worldbody>``'s own) on ``model`` (built by
+    :func:`mjcf_model` from the same file, full or reduced), each on its body's frame."""
+    mj = compiled(path)
+    geometry = pin.GeometryModel()
+    for g in range(mj.ngeom):
+        body = mj.geom_bodyid[g]
+        shape = _shape(mj, g) if body > 0 and (mj.geom_contype[g] or mj.geom_conaffinity[g]) else None
+        if shape is None:
+            continue
+        index = model.getFrameId(_name(mj, "body", body), pin.FrameType.BODY)
+        frame = model.frames[index]
+        placement = frame.placement * _placement(mj.geom_quat[g], mj.geom_pos[g])
+        name = mj.geom(g).name or f"{_name(mj, 'body', body)}_geom{g}"
+        geometry.addGeometryObject(pin.GeometryObject(name, frame.parentJoint, index, placement, shape))
+    return geometry
+
+
+def check_mjcf(path: Path, active: list[str], locked: list[str] = ()) -> None:
+    """The ``active`` and ``locked`` joints respect the MJCF's joint couplings (:func:`mjcf_couplings`,
+    checked as a URDF's ``<mimic>``).
 
     Raises:
-        ExciteError: (``robot.urdf``) joints the parser left out, named with the likely cause; see
-            :func:`~excite_cli.dynamics.urdf_checks.check_couplings`.
+        ExciteError: see :func:`~excite_cli.dynamics.urdf_checks.check_couplings`.
     """
-    root = ElementTree.parse(path).getroot()
-    world = root.find("worldbody")
-    declared = [] if world is None else [j.get("name") for j in world.iter("joint")]
-    missing = [name for name in declared if name and name not in model.names]
-    if missing:
-        raise ExciteError(
-            "robot.urdf",
-            f"pinocchio's MJCF reader leaves out joint(s) {', '.join(missing)} of {path.name} (bodies inside a "
-            "<frame> element, which it skips)",
-            missing[0],
-            "the bodies of those joints directly inside their parent <body> (no <frame>), or the robot's URDF",
-        )
     check_couplings(mjcf_couplings(path), active, locked)

@@ -242,7 +242,7 @@ def load_robot(
     problems = [] if mjcf else check_urdf(path, active, physical, locked)  # before urdfdom prints what it cannot parse
     full = robot_model(path, cfg.floating_base)
     if mjcf:
-        check_mjcf(path, full, active, locked)
+        check_mjcf(path, active, locked)
     apply_joint_ranges(full, cfg.joint_ranges, path.name)
 
     movable = _check_joints(cfg, full)

@@ -1,4 +1,4 @@
-"""An MJCF read by pinocchio's MJCF parser is the same robot as its URDF: MuJoCo writes the Panda's
+"""An MJCF read as MuJoCo compiles it is the same robot as its URDF: MuJoCo writes the Panda's
 MJCF from example-robot-data's URDF, and excite's regressor and base parameters of it equal those of
 the URDF. MuJoCo's units (degrees unless said), joints without a range, couplings, and what the
 parser would drop are each checked."""
@@ -11,7 +11,7 @@ from excite_cli.config import RobotConfig
 from excite_cli.dynamics.base_parameters import compute_base_parameters
 from excite_cli.dynamics.mjcf_source import is_mjcf, mjcf_couplings
 from excite_cli.dynamics.robot import load_robot
-from excite_cli.errors import ExciteError
+from excite_cli.errors import ExciteError, ExciteWarning
 
 ARM = """<mujoco model="arm">{compiler}
   <worldbody>
@@ -92,31 +92,79 @@ def test_a_coupled_joint_is_checked_as_a_mimic(tmp_path):
     assert load_robot(held).joint_names == ["shoulder", "elbow"]
 
 
-def test_joints_the_parser_would_drop_are_refused(tmp_path):
-    """MuJoCo writes a URDF's fixed links as <frame> elements, which pinocchio's parser skips with what
-    is in them: the Panda's fingers and hand vanished, mass and all, without a word."""
-    path = panda_mjcf(tmp_path, frames=True)
-    with pytest.raises(ExciteError, match="leaves out joint.s. panda_finger_joint1, panda_finger_joint2 of panda.xml"):
-        load_robot(RobotConfig(urdf=str(path), active_joints=JOINTS))
+def test_bodies_in_frames_are_read_as_mujoco_reads_them(tmp_path):
+    """MuJoCo writes a URDF's fixed links as <frame> elements (pinocchio's parser skipped them with
+    what is in them: the Panda's fingers and hand vanished, mass and all): the same model as without."""
+    plain = load_robot(RobotConfig(urdf=str(panda_mjcf(tmp_path)), active_joints=JOINTS))
+    (tmp_path / "framed").mkdir()
+    framed_path = panda_mjcf(tmp_path / "framed", frames=True)
+    framed = load_robot(RobotConfig(urdf=str(framed_path), active_joints=JOINTS))
+    assert framed.model.njoints == plain.model.njoints
+    values = plain.urdf_parameters()  # MuJoCo writes the framed file to 6 digits
+    np.testing.assert_allclose(framed.urdf_parameters(), values, atol=1e-5 * np.abs(values).max())
 
 
-ON_A_FLOOR = """<mujoco model="arm"><compiler angle="radian"/>{include}<worldbody>
+ARM_WITH_PARTS = """<mujoco model="arm"><compiler angle="degree"/><default><joint damping="0.1"/></default>
+  <worldbody><geom name="floor" type="plane" size="2 2 0.1"/>
+    <body name="link1" pos="0 0 0.1"><joint name="joint1" axis="0 0 1" range="-170 170"/>
+      <geom type="cylinder" size="0.05 0.1" mass="2"/><include file="{include}"/></body>
+  </worldbody>
+  <actuator><motor joint="joint1" gear="50" ctrlrange="-1 1" ctrllimited="true"/>
+    <motor joint="joint2" forcerange="-40 40" forcelimited="true"/>
+    <general joint="joint3" gear="10" ctrlrange="-2 2"/>
+    <position joint="joint3" kp="100" ctrlrange="-1 1"/></actuator>
+</mujoco>"""
+PARTS = """<mujoco><body name="link2" pos="0 0 0.3">
+    <joint name="joint2" axis="0 1 0" range="-90 90" damping="0.5" frictionloss="0.2" armature="0.01"/>
+    <geom type="capsule" fromto="0 0 0 0.05 0 0.3" size="0.04" mass="1.5"/>
+    <frame pos="0 0.02 0.3" euler="0 0 90"><body name="link3"><joint name="joint3" axis="0 1 0" pos="0 0 0.02"
+      range="-90 90"/><geom type="box" size="0.03 0.02 0.1" pos="0.01 0 0.1" mass="0.8"/></body></frame>
+</body></mujoco>"""
+
+
+def test_an_mjcf_with_includes_frames_a_floor_and_actuators_is_the_robot_mujoco_simulates(tmp_path):
+    """What MuJoCo compiles, excite models: every joint (one in an included file, one in a <frame>),
+    the floor left to the world, torque limits from the actuators (gear × ctrlrange of a motor, the
+    forcerange, a general actuator's gain; a position servo's ctrlrange is a position), the damping
+    and frictionloss said; MuJoCo's own inverse dynamics of the file equals excite's (RNEA with the
+    armature) once the said damping is added, at random states, constraints off."""
+    mujoco = pytest.importorskip("mujoco")
+    (tmp_path / "parts.xml").write_text(PARTS)
+    (tmp_path / "arm.xml").write_text(ARM_WITH_PARTS.format(include="parts.xml"))
+    joints = ["joint1", "joint2", "joint3"]
+    with pytest.warns(
+        ExciteWarning,
+        match=r"damping \[N·m·s/rad\] \(joint1 0.1, joint2 0.5, joint3 0.1\).*"
+        r"frictionloss \[N·m\] \(joint2 0.2\)",
+    ):
+        robot = load_robot(RobotConfig(urdf=str(tmp_path / "arm.xml"), active_joints=joints), collision=True)
+    assert robot.joint_names == joints
+    np.testing.assert_allclose(robot.model.effortLimit[robot.v_idx], [50.0, 40.0, 20.0])
+    np.testing.assert_allclose(robot.lower, np.radians([-170, -90, -90]))
+    assert len(robot.collision_model.geometryObjects) == 3  # not the floor
+    mj = mujoco.MjModel.from_xml_path(str(tmp_path / "arm.xml"))
+    mj.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
+    data = mujoco.MjData(mj)
+    rng = np.random.default_rng(0)
+    for q, qd, qdd in zip(*rng.uniform(-1, 1, (3, 5, 3))):
+        data.qpos[:], data.qvel[:], data.qacc[:] = q, qd, qdd
+        mujoco.mj_inverse(mj, data)
+        excite = robot.torques(q, qd, qdd) + mj.dof_damping * qd
+        np.testing.assert_allclose(excite, data.qfrc_inverse, rtol=1e-9, atol=1e-9)
+    (tmp_path / "missing.xml").write_text(ARM_WITH_PARTS.format(include="hand.xml"))
+    with pytest.raises(ExciteError, match=r"robot.urdf: MuJoCo cannot compile missing.xml: .*'hand.xml'"):
+        load_robot(RobotConfig(urdf=str(tmp_path / "missing.xml"), active_joints=joints))
+
+
+ON_A_FLOOR = """<mujoco model="arm"><compiler angle="radian"/><worldbody>
   <geom name="floor" type="plane" size="2 2 0.1"/>
   <body name="link1" pos="0 0 0.1"><joint name="j1" type="hinge" axis="0 0 1" range="-2 2"/>
     <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.03" mass="1"/></body>
 </worldbody></mujoco>"""
 
 
-def test_a_floor_in_the_worldbody_is_the_world_s_and_an_include_is_named(tmp_path):
-    """A floor geom directly in <worldbody> ended init in an IndexError (pinocchio's reduced model
-    loses its frame); an <include> was ignored in silence (a 3-joint arm drafted as 2 joints)."""
-    (tmp_path / "arm.xml").write_text(ON_A_FLOOR.format(include=""))
+def test_a_floor_in_the_worldbody_is_the_world_s(tmp_path):
+    """A floor geom directly in <worldbody> ended init in an IndexError."""
+    (tmp_path / "arm.xml").write_text(ON_A_FLOOR)
     robot = load_robot(RobotConfig(urdf=str(tmp_path / "arm.xml"), active_joints=["j1"]), collision=True)
     assert [robot.model.frames[o.parentFrame].name for o in robot.collision_model.geometryObjects] == ["link1"]
-    (tmp_path / "top.xml").write_text(ON_A_FLOOR.format(include='<include file="hand.xml"/>'))
-    config = RobotConfig(urdf=str(tmp_path / "top.xml"), active_joints=["j1"])
-    with pytest.raises(ExciteError, match="top.xml includes hand.xml, which does not exist"):
-        load_robot(config)
-    (tmp_path / "hand.xml").write_text("<mujoco><worldbody/></mujoco>")
-    with pytest.raises(ExciteError, match=r"top.xml includes hand.xml \(<include>\), which pinocchio's MJCF reader"):
-        load_robot(config)
