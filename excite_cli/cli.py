@@ -42,7 +42,7 @@ def optimize(
     resume: bool = typer.Option(False, "--resume", help="Continue the iterations already in the output file."),
     dry_run: bool = typer.Option(False, "--dry-run", help="Build the problem and say what would run (as `check`)."),
 ) -> None:
-    """Optimize Fourier trajectories minimizing cond(C), sequentially; the result is rewritten after every iteration."""
+    """Optimize exciting Fourier trajectories by optimizer.objective (default A-optimality; log_cond: the paper's)."""
     problem = _load(
         config,
         {

@@ -141,3 +141,19 @@ def test_the_figures_page_holds_current_results_only():
     assert DEVELOPMENT_LOG.search("re-measured with the code of today (2026-11-25)")
     images = re.findall(r"^!\[.*\]\(images/.*\)\n\n(.*)$", page, flags=re.M)
     assert len(images) == page.count("](images/") and all(line.startswith("*") for line in images)
+
+
+def test_every_section_of_how_it_works_cited_elsewhere_is_a_heading_its_links_reach():
+    """Other pages cite How it works by section: each citation is a link, and each link's anchor is
+    the slug mkdocs gives one of the page's headings (the build checks links to pages, not anchors)."""
+    from markdown.extensions.toc import slugify
+
+    page = (ROOT / "docs" / "how-it-works.md").read_text()
+    anchors = {slugify(title, "-") for title in re.findall(r"^#+ (.+)$", page, flags=re.M)}
+    pages = [ROOT / "README.md", *sorted(p for p in (ROOT / "docs").glob("*.md") if p.name != "how-it-works.md")]
+    texts = {p.name: p.read_text() for p in pages}
+    linked = {(name, a) for name, text in texts.items() for a in re.findall(r"how-it-works\.md#([\w-]+)", text)}
+    cited = [(name, m.group()) for name, text in texts.items() for m in re.finditer(r'(?<!\[)[Hh]ow it works, "', text)]
+    assert cited == []  # every citation by section is a link
+    assert len({a for _, a in linked}) >= 8
+    assert sorted((name, a) for name, a in linked if a not in anchors) == []

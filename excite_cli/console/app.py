@@ -50,7 +50,7 @@ APPROACH = typer.Option(
 EFFORT = typer.Option(
     False,
     "--effort",
-    help="ros2/rosbag2: the feed-forward torque as the points' effort, for an effort-controlled "
+    help="ros2/rosbag2: the feed-forward torque (gravity included) as the points' effort, for an effort-controlled "
     "joint_trajectory_controller (ros2_controllers 4.22 on, Jazzy); others refuse any effort.",
 )
 RUNS = typer.Option(None, "--runs", help="identify: measured runs (CSV, NPZ, MAT, HDF5, ROS bag), repeatable.")
