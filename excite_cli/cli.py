@@ -206,10 +206,11 @@ def export(
     force: bool = FORCE,
     output: Optional[Path] = typer.Option(None, "--output", "-o", help="File to write (default: beside the result)."),
     approach: Optional[float] = console.app.APPROACH,
+    joint_names: Optional[str] = console.app.JOINT_NAMES,
 ) -> None:
     """Write a trajectory as a robot plays it: home → P periods → home, at the controller's rate, with torques."""
     exported, target = workflows.run_export(
-        result, iteration, rate, periods, fmt, output, force, speed, effort, approach
+        result, iteration, rate, periods, fmt, output, force, speed, effort, approach, joint_names
     )
     say(console.export_lines.export_lines(exported, rate, target, fmt, effort))
 

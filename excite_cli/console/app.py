@@ -44,6 +44,9 @@ MODEL = typer.Option(None, "--model", help="Identify report whose effects to des
 JOINTS = typer.Option(
     None, "--joints", help="Active joints, repeatable or comma-separated (default: the arm's revolute joints)."
 )
+JOINT_NAMES = typer.Option(
+    None, "--joint-names", help="Joints as the controller names them: robot=controller pairs, or a YAML map file."
+)
 APPROACH = typer.Option(
     None, "--approach", help="Seconds a ROS 2 trajectory gives to reach home first (default: from anywhere)."
 )

@@ -11,6 +11,7 @@ from excite_cli.errors import ExciteError
 from excite_cli.storage.export import Export, Played, check_playback, export_trajectory
 from excite_cli.storage.export_files import write_export
 from excite_cli.storage.formats import export_format
+from excite_cli.storage.joint_map import read_joint_map, renamed
 from excite_cli.storage.paths import check_target
 from excite_cli.storage.results import read_alphas
 from excite_cli.storage.rosbag import check_bag_target
@@ -61,20 +62,24 @@ def run_export(
     speed: float = 1.0,
     effort: bool = False,
     approach: float | None = None,
+    joint_names: str | None = None,
 ) -> tuple[Export, Path]:
     """:func:`played_result` written by :func:`write_export` to ``output`` (default
     ``<result>_iteration<K>_<rate>Hz.<ending>``, the format's ending, beside the result; a
     bag is a folder of that name without an ending); a given ``output`` is checked first. ``effort``
-    puts τ in a ROS 2 trajectory's points (for an effort-controlled joint_trajectory_controller).
+    puts τ in a ROS 2 trajectory's points (for an effort-controlled joint_trajectory_controller);
+    ``joint_names`` renames the joints as the controller names them (:mod:`~excite_cli.storage.joint_map`).
 
     Raises:
-        ExciteError: see both, and a bad or existing (without ``force``) output path.
+        ExciteError: see both and :func:`~excite_cli.storage.joint_map.renamed`, and a bad or existing
+            (without ``force``) output path.
     """
     form = export_format(fmt, effort)
     check = check_bag_target if form.folder else check_target
     if output is not None:
         check(output, "output", force)
-    export = played_result(result, iteration, rate, periods, speed, approach)
+    mapping = read_joint_map(joint_names) if joint_names else {}
+    export = renamed(played_result(result, iteration, rate, periods, speed, approach), mapping)
     faster = f"_speed{speed:g}" if speed != 1.0 else ""
     target = output or result.with_name(f"{result.stem}_iteration{export.iteration}_{rate:g}Hz{faster}{form.suffix}")
     return export, write_export(check(target, "output", force), export, fmt, effort)
