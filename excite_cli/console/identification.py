@@ -217,7 +217,21 @@ def _selection_tables(report: Report) -> list[Table | str]:
         if sel.absorbed
         else []
     )
-    return [ladder, *search(report), effects, *absorbed, *_guarded(report), params]
+    return [ladder, *search(report), effects, *absorbed, *_guarded(report), params, *_unresolved(report)]
+
+
+#: A base parameter whose standard deviation is this many times its magnitude is not told from 0.
+UNRESOLVED = 10.0
+
+
+def _unresolved(report: Report) -> list[str]:
+    """A line naming the base parameters whose std is ``UNRESOLVED`` times their least-squares value
+    or more (a direction the data hardly excites, or a rounding of the robot's file), if any."""
+    fit = report.selection.fit
+    names = [n for n, x, s in zip(report.base_names, fit.x, fit.std) if s >= UNRESOLVED * abs(x)]
+    if not names:
+        return []
+    return [f"std ≥ {UNRESOLVED:g} × the value (the data cannot tell them from 0): {', '.join(names)}"]
 
 
 def _guarded(report: Report) -> list[str]:

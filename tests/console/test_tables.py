@@ -16,7 +16,7 @@ from excite_cli.config_file import load_problem
 from excite_cli.console import tables
 from excite_cli.console.bodies import consistent_bodies
 from excite_cli.console.errors import printed_warnings, spellings, word
-from excite_cli.console.identification import validation
+from excite_cli.console.identification import _unresolved, validation
 from excite_cli.console.progress import Bars
 from excite_cli.errors import ExciteError, ExciteWarning, OutputExists
 from excite_cli.identification.fitting.physical import ConsistentFit
@@ -149,3 +149,15 @@ def test_the_consistent_bodies_table_gives_the_last_body_with_its_payload_the_pa
         1e-5 * payload[None], [last], np.zeros(0, dtype=bool),
     )  # fmt: skip
     assert re.search(rf"\(in their masses above\): {last} 0.000 kg\s*$", _text([consistent_bodies(fit, robot)]))
+
+
+def test_base_parameters_the_data_cannot_tell_from_zero_are_named():
+    """The two directions a rounded URDF adds came out of identify as 0.063 ± 7.98 and −3e-5 ± 4.06
+    without a word."""
+    from types import SimpleNamespace
+
+    fit = SimpleNamespace(x=np.array([1.2, 0.063, -3e-5, 0.01]), std=np.array([0.01, 7.98, 4.06, 0.05]))
+    report = SimpleNamespace(base_names=["m1", "a", "b", "c"], selection=SimpleNamespace(fit=fit))
+    assert _unresolved(report) == ["std ≥ 10 × the value (the data cannot tell them from 0): a, b"]
+    fit.std[1:3] = [0.001, 1e-6]
+    assert _unresolved(report) == []
