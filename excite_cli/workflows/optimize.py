@@ -27,6 +27,9 @@ from excite_cli.storage.results import read_iterations, write_result
 #: The largest cond(C) of a result that identifies something: above it, noise in the torques is
 #: amplified a million times into the base parameters (Eq. 5 bounds the relative error by cond(C)).
 MAX_USEFUL_COND = 1e6
+#: Neighbouring singular values of the stacked C further apart than this leave directions behind the
+#: rest (a well-excited C has all within its cond(C), 10–100).
+LONE_GAP = 1e3
 #: Coefficients the table of improvements shows.
 IMPROVED_SHOWN = 8
 RESUMABLE_CHANGES = ("sequence.iterations", "optimizer.workers", "optimizer.scheduler", "optimizer.worker_wait")
@@ -69,12 +72,29 @@ class OptimizeRun:
         order = np.argsort(-gain, kind="stable")[:IMPROVED_SHOWN]
         return [(names[k], float(before[k]), float(after[k])) for k in order]
 
+    def _lone_direction(self) -> str:
+        """Why a cond(C) below :data:`MAX_USEFUL_COND` still hides an unexcited direction, "" when
+        nothing: the stacked C's singular values with a gap of more than :data:`LONE_GAP` between two
+        neighbours (the directions below it dominate cond(C); a URDF's rounding adds such)."""
+        C = np.vstack([*([] if self.prior is None else [self.prior]), *[r.regressor for r in self.results]])
+        sigma = np.linalg.svd(C, compute_uv=False)
+        ratios = sigma[:-1] / np.maximum(sigma[1:], np.finfo(float).tiny)
+        if not ratios.size or ratios.max() <= LONE_GAP:
+            return ""
+        below = sigma.size - 1 - int(np.argmax(ratios))
+        return (
+            f"{below} direction(s) of the stacked regressor lie {ratios.max():.3g} times below the rest: cond(C) "
+            f"{self.results[-1].cond_stacked:.3g} is theirs, and what they carry no trajectory here excites "
+            "(a rounding of the robot's file, or a parameter the limits leave still)"
+        )
+
     @property
     def warning(self) -> str:
         """Why the result should not be run, "" when nothing: an iteration the fine check rejects
         (a constraint no restart could meet, such as ``limits.min_torque_use``), or the stacked
         regressor of the last iteration with cond(C) above :data:`MAX_USEFUL_COND` (rank-deficient
-        or nearly: no motion, or limits that leave none)."""
+        or nearly: no motion, or limits that leave none), or one with a lone direction
+        (:meth:`_lone_direction`)."""
         for result in self.results:
             if result.max_violation > 0:
                 return (
@@ -83,7 +103,7 @@ class OptimizeRun:
                 )
         cond = self.results[-1].cond_stacked
         if cond <= MAX_USEFUL_COND:
-            return ""
+            return self._lone_direction()
         return (
             f"cond(C) {cond:.3g} after iteration {self.results[-1].index}: the trajectories do not excite every "
             f"base parameter (expected cond(C) ≤ {MAX_USEFUL_COND:g}; are the limits or the frequency leaving "

@@ -121,3 +121,24 @@ def test_interrupted_run_keeps_finished_iterations(tmp_path, monkeypatch):
     with h5py.File(out) as f:
         assert list(f["iterations"].keys()) == ["1"] and len(f["table"]) == 1
     assert not out.with_name(".cut.h5.partial").exists()
+
+
+def test_a_direction_orders_below_the_rest_is_warned_about_below_the_cond_limit():
+    """A stacked C whose cond(C) is 7.6e5 (under 1e6) because two directions sit 1e-5 below the rest
+    (the issue's rounded 7-axis arm: "converged", no word): warned; a well-excited C is not."""
+    from types import SimpleNamespace
+
+    from excite_cli.workflows.optimize import OptimizeRun
+
+    rng = np.random.default_rng(0)
+    U, _ = np.linalg.qr(rng.standard_normal((300, 12)))
+    V, _ = np.linalg.qr(rng.standard_normal((12, 12)))
+    sigma = np.r_[np.linspace(40.0, 8.0, 10), 1.3e-4, 5.3e-5]
+    C = U @ np.diag(sigma) @ V.T
+    result = SimpleNamespace(max_violation=-1.0, regressor=C[150:], cond_stacked=np.linalg.cond(C))
+    run = OptimizeRun(None, [result], None, [], prior=C[:150])
+    assert result.cond_stacked < 1e6
+    assert run.warning.startswith("2 direction(s) of the stacked regressor lie 6.15e+04 times below the rest")
+    well = C @ V @ np.diag(np.r_[np.ones(10), 1e4, 1e4]) @ V.T  # the same directions excited
+    result.regressor, result.cond_stacked = well[150:], np.linalg.cond(well)
+    assert OptimizeRun(None, [result], None, [], prior=well[:150]).warning == ""
