@@ -306,3 +306,33 @@ def chain_urdf(arm: list[str], gripper: bool = True) -> str:
         )
         joint("left_finger_tip_joint", "revolute", "left_prox_link", "left_dist_link", "right_finger_bottom_joint")
     return f'<robot name="arm">{"".join(links)}{"".join(joints)}</robot>'
+
+
+ARM_WITH_PARTS = """<mujoco model="arm"><compiler angle="degree"/><default><joint damping="0.1"/></default>
+  <worldbody><geom name="floor" type="plane" size="2 2 0.1"/>
+    <body name="link1" pos="0 0 0.1"><joint name="joint1" axis="0 0 1" range="-170 170"/>
+      <geom type="cylinder" size="0.05 0.1" mass="2"/><include file="{include}"/></body>
+  </worldbody>
+  <actuator><motor joint="joint1" gear="50" ctrlrange="-1 1" ctrllimited="true"/>
+    <motor joint="joint2" forcerange="-40 40" forcelimited="true"/>
+    <general joint="joint3" gear="10" ctrlrange="-2 2"/>
+    <position joint="joint3" kp="100" ctrlrange="-1 1"/></actuator>
+</mujoco>"""
+PARTS = """<mujoco><body name="link2" pos="0 0 0.3">
+    <joint name="joint2" axis="0 1 0" range="-90 90" damping="0.5" frictionloss="0.2" armature="0.01"/>
+    <geom type="capsule" fromto="0 0 0 0.05 0 0.3" size="0.04" mass="1.5"/>
+    <frame pos="0 0.02 0.3" euler="0 0 90"><body name="link3"><joint name="joint3" axis="0 1 0" pos="0 0 0.02"
+      range="-90 90"/><geom type="box" size="0.03 0.02 0.1" pos="0.01 0 0.1" mass="0.8"/></body></frame>
+</body></mujoco>"""
+
+
+def included_arm_mjcf(folder: Path, include: str = "parts.xml", name: str = "arm.xml") -> Path:
+    """A 3-joint MJCF arm as a lab writes one: joints 2 and 3 in an included file, joint 3's body in a
+    <frame>, a floor in <worldbody>, a default class, damping and frictionloss, and actuators of
+    three kinds (a motor with gear 50 and ctrlrange 1: 50 N·m; forcerange 40 N·m; a general actuator
+    with gear 10 and ctrlrange 2: 20 N·m; a position servo, whose range is a position), as
+    ``folder/name`` including ``folder/include`` (written only when it is ``parts.xml``)."""
+    if include == "parts.xml":
+        (folder / include).write_text(PARTS)
+    (folder / name).write_text(ARM_WITH_PARTS.format(include=include))
+    return folder / name

@@ -5,7 +5,7 @@ parser would drop are each checked."""
 
 import numpy as np
 import pytest
-from conftest import JOINTS, panda_mjcf
+from conftest import JOINTS, included_arm_mjcf, panda_mjcf
 
 from excite_cli.config import RobotConfig
 from excite_cli.dynamics.base_parameters import compute_base_parameters
@@ -104,24 +104,6 @@ def test_bodies_in_frames_are_read_as_mujoco_reads_them(tmp_path):
     np.testing.assert_allclose(framed.urdf_parameters(), values, atol=1e-5 * np.abs(values).max())
 
 
-ARM_WITH_PARTS = """<mujoco model="arm"><compiler angle="degree"/><default><joint damping="0.1"/></default>
-  <worldbody><geom name="floor" type="plane" size="2 2 0.1"/>
-    <body name="link1" pos="0 0 0.1"><joint name="joint1" axis="0 0 1" range="-170 170"/>
-      <geom type="cylinder" size="0.05 0.1" mass="2"/><include file="{include}"/></body>
-  </worldbody>
-  <actuator><motor joint="joint1" gear="50" ctrlrange="-1 1" ctrllimited="true"/>
-    <motor joint="joint2" forcerange="-40 40" forcelimited="true"/>
-    <general joint="joint3" gear="10" ctrlrange="-2 2"/>
-    <position joint="joint3" kp="100" ctrlrange="-1 1"/></actuator>
-</mujoco>"""
-PARTS = """<mujoco><body name="link2" pos="0 0 0.3">
-    <joint name="joint2" axis="0 1 0" range="-90 90" damping="0.5" frictionloss="0.2" armature="0.01"/>
-    <geom type="capsule" fromto="0 0 0 0.05 0 0.3" size="0.04" mass="1.5"/>
-    <frame pos="0 0.02 0.3" euler="0 0 90"><body name="link3"><joint name="joint3" axis="0 1 0" pos="0 0 0.02"
-      range="-90 90"/><geom type="box" size="0.03 0.02 0.1" pos="0.01 0 0.1" mass="0.8"/></body></frame>
-</body></mujoco>"""
-
-
 def test_an_mjcf_with_includes_frames_a_floor_and_actuators_is_the_robot_mujoco_simulates(tmp_path):
     """What MuJoCo compiles, excite models: every joint (one in an included file, one in a <frame>),
     the floor left to the world, torque limits from the actuators (gear × ctrlrange of a motor, the
@@ -129,8 +111,7 @@ def test_an_mjcf_with_includes_frames_a_floor_and_actuators_is_the_robot_mujoco_
     and frictionloss said; MuJoCo's own inverse dynamics of the file equals excite's (RNEA with the
     armature) once the said damping is added, at random states, constraints off."""
     mujoco = pytest.importorskip("mujoco")
-    (tmp_path / "parts.xml").write_text(PARTS)
-    (tmp_path / "arm.xml").write_text(ARM_WITH_PARTS.format(include="parts.xml"))
+    included_arm_mjcf(tmp_path)
     joints = ["joint1", "joint2", "joint3"]
     with pytest.warns(
         ExciteWarning,
@@ -151,7 +132,7 @@ def test_an_mjcf_with_includes_frames_a_floor_and_actuators_is_the_robot_mujoco_
         mujoco.mj_inverse(mj, data)
         excite = robot.torques(q, qd, qdd) + mj.dof_damping * qd
         np.testing.assert_allclose(excite, data.qfrc_inverse, rtol=1e-9, atol=1e-9)
-    (tmp_path / "missing.xml").write_text(ARM_WITH_PARTS.format(include="hand.xml"))
+    included_arm_mjcf(tmp_path, "hand.xml", "missing.xml")
     with pytest.raises(ExciteError, match=r"robot.urdf: MuJoCo cannot compile missing.xml: .*'hand.xml'"):
         load_robot(RobotConfig(urdf=str(tmp_path / "missing.xml"), active_joints=joints))
 

@@ -9,7 +9,7 @@ import h5py
 import numpy as np
 import pytest
 import yaml
-from conftest import CHAIN_INERTIAL, GOOD, PENDULUM, assert_refused, chain_urdf, panda_mjcf
+from conftest import CHAIN_INERTIAL, GOOD, PENDULUM, assert_refused, chain_urdf, included_arm_mjcf, panda_mjcf
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
@@ -137,3 +137,18 @@ def test_a_urdf_without_inertias_gets_no_torque_limit_and_a_given_one_is_refused
     result = runner.invoke(app, ["check", "iiwa.yaml"], env={"COLUMNS": "300"})
     assert result.exit_code == 2 and "gives no mass to anything" in result.output  # warned, then refused
     assert "error: iiwa.yaml: limits.torque: joint_1, joint_2, joint_3 move(s) no mass" in result.output
+
+
+def test_init_and_check_draft_an_included_framed_mjcf_arm_with_its_actuators_torque_limits(tmp_path, monkeypatch):
+    """The full joint set (one joint in an included file, one in a <frame>), torque limits drafted
+    from the actuators, the floor left to the world, the damping said; a missing include named."""
+    monkeypatch.chdir(tmp_path)
+    included_arm_mjcf(tmp_path)
+    said = _ok(["init", "arm.xml"])
+    config = yaml.safe_load((tmp_path / "arm.yaml").read_text())
+    assert config["robot"]["active_joints"] == ["joint1", "joint2", "joint3"]
+    assert config["limits"]["torque"] == "urdf" and "actuators' force ranges" in said
+    assert "damping [N·m·s/rad] (joint1 0.1, joint2 0.5, joint3 0.1)" in said
+    assert "optimize would start" in _ok(["check", "arm.yaml"])
+    included_arm_mjcf(tmp_path, "hand.xml", "missing.xml")
+    assert_refused(tmp_path, ["init", "missing.xml"], "MuJoCo cannot compile missing.xml")
