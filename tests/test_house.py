@@ -321,3 +321,26 @@ def test_test_modules_have_unique_names():
     of one name in different folders fail collection."""
     names = [p.name for p in TESTS.rglob("test_*.py")]
     assert sorted(n for n in set(names) if names.count(n) > 1) == []
+
+
+def test_restart_ends_and_stop_reasons_are_enum_members_not_strings():
+    """A restart's end and stop reason are members of ``End`` and ``Stop``: a string of one of their
+    values anywhere else in the package is a kind spelled by hand, which a typo turns into a new kind."""
+    from excite_cli.search.kkt import Stop
+    from excite_cli.search.nlp import End
+
+    words = {m.value for m in (*Stop, *End)} - {"none", "start"}  # common words besides
+    found = []
+    for name, tree in _modules().items():
+        definitions = {
+            id(c)
+            for node in ast.walk(tree)
+            if isinstance(node, ast.ClassDef) and node.name in ("Stop", "End")
+            for c in ast.walk(node)
+        }
+        found += [
+            f"{name}:{node.lineno} {node.value!r}"
+            for node in ast.walk(tree)
+            if isinstance(node, ast.Constant) and node.value in words and id(node) not in definitions
+        ]
+    assert found == []

@@ -33,6 +33,7 @@ from __future__ import annotations
 import time
 import warnings
 from dataclasses import dataclass
+from enum import StrEnum
 from typing import Callable, Protocol, Sequence
 
 import numpy as np
@@ -53,16 +54,23 @@ IMPROVEMENT = 1e-3
 #: The solver's iterates between two Clarke tests of a non-smooth criterion (each a small SDP).
 NONSMOOTH_EVERY = 10
 
-#: The stop reasons a restart can end with (``INFEASIBLE``: no end point met a constraint that needs
-#: motion; ``TIME_BUDGET``: ``optimizer.time_budget`` ran out first, a result that depends on the machine).
-CONVERGED, STILL_IMPROVING, STALLED, SOLVER_FAILED, INFEASIBLE, TIME_BUDGET = (
-    "converged",
-    "iteration limit, still improving",
-    "stalled",
-    "solver failed",
-    "infeasible",
-    "time budget",
-)
+
+class Stop(StrEnum):
+    """The stop reasons a restart can end with (``INFEASIBLE``: no end point met a constraint that needs
+    motion; ``TIME_BUDGET``: ``optimizer.time_budget`` ran out first, a result that depends on the
+    machine; ``SCREENED_OUT``: left after its first solver iterations for better starts). Members are
+    the words results store and tables print."""
+
+    CONVERGED = "converged"
+    STILL_IMPROVING = "iteration limit, still improving"
+    STALLED = "stalled"
+    SOLVER_FAILED = "solver failed"
+    INFEASIBLE = "infeasible"
+    TIME_BUDGET = "time budget"
+    SCREENED_OUT = "screened out"
+
+
+CONVERGED, STILL_IMPROVING, STALLED, SOLVER_FAILED, INFEASIBLE, TIME_BUDGET, SCREENED_OUT = Stop
 
 
 @dataclass(frozen=True)

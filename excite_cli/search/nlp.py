@@ -5,6 +5,7 @@ solver's iterate (or, where that fails, a feasible point towards it)."""
 
 from __future__ import annotations
 
+from enum import StrEnum
 from typing import Optional, Sequence
 
 import numpy as np
@@ -22,6 +23,20 @@ from excite_cli.search.kkt import (
 )
 from excite_cli.trajectory.boundary import BoundaryConditions
 from excite_cli.trajectory.fourier import FourierBasis
+
+
+class End(StrEnum):
+    """Which point a restart kept (:class:`~excite_cli.search.optimizer.RestartResult`): its start, the
+    feasible point nearest the solver's last iterate (``PROJECTED``), a point towards the start
+    (``BISECTION``: never kept as the solver's own), its best iterate inside every constraint
+    (``INSIDE``), or none (no end point met a constraint that needs motion)."""
+
+    START = "start"
+    PROJECTED = "projected"
+    BISECTION = "bisection"
+    INSIDE = "inside"
+    NONE = "none"
+
 
 #: Bisection steps towards a feasible point (the segment's length / 2¹²).
 BISECTIONS = 12
@@ -263,9 +278,9 @@ def onto_fine_grid(
         tightened = problem.tightened(violations * 2.0**k)
         projected = project(tightened, problem.boundary.to_variables(alpha))
         if projected is not None and accepted(problem.all, projected, fine_basis):
-            return tightened, projected, "projected"
+            return tightened, projected, End.PROJECTED
     t = farthest_accepted(problem.all, start, alpha, BISECTIONS, fine_basis)
-    return problem, start + t * (alpha - start), "bisection"
+    return problem, start + t * (alpha - start), End.BISECTION
 
 
 def repair(

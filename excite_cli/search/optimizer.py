@@ -25,7 +25,7 @@ from excite_cli.config import OptimizerConfig
 from excite_cli.constraints import Constraint, accepted
 from excite_cli.design.criterion import Criterion
 from excite_cli.search.kkt import INFEASIBLE, SOLVER_FAILED, Optimality, stationary, stop_reason, until_done
-from excite_cli.search.nlp import Epigraph, Evaluations, onto_fine_grid, project, repair
+from excite_cli.search.nlp import End, Epigraph, Evaluations, onto_fine_grid, project, repair
 from excite_cli.search.smoothing import Smoothed
 from excite_cli.search.solvers import SolverRun, criterion_scale, solve
 from excite_cli.trajectory.boundary import BoundaryConditions
@@ -84,7 +84,7 @@ class RestartResult:
         """Whether the solver's run gave a result: it did not fail, and the end point is its own (the
         feasible point nearest its last iterate, or its best iterate inside), not the start or a
         bisection towards it."""
-        return self.stop not in (SOLVER_FAILED, INFEASIBLE) and self.end in ("projected", "inside")
+        return self.stop not in (SOLVER_FAILED, INFEASIBLE) and self.end in (End.PROJECTED, End.INSIDE)
 
 
 def best_restart(results: Sequence[RestartResult]) -> RestartResult:
@@ -234,24 +234,24 @@ def optimize_restart(
     out_of_time = time.perf_counter() > deadline
     if len(history) < run.iterations:  # a solver that ends inside an iteration calls back no more: its last iterate
         on_iterate(run.z)
-    ends = [("start", start)]
+    ends = [(End.START, start)]
     projected = project(problem, run.z)
     if projected is not None:
-        ends.append(("projected", projected))
+        ends.append((End.PROJECTED, projected))
     else:
-        ends.append(("bisection", repair(constraints, boundary.to_alpha(run.z), start, boundary)))
+        ends.append((End.BISECTION, repair(constraints, boundary.to_alpha(run.z), start, boundary)))
     if problem.best_inside is not None:
-        ends.append(("inside", problem.best_inside))
+        ends.append((End.INSIDE, problem.best_inside))
     # judged by the criterion the solver minimized: a smoothing's start (a stalled end) can be lower in
     # the criterion itself by what the smoothing costs (excite_cli.search.restarts._smoothed_round weighs that)
     judge = (lambda a: nlp.value(boundary.to_variables(a))) if isinstance(nlp, Smoothed) else criterion.value
     scored = [
         (judge(alpha), k, name, alpha)
         for k, (name, alpha) in enumerate(ends)
-        if name == "projected" or accepted(constraints, alpha)
+        if name == End.PROJECTED or accepted(constraints, alpha)
     ]  # the projection is already accepted
     # only a constraint that needs motion rejects the start: when no end point meets it, none is kept
-    _, _, end, alpha = min(scored, key=lambda item: item[:2]) if scored else (np.inf, 0, "none", start)
+    _, _, end, alpha = min(scored, key=lambda item: item[:2]) if scored else (np.inf, 0, End.NONE, start)
     value = criterion.value(alpha) if scored else np.inf
     if scored and fine_basis is not None and not accepted(constraints, alpha, fine_basis):
         problem, alpha, end = onto_fine_grid(problem, alpha, start, fine_basis)

@@ -11,7 +11,7 @@ import numpy as np
 
 from excite_cli.design.excitation import Excitation
 from excite_cli.search.engine import Engine
-from excite_cli.search.kkt import CONVERGED, STALLED, TIME_BUDGET
+from excite_cli.search.kkt import CONVERGED, SCREENED_OUT, STALLED, TIME_BUDGET
 from excite_cli.search.optimizer import ProgressHook, RestartResult, optimize_restart
 from excite_cli.search.smoothing import log_criterion, smoothing_bound
 
@@ -223,7 +223,7 @@ def _restart_round(context: RestartContext, indices: range) -> list[RestartResul
     continued = {c.index: c for c in context.run(more, shifted)}
     screened = {r.index: r for r in chosen}
     return [
-        _joined(screened[r.index], continued[r.index]) if r.index in continued else replace(r, stop="screened out")
+        _joined(screened[r.index], continued[r.index]) if r.index in continued else replace(r, stop=SCREENED_OUT)
         for r in runs
     ]
 
