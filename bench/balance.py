@@ -1,5 +1,5 @@
 """Does the standing robot stay on its feet? Each iteration of the shipped G1 problem, optimized for
-every seed, played in MuJoCo on a floor (excite_cli/design/mujoco_stance.py: MuJoCo compiles the
+every seed, played in MuJoCo on a floor (bench/mujoco_stance.py: MuJoCo compiles the
 URDF itself; the soles' contact spheres, the free root, MuJoCo's integrator and soft contacts, and
 every joint given the damping, armature and dry friction of MuJoCo Menagerie's G1, which the URDF and
 excite's model do not have), as `excite export` plays it (home → one period → home, at 2 kHz, speed 1
@@ -44,12 +44,12 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
+from mujoco_stance import TIMESTEP, Stance, play_standing, standing_model
 from scipy.signal import find_peaks
 
 from excite_cli.config_file import load_problem
 from excite_cli.constraints.zmp import GRAVITY, zero_moment_point
 from excite_cli.design.held_joints import held_joints
-from excite_cli.design.mujoco_stance import TIMESTEP, Stance, play_standing, standing_model
 from excite_cli.design.playback import plan_playback
 from excite_cli.design.resolve import build_excitation
 from excite_cli.dynamics.urdf_source import resolve_urdf

@@ -111,6 +111,7 @@ FLOORS = (
     "dynamics",
     "collision",
     "constraints",
+    "stored",
     "identification",
     "config_file",
     "design",
@@ -326,8 +327,7 @@ def test_test_modules_have_unique_names():
 def test_restart_ends_and_stop_reasons_are_enum_members_not_strings():
     """A restart's end and stop reason are members of ``End`` and ``Stop``: a string of one of their
     values anywhere else in the package is a kind spelled by hand, which a typo turns into a new kind."""
-    from excite_cli.search.kkt import Stop
-    from excite_cli.search.nlp import End
+    from excite_cli.search.kkt import End, Stop
 
     words = {m.value for m in (*Stop, *End)} - {"none", "start"}  # common words besides
     found = []
@@ -344,3 +344,19 @@ def test_restart_ends_and_stop_reasons_are_enum_members_not_strings():
             if isinstance(node, ast.Constant) and node.value in words and id(node) not in definitions
         ]
     assert found == []
+
+
+def test_the_design_wing_and_the_identification_wing_import_nothing_of_each_other():
+    """What one run hands the next (a report, its model, prior data) is read in ``stored/``, under both
+    wings: the design and its search import nothing of the identification (the floors already keep the
+    identification from reaching them)."""
+    wing = ("excite_cli.design", "excite_cli.search")
+    crossing = sorted(
+        (name, dep)
+        for name, tree in _modules().items()
+        if name.startswith(wing)
+        for dep in _imports(tree)
+        if dep.startswith("excite_cli.identification")
+    )
+    assert crossing == []
+    assert _floor("excite_cli.stored.report") < _floor("excite_cli.identification.pipeline")

@@ -28,7 +28,7 @@ from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.dynamics.effect_columns import EffectColumns
 from excite_cli.dynamics.robot import Robot, load_robot
 from excite_cli.errors import ExciteError
-from excite_cli.identification.reporting.design_model import MeasuredPrior
+from excite_cli.stored.design_model import MeasuredPrior
 from excite_cli.trajectory.boundary import BoundaryConditions, boundary_conditions
 from excite_cli.trajectory.fourier import FourierBasis, FourierTrajectory, sample_times
 

@@ -1,6 +1,6 @@
 """The identification model a design is for, beyond the rigid body's base parameters: the effect
 columns beside the base columns (``effects``, ``effects.model``) and, when ``sequence.prior`` is an identify
-report, how its measured rows weigh (:mod:`~excite_cli.identification.reporting.design_model`)."""
+report, how its measured rows weigh (:mod:`~excite_cli.stored.design_model`)."""
 
 from __future__ import annotations
 
@@ -13,8 +13,8 @@ from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.dynamics.effect_columns import EffectColumns, effect_columns
 from excite_cli.dynamics.robot import Robot
 from excite_cli.errors import ExciteError
-from excite_cli.identification.reporting.design_model import MeasuredPrior, measured_prior_of, with_report_model
-from excite_cli.identification.reporting.stored_report import read_report
+from excite_cli.stored.design_model import MeasuredPrior, measured_prior_of, with_report_model
+from excite_cli.stored.report import read_report
 
 
 def measured_prior(path: str | None, folder: Path | None, robot: Robot) -> MeasuredPrior | None:

@@ -16,7 +16,7 @@ the weights move with α and their gradient ∂s/∂τ = −s ρ² τ / (σ² + 
 no joint's sensor measures) weigh as a row of noise σ̄.
 
 With an identify report as prior data (``sequence.prior``), σ_j are the report's
-(:class:`~excite_cli.identification.reporting.design_model.MeasuredPrior`): the rows of its recording
+(:class:`~excite_cli.stored.design_model.MeasuredPrior`): the rows of its recording
 are weighed by them, and the new trajectory's by the same σ_j and the config's ρ.
 """
 
@@ -29,7 +29,7 @@ import numpy as np
 from excite_cli.config import NoiseConfig
 from excite_cli.constraints.joint_limits import per_joint
 from excite_cli.dynamics.robot import Robot
-from excite_cli.identification.reporting.design_model import MeasuredPrior
+from excite_cli.stored.design_model import MeasuredPrior
 
 
 @dataclass(frozen=True)

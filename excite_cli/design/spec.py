@@ -31,7 +31,7 @@ from excite_cli.config import (
 )
 from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.dynamics.effect_columns import EffectColumns
-from excite_cli.identification.reporting.design_model import MeasuredPrior
+from excite_cli.stored.design_model import MeasuredPrior
 
 
 @dataclass(frozen=True)
@@ -65,7 +65,7 @@ class DesignSpec:
             the choice of base columns (:func:`~excite_cli.design.information.scaled_frame`), each
             effect column scaled by its typical magnitude (:meth:`EffectColumns.magnitudes`).
         measured: how the rows of ``sequence.prior`` weigh when it is an identify report
-            (:class:`~excite_cli.identification.reporting.design_model.MeasuredPrior`), or None.
+            (:class:`~excite_cli.stored.design_model.MeasuredPrior`), or None.
     """
 
     robot: RobotConfig

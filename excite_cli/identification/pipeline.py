@@ -35,7 +35,7 @@ from excite_cli.identification.measured.measurements import (
 )
 from excite_cli.identification.measured.payload import payload_parameters
 from excite_cli.identification.measured.preprocessing import choose_cutoff, preprocess
-from excite_cli.identification.reporting.design_model import PriorRows, prior_rows
+from excite_cli.identification.reporting.prior_rows import PriorRows, prior_rows
 from excite_cli.identification.reporting.report import Report
 from excite_cli.identification.reporting.urdf_out import urdf_deviation, write_urdf
 from excite_cli.memory import return_freed_memory, trim_freed_memory
@@ -178,7 +178,7 @@ def run_identification(
     Returns:
         The :class:`Report`, the robot, its base parameters and the rows of all samples, fit then
         validation, as prior data C₀ for ``optimize`` (Eq. 41): the base regressor and the chosen
-        effects' design columns (:class:`~excite_cli.identification.reporting.design_model.PriorRows`).
+        effects' design columns (:class:`~excite_cli.identification.reporting.prior_rows.PriorRows`).
 
     Raises:
         ExciteError: bad data or config (see :func:`prepare_data`), or a consistent fit without a

@@ -27,7 +27,7 @@ from excite_cli.identification.measured.gaps import split_at_gaps
 from excite_cli.identification.measured.measurements import load_run
 from excite_cli.identification.measured.payload import payload_parameters
 from excite_cli.identification.measured.preprocessing import preprocess
-from excite_cli.identification.reporting.stored_report import read_identify_report
+from excite_cli.stored.report import read_identify_report
 
 
 @dataclass(frozen=True)

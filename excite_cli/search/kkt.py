@@ -73,6 +73,19 @@ class Stop(StrEnum):
 CONVERGED, STILL_IMPROVING, STALLED, SOLVER_FAILED, INFEASIBLE, TIME_BUDGET, SCREENED_OUT = Stop
 
 
+class End(StrEnum):
+    """Which point a restart kept (:class:`~excite_cli.search.optimizer.RestartResult`): its start, the
+    feasible point nearest the solver's last iterate (``PROJECTED``), a point towards the start
+    (``BISECTION``: never kept as the solver's own), its best iterate inside every constraint
+    (``INSIDE``), or none (no end point met a constraint that needs motion)."""
+
+    START = "start"
+    PROJECTED = "projected"
+    BISECTION = "bisection"
+    INSIDE = "inside"
+    NONE = "none"
+
+
 @dataclass(frozen=True)
 class Optimality:
     """First-order optimality at a point.

@@ -5,7 +5,6 @@ solver's iterate (or, where that fails, a feasible point towards it)."""
 
 from __future__ import annotations
 
-from enum import StrEnum
 from typing import Optional, Sequence
 
 import numpy as np
@@ -16,6 +15,7 @@ from excite_cli.design.criterion import Criterion
 from excite_cli.memo import once
 from excite_cli.search.kkt import (
     CLUSTER_SIZE,
+    End,
     Optimality,
     clarke_optimality,
     extreme_clusters,
@@ -23,20 +23,6 @@ from excite_cli.search.kkt import (
 )
 from excite_cli.trajectory.boundary import BoundaryConditions
 from excite_cli.trajectory.fourier import FourierBasis
-
-
-class End(StrEnum):
-    """Which point a restart kept (:class:`~excite_cli.search.optimizer.RestartResult`): its start, the
-    feasible point nearest the solver's last iterate (``PROJECTED``), a point towards the start
-    (``BISECTION``: never kept as the solver's own), its best iterate inside every constraint
-    (``INSIDE``), or none (no end point met a constraint that needs motion)."""
-
-    START = "start"
-    PROJECTED = "projected"
-    BISECTION = "bisection"
-    INSIDE = "inside"
-    NONE = "none"
-
 
 #: Bisection steps towards a feasible point (the segment's length / 2¹²).
 BISECTIONS = 12

@@ -24,8 +24,8 @@ import numpy as np
 from excite_cli.config import OptimizerConfig
 from excite_cli.constraints import Constraint, accepted
 from excite_cli.design.criterion import Criterion
-from excite_cli.search.kkt import INFEASIBLE, SOLVER_FAILED, Optimality, stationary, stop_reason, until_done
-from excite_cli.search.nlp import End, Epigraph, Evaluations, onto_fine_grid, project, repair
+from excite_cli.search.kkt import INFEASIBLE, SOLVER_FAILED, End, Optimality, stationary, stop_reason, until_done
+from excite_cli.search.nlp import Epigraph, Evaluations, onto_fine_grid, project, repair
 from excite_cli.search.smoothing import Smoothed
 from excite_cli.search.solvers import SolverRun, criterion_scale, solve
 from excite_cli.trajectory.boundary import BoundaryConditions

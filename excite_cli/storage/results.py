@@ -122,7 +122,7 @@ def _write_iteration(group: h5py.Group, r: IterationResult) -> None:
     correlations.attrs["description"] = "with each earlier iteration's mean-removed q, in order (1: the same motion)"
     group.attrs["wall_time_s"] = r.wall_time_s
     group.attrs["sqp_iterations"] = r.sqp_iterations
-    group.attrs["stop"] = r.stop
+    group.attrs["stop"] = str(r.stop)  # a Stop member: its word
     group.attrs["optimizer_message"] = r.best.message if r.best else ""
     for key, value in r.checks.items():
         group.attrs[key] = value
@@ -137,8 +137,10 @@ def _write_restart(group: h5py.Group, r: RestartResult) -> None:
     history = group.create_dataset("history", data=r.history)
     history.attrs["columns"] = "objective, largest constraint value g (normalized, > 0 outside)"
     history.attrs["description"] = "one row per solver iteration, at its accepted iterate"
-    for name in ("objective", "start_objective", "iterations", "message", "wall_time_s", "stop", "end"):
+    for name in ("objective", "start_objective", "iterations", "wall_time_s"):
         group.attrs[name] = getattr(r, name)
+    for name in ("message", "stop", "end"):  # words (``stop`` and ``end`` are Stop and End members)
+        group.attrs[name] = str(getattr(r, name))
     o = r.optimality
     group.attrs.update(
         kkt_residual=o.residual,

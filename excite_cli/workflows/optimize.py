@@ -21,8 +21,8 @@ from excite_cli.search.engine import Engine, default_workers
 from excite_cli.search.optimizer import ProgressHook
 from excite_cli.search.sequence import IterationResult, run_sequence
 from excite_cli.storage.paths import check_target, output_lock
-from excite_cli.storage.prior import read_prior
 from excite_cli.storage.results import read_iterations, write_result
+from excite_cli.stored.prior import read_prior
 
 #: The largest cond(C) of a result that identifies something: above it, noise in the torques is
 #: amplified a million times into the base parameters (Eq. 5 bounds the relative error by cond(C)).

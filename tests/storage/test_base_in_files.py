@@ -11,8 +11,8 @@ from excite_cli.design.resolve import build_excitation
 from excite_cli.errors import ExciteError
 from excite_cli.h5 import read_strings, write_strings
 from excite_cli.search.sequence import describe
-from excite_cli.storage.prior import read_prior
 from excite_cli.storage.results import read_iterations, write_result
+from excite_cli.stored.prior import read_prior
 
 
 @pytest.fixture(scope="module")

@@ -16,9 +16,9 @@ from excite_cli.dynamics.robot import Robot
 from excite_cli.h5 import atomic_h5, write_parts, write_strings, write_table
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.fitting.bodies import body_properties
-from excite_cli.identification.reporting.design_model import PriorRows
 from excite_cli.identification.reporting.mjcf_check import MujocoCheck, write_mujoco_group
 from excite_cli.identification.reporting.mjcf_out import MjcfModel
+from excite_cli.identification.reporting.prior_rows import PriorRows
 from excite_cli.identification.reporting.report import Report
 
 STR = h5py.string_dtype()

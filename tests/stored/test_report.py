@@ -8,7 +8,7 @@ import pytest
 from excite_cli.errors import ExciteError
 from excite_cli.identification.effects import Term
 from excite_cli.identification.fitting.least_squares import predict
-from excite_cli.identification.reporting.stored_report import read_identify_report, read_report
+from excite_cli.stored.report import read_identify_report, read_report
 
 
 def test_the_report_read_back_is_the_reported_model(simulated_identification, report_file):

@@ -11,14 +11,14 @@ from excite_cli.config_file import load_problem
 from excite_cli.design.resolve import build_excitation
 from excite_cli.errors import ExciteError
 from excite_cli.h5 import read_strings
-from excite_cli.identification.reporting.design_model import (
+from excite_cli.stored.design_model import (
     MeasuredPrior,
     measured_prior_of,
     report_model,
     with_report_model,
 )
-from excite_cli.identification.reporting.stored_report import read_identify_report, read_report
-from excite_cli.storage.prior import read_prior
+from excite_cli.stored.prior import read_prior
+from excite_cli.stored.report import read_identify_report, read_report
 
 
 def test_the_reports_friction_becomes_the_designs_columns(report_file, simulated_identification):
@@ -183,33 +183,6 @@ def test_a_report_whose_rows_do_not_match_is_refused_in_one_line(report_file, tm
         f["regressor"] = rows
     with pytest.raises(ExciteError, match=r"sequence\.prior.*not a whole number of instants"):
         read_prior(edited, excitation.base, (), excitation.measured, 0.2)
-
-
-def test_a_coupled_motor_and_an_offset_are_named_and_placed_as_a_design_has_them():
-    """prior_rows of a two-joint dataset with a motor turning with both joints and an offset on the
-    first: the names are those a design of the same model gives (effect_columns), the motor's block
-    stands on both joints' rows times their transmission, the offset is ones on its joint's rows."""
-    from excite_cli.config import EffectsConfig, MotorConfig
-    from excite_cli.dynamics.effect_columns import effect_columns
-    from excite_cli.identification.effects import Term
-    from excite_cli.identification.fitting.dataset import Dataset
-    from excite_cli.identification.reporting.design_model import prior_rows
-
-    motor, offset = Term("motor", 0, coupling=(1.0, -2.0)), Term("offset", 0)
-    cols = np.arange(9.0).reshape(3, 3)
-    data = Dataset(
-        np.ones((6, 4)), np.zeros(6), np.arange(3.0), np.zeros(3, int), {motor: cols, offset: np.ones((3, 1))}
-    )
-    rows = prior_rows([data], [offset, motor], ["a", "b"])
-    design = effect_columns(
-        EffectsConfig(joints={"a": ["offset"]}, motors=[MotorConfig(joints=["a", "b"], transmission=[1.0, -2.0])]),
-        ["a", "b"],
-        2,
-    )
-    assert rows.effect_names == list(design.names)
-    np.testing.assert_array_equal(rows.effects[0][:, 0], [1.0, 0.0] * 3)
-    np.testing.assert_array_equal(rows.effects[0][0::2, 1:], cols)
-    np.testing.assert_array_equal(rows.effects[0][1::2, 1:], -2.0 * cols)
 
 
 def _damaged(report_file, tmp_path, edit):

@@ -12,7 +12,7 @@ import numpy as np
 from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.errors import ExciteError
 from excite_cli.h5 import open_h5, read_strings
-from excite_cli.identification.reporting.design_model import MeasuredPrior
+from excite_cli.stored.design_model import MeasuredPrior
 
 
 def read_prior(
@@ -28,7 +28,7 @@ def read_prior(
     an identify report's ``/effect_regressor``: those it holds, taken by name).
 
     An identify report's rows (``measured``, see
-    :class:`~excite_cli.identification.reporting.design_model.MeasuredPrior`) are weighed as
+    :class:`~excite_cli.stored.design_model.MeasuredPrior`) are weighed as
     identification weighs them: each joint's rows times σ̄/σ_j, and every row times
     √(1 / (cost_period · rate)) so that one second of recording carries the information of one second
     of a trajectory on the cost grid (``cost_period`` [s]).

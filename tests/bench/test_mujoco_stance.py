@@ -4,6 +4,9 @@ fast random arm motion, where the centre of mass's projection does not, and MuJo
 span excite's support polygon. Held by a joint PD instead of welded, the stance sways away from the
 prediction unless its held joints get the feed-forward ``export`` writes for them."""
 
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 from conftest import CONFIGS
@@ -11,10 +14,12 @@ from conftest import CONFIGS
 from excite_cli.config_file import load_problem
 from excite_cli.constraints.zmp import zero_moment_point
 from excite_cli.design.held_joints import held_joints
-from excite_cli.design.mujoco_stance import TIMESTEP, Stance, StandingRun, play_standing, standing_model
 from excite_cli.design.resolve import build_excitation
 from excite_cli.dynamics.urdf_source import resolve_urdf
 from excite_cli.errors import ExciteError
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))
+from mujoco_stance import TIMESTEP, Stance, StandingRun, play_standing, standing_model  # noqa: E402  (a bench module)
 
 
 @pytest.fixture(scope="module")

@@ -4,8 +4,9 @@ and viscous friction, armature and torque offset, and each coupled motor with it
 (``/identification/effect_coupling``). Effects the design cannot hold as columns (asymmetric,
 Stribeck, held and load-dependent friction: nonlinear in a shape or a first fit; springs and position
 harmonics) are named and left out. As ``sequence.prior`` its rows are weighed as identification
-weighs them (:class:`MeasuredPrior`), and hold the columns of those effects too (:func:`prior_rows`), so
-one report is both the model and the prior data of the next design."""
+weighs them (:class:`MeasuredPrior`), and hold the columns of those effects too
+(:func:`~excite_cli.identification.reporting.prior_rows.prior_rows` wrote them), so one report is both
+the model and the prior data of the next design."""
 
 from __future__ import annotations
 
@@ -16,12 +17,9 @@ from pathlib import Path
 import numpy as np
 
 from excite_cli.config import EffectsConfig, MotorConfig
-from excite_cli.dynamics.effect_columns import coefficient_name
 from excite_cli.effects import DESIGNED, EFFECTS
 from excite_cli.errors import ExciteError, ExciteWarning
-from excite_cli.identification.effects import Term
-from excite_cli.identification.fitting.dataset import Dataset
-from excite_cli.identification.reporting.stored_report import StoredReport, read_identify_report
+from excite_cli.stored.report import StoredReport, read_identify_report
 
 
 @dataclass(frozen=True)
@@ -179,63 +177,3 @@ def measured_prior_of(report: StoredReport, path: Path) -> MeasuredPrior:
             f"a positive rate up to {HIGHEST_RATE:g} Hz",
         )
     return MeasuredPrior(joints, sigma, rate)
-
-
-@dataclass
-class PriorRows:
-    """An identify report's rows as prior data: the base regressor and the design's effect columns of
-    the same samples, in parts (fit, then validation), which the report file writes and empties.
-
-    Attributes:
-        regressor: (M_k, b) base regressor rows per part.
-        effects: (M_k, e) effect columns per part, named ``effect_names`` as a design names them
-            (:func:`~excite_cli.dynamics.effect_columns.effect_columns`: ``Fc_panda_joint4``,
-            ``Ia_motor_wrist_2+wrist_3``).
-        effect_names: (e,) the names.
-    """
-
-    regressor: list[np.ndarray]
-    effects: list[np.ndarray]
-    effect_names: list[str]
-
-
-def _design_names(term: Term, joints: list[str]) -> list[str] | None:
-    """The design's names of ``term``'s columns, or None for an effect a design does not hold (module
-    docstring) or a coupled joint effect (the design couples only motors)."""
-    if term.kind.parts:  # a motor: its columns are its parts', in that order
-        return [coefficient_name(kind, [joints[j] for j in term.joints], motor=True) for kind in term.kind.parts]
-    if term.kind.designed and term.coupling is None:
-        return [coefficient_name(term.effect, [joints[term.joint]])]
-    return None
-
-
-def prior_rows(parts: list[Dataset], terms: list[Term], joints: list[str]) -> PriorRows:
-    """The rows of ``parts`` (the identification's fit and validation data) as prior data: their base
-    regressor, and the columns of the chosen ``terms`` a design holds, taken from the parts' own
-    low-passed and decimated effect blocks (the columns identification fitted, weighed as it weighed
-    them), an offset as one column of ones on its joint's rows (the design's, not one per run).
-
-    Args:
-        parts: datasets with the blocks of ``terms``; joints: the active joints (n), in the rows' order.
-
-    Returns:
-        Per part, (M_k, b) base regressor rows and (M_k, e) effect columns: the prior data C₀ of the
-        paper's sequential generation (Eq. 41) once :func:`~excite_cli.storage.prior.read_prior` weighs
-        them as identification did.
-    """
-    names: list[str] = []
-    columns: list[list[np.ndarray]] = [[] for _ in parts]
-    for term in terms:
-        named = _design_names(term, joints)
-        if named is None:
-            continue
-        names += named
-        for out, data in zip(columns, parts):
-            if term.kind.per_run:  # the design's offset: one column of ones, not one per run
-                block = np.zeros((data.tau.size, 1))
-                block[term.joint :: data.n] = 1.0
-            else:
-                block = data.block(term)
-            out.append(block)
-    effects = [np.hstack(c) if c else np.zeros((d.tau.size, 0)) for c, d in zip(columns, parts)]
-    return PriorRows([d.regressor for d in parts], effects, names)
