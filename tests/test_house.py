@@ -360,3 +360,23 @@ def test_the_design_wing_and_the_identification_wing_import_nothing_of_each_othe
     )
     assert crossing == []
     assert _floor("excite_cli.stored.report") < _floor("excite_cli.identification.pipeline")
+
+
+def test_no_module_outside_the_constraints_asks_a_constraint_its_class():
+    """The plots and the drafting learn what a constraint draws, keeps apart or leaves idle from its own
+    methods (``drawn``, ``capsules``, ``never_apart``, ``always_within``), not from ``isinstance`` at the
+    caller: a new constraint class is then drawn and drafted without touching them."""
+    import excite_cli.design.excitation  # noqa: F401  (imports every constraint class)
+    from excite_cli.constraints import Constraint
+
+    classes = {c.__name__ for c in _subclasses(Constraint)} | {"Constraint"}
+    asked = []
+    for name, tree in _modules().items():
+        if name.startswith("excite_cli.constraints"):
+            continue
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Call) and getattr(node.func, "id", "") == "isinstance" and len(node.args) == 2:
+                named = {n.id for n in ast.walk(node.args[1]) if isinstance(n, ast.Name)}
+                if named & classes:
+                    asked.append(f"{name}:{node.lineno}")
+    assert asked == []

@@ -107,6 +107,10 @@ class ComRegion(Constraint):
 
     track_units = {"com_xy": "m"}
 
+    def drawn(self) -> dict[str, object]:
+        """The region around the CoM's track: its centre, and its radius or polygon."""
+        return {"centre": self.centre, "radius": self.radius, "polygon": self.polygon}
+
     def track(self, alpha: np.ndarray, basis: FourierBasis) -> dict[str, np.ndarray]:
         """``com_xy``: (T, 2) ground projection of the CoM [m]."""
         return {"com_xy": self._com(basis.q @ alpha.T)[0]}

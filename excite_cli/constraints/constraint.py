@@ -54,6 +54,7 @@ class Constraint(ABC):
     needs_motion: bool = False
     advisory: bool = False
     bounds_torque: bool = False
+    capsules: Sequence = ()
 
     @abstractmethod
     def evaluate(self, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -94,6 +95,22 @@ class Constraint(ABC):
         """(K,) at each posture Q (K, n) [rad] the smallest distance [m] beyond its margin that it keeps
         (a distance constraint's; default inf: it keeps no distance)."""
         return np.full(len(Q), np.inf)
+
+    def never_apart(self, Q: np.ndarray, apart: float) -> list[tuple[tuple[str, str], float]]:
+        """Link pairs whose capsules are never farther apart than ``apart`` [m] at the postures Q
+        (K, n) [rad], with the largest distance [m] (a self-collision's; default none): pairs no motion
+        separates, which ``init`` excludes."""
+        return []
+
+    def always_within(self, Q: np.ndarray) -> list[tuple[str, float]]:
+        """Links within a world shape's margin at every posture Q (K, n) [rad], with that margin [m]
+        (the world's; default none): links no motion moves off the shape, which ``init`` ignores."""
+        return []
+
+    def drawn(self) -> dict[str, object]:
+        """What the constraint-tracks figure draws for it beside its tracks, as keyword arguments of
+        :func:`~excite_cli.plots.optimize.plot_constraint_tracks` (default: nothing)."""
+        return {}
 
     def track(self, alpha: np.ndarray, basis: FourierBasis) -> dict[str, np.ndarray]:
         """Named time series worth plotting and storing, on ``basis``'s instants (default: none)."""

@@ -65,6 +65,21 @@ class SelfCollision(Constraint):
         links = {frozenset((self.capsules[i].link, self.capsules[j].link)) for i, j in self.pairs}
         return f"one per capsule pair ({len(self.pairs)}, of {len(links)} link pairs)"
 
+    def never_apart(self, Q: np.ndarray, apart: float) -> list[tuple[tuple[str, str], float]]:
+        """Link pairs never more than ``apart`` [m] apart at the postures Q (K, n), with the largest distance."""
+        if not self.pairs:
+            return []
+        d = self.distances(Q).max(axis=0)
+        return [
+            ((self.capsules[i].link, self.capsules[j].link), float(d[k]))
+            for k, (i, j) in enumerate(self.pairs)
+            if d[k] < apart
+        ]
+
+    def drawn(self) -> dict[str, object]:
+        """The margin under the closest capsule distance's track."""
+        return {"margin": self.margin}
+
     def clearance(self, Q: np.ndarray) -> np.ndarray:
         """(K,) the smallest distance [m] beyond the margin over every pair at the postures Q (K, n)."""
         return (self.distances(Q) - self.margin).min(axis=1, initial=np.inf)

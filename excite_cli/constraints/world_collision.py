@@ -179,6 +179,17 @@ class WorldCollision(Constraint):
         """The rows, in words (for ``check``)."""
         return f"one per capsule and world shape ({len(self.pairs)})"
 
+    def always_within(self, Q: np.ndarray) -> list[tuple[str, float]]:
+        """Links within a shape's margin at every posture Q (K, n), with that margin [m]."""
+        if not self.pairs:
+            return []
+        d = self.distances(Q)
+        return [
+            (self.capsules[i].link, self.shapes[s].margin)
+            for k, (i, s) in enumerate(self.pairs)
+            if np.all(d[:, k] < self.shapes[s].margin)
+        ]
+
     def clearance(self, Q: np.ndarray) -> np.ndarray:
         """(K,) the smallest distance [m] beyond its shape's margin over every pair at the postures Q (K, n)."""
         return (self.distances(Q) - self._margin).min(axis=1, initial=np.inf)

@@ -172,6 +172,10 @@ class ZeroMomentPoint(Constraint):
             ),
         )
 
+    def drawn(self) -> dict[str, object]:
+        """The support polygon around the ZMP's track, less its margin."""
+        return {"support": self.polygon, "zmp_margin": self.margin}
+
     def track(self, alpha: np.ndarray, basis: FourierBasis) -> dict[str, np.ndarray]:
         """``zmp_xy``: (T, 2) the ZMP on the ground plane [m] on ``basis``'s instants."""
         return {"zmp_xy": zero_moment_point(self.wrenches(*basis.evaluate(alpha)), self.polygon.height)}

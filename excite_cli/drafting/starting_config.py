@@ -15,8 +15,6 @@ import numpy as np
 import pinocchio as pin
 
 from excite_cli.config_file import drafted_problem
-from excite_cli.constraints import SelfCollision
-from excite_cli.constraints.world_collision import WorldCollision
 from excite_cli.design.excitation import Excitation
 from excite_cli.design.resolve import build_excitation
 from excite_cli.drafting.home_posture import home_posture
@@ -122,26 +120,18 @@ def _always_overlapping(excitation: Excitation, Q: np.ndarray, draft: StartingCo
     link pairs), with why; links within a world shape's margin at every posture: ignored by the world
     constraint, with why."""
     for c in excitation.constraints:
-        if isinstance(c, SelfCollision) and c.pairs:
-            d = c.distances(Q)
-            for k, (i, j) in enumerate(c.pairs):
-                pair = (c.capsules[i].link, c.capsules[j].link)
-                if d[:, k].max() < NEVER_APART and pair not in [(x, y) for x, y, _ in draft.excluded]:
-                    farthest = d[:, k].max() * 100
-                    why = (
-                        f"never more than {farthest:.1f} cm apart at {len(Q)} random postures"
-                        if farthest >= 0
-                        else f"overlapping by at least {-farthest:.1f} cm at all {len(Q)} random postures"
-                    ) + ": the capsules of neighbouring links, which touch at every posture"
-                    draft.excluded.append((*pair, why))
-        if isinstance(c, WorldCollision) and c.pairs:
-            d = c.distances(Q)
-            for k, (i, s) in enumerate(c.pairs):
-                link = c.capsules[i].link
-                if np.all(d[:, k] < c.shapes[s].margin) and link not in [x for x, _ in draft.ignored]:
-                    draft.ignored.append(
-                        (link, f"within {c.shapes[s].margin:g} m of the mounting plane at all postures")
-                    )
+        for pair, distance in c.never_apart(Q, NEVER_APART):
+            if pair not in [(x, y) for x, y, _ in draft.excluded]:
+                farthest = distance * 100
+                why = (
+                    f"never more than {farthest:.1f} cm apart at {len(Q)} random postures"
+                    if farthest >= 0
+                    else f"overlapping by at least {-farthest:.1f} cm at all {len(Q)} random postures"
+                ) + ": the capsules of neighbouring links, which touch at every posture"
+                draft.excluded.append((*pair, why))
+        for link, margin in c.always_within(Q):
+            if link not in [x for x, _ in draft.ignored]:
+                draft.ignored.append((link, f"within {margin:g} m of the mounting plane at all postures"))
 
 
 #: The trajectory, optimizer and sequence a starting config gets: the shipped lab arms' (10 s, 5 harmonics),
@@ -208,7 +198,7 @@ def draft_config(
     draft.config["sequence"] = {"iterations": 3}
     draft.config["output"] = f"results/{urdf.stem}.h5"
     excitation = build_excitation(drafted_problem(draft.config, target), check_home=False)
-    if not any(isinstance(c, (SelfCollision, WorldCollision)) and c.capsules for c in excitation.constraints):
+    if not any(len(c.capsules) for c in excitation.constraints):
         draft.config.pop("constraints", None)
         draft.assumptions.pop("constraints.environment", None)
         draft.assumptions["constraints"] = (

@@ -15,10 +15,8 @@ from matplotlib.collections import LineCollection, PolyCollection  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
 
-from excite_cli.constraints import ComRegion, SelfCollision  # noqa: E402
 from excite_cli.constraints.support import SupportPolygon  # noqa: E402
-from excite_cli.constraints.world_collision import WorldCollision, WorldShape, world_shapes  # noqa: E402
-from excite_cli.constraints.zmp import ZeroMomentPoint  # noqa: E402
+from excite_cli.constraints.world_collision import WorldShape, world_shapes  # noqa: E402
 from excite_cli.design.excitation import Excitation  # noqa: E402
 from excite_cli.plots.figure import save_figure  # noqa: E402
 from excite_cli.plots.shapes import draw_shape, stadium  # noqa: E402
@@ -36,11 +34,8 @@ def figure_paths(target: Path) -> list[Path]:
 def plot_result(target: Path, excitation: Excitation, results: Sequence[IterationResult]) -> list[Path]:
     """The PNG figures of an ``optimize`` result beside ``target`` (:func:`figure_paths`)."""
     trajectories, cond, postures, tracks = figure_paths(target)
-    com = next((c for c in excitation.constraints if isinstance(c, ComRegion)), None)
-    zmp = next((c for c in excitation.constraints if isinstance(c, ZeroMomentPoint)), None)
-    collision = next((c for c in excitation.constraints if isinstance(c, SelfCollision)), None)
-    world = next((c for c in excitation.constraints if isinstance(c, WorldCollision)), None)
-    capsules = collision.capsules if collision else world.capsules if world else []
+    drawn = {key: value for c in excitation.constraints for key, value in c.drawn().items()}
+    capsules = next((c.capsules for c in excitation.constraints if len(c.capsules)), [])
     limits = excitation.limits
     plots = [
         plot_trajectories(
@@ -65,12 +60,7 @@ def plot_result(target: Path, excitation: Excitation, results: Sequence[Iteratio
             plot_constraint_tracks(
                 tracks,
                 results,
-                centre=com.centre if com else None,
-                radius=com.radius if com else None,
-                polygon=com.polygon if com else None,
-                margin=collision.margin if collision else None,
-                support=zmp.polygon if zmp else None,
-                zmp_margin=zmp.margin if zmp else 0.0,
+                **drawn,
                 joints=excitation.robot.joint_names,
             )
         )

@@ -5,6 +5,8 @@ small problems register every constraint class (the G1 arms standing: joint limi
 zero-moment point, self-collision; a Panda on its table: torque limits, minimum torque use, the
 world, self-collision); a class nobody registers fails the test, and so does a perturbed Jacobian."""
 
+import inspect
+
 import numpy as np
 import pytest
 import yaml
@@ -15,6 +17,7 @@ from excite_cli.constraints.constraint import Constraint, FineCheck
 from excite_cli.criteria import NAMES
 from excite_cli.design.resolve import build_excitation
 from excite_cli.design.verify import check_gradient, constraint_jacobian_error
+from excite_cli.plots.optimize import plot_constraint_tracks
 
 SMALL = {"harmonics": 3, "cost_samples": 10, "cost_period": 0.8, "constraint_period": 0.1}
 
@@ -67,6 +70,11 @@ def test_every_constraint_keeps_the_contract(problems):
         assert isinstance(fine, FineCheck) and np.isfinite(fine.max_violation), c.name
         assert all(isinstance(v, (float, int, str)) for v in fine.details.values()), c.name
         assert c.name and c.field and c.in_words(), c.name
+        assert set(c.drawn()) <= set(inspect.signature(plot_constraint_tracks).parameters), c.name
+        Q = excitation.trajectory.basis(np.linspace(0.0, 1.0, 5)).evaluate(alpha)[0]
+        for pair, distance in c.never_apart(Q, 0.05):
+            assert len(pair) == 2 and distance < 0.05, c.name
+        assert all(isinstance(link, str) and margin >= 0 for link, margin in c.always_within(Q)), c.name
 
 
 def test_a_perturbed_jacobian_row_breaks_the_contract(problems):
