@@ -125,6 +125,7 @@ def _smoke(tmp_path, name: str, min_torque_use, **optimizer) -> tuple[int, str]:
     return result.exit_code, result.output
 
 
+@pytest.mark.end_to_end
 def test_a_minimum_torque_use_is_reached_in_the_exported_motion(tmp_path):
     """The smoke problem's joint 1 (the vertical axis: inertia alone) uses 9.6 % of its 87 Nm
     without it; asked for 20 %, the exported 1 kHz motion reaches it (pinocchio's RNEA of the URDF,

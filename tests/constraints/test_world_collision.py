@@ -169,6 +169,7 @@ def test_a_world_shape_that_cannot_be_is_refused(tmp_path, shape, expected):
     assert_refused(tmp_path, ["optimize", str(tmp_path / "bad.yaml")], expected)
 
 
+@pytest.mark.end_to_end
 @pytest.mark.parametrize("config", ["panda.yaml", "ur5.yaml"])
 def test_a_lab_arm_plays_above_its_table_apart_from_itself_and_within_its_torques(tmp_path, config):
     """The shipped lab arms (configs/panda.yaml, configs/ur5.yaml) with a short optimization,

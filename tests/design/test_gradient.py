@@ -155,6 +155,7 @@ def test_gradient_with_a_prismatic_joint(panda_problem):
     assert np.linalg.norm(analytic - fd) / np.linalg.norm(fd) < 1e-6
 
 
+@pytest.mark.end_to_end
 @pytest.mark.parametrize("name", ["g1_problem", "ur5_problem"])
 @pytest.mark.parametrize("objective, scaling", [("log_det", "none"), ("log_cond", "urdf"), ("sigma_min", "none")])
 def test_gradient_with_effect_columns_matches_finite_differences(name, objective, scaling, request):

@@ -143,6 +143,7 @@ def _found(report) -> dict:
     return {(t.effect, c, report.joints[t.joint]): (v, s, t.shape) for t, c, v, s in report.effect_values()}
 
 
+@pytest.mark.end_to_end
 def test_undeclared_friction_and_armature_are_found_and_written_to_mjcf(tmp_path, optimized):
     effects = {"coulomb": {"*": TRUE["coulomb"]}, "viscous": {"*": TRUE["viscous"]}, "armature": ARMATURE}
     report, robot, base, noise_level, problem = _simulate_and_identify(tmp_path, optimized, effects, consistent=True)
@@ -179,6 +180,7 @@ def test_undeclared_friction_and_armature_are_found_and_written_to_mjcf(tmp_path
     assert np.all(report.rms_before >= 3 * report.rms_after)
 
 
+@pytest.mark.end_to_end
 def test_no_effect_in_the_data_adds_none(tmp_path, optimized):
     report, *_ = _simulate_and_identify(tmp_path, optimized, {})  # the default candidates: every effect
     assert report.selection.terms == []
@@ -201,6 +203,7 @@ NEW_EFFECTS = {
 }
 
 
+@pytest.mark.end_to_end
 @pytest.mark.parametrize("case", list(NEW_EFFECTS))
 def test_each_undeclared_effect_is_named_with_its_value_and_shape(tmp_path, optimized, case):
     effects, shapes = NEW_EFFECTS[case]
@@ -221,6 +224,7 @@ def test_each_undeclared_effect_is_named_with_its_value_and_shape(tmp_path, opti
             assert shape == shapes[EFFECTS[effect].shape_field]
 
 
+@pytest.mark.end_to_end
 def test_offsets_per_run_and_a_known_payload(tmp_path, optimized):
     """Two runs with different torque offsets on joint 3 and a 1.5 kg payload on the flange in the
     first: the payload's torque (pinocchio RNEA with the payload added to link 7, independent of
@@ -443,6 +447,7 @@ def test_real_panda_fitted_on_a_short_first_phase_reports_the_fit_that_transfers
     assert not any("the chosen fit" in w for w in report.warnings)
 
 
+@pytest.mark.end_to_end
 @pytest.mark.skipif(not (SHARED / "exciting_traj_1.csv").exists(), reason="shared Panda data not present")
 def test_real_panda_unseen_phase_holds_with_the_defaults_and_validate_scores_the_report_again(tmp_path):
     """Issues 10 and 21: on a phase of the period that neither the fit nor the selection saw, the
@@ -515,6 +520,7 @@ def test_real_panda_unseen_phase_holds_with_the_defaults_and_validate_scores_the
     assert result.exit_code == 2 and "Traceback" not in result.output
 
 
+@pytest.mark.end_to_end
 @pytest.mark.skipif(not (SHARED / "exciting_traj_1.csv").exists(), reason="shared Panda data not present")
 def test_report_has_per_run_validation_errors(tmp_path):
     config = yaml.safe_load((HERE.parent / "configs" / "panda_identify_phase.yaml").read_text())
@@ -540,6 +546,7 @@ def test_report_has_per_run_validation_errors(tmp_path):
     np.testing.assert_allclose(np.sqrt(total), rms_after, rtol=1e-9)
 
 
+@pytest.mark.end_to_end
 def test_shipped_simulated_runs_give_back_their_undeclared_friction():
     """data/panda_simulated (shipped, no ../shared needed): Coulomb 0.6 Nm and viscous 0.4 Nm·s/rad on
     every joint, undeclared in configs/panda_identify_simulated.yaml."""

@@ -38,6 +38,7 @@ def _mean(report) -> float:
     return float(report.relative_after.mean())
 
 
+@pytest.mark.end_to_end
 def test_an_effect_of_one_fit_run_is_dropped_by_recording_folds(tmp_path, optimized):  # noqa: F811
     """Coulomb friction 0.4 Nm on every joint in every run; viscous friction 0.6 Nm·s/rad on joint 5
     only in the first fit run (a pattern of one run). Fit on three recordings, validate on a fourth."""
@@ -70,6 +71,7 @@ def _write_run(path: Path, time, q, tau) -> str:
     return path.name
 
 
+@pytest.mark.end_to_end
 @pytest.mark.parametrize("amplitude", [0.1])
 def test_poorly_exciting_fit_runs_get_the_fit_that_transfers(tmp_path, optimized, amplitude):  # noqa: F811
     """Fit runs: two optimized motions shrunk to ``amplitude`` about their mean posture, one period
@@ -114,6 +116,7 @@ def test_poorly_exciting_fit_runs_get_the_fit_that_transfers(tmp_path, optimized
     )
 
 
+@pytest.mark.end_to_end
 def test_a_position_effect_fitted_on_a_narrower_range_is_held_at_its_ends(tmp_path, optimized):  # noqa: F811
     """A cable-like torque 0.3 tanh((q₆ − q̄₆)/w) Nm on joint 6 that saturates outside the fit runs'
     q range: fit runs are two optimized motions at half amplitude about their mean posture,

@@ -318,6 +318,7 @@ def test_a_failed_restart_is_never_kept_when_another_succeeded():
     assert best_restart([failed, at_start]) is failed  # a result written before the rule: the lowest
 
 
+@pytest.mark.end_to_end
 def test_when_every_restart_fails_more_starts_run_then_the_run_stops(ur5_problem):
     """95 % of every joint's torque is out of reach at the UR5's limits: every restart ends
     infeasible. More starts run, each from its own seed, until the time budget is spent; then the

@@ -84,6 +84,7 @@ def _dask(tmp_path: Path) -> tuple[list[subprocess.Popen], str]:
     return processes, json.loads(file.read_text())["address"]
 
 
+@pytest.mark.end_to_end
 def test_restarts_on_real_dask_workers_equal_this_process_for_a_spec_changed_in_memory(tmp_path):
     """Dask workers build from the main process's spec: with its scaling frame changed in memory (as
     bench/loop.py weighs the effects) they give this process's sequence bit for bit, which differs

@@ -169,6 +169,7 @@ def _rigid_runs(tmp: Path, optimized: Path, truth: np.ndarray, periods: int, see
     return files
 
 
+@pytest.mark.end_to_end
 def test_simulated_data_consistent_fit_recovers_the_base_parameters(tmp_path, optimized):  # noqa: F811
     sim = {
         "sample_rate": 500,
@@ -190,6 +191,7 @@ def test_simulated_data_consistent_fit_recovers_the_base_parameters(tmp_path, op
     assert np.all(_eigenvalues(report.consistent.standard) > 0)
 
 
+@pytest.mark.end_to_end
 def test_negative_mass_data_stays_physical_with_the_consistent_fit(tmp_path, optimized):  # noqa: F811
     """Torques of a model whose hand body (link 7 with the hand merged) has all parameters negated:
     plain least squares says its mass is negative, the consistent fit keeps every body physical."""
@@ -202,6 +204,7 @@ def test_negative_mass_data_stays_physical_with_the_consistent_fit(tmp_path, opt
     assert np.all(consistent[0::10] > 0) and np.all(_eigenvalues(consistent) > 0)
 
 
+@pytest.mark.end_to_end
 def test_rotors_that_regroup_with_the_links_stay_out_of_the_bodies(tmp_path, optimized):  # noqa: F811
     """A simulated Panda whose joints 1 and 2 have rotors of 0.3 kg·m² (an armature that regroups with
     link inertias in the base parameters, so least squares cannot tell them apart): the consistent fit
@@ -233,6 +236,7 @@ def test_rotors_that_regroup_with_the_links_stay_out_of_the_bodies(tmp_path, opt
     assert report.relative_consistent.mean() <= 1.3 * report.relative_least_squares.mean()
 
 
+@pytest.mark.end_to_end
 def test_an_undeclared_payload_on_the_flange_is_a_body_of_its_own_and_the_links_keep_their_masses(
     tmp_path,
     optimized,  # noqa: F811

@@ -117,6 +117,7 @@ def test_a_bag_reads_to_the_samples_of_its_csv(simulated, kind, name):
     assert run.qd is None  # the messages leave velocity empty
 
 
+@pytest.mark.end_to_end
 def test_a_bag_identifies_the_simulated_friction(simulated):
     tmp, table = simulated
     bag = write_bag(tmp / "identify_bag", table, "mcap")

@@ -100,6 +100,7 @@ def test_a_recording_whose_every_piece_is_too_short_is_refused_by_its_gaps_on_it
         split_at_gaps(_run(time))
 
 
+@pytest.mark.end_to_end
 def test_a_2_s_gap_identifies_the_friction_as_the_whole_recording_does(tmp_path, simulated_identification):
     """The shipped simulated runs (Coulomb 0.6 Nm and viscous 0.4 Nm·s/rad undeclared on every joint)
     with 2 s cut out of the middle of the fit run: the same effects, every value within 10 % of the
