@@ -195,7 +195,7 @@ def _selection_tables(report: Report) -> list[Table | str]:
                 "" if t.shape is None else f"{t.shape:g}",
                 f"{name} [{t.kind.units[0]}]",
                 f"{value:.5g}",
-                f"{std:.2g}",
+                f"{std:.2g}" if np.isfinite(std) else "held at 0",
                 *((f"{consistent.effects[k]:.5g}",) if consistent else ()),
             )
             for k, (t, name, value, std) in enumerate(report.effect_values())

@@ -16,7 +16,7 @@ per-joint normal equations of :mod:`excite_cli.identification.fitting.normal` (n
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -32,11 +32,14 @@ class Fit:
     Attributes:
         x: (p,) estimates; std: (p,) their standard deviations.
         sigma: (n,) per-joint residual standard deviation [Nm] of this fit.
+        held: (p,) the unknowns held at their bound 0 (friction, armature: ``NONNEGATIVE``), which have
+            no two-sided standard deviation; none when empty.
     """
 
     x: np.ndarray
     std: np.ndarray
     sigma: np.ndarray
+    held: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
 
 
 def least_squares(
@@ -54,12 +57,13 @@ def least_squares(
         middle: (m, m) AᵀWΣWA for the sandwich (m the model's unknowns), or None for σ² (AᵀWA)⁻¹.
     """
     G, c, s = normal.system(weights, effects)
-    x = solve(G, c, normal.nonnegative(effects))
+    bounded = normal.nonnegative(effects)
+    x = solve(G, c, bounded)
     dof = max(1, normal.rows - x.size)
     s2 = sse(G, c, s, x) / dof
     sigma = np.sqrt(normal.joint_sse(x, effects) / (normal.rows / normal.n) / (dof / normal.rows))
     variance = s2 * covariance_diagonal(G) if middle is None else covariance_diagonal(G, middle)
-    return Fit(x, np.sqrt(np.maximum(variance, 0.0)), sigma)
+    return Fit(x, np.sqrt(np.maximum(variance, 0.0)), sigma, bounded & (x == 0.0))
 
 
 def joint_weights(normal: NormalEquations, weighted: bool) -> np.ndarray | None:

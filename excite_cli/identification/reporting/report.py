@@ -170,12 +170,17 @@ class Report:
 
     def effect_values(self, consistent: bool = False) -> list[tuple[Term, str, float, float]]:
         """(term, coefficient, value, std) for every chosen effect coefficient, in order: of the
-        least-squares fit, or with ``consistent`` of the physically consistent one (std NaN), followed
+        least-squares fit (std NaN for a coefficient held at its bound 0:
+        :attr:`~excite_cli.identification.fitting.least_squares.Fit.held`), or with
+        ``consistent`` of the physically consistent one (std NaN), followed
         by its rotors held apart from the bodies, as the armature of their joints (what a model file
         of its bodies lacks)."""
         b = len(self.base_names)
-        values = self.consistent.effects if consistent else self.selection.fit.x[b:]
-        stds = np.full(values.size, np.nan) if consistent else self.selection.fit.std[b:]
+        fit = self.selection.fit
+        values = self.consistent.effects if consistent else fit.x[b:]
+        stds = np.full(values.size, np.nan) if consistent else fit.std[b:].copy()
+        if not consistent and fit.held.size:
+            stds[fit.held[b:]] = np.nan  # held at its bound 0: no two-sided std
         names = [(term, name) for term in self.selection.terms for name in coefficient_names(term, self.offset_runs)]
         out = [(term, name, float(v), float(s)) for (term, name), v, s in zip(names, values, stds)]
         if consistent:

@@ -67,3 +67,6 @@ def test_a_negative_viscous_friction_is_fitted_at_zero_and_an_offset_keeps_its_s
     A = np.column_stack([Y, np.ones(N)])  # the model with the viscous coefficient held at its bound 0
     np.testing.assert_allclose(fit.x, np.insert(np.linalg.lstsq(A, tau, rcond=None)[0], 2, 0.0), atol=1e-10)
     assert fit.x[3] < -0.4  # the offset is free to be negative
+    np.testing.assert_array_equal(fit.held, [False, False, True, False])  # held at 0: no two-sided std
+    free = least_squares(NormalEquations(data, terms[1:]), terms[1:])  # nothing at a bound
+    assert not free.held.any()
