@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Optional
@@ -88,7 +89,7 @@ class OptimizeRun:
             "(a rounding of the robot's file, or a parameter the limits leave still)"
         )
 
-    @property
+    @functools.cached_property
     def warning(self) -> str:
         """Why the result should not be run, "" when nothing: an iteration the fine check rejects
         (a constraint no restart could meet, such as ``limits.min_torque_use``), or the stacked

@@ -44,13 +44,19 @@ class Gap:
     into: float = 0.0
 
 
+def _longest_step(steps: np.ndarray) -> float:
+    """The longest step [s] between time stamps that is no gap: :data:`GAP_PERIODS` × the median step,
+    at least :data:`MIN_GAP_S`."""
+    return max(GAP_PERIODS * float(np.median(steps)), MIN_GAP_S)
+
+
 def find_gaps(time: np.ndarray) -> list[Gap]:
     """The gaps of a run's time stamps (T,) [s], strictly increasing: steps longer than
     :data:`GAP_PERIODS` × their median and than :data:`MIN_GAP_S`."""
     steps = np.diff(time)
     if steps.size == 0:
         return []
-    at = np.flatnonzero(steps > max(GAP_PERIODS * np.median(steps), MIN_GAP_S))
+    at = np.flatnonzero(steps > _longest_step(steps))
     return [Gap(float(time[k]), float(steps[k]), int(k + 1), float(time[k] - time[0])) for k in at]
 
 
@@ -61,7 +67,7 @@ def missing_messages(time: np.ndarray) -> int:
     if steps.size == 0:
         return 0
     period = np.median(steps)
-    short = steps[steps <= max(GAP_PERIODS * period, MIN_GAP_S)]
+    short = steps[steps <= _longest_step(steps)]
     return int(np.sum(np.maximum(np.rint(short / period) - 1, 0)))
 
 
