@@ -4,52 +4,50 @@ report, how its measured rows weigh (:mod:`~excite_cli.stored.design_model`)."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
-from excite_cli.config import EffectsConfig, resolve_path
+from excite_cli.config import EffectsConfig
 from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.dynamics.effect_columns import EffectColumns, effect_columns
 from excite_cli.dynamics.robot import Robot
 from excite_cli.errors import ExciteError
 from excite_cli.stored.design_model import MeasuredPrior, measured_prior_of, with_report_model
-from excite_cli.stored.report import read_report
+from excite_cli.stored.inputs import StoredInputs
+from excite_cli.stored.prior import PriorFile
 
 
-def measured_prior(path: str | None, folder: Path | None, robot: Robot) -> MeasuredPrior | None:
-    """How ``sequence.prior`` (``path``, relative to ``folder``) weighs when it is an identify report
-    (else None).
+def measured_prior(prior: PriorFile | None, robot: Robot) -> MeasuredPrior | None:
+    """How ``sequence.prior`` (``prior``, read once) weighs when it is an identify report (else None).
 
     Raises:
         ExciteError: (``sequence.prior``) a report whose joints are not this problem's active joints, or
-            that no weighing can use (:func:`read_report`, :func:`measured_prior_of`).
+            that no weighing can use (:func:`measured_prior_of`).
     """
-    found = None if path is None else resolve_path(path, folder)
-    report = None if found is None else read_report(found, "sequence.prior")
-    if report is None:
+    if prior is None or prior.report is None:
         return None
-    measured = measured_prior_of(report, found)
+    measured = measured_prior_of(prior.report, prior.path)
     if sorted(measured.joints) != sorted(robot.joint_names):
         raise ExciteError(
             "sequence.prior",
-            f"{path} identified the joints {', '.join(measured.joints)}; this problem's active joints are "
+            f"{prior.path} identified the joints {', '.join(measured.joints)}; this problem's active joints are "
             f"{', '.join(robot.joint_names)}",
         )
     return measured
 
 
-def design_effects(cfg: EffectsConfig, folder: Path | None, robot: Robot, base: BaseParameters) -> EffectColumns | None:
-    """The effect columns of ``effects`` (``cfg``, its model file relative to ``folder``) that the rigid
-    body's base columns do not already hold (on random states:
+def design_effects(
+    cfg: EffectsConfig, stored: StoredInputs, robot: Robot, base: BaseParameters
+) -> EffectColumns | None:
+    """The effect columns of ``effects`` (``cfg``, with the report of ``effects.model`` read once in
+    ``stored``) that the rigid body's base columns do not already hold (on random states:
     :meth:`~excite_cli.dynamics.effect_columns.EffectColumns.beside`), or None.
 
     Raises:
         ExciteError: an effect on a joint that is not active (:func:`effect_columns`), an
-            ``effects.model`` that is not an identify report of this problem's joints.
+            ``effects.model`` report of other joints than this problem's.
     """
-    if cfg.model is not None:
-        cfg = with_report_model(cfg, resolve_path(cfg.model, folder), robot.joint_names)
+    if stored.model is not None:
+        cfg = with_report_model(cfg, stored.model, stored.model_path, robot.joint_names)
     effects = effect_columns(cfg, robot.joint_names, robot.n_rows)
     if effects is None:
         return None

@@ -17,15 +17,20 @@ from excite_cli.design.model_columns import design_effects, measured_prior
 from excite_cli.design.spec import ConfigText, DesignSpec, needs_collision
 from excite_cli.dynamics.base_parameters import BaseParameters, compute_base_parameters
 from excite_cli.dynamics.robot import Robot, load_robot
+from excite_cli.stored.inputs import StoredInputs, read_inputs
 
 
-def resolve(problem: Problem, base: BaseParameters | None = None) -> tuple[DesignSpec, Robot]:
+def resolve(
+    problem: Problem, base: BaseParameters | None = None, stored: StoredInputs | None = None
+) -> tuple[DesignSpec, Robot]:
     """The design of ``problem`` as values, and the robot it was resolved on (its pinocchio and coal
     objects, which :func:`~excite_cli.design.excitation.build_design` reuses in this process).
 
     Args:
         problem: the validated config.
         base: the robot's base parameters when already computed; default: computed here.
+        stored: the files of ``effects.model`` and ``sequence.prior``, read once by the caller that
+            uses them again; default: read here (:func:`~excite_cli.stored.inputs.read_inputs`).
 
     Raises:
         ExciteError: bad robot, limits, effects or prior input (:func:`load_robot`,
@@ -34,17 +39,23 @@ def resolve(problem: Problem, base: BaseParameters | None = None) -> tuple[Desig
     p = problem
     robot = load_robot(p.robot, p.folder, needs_collision(p.constraints))
     base = base or compute_base_parameters(robot)
-    effects = design_effects(p.effects, p.folder, robot, base)
+    stored = stored or read_inputs(p.effects.model, p.sequence.prior, p.folder)
+    effects = design_effects(p.effects, stored, robot, base)
     frame = scaled_frame(base, parameter_magnitudes(robot))
     if effects is not None:
         _, upper = joint_limit_bounds(p.limits, robot)
         frame = block_diag(frame, np.diag(effects.magnitudes(robot.model.effortLimit[robot.v_idx], upper[1], upper[2])))
     text = ConfigText(effective_yaml(p), p.source_text, str(p.source_path or ""))
     sections = (p.robot, p.trajectory, p.limits, p.constraints, p.optimizer, p.sequence, p.noise, p.folder, text)
-    return DesignSpec(*sections, base, effects, frame, measured_prior(p.sequence.prior, p.folder, robot)), robot
+    return DesignSpec(*sections, base, effects, frame, measured_prior(stored.prior, robot)), robot
 
 
-def build_excitation(problem: Problem, base: BaseParameters | None = None, check_home: bool = True) -> Excitation:
+def build_excitation(
+    problem: Problem,
+    base: BaseParameters | None = None,
+    check_home: bool = True,
+    stored: StoredInputs | None = None,
+) -> Excitation:
     """Resolve ``problem`` (:func:`resolve`) and build its excitation
     (:func:`~excite_cli.design.excitation.build_design`).
 
@@ -52,9 +63,10 @@ def build_excitation(problem: Problem, base: BaseParameters | None = None, check
         problem: the validated config.
         base: the robot's base parameters when already computed; default: computed here.
         check_home: refuse a home posture that violates a constraint (off: a caller searching for one).
+        stored: see :func:`resolve`.
 
     Raises:
         ExciteError: see :func:`resolve` and :func:`~excite_cli.design.excitation.build_design`.
     """
-    spec, robot = resolve(problem, base)
+    spec, robot = resolve(problem, base, stored)
     return build_design(spec, robot, check_home)

@@ -19,7 +19,7 @@ import numpy as np
 from excite_cli.config import EffectsConfig, MotorConfig
 from excite_cli.effects import DESIGNED, EFFECTS
 from excite_cli.errors import ExciteError, ExciteWarning
-from excite_cli.stored.report import StoredReport, read_identify_report
+from excite_cli.stored.report import StoredReport
 
 
 @dataclass(frozen=True)
@@ -63,15 +63,15 @@ def report_model(report: StoredReport) -> ReportModel:
     return ReportModel(joints, motors, report.coulomb_velocity, left_out)
 
 
-def with_report_model(cfg: EffectsConfig, path: Path, joint_names: list[str]) -> EffectsConfig:
-    """``cfg`` with the effects of the identify report at ``path`` added (the report's smooth-sign
-    velocity taken); an :class:`~excite_cli.errors.ExciteWarning` names the effects left out.
+def with_report_model(cfg: EffectsConfig, report: StoredReport, path: Path, joint_names: list[str]) -> EffectsConfig:
+    """``cfg`` with the effects of the identify ``report`` (read from ``path``) added (the report's
+    smooth-sign velocity taken); an :class:`~excite_cli.errors.ExciteWarning` names the effects left out.
 
     Raises:
-        ExciteError: (``effects.model``) not an identify report, or one whose joints are not all
-            active in this problem (a report of another robot or joint set).
+        ExciteError: (``effects.model``) a report whose joints are not all active in this problem (a
+            report of another robot or joint set).
     """
-    model = report_model(read_identify_report(path, "effects.model"))
+    model = report_model(report)
     unknown = [j for j in [*model.joints, *(j for joints, _ in model.motors for j in joints)] if j not in joint_names]
     if unknown:
         raise ExciteError(

@@ -4,6 +4,7 @@ trajectory's, in this design's columns (base parameters by name, then the same e
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Sequence
 
@@ -13,10 +14,59 @@ from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.errors import ExciteError
 from excite_cli.h5 import open_h5, read_strings
 from excite_cli.stored.design_model import MeasuredPrior
+from excite_cli.stored.report import StoredReport, report_in
 
 
-def read_prior(
-    path: Path,
+@dataclass(frozen=True)
+class PriorFile:
+    """The prior data of ``sequence.prior`` as stored (read once: :func:`read_prior_file`).
+
+    Attributes:
+        path: the file.
+        rows: (m, b) base-regressor rows: every iteration's of an excite result, stacked, or the file's
+            ``/regressor``; None: neither is in the file.
+        base_names: (b,) their base-parameter names (``/robot/base_parameter_names``), or None.
+        effect_names: the effect columns among ``rows``' (``/robot/effect_names`` of a result), or None.
+        effect_columns: (m, e') an identify report's ``/effect_regressor``, or None; effect_column_names:
+            its (e',) names.
+        report: the identify report the file is (:func:`~excite_cli.stored.report.read_report`), or None.
+    """
+
+    path: Path
+    rows: np.ndarray | None
+    base_names: list[str] | None
+    effect_names: list[str] | None
+    effect_columns: np.ndarray | None
+    effect_column_names: list[str]
+    report: StoredReport | None
+
+
+def read_prior_file(path: Path, field: str = "sequence.prior") -> PriorFile:
+    """The file at ``path`` opened once: its prior rows and, when it is one, its identify report.
+
+    Raises:
+        FileNotFound, ExciteError: (``field``) no readable HDF5 file; a damaged report (:func:`report_in`).
+    """
+    with open_h5(path, field) as f:
+        rows = None
+        if "iterations" in f:
+            rows = [f["iterations"][k]["regressor"][()] for k in sorted(f["iterations"].keys(), key=int)]
+        elif "regressor" in f:
+            rows = [np.asarray(f["regressor"][()], dtype=float)]
+        has_columns = "effect_regressor" in f
+        return PriorFile(
+            path,
+            None if rows is None else np.vstack(rows) if rows else np.zeros((0, 0)),
+            read_strings(f["robot"], "base_parameter_names") if "robot/base_parameter_names" in f else None,
+            read_strings(f["robot"], "effect_names") if "robot/effect_names" in f else None,
+            np.asarray(f["effect_regressor"][()], dtype=float) if has_columns else None,
+            [str(n) for n in f["effect_regressor"].attrs.get("names", [])] if has_columns else [],
+            report_in(f, path, field),
+        )
+
+
+def prior_rows(
+    stored: PriorFile,
     base: BaseParameters,
     effect_names: Sequence[str] = (),
     measured: MeasuredPrior | None = None,
@@ -34,23 +84,16 @@ def read_prior(
     of a trajectory on the cost grid (``cost_period`` [s]).
 
     Raises:
-        ExciteError: missing or unreadable file, no regressor inside, or base parameters or effect
-            columns that differ.
+        ExciteError: no regressor in the file, or base parameters or effect columns that differ.
     """
-    with open_h5(path, "sequence.prior") as f:
-        if "iterations" in f:
-            keys = sorted(f["iterations"].keys(), key=int)
-            blocks = [f["iterations"][k]["regressor"][()] for k in keys]
-            prior = np.vstack(blocks) if blocks else np.zeros((0, base.count + len(effect_names)))
-        elif "regressor" in f:
-            prior = np.asarray(f["regressor"][()], dtype=float)
-        else:
-            raise ExciteError("sequence.prior", f"{path} has neither /iterations nor /regressor")
-        names = read_strings(f["robot"], "base_parameter_names") if "robot/base_parameter_names" in f else None
-        effects = read_strings(f["robot"], "effect_names") if "robot/effect_names" in f else None
-        if effect_names and "effect_regressor" in f:  # an identify report's effect columns, taken by name
-            prior = np.hstack([prior, _report_effects(f["effect_regressor"], effect_names, path, len(prior))])
-            effects = list(effect_names)
+    path, names, effects = stored.path, stored.base_names, stored.effect_names
+    if stored.rows is None:
+        raise ExciteError("sequence.prior", f"{path} has neither /iterations nor /regressor")
+    empty = stored.rows.shape == (0, 0)  # a result without iterations
+    prior = np.zeros((0, base.count + len(effect_names))) if empty else stored.rows
+    if effect_names and stored.effect_columns is not None:  # an identify report's effect columns, by name
+        prior = np.hstack([prior, _report_effects(stored, effect_names, len(prior))])
+        effects = list(effect_names)
     columns = base.count + len(effect_names)
     if (effects is not None and list(effects) != list(effect_names)) or (effects is None and names and effect_names):
         raise ExciteError(
@@ -84,14 +127,14 @@ def read_prior(
     return prior[:, order]
 
 
-def _report_effects(dataset, effect_names: Sequence[str], path: Path, rows: int) -> np.ndarray:
+def _report_effects(stored: PriorFile, effect_names: Sequence[str], rows: int) -> np.ndarray:
     """The columns ``effect_names`` of an identify report's ``/effect_regressor`` (M, e), by its names;
     M must be ``rows``, the report's ``/regressor`` rows.
 
     Raises:
         ExciteError: a design effect the report did not identify, or a dataset of another shape.
     """
-    held = [str(name) for name in dataset.attrs.get("names", [])]
+    path, held, columns = stored.path, stored.effect_column_names, stored.effect_columns
     missing = [name for name in effect_names if name not in held]
     if missing:
         raise ExciteError(
@@ -99,7 +142,6 @@ def _report_effects(dataset, effect_names: Sequence[str], path: Path, rows: int)
             f"{path} holds the effect columns [{', '.join(held)}], not this design's {', '.join(missing)} (design "
             "for the report's own effects, effects.model, or leave those effects out)",
         )
-    columns = np.asarray(dataset[()], dtype=float)
     if columns.shape != (rows, len(held)):
         shape = "x".join(str(n) for n in columns.shape)
         raise ExciteError(

@@ -71,42 +71,52 @@ def read_report(path: Path, field: str) -> StoredReport | None:
             not finite, a cut-off or Coulomb velocity scale that is not a positive number.
     """
     with open_h5(path, field) as f:
-        if "identification" not in f:
-            return None
-        g = f["identification"]
-        if "effects" not in g:
-            raise ExciteError(field, f"{path} is not an identify report (no /identification/effects)")
-        for name, unit in (("cutoff_Hz", "Hz"), ("coulomb_velocity_rad_s", "rad/s")):
-            value = float(g.attrs.get(name, COULOMB_VELOCITY))
-            if not (np.isfinite(value) and value > 0.0):  # checked like the config field it came from
-                raise ExciteError(field, f"{path}: /identification {name} is {value:g}", value, f"> 0 {unit}")
-        joints, names = read_strings(g, "joint_names"), read_strings(g, "base_parameter_names")
-        rows = g["effects"][()]
-        for column in ("effect", "joint", "value"):
-            if rows.dtype.names is None or column not in rows.dtype.names:
-                raise ExciteError(field, f"{path}: /identification/effects has no field '{column}' (damaged?)")
-        consistent = bool(g["physically_consistent"][()]) if "physically_consistent" in g else False
-        values = rows["value_consistent"] if consistent and "value_consistent" in rows.dtype.names else rows["value"]
-        checked = _Checked(g, path, field)
-        coupling = checked("effect_coupling", (len(rows), len(joints))) if "effect_coupling" in g else None
-        rotors, inertias = _own_rotors(g, checked) if consistent else ([], np.zeros(0))
-        return StoredReport(
-            joints,
-            names,
-            checked("base_parameters", (len(names),)),
-            checked("base_parameters_rigid_only", (len(names),)),
-            _known(_terms(rows, coupling) + rotors, joints, path, field),
-            checked.finite(np.concatenate([np.asarray(values, dtype=float), inertias]), "effects"),
-            max(1, len(g["offset_runs"][()])) if "offset_runs" in g else 1,
-            float(g.attrs["cutoff_Hz"]),
-            float(g.attrs.get("coulomb_velocity_rad_s", COULOMB_VELOCITY)),
-            checked("fit_q_range", (len(joints), 2)) if "fit_q_range" in g else None,
-            np.asarray(g["rms_after"][()], dtype=float) if "rms_after" in g else None,
-            float(f["regressor"].attrs["sample_rate_Hz"])
-            if "regressor" in f and "sample_rate_Hz" in f["regressor"].attrs
-            else None,
-            len(rotors),
-        )
+        return report_in(f, path, field)
+
+
+def report_in(f, path: Path, field: str) -> StoredReport | None:
+    """:func:`read_report` of the open HDF5 file ``f`` (read from ``path``), for a reader that takes
+    more of the same file in the same opening.
+
+    Raises:
+        ExciteError: as :func:`read_report`.
+    """
+    if "identification" not in f:
+        return None
+    g = f["identification"]
+    if "effects" not in g:
+        raise ExciteError(field, f"{path} is not an identify report (no /identification/effects)")
+    for name, unit in (("cutoff_Hz", "Hz"), ("coulomb_velocity_rad_s", "rad/s")):
+        value = float(g.attrs.get(name, COULOMB_VELOCITY))
+        if not (np.isfinite(value) and value > 0.0):  # checked like the config field it came from
+            raise ExciteError(field, f"{path}: /identification {name} is {value:g}", value, f"> 0 {unit}")
+    joints, names = read_strings(g, "joint_names"), read_strings(g, "base_parameter_names")
+    rows = g["effects"][()]
+    for column in ("effect", "joint", "value"):
+        if rows.dtype.names is None or column not in rows.dtype.names:
+            raise ExciteError(field, f"{path}: /identification/effects has no field '{column}' (damaged?)")
+    consistent = bool(g["physically_consistent"][()]) if "physically_consistent" in g else False
+    values = rows["value_consistent"] if consistent and "value_consistent" in rows.dtype.names else rows["value"]
+    checked = _Checked(g, path, field)
+    coupling = checked("effect_coupling", (len(rows), len(joints))) if "effect_coupling" in g else None
+    rotors, inertias = _own_rotors(g, checked) if consistent else ([], np.zeros(0))
+    return StoredReport(
+        joints,
+        names,
+        checked("base_parameters", (len(names),)),
+        checked("base_parameters_rigid_only", (len(names),)),
+        _known(_terms(rows, coupling) + rotors, joints, path, field),
+        checked.finite(np.concatenate([np.asarray(values, dtype=float), inertias]), "effects"),
+        max(1, len(g["offset_runs"][()])) if "offset_runs" in g else 1,
+        float(g.attrs["cutoff_Hz"]),
+        float(g.attrs.get("coulomb_velocity_rad_s", COULOMB_VELOCITY)),
+        checked("fit_q_range", (len(joints), 2)) if "fit_q_range" in g else None,
+        np.asarray(g["rms_after"][()], dtype=float) if "rms_after" in g else None,
+        float(f["regressor"].attrs["sample_rate_Hz"])
+        if "regressor" in f and "sample_rate_Hz" in f["regressor"].attrs
+        else None,
+        len(rotors),
+    )
 
 
 def _terms(rows: np.ndarray, coupling: np.ndarray | None) -> list[StoredTerm]:

@@ -10,7 +10,7 @@ from typing import Callable, Optional
 import numpy as np
 import yaml
 
-from excite_cli.config import Problem, resolve_path
+from excite_cli.config import Problem
 from excite_cli.config_file import parse_yaml
 from excite_cli.design.excitation import Excitation
 from excite_cli.design.information import predicted_std
@@ -23,7 +23,8 @@ from excite_cli.search.optimizer import ProgressHook
 from excite_cli.search.sequence import IterationResult, run_sequence
 from excite_cli.storage.paths import check_target, output_lock
 from excite_cli.storage.results import read_iterations, write_result
-from excite_cli.stored.prior import read_prior
+from excite_cli.stored.inputs import read_inputs
+from excite_cli.stored.prior import prior_rows
 
 #: The largest cond(C) of a result that identifies something: above it, noise in the torques is
 #: amplified a million times into the base parameters (Eq. 5 bounds the relative error by cond(C)).
@@ -142,16 +143,13 @@ def run_optimize(
         check_target(figure, "output", force=True)
     if resume and not target.is_file():
         raise FileNotFound("resume", target, "result to continue")
-    excitation = build_excitation(problem)
+    stored = read_inputs(problem.effects.model, problem.sequence.prior, problem.folder)  # each opened once
+    excitation = build_excitation(problem, stored=stored)
     prior = (
-        read_prior(
-            resolve_path(problem.sequence.prior, problem.folder),
-            excitation.base,
-            excitation.effect_names,
-            excitation.measured,
-            problem.trajectory.cost_period,
+        prior_rows(
+            stored.prior, excitation.base, excitation.effect_names, excitation.measured, problem.trajectory.cost_period
         )
-        if problem.sequence.prior
+        if stored.prior
         else None
     )
     finished = _resumable(target, excitation, prior) if resume else []

@@ -13,6 +13,7 @@ from excite_cli.dynamics.base_parameters import compute_base_parameters
 from excite_cli.dynamics.robot import load_robot
 from excite_cli.errors import ExciteError
 from excite_cli.h5 import read_strings, write_strings
+from excite_cli.stored.inputs import read_inputs
 
 
 def _report(source, path, joints, sigma):
@@ -36,9 +37,19 @@ def _report(source, path, joints, sigma):
 def test_a_rigid_design_has_no_effect_columns_and_a_result_prior_no_weights(optimized):
     problem = load_problem(CONFIGS / "smoke.yaml")
     robot = load_robot(problem.robot, problem.folder)
-    assert design_effects(problem.effects, problem.folder, robot, compute_base_parameters(robot)) is None
+    assert (
+        design_effects(
+            problem.effects,
+            read_inputs(problem.effects.model, problem.sequence.prior, problem.folder),
+            robot,
+            compute_base_parameters(robot),
+        )
+        is None
+    )
     problem.sequence.prior = str(optimized)  # an optimize result: its rows are the design's own
-    assert measured_prior(problem.sequence.prior, problem.folder, robot) is None
+    assert (
+        measured_prior(read_inputs(problem.effects.model, problem.sequence.prior, problem.folder).prior, robot) is None
+    )
 
 
 def test_a_report_of_the_problems_joints_weighs_them_and_of_others_is_refused(report_file, tmp_path):
@@ -46,12 +57,12 @@ def test_a_report_of_the_problems_joints_weighs_them_and_of_others_is_refused(re
     robot = load_robot(problem.robot, problem.folder)
     sigma = np.linspace(0.1, 0.7, robot.n_joints)
     problem.sequence.prior = str(_report(report_file, tmp_path / "ok.h5", robot.joint_names[::-1], sigma))
-    measured = measured_prior(problem.sequence.prior, problem.folder, robot)
+    measured = measured_prior(read_inputs(problem.effects.model, problem.sequence.prior, problem.folder).prior, robot)
     assert measured.rate == 200.0 and measured.joints == robot.joint_names[::-1]
     others = [f"joint_{k}" for k in range(robot.n_joints)]
     problem.sequence.prior = str(_report(report_file, tmp_path / "other.h5", others, np.ones(robot.n_joints)))
     with pytest.raises(ExciteError, match=r"sequence\.prior.*identified the joints joint_0"):
-        measured_prior(problem.sequence.prior, problem.folder, robot)
+        measured_prior(read_inputs(problem.effects.model, problem.sequence.prior, problem.folder).prior, robot)
 
 
 def test_predicted_standard_deviations_match_least_squares_on_noisy_data():

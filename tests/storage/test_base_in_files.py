@@ -12,7 +12,7 @@ from excite_cli.errors import ExciteError
 from excite_cli.h5 import read_strings, write_strings
 from excite_cli.search.sequence import describe
 from excite_cli.storage.results import read_iterations, write_result
-from excite_cli.stored.prior import read_prior
+from excite_cli.stored.prior import prior_rows, read_prior_file
 
 
 @pytest.fixture(scope="module")
@@ -36,7 +36,7 @@ def test_prior_columns_in_another_order_are_mapped_by_name(tmp_path, excitation,
     base = excitation.base
     order = np.random.default_rng(1).permutation(base.count)
     path = _prior_file(tmp_path / "prior.h5", rows[:, order], [base.names[k] for k in order])
-    np.testing.assert_array_equal(read_prior(path, base), rows)
+    np.testing.assert_array_equal(prior_rows(read_prior_file(path), base), rows)
 
 
 def test_prior_of_other_base_parameters_is_refused_by_name(tmp_path, excitation, rows):
@@ -44,7 +44,7 @@ def test_prior_of_other_base_parameters_is_refused_by_name(tmp_path, excitation,
     names[3] = "Izz_panda_link9 + 1·m_panda_link1"
     path = _prior_file(tmp_path / "prior.h5", rows, names)
     with pytest.raises(ExciteError) as caught:
-        read_prior(path, excitation.base)
+        prior_rows(read_prior_file(path), excitation.base)
     assert caught.value.field == "sequence.prior" and "Izz_panda_link9" in str(caught.value)
 
 
@@ -75,10 +75,10 @@ def test_a_prior_with_effect_columns_enters_only_a_design_with_the_same_effects(
     path = _prior_file(tmp_path / "prior.h5", wide, base.names)
     with h5py.File(path, "a") as f:
         write_strings(f["robot"], "effect_names", effects)
-    np.testing.assert_array_equal(read_prior(path, base, effects), wide)
+    np.testing.assert_array_equal(prior_rows(read_prior_file(path), base, effects), wide)
     for other in ([], ["Fc_panda_joint1"], effects[::-1]):
         with pytest.raises(ExciteError, match=r"effect columns \[Fc_panda_joint1, Fv_panda_joint1\]"):
-            read_prior(path, base, other)
+            prior_rows(read_prior_file(path), base, other)
     rigid = _prior_file(tmp_path / "rigid.h5", rows, base.names)
     with pytest.raises(ExciteError, match=r"effect columns \[\]; this design has \[Fc_panda_joint1"):
-        read_prior(rigid, base, effects)
+        prior_rows(read_prior_file(rigid), base, effects)

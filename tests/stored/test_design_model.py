@@ -1,5 +1,7 @@
 """An identify report's chosen effects as the next design's columns (``effects.model``)."""
 
+from pathlib import Path
+
 import h5py
 import numpy as np
 import pytest
@@ -17,7 +19,8 @@ from excite_cli.stored.design_model import (
     report_model,
     with_report_model,
 )
-from excite_cli.stored.prior import read_prior
+from excite_cli.stored.inputs import read_inputs
+from excite_cli.stored.prior import prior_rows, read_prior_file
 from excite_cli.stored.report import read_identify_report, read_report
 
 
@@ -52,10 +55,30 @@ def test_a_report_with_a_coupled_motor_and_a_shaped_effect(report_file, tmp_path
 
 def test_a_file_that_is_not_a_report_or_of_other_joints_is_refused_naming_the_field(report_file, optimized):
     problem = load_problem(CONFIGS / "smoke.yaml")
+    problem.effects.model = str(optimized)
     with pytest.raises(ExciteError, match=r"effects\.model.*is not an identify report"):
-        with_report_model(problem.effects, optimized, ["panda_joint1"])
+        read_inputs(problem.effects.model, None, problem.folder)
+    report = read_identify_report(report_file, "effects.model")
     with pytest.raises(ExciteError, match=r"effects\.model.*'panda_joint\d', which is not an active joint"):
-        with_report_model(problem.effects, report_file, ["shoulder_pan_joint"])
+        with_report_model(problem.effects, report, report_file, ["shoulder_pan_joint"])
+
+
+def test_optimize_opens_a_report_named_as_model_and_prior_once(report_file, tmp_path, monkeypatch):
+    """`excite optimize CONFIG --model REPORT.h5 --prior REPORT.h5`: the design's model, the weighing of
+    its rows and the rows themselves come from one opening of the file."""
+    opened, real = [], h5py.File
+
+    def counted(name, *args, **kwargs):
+        opened.append(Path(name).resolve() if isinstance(name, (str, Path)) else name)
+        return real(name, *args, **kwargs)
+
+    monkeypatch.setattr(h5py, "File", counted)
+    both = ["--model", str(report_file), "--prior", str(report_file)]
+    run = CliRunner().invoke(
+        app, ["optimize", str(CONFIGS / "smoke.yaml"), *both, "-o", str(tmp_path / "o.h5"), "-k", "1"]
+    )
+    assert run.exit_code == 0, run.output
+    assert opened.count(report_file.resolve()) == 1 and len(opened) > 1  # the result was written too
 
 
 def test_optimize_with_the_report_as_model_designs_for_its_friction(report_file, tmp_path, monkeypatch):
@@ -140,7 +163,7 @@ def test_one_report_is_the_model_and_the_prior_data(report_file, tmp_path):
     problem = load_problem(CONFIGS / "smoke.yaml")
     problem.effects.model = problem.sequence.prior = str(report_file)
     excitation = build_excitation(problem)
-    prior = read_prior(report_file, excitation.base, excitation.effect_names, excitation.measured, 0.2)
+    prior = prior_rows(read_prior_file(report_file), excitation.base, excitation.effect_names, excitation.measured, 0.2)
     with h5py.File(report_file) as f:
         held = [str(name) for name in f["effect_regressor"].attrs["names"]]
         raw = f["effect_regressor"][()][:, [held.index(name) for name in excitation.effect_names]]
@@ -155,7 +178,7 @@ def test_one_report_is_the_model_and_the_prior_data(report_file, tmp_path):
     problem.effects.joints = {"panda_joint2": ["offset"]}
     extra = build_excitation(problem)
     with pytest.raises(ExciteError, match=r"sequence\.prior.*not this design's tau0_panda_joint2"):
-        read_prior(report_file, extra.base, extra.effect_names, extra.measured, 0.2)
+        prior_rows(read_prior_file(report_file), extra.base, extra.effect_names, extra.measured, 0.2)
 
 
 def test_a_report_whose_rows_do_not_match_is_refused_in_one_line(report_file, tmp_path):
@@ -176,13 +199,13 @@ def test_a_report_whose_rows_do_not_match_is_refused_in_one_line(report_file, tm
         f.create_dataset("effect_regressor", data=short).attrs["names"] = names
     args = (excitation.base, excitation.effect_names, excitation.measured, 0.2)
     with pytest.raises(ExciteError, match=r"sequence\.prior.*effect_regressor of shape"):
-        read_prior(edited, *args)
+        prior_rows(read_prior_file(edited), *args)
     with h5py.File(edited, "a") as f:
         rows = f["regressor"][()][:-3]
         del f["regressor"]
         f["regressor"] = rows
     with pytest.raises(ExciteError, match=r"sequence\.prior.*not a whole number of instants"):
-        read_prior(edited, excitation.base, (), excitation.measured, 0.2)
+        prior_rows(read_prior_file(edited), excitation.base, (), excitation.measured, 0.2)
 
 
 def _damaged(report_file, tmp_path, edit):

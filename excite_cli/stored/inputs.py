@@ -1,0 +1,48 @@
+"""The files a problem names that an earlier run wrote (``effects.model``, ``sequence.prior``), each
+resolved and opened once per command and handed on as values: the design takes its model and the
+weighing of measured rows from them, the sequence its prior rows C₀."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from excite_cli.config import resolve_path
+from excite_cli.errors import ExciteError
+from excite_cli.stored.prior import PriorFile, read_prior_file
+from excite_cli.stored.report import StoredReport
+
+
+@dataclass(frozen=True)
+class StoredInputs:
+    """What ``effects.model`` and ``sequence.prior`` hold.
+
+    Attributes:
+        model: the identify report of ``effects.model``, or None (none named); model_path: its file.
+        prior: the file of ``sequence.prior`` (its rows, and its report when it is one), or None.
+    """
+
+    model: StoredReport | None = None
+    model_path: Path | None = None
+    prior: PriorFile | None = None
+
+
+def read_inputs(model: str | None, prior: str | None, folder: Path | None) -> StoredInputs:
+    """The files a problem names, each opened once (one file named by both fields is read once, its
+    errors named under ``effects.model``).
+
+    Args:
+        model: ``effects.model``; prior: ``sequence.prior``; each relative to ``folder``, or None.
+
+    Raises:
+        FileNotFound, ExciteError: a file missing or unreadable; ``effects.model`` not an identify
+            report (:func:`~excite_cli.stored.prior.read_prior_file`).
+    """
+    model_path = resolve_path(model, folder) if model else None
+    prior_path = resolve_path(prior, folder) if prior else None
+    model_file = None if model_path is None else read_prior_file(model_path, "effects.model")
+    if model_file is not None and model_file.report is None:
+        raise ExciteError("effects.model", f"{model_path} is not an identify report (no /identification/effects)")
+    same = prior_path is not None and model_path is not None and prior_path.resolve() == model_path.resolve()
+    prior = model_file if same else None if prior_path is None else read_prior_file(prior_path)
+    return StoredInputs(None if model_file is None else model_file.report, model_path, prior)
