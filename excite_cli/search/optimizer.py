@@ -8,7 +8,7 @@ criterion has a kink at its optimum (a continuation of a restart that stalled in
 its smoothing, :mod:`~excite_cli.search.smoothing`). Quasi-Newton iterates of this problem approach
 the constraint boundary from outside (on the G1 problem SLSQP's iterates stay up to 3 cm outside the
 CoM region for most of the run), so a restart ends at the feasible point nearest to the solver's last iterate
-(:func:`~excite_cli.search.nlp.project`): what the restart found is then judged by a point
+(:func:`~excite_cli.search.feasible.project`): what the restart found is then judged by a point
 every constraint accepts, with its first-order optimality (:mod:`excite_cli.search.kkt`)
 and an honest stop reason.
 """
@@ -24,8 +24,9 @@ import numpy as np
 from excite_cli.config import OptimizerConfig
 from excite_cli.constraints import Constraint, accepted
 from excite_cli.design.criterion import Criterion
+from excite_cli.search.feasible import onto_fine_grid, project, repair
 from excite_cli.search.kkt import INFEASIBLE, SOLVER_FAILED, End, Optimality, stationary, stop_reason, until_done
-from excite_cli.search.nlp import Epigraph, Evaluations, onto_fine_grid, project, repair
+from excite_cli.search.nlp import Epigraph, Evaluations, NlpForm
 from excite_cli.search.smoothing import Smoothed
 from excite_cli.search.solvers import SolverRun, criterion_scale, solve
 from excite_cli.trajectory.boundary import BoundaryConditions
@@ -120,10 +121,7 @@ def _solve_recovering(
       iteration can change the criterion by less than the tolerance: on the G1 (seed 1, iteration 3)
       a restart ended after 1 iteration at its start, 3.047 against the other restart's 2.835."""
 
-    def variables(z: np.ndarray) -> np.ndarray:  # the epigraph's bounds start at their extremes
-        return nlp.start(z) if isinstance(nlp, Epigraph) else z
-
-    problem = nlp if isinstance(nlp, Evaluations) else nlp.problem
+    variables, problem = nlp.start, nlp.problem  # the epigraph's bounds start at their extremes
 
     tolerance = options.tolerance
     run = solve(options.method, nlp, variables(z0), iterations, tolerance, on_iterate, scale)
@@ -184,12 +182,12 @@ def optimize_restart(
     hold exactly, with diagonal preconditioning s, see :mod:`excite_cli.trajectory.boundary`); everything else
     sees α. The restart ends with the best of: the start, the best iterate whose aggregated
     constraints were all ≤ 0, and the feasible point nearest to the last iterate
-    (:func:`~excite_cli.search.nlp.project`; if the projection fails,
-    :func:`~excite_cli.search.nlp.repair`); each is confirmed by every constraint's exact grid check.
+    (:func:`~excite_cli.search.feasible.project`; if the projection fails,
+    :func:`~excite_cli.search.feasible.repair`); each is confirmed by every constraint's exact grid check.
     The one kept is confirmed on ``fine_basis`` too, the re-check its result is judged by (the grid
     margin covers the overshoot between grid instants, but not always): where that check fails, the
     constraints it rejects get a margin of their own and the point is projected onto that problem,
-    or else moved towards the start (:func:`~excite_cli.search.nlp.onto_fine_grid`).
+    or else moved towards the start (:func:`~excite_cli.search.feasible.onto_fine_grid`).
 
     Args:
         criterion: the criterion (value and gradient).
@@ -225,7 +223,7 @@ def optimize_restart(
     done = until_done(problem, on_iterate, options.optimality_tolerance, deadline)
     # a criterion of the extreme singular values is solved in its epigraph form (smooth where it is not)
     nlp = (Smoothed if smoothed else Epigraph)(problem) if criterion.objective.extremes else problem
-    if scale is None and isinstance(nlp, Evaluations):  # the epigraph's criterion is its bounds' weights
+    if scale is None and nlp.form is NlpForm.PLAIN:  # the epigraph's criterion is its bounds' weights
         scale = own_scale(criterion, boundary, start)
     run = _solve_recovering(
         options, nlp, z0, max_iterations or options.max_iterations, lambda w: done(w[: z0.size]), scale
@@ -234,32 +232,11 @@ def optimize_restart(
     out_of_time = time.perf_counter() > deadline
     if len(history) < run.iterations:  # a solver that ends inside an iteration calls back no more: its last iterate
         on_iterate(run.z)
-    ends = [(End.START, start)]
-    projected = project(problem, run.z)
-    if projected is not None:
-        ends.append((End.PROJECTED, projected))
-    else:
-        ends.append((End.BISECTION, repair(constraints, boundary.to_alpha(run.z), start, boundary)))
-    if problem.best_inside is not None:
-        ends.append((End.INSIDE, problem.best_inside))
-    # judged by the criterion the solver minimized: a smoothing's start (a stalled end) can be lower in
-    # the criterion itself by what the smoothing costs (excite_cli.search.restarts._smoothed_round weighs that)
-    judge = (lambda a: nlp.value(boundary.to_variables(a))) if isinstance(nlp, Smoothed) else criterion.value
-    scored = [
-        (judge(alpha), k, name, alpha)
-        for k, (name, alpha) in enumerate(ends)
-        if name == End.PROJECTED or accepted(constraints, alpha)
-    ]  # the projection is already accepted
-    # only a constraint that needs motion rejects the start: when no end point meets it, none is kept
-    _, _, end, alpha = min(scored, key=lambda item: item[:2]) if scored else (np.inf, 0, End.NONE, start)
-    value = criterion.value(alpha) if scored else np.inf
-    if scored and fine_basis is not None and not accepted(constraints, alpha, fine_basis):
-        problem, alpha, end = onto_fine_grid(problem, alpha, start, fine_basis)
-        value = criterion.value(alpha)
+    problem, alpha, end, value = _kept_end(nlp, problem, start, run.z, fine_basis)
     optimality = problem.optimality(alpha)
     history_values = [f for f, _ in history]
     stop = stop_reason(optimality, history_values, run.limit, run.failed, options.optimality_tolerance, out_of_time)
-    stop = stop if scored else INFEASIBLE
+    stop = stop if end is not End.NONE else INFEASIBLE
     return RestartResult(
         index,
         alpha,
@@ -275,3 +252,41 @@ def optimize_restart(
         run.scale,
         problem.margins,
     )
+
+
+def _kept_end(
+    nlp: Evaluations | Epigraph | Smoothed,
+    problem: Evaluations,
+    start: np.ndarray,
+    last: np.ndarray,
+    fine_basis: Optional[FourierBasis],
+) -> tuple[Evaluations, np.ndarray, End, float]:
+    """The end point a restart keeps (:func:`optimize_restart`): the lowest of its start, the feasible
+    point nearest the solver's ``last`` iterate z (n_z,) (or a repair towards the start), and the best
+    iterate inside, among those every constraint's grid check accepts; moved onto the fine grid where
+    its check fails. Returns the problem it is judged in (with the fine check's margins), its α
+    (n, 2N+1), which end it is (``End.NONE`` and the start when none is accepted) and its criterion
+    (``inf`` then)."""
+    criterion, constraints, boundary = problem.criterion, problem.all, problem.boundary
+    ends = [(End.START, start)]
+    projected = project(problem, last)
+    if projected is not None:
+        ends.append((End.PROJECTED, projected))
+    else:
+        ends.append((End.BISECTION, repair(constraints, boundary.to_alpha(last), start, boundary)))
+    if problem.best_inside is not None:
+        ends.append((End.INSIDE, problem.best_inside))
+    # judged by the criterion the solver minimized: a smoothing's start (a stalled end) can be lower in
+    # the criterion itself by what the smoothing costs (excite_cli.search.restarts._smoothed_round weighs that)
+    judge = (lambda a: nlp.value(boundary.to_variables(a))) if nlp.form is NlpForm.SMOOTHED else criterion.value
+    scored = [
+        (judge(alpha), k, name, alpha)
+        for k, (name, alpha) in enumerate(ends)
+        if name == End.PROJECTED or accepted(constraints, alpha)
+    ]  # the projection is already accepted
+    if not scored:  # only a constraint that needs motion rejects the start: when no end point meets it, none is kept
+        return problem, start, End.NONE, np.inf
+    _, _, end, alpha = min(scored, key=lambda item: item[:2])
+    if fine_basis is not None and not accepted(constraints, alpha, fine_basis):
+        problem, alpha, end = onto_fine_grid(problem, alpha, start, fine_basis)
+    return problem, alpha, end, criterion.value(alpha)

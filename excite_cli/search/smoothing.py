@@ -27,7 +27,7 @@ from scipy.special import logsumexp, softmax
 
 from excite_cli.design.criterion import Criterion
 from excite_cli.memo import once
-from excite_cli.search.nlp import Evaluations
+from excite_cli.search.nlp import Evaluations, NlpForm
 
 #: μ [1, of log σ]: the smoothing's width, and its largest cost per extreme over log |B_c|.
 SMOOTHING = 1e-4
@@ -40,10 +40,16 @@ class Smoothed:
     the extreme singular values replaced by f_μ (module docstring): value and gradient in z (n_z,),
     the constraints as they are."""
 
+    form = NlpForm.SMOOTHED
+
     def __init__(self, problem: Evaluations, mu: float = SMOOTHING):
         self.problem, self.mu = problem, mu
         self.constraint_values, self.constraint_jacobian = problem.constraint_values, problem.constraint_jacobian
         self.sides = problem.criterion.objective.weighed_extremes
+
+    def start(self, z: np.ndarray) -> np.ndarray:
+        """The solver's variables at z (n_z,): z."""
+        return z
 
     def value(self, z: np.ndarray) -> float:
         """f_μ at z (n_z,) [1, of log σ]."""

@@ -18,6 +18,7 @@ from excite_cli.config_file import load_problem
 from excite_cli.constraints import accepted
 from excite_cli.design.resolve import build_excitation
 from excite_cli.design.verify import finite_difference_gradient
+from excite_cli.search.feasible import project, repair
 from excite_cli.search.kkt import (
     ACTIVE_TOLERANCE,
     CONVERGED,
@@ -31,7 +32,7 @@ from excite_cli.search.kkt import (
     kkt_optimality,
     stop_reason,
 )
-from excite_cli.search.nlp import Evaluations, project, repair
+from excite_cli.search.nlp import Evaluations
 
 runner = CliRunner()
 

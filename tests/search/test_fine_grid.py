@@ -7,7 +7,8 @@ import pytest
 
 from excite_cli.constraints import accepted
 from excite_cli.design.resolve import build_excitation
-from excite_cli.search.nlp import Evaluations, onto_fine_grid, project
+from excite_cli.search.feasible import onto_fine_grid, project
+from excite_cli.search.nlp import Evaluations
 from excite_cli.search.restarts import RestartTask
 
 
