@@ -15,9 +15,9 @@ from excite_cli.storage.formats import FORMATS
 
 def _load(path: Path, overrides: Optional[dict] = None, kind: str = "optimize"):
     """The ``kind`` config at ``path`` with the options' ``overrides`` (:func:`load_config`)."""
-    from excite_cli.config_file import load_config  # here, not at start-up
+    from excite_cli.config_file import ConfigKind, load_config  # here, not at start-up
 
-    return load_config(path, overrides, kind)
+    return load_config(path, overrides, ConfigKind(kind))
 
 
 @app.callback()

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import functools
 import reprlib
+from enum import StrEnum
 from pathlib import Path
 
 import yaml
@@ -246,18 +247,39 @@ def drafted_problem(config: dict, target: Path) -> Problem:
     return problem
 
 
-def load_config(path: str | Path, overrides: dict[str, object] | None = None, kind: str = "optimize") -> BaseModel:
-    """The config of ``kind`` at ``path``: ``optimize`` (:class:`Problem`), ``identify``
-    (:class:`~excite_cli.identification.config.IdentifyProblem`) or ``effects``
-    (:class:`~excite_cli.identification.simulation_config.SimulationConfig`), validated, with the
-    command line's ``overrides`` (:func:`with_overrides`; none: the file as read).
+class ConfigKind(StrEnum):
+    """The configs the commands read, each validated by its own schema."""
+
+    OPTIMIZE = "optimize"
+    IDENTIFY = "identify"
+    EFFECTS = "effects"
+
+    def schema(self) -> type[BaseModel]:
+        """:class:`Problem`, :class:`~excite_cli.identification.config.IdentifyProblem` or
+        :class:`~excite_cli.identification.simulation_config.SimulationConfig`."""
+        from excite_cli.identification.config import IdentifyProblem
+        from excite_cli.identification.simulation_config import SimulationConfig
+
+        return {
+            ConfigKind.OPTIMIZE: Problem,
+            ConfigKind.IDENTIFY: IdentifyProblem,
+            ConfigKind.EFFECTS: SimulationConfig,
+        }[self]
+
+    @property
+    def field(self) -> str:
+        """The argument that names such a file, for the messages: ``effects`` or ``config``."""
+        return "effects" if self is ConfigKind.EFFECTS else "config"
+
+
+def load_config(
+    path: str | Path, overrides: dict[str, object] | None = None, kind: ConfigKind = ConfigKind.OPTIMIZE
+) -> BaseModel:
+    """The config of ``kind`` at ``path`` (:meth:`ConfigKind.schema`), validated, with the command
+    line's ``overrides`` (:func:`with_overrides`; none: the file as read).
 
     Raises:
         ExciteError: as :func:`load_problem` and :func:`with_overrides`.
     """
-    from excite_cli.identification.config import IdentifyProblem
-    from excite_cli.identification.simulation_config import SimulationConfig
-
-    model = {"identify": IdentifyProblem, "effects": SimulationConfig}.get(kind, Problem)
-    problem = load_problem(path, model, "effects" if kind == "effects" else "config")
+    problem = load_problem(path, kind.schema(), kind.field)
     return with_overrides(problem, overrides) if overrides else problem

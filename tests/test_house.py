@@ -380,3 +380,25 @@ def test_no_module_outside_the_constraints_asks_a_constraint_its_class():
                 if named & classes:
                     asked.append(f"{name}:{node.lineno}")
     assert asked == []
+
+
+def test_shape_kinds_and_solver_forms_are_enum_members_not_strings_or_classes():
+    """A world shape's kind is a ``ShapeKind`` member (never compared with a string), the form the solver
+    sees a criterion in is the problem's ``form`` (an ``NlpForm``, never ``isinstance`` on the problem
+    classes): a new kind is then a new member that every branch must name."""
+    forms = {"Evaluations", "Epigraph", "Smoothed"}
+    found = []
+    for name, tree in _modules().items():
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Compare) and any(
+                isinstance(side, ast.Attribute)
+                and side.attr == "kind"
+                and not (isinstance(side.value, ast.Attribute) and side.value.attr == "dtype")  # numpy's
+                for side in [node.left, *node.comparators]
+            ):
+                if any(isinstance(side, ast.Constant) and isinstance(side.value, str) for side in node.comparators):
+                    found.append(f"{name}:{node.lineno}")
+            if isinstance(node, ast.Call) and getattr(node.func, "id", "") == "isinstance" and len(node.args) == 2:
+                if {n.id for n in ast.walk(node.args[1]) if isinstance(n, ast.Name)} & forms:
+                    found.append(f"{name}:{node.lineno}")
+    assert found == []

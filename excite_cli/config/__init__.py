@@ -23,6 +23,7 @@ from excite_cli.config.constraints import (
     ConstraintsConfig,
     EnvironmentConfig,
     SelfCollisionConfig,
+    ShapeKind,
     WorldShapeConfig,
     ZmpConfig,
 )
@@ -64,6 +65,7 @@ __all__ = [
     "Section",
     "SelfCollisionConfig",
     "SequenceConfig",
+    "ShapeKind",
     "TrajectoryConfig",
     "WorldShapeConfig",
     "ZmpConfig",

@@ -22,7 +22,7 @@ import pinocchio as pin
 
 from excite_cli.collision.capsules import Capsule, capsule_frames, segment_ends
 from excite_cli.collision.segments import segment_closest_points
-from excite_cli.config import EnvironmentConfig
+from excite_cli.config import EnvironmentConfig, ShapeKind
 from excite_cli.constraints.constraint import Constraint, FineCheck
 from excite_cli.constraints.lse import ACCEPT_MARGIN, smooth_max, smooth_max_value
 from excite_cli.constraints.self_collision import LENGTH_SCALE
@@ -38,7 +38,7 @@ class WorldShape:
 
     Attributes:
         name: its name in the config, for messages.
-        kind: ``half_space``, ``sphere`` or ``capsule``.
+        kind: a half-space, a sphere, a capsule or a box.
         start: (3,) a point on the plane, the sphere's centre or the capsule's first end [m].
         end: (3,) the plane's unit normal (towards the robot's side) or the capsule's second end
             [m] (the centre again for a sphere).
@@ -49,7 +49,7 @@ class WorldShape:
     """
 
     name: str
-    kind: str
+    kind: ShapeKind
     start: np.ndarray
     end: np.ndarray
     radius: float
@@ -62,12 +62,12 @@ def world_shapes(cfg: EnvironmentConfig | None) -> list[WorldShape]:
     """The shapes of ``constraints.environment`` (their fields checked by the config); none without one."""
     shapes = []
     for s in cfg.shapes if cfg else []:
-        if s.type == "half_space":
+        if s.type is ShapeKind.HALF_SPACE:
             normal = np.asarray(s.normal, dtype=float)
             shapes.append(
                 WorldShape(s.name, s.type, np.asarray(s.point, float), normal / np.linalg.norm(normal), 0.0, s.margin)
             )
-        elif s.type in ("sphere", "box"):
+        elif s.type in (ShapeKind.SPHERE, ShapeKind.BOX):
             centre, rotation = np.asarray(s.centre, dtype=float), pin.rpy.rpyToMatrix(*s.rpy)
             size = np.asarray(s.size if s.size else (0.0, 0.0, 0.0), dtype=float)
             shapes.append(WorldShape(s.name, s.type, centre, centre, s.radius or 0.0, s.margin, size, rotation))
@@ -99,9 +99,9 @@ def distance_bound(robot: Robot, capsule: Capsule, shape: WorldShape) -> float:
     origin = data.oMi[below[0]].translation
     reach = sum(float(np.linalg.norm(model.jointPlacements[j].translation)) for j in below[1:])
     reach += max(float(np.linalg.norm(capsule.start)), float(np.linalg.norm(capsule.end))) + capsule.radius
-    if shape.kind == "half_space":
+    if shape.kind is ShapeKind.HALF_SPACE:
         away = float(shape.end @ (origin - shape.start))
-    elif shape.kind == "box":
+    elif shape.kind is ShapeKind.BOX:
         away = float(np.linalg.norm(origin - shape.start) - np.linalg.norm(shape.size) / 2.0)
     else:
         closest = segment_closest_points(shape.start, shape.end, origin, origin)[0]
@@ -212,10 +212,10 @@ class WorldCollision(Constraint):
         for k, shape in enumerate(self.shapes):
             cols = self._shape == k
             ak, bk = a[..., cols], b[..., cols]
-            if shape.kind == "box":
+            if shape.kind is ShapeKind.BOX:
                 frames = frames or capsule_frames(R, p, self.capsules)
                 d[:, cols], point[..., cols], normal[..., cols] = self._to_box(shape, *frames, np.flatnonzero(cols))
-            elif shape.kind == "half_space":
+            elif shape.kind is ShapeKind.HALF_SPACE:
                 n, o = shape.end[:, None, None], shape.start[:, None, None]
                 ha, hb = (((x - o) * n).sum(axis=0) for x in (ak, bk))
                 point[..., cols] = np.where(ha <= hb, ak, bk)

@@ -13,6 +13,7 @@ import numpy as np
 import pinocchio as pin
 
 from excite_cli.atomic import MARK, atomic_bytes
+from excite_cli.config import ShapeKind
 from excite_cli.constraints.world_collision import WorldShape
 from excite_cli.dynamics.robot import Robot
 from excite_cli.errors import ExciteError
@@ -75,11 +76,11 @@ def _draw_shape(node, shape: WorldShape) -> None:
     import meshcat.transformations as tf
 
     material = mg.MeshLambertMaterial(color=0x999999, opacity=0.6, transparent=True)
-    if shape.kind == "box":
+    if shape.kind is ShapeKind.BOX:
         node.set_object(mg.Box(list(shape.size)), material)
         node.set_transform(pin.SE3(shape.rotation, shape.start).homogeneous)
         return
-    if shape.kind == "half_space":
+    if shape.kind is ShapeKind.HALF_SPACE:
         side, thick = SLAB
         node.set_object(mg.Box([side, side, thick]), material)
         rotation = pin.Quaternion.FromTwoVectors(np.array([0.0, 0.0, 1.0]), shape.end).matrix()
@@ -87,7 +88,7 @@ def _draw_shape(node, shape: WorldShape) -> None:
         return
     node["a"].set_object(mg.Sphere(shape.radius), material)
     node["a"].set_transform(tf.translation_matrix(shape.start))
-    if shape.kind == "sphere":
+    if shape.kind is ShapeKind.SPHERE:
         return
     node["b"].set_object(mg.Sphere(shape.radius), material)
     node["b"].set_transform(tf.translation_matrix(shape.end))

@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import ConvexHull
 
+from excite_cli.config import ShapeKind
 from excite_cli.constraints.world_collision import WorldShape
 
 
@@ -31,12 +32,12 @@ def draw_shape(ax, shape: WorldShape, axis: int, sign: float) -> None:
     def h(x: np.ndarray) -> np.ndarray:
         return np.array([sign * x[axis], x[2]])
 
-    if shape.kind == "box":
+    if shape.kind is ShapeKind.BOX:
         corners = np.array([h(shape.start + shape.rotation @ (shape.size * np.array(c) / 2)) for c in CORNERS])
         outline = corners[ConvexHull(corners).vertices]
         ax.fill(outline[:, 0], outline[:, 1], color="0.5", alpha=0.4, linewidth=0)
         return
-    if shape.kind != "half_space":
+    if shape.kind is not ShapeKind.HALF_SPACE:
         outline = stadium(h(shape.start), h(shape.end), shape.radius)
         ax.fill(outline[:, 0], outline[:, 1], color="0.5", alpha=0.4, linewidth=0)
         return

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from excite_cli.config_file import load_config, read_yaml
+from excite_cli.config_file import ConfigKind, load_config, read_yaml
 from excite_cli.dynamics.base_parameters import compute_base_parameters
 from excite_cli.dynamics.robot import load_robot
 from excite_cli.errors import ExciteError
@@ -131,4 +131,4 @@ def plan_check(path: Path, overrides: dict[str, object]) -> Plan | IdentifyPlan:
     given = [name.split(".")[-1] for name, v in overrides.items() if v is not None]  # the option's own name
     if given:
         raise ExciteError(given[0], "applies to an optimize config; this is an identify config (it has a data section)")
-    return plan_identify(load_config(path, None, "identify"))
+    return plan_identify(load_config(path, None, ConfigKind.IDENTIFY))

@@ -7,7 +7,7 @@ from conftest import assert_refused, pendulum_config
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
-from excite_cli.config_file import load_config
+from excite_cli.config_file import ConfigKind, load_config
 from excite_cli.workflows.check_identify import plan_identify
 
 runner = CliRunner()
@@ -32,7 +32,7 @@ def identify_config(tmp_path_factory):
 
 
 def test_each_run_is_summarized_as_identify_reads_it(identify_config):
-    plan = plan_identify(load_config(identify_config, None, "identify"))
+    plan = plan_identify(load_config(identify_config, None, ConfigKind.IDENTIFY))
     [run] = plan.runs
     assert (run.samples, run.seconds, run.signals, run.role) == (1001, pytest.approx(10.0), ("q", "tau"), "blocks")
     assert run.rate == pytest.approx(100.0)
