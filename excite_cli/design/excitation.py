@@ -7,6 +7,7 @@ optimizer and the sequential generation use these, never the config file.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -119,9 +120,10 @@ class Excitation:
         """b + e: the regressor's columns, base parameters then effect columns."""
         return self.spec.columns
 
-    @property
+    @cached_property
     def noise(self) -> RowNoise | None:
-        """The regressor rows' noise (``noise``, σ_j from a measured prior's report), or None: unweighted."""
+        """The regressor rows' noise (``noise``, σ_j from a measured prior's report), or None: unweighted;
+        resolved once per design (every criterion it builds takes the same)."""
         return row_noise(self.spec.noise, self.robot, self.measured)
 
     @property
@@ -211,7 +213,7 @@ def build_design(spec: DesignSpec, robot: Robot | None = None, check_home: bool 
         constraints=_constraints(spec.limits, spec.constraints, robot, grid_basis, limits),
         boundary=boundary_conditions(tcfg, trajectory, limits.coefficient_scale(), home_posture(robot, limits)),
     )
-    row_noise(spec.noise, robot, spec.measured)  # the noise section checked before any work
+    excitation.noise  # the noise section resolved and checked before any work
     if check_home:
         _check_home_posture(excitation)
     return excitation
