@@ -109,7 +109,7 @@ class Constraint(ABC):
 
     def drawn(self) -> dict[str, object]:
         """What the constraint-tracks figure draws for it beside its tracks, as keyword arguments of
-        :func:`~excite_cli.plots.optimize.plot_constraint_tracks` (default: nothing)."""
+        :func:`~excite_cli.plots.tracks.plot_constraint_tracks` (default: nothing)."""
         return {}
 
     def track(self, alpha: np.ndarray, basis: FourierBasis) -> dict[str, np.ndarray]:

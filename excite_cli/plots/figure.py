@@ -25,3 +25,9 @@ def save_figure(fig: plt.Figure, path: Path, dpi: int) -> Path:
     finally:
         plt.close(fig)
     return atomic_bytes(path, buffer.getvalue(), "output")
+
+
+def joint_colours(count: int) -> list:
+    """``count`` distinguishable colours (tab10, then tab20's light shades; 20 before repeating)."""
+    palette = list(plt.get_cmap("tab10").colors) + list(plt.get_cmap("tab20").colors[1::2])
+    return [palette[j % len(palette)] for j in range(count)]

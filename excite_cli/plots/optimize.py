@@ -1,5 +1,5 @@
 """The PNG figures of an optimize result: joint trajectories with their limits, the condition-number table,
-constraint tracks and posture strips."""
+posture strips, and the constraint tracks (:mod:`~excite_cli.plots.tracks`)."""
 
 from __future__ import annotations
 
@@ -15,12 +15,12 @@ from matplotlib.collections import LineCollection, PolyCollection  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
 
-from excite_cli.constraints.support import SupportPolygon  # noqa: E402
 from excite_cli.constraints.world_collision import WorldShape, world_shapes  # noqa: E402
 from excite_cli.design.excitation import Excitation  # noqa: E402
-from excite_cli.plots.figure import save_figure  # noqa: E402
+from excite_cli.plots.figure import joint_colours, save_figure  # noqa: E402
 from excite_cli.plots.shapes import draw_shape, stadium  # noqa: E402
 from excite_cli.plots.skeleton import capsule_segments, skeleton  # noqa: E402
+from excite_cli.plots.tracks import Drawn, plot_constraint_tracks  # noqa: E402
 from excite_cli.search.sequence import IterationResult  # noqa: E402
 
 
@@ -56,21 +56,8 @@ def plot_result(target: Path, excitation: Excitation, results: Sequence[Iteratio
         ),
     ]
     if any(r.tracks for r in results):
-        plots.append(
-            plot_constraint_tracks(
-                tracks,
-                results,
-                **drawn,
-                joints=excitation.robot.joint_names,
-            )
-        )
+        plots.append(plot_constraint_tracks(tracks, results, Drawn(**drawn, joints=excitation.robot.joint_names)))
     return plots
-
-
-def _joint_colours(count: int) -> list:
-    """``count`` distinguishable colours (tab10, then tab20's light shades; 20 before repeating)."""
-    palette = list(plt.get_cmap("tab10").colors) + list(plt.get_cmap("tab20").colors[1::2])
-    return [palette[j % len(palette)] for j in range(count)]
 
 
 def plot_trajectories(
@@ -86,7 +73,7 @@ def plot_trajectories(
     Args:
         lower, upper: (3, n) bounds of q [rad], q̇ [rad/s], q̈ [rad/s²], or None.
     """
-    colours = _joint_colours(len(joint_names))
+    colours = joint_colours(len(joint_names))
     fig, axes = plt.subplots(3, len(results), figsize=(4.5 * len(results) + 2.5, 8), sharex=True, squeeze=False)
     for col, r in enumerate(results):
         for row, (name, unit) in enumerate((("q", "rad"), ("qd", "rad/s"), ("qdd", "rad/s²"))):
@@ -200,73 +187,3 @@ def _in_view(segments: np.ndarray, axis: int, sign: float) -> np.ndarray:
     and vertical z: (S, 2, 2)."""
     segments = np.asarray(segments, dtype=float).reshape(-1, 2, 3)
     return np.stack([sign * segments[..., axis], segments[..., 2]], axis=-1)
-
-
-def plot_constraint_tracks(
-    path: Path,
-    results: Sequence[IterationResult],
-    centre=None,
-    radius: float | None = None,
-    polygon=None,
-    margin: float | None = None,
-    support: SupportPolygon | None = None,
-    zmp_margin: float = 0.0,
-    joints: Sequence[str] = (),
-) -> Path:
-    """Per iteration, for the constraints the run has: the CoM ground track against its region
-    (Eq. 52), the zero-moment point's track in the support polygon, the smallest capsule distance over
-    time against the margin (Eq. 53) and the smallest distance to the world, in cm, and each joint's
-    torque as a fraction of its limit; written to ``path`` (PNG).
-
-    Args:
-        centre: (2,) region centre [m]; radius [m] or polygon (K, 2) relative to it [m].
-        margin: capsule safety margin [m].
-        support: the support polygon the ZMP keeps ``zmp_margin`` [m] inside.
-        joints: (n,) the active joints' names, for the torque panel's legend.
-    """
-    names = ("com_xy", "zmp_xy", "min_capsule_distance", "min_world_distance", "torque_use")
-    kinds = [k for k in names if any(k in r.tracks for r in results)]
-    fig, axes = plt.subplots(len(kinds), len(results), figsize=(4.2 * len(results), 3.7 * len(kinds)), squeeze=False)
-    for col, r in enumerate(results):
-        axes[0, col].set_title(f"iteration {r.index}")
-        for ax, kind in zip(axes[:, col], kinds):
-            ax.grid(alpha=0.3)
-            if kind not in r.tracks:
-                continue
-            if kind == "com_xy" and centre is not None:
-                xy = (r.tracks["com_xy"] - centre) * 100
-                ax.plot(xy[:, 0], xy[:, 1], linewidth=0.8, label="CoM track")
-                if radius is not None:
-                    ax.add_patch(plt.Circle((0, 0), radius * 100, fill=False, color="r", label="region"))
-                if polygon is not None:
-                    ax.add_patch(plt.Polygon(polygon * 100, fill=False, color="r", label="region"))
-                ax.set(aspect="equal", xlabel="x − centre [cm]", ylabel="y − centre [cm]")
-            elif kind == "zmp_xy" and support is not None:
-                ax.plot(*(r.tracks["zmp_xy"] * 100).T, linewidth=0.8, label="ZMP track")
-                ax.add_patch(plt.Polygon(support.vertices * 100, fill=False, color="k", label="support polygon"))
-                inner = support.shrunk(zmp_margin) * 100
-                ax.add_patch(
-                    plt.Polygon(inner, fill=False, color="r", linestyle="--", label=f"{zmp_margin * 1000:g} mm in")
-                )
-                ax.set(aspect="equal", xlabel="x [cm]", ylabel="y [cm]")
-            elif kind == "min_capsule_distance":
-                ax.plot(r.time, r.tracks[kind] * 100, linewidth=0.8, label="smallest distance")
-                if margin is not None:
-                    ax.axhline(margin * 100, color="r", linestyle="--", label="margin")
-                ax.set(xlabel="time [s]", ylabel="capsule distance [cm]")
-            elif kind == "min_world_distance":
-                ax.plot(r.time, r.tracks[kind] * 100, linewidth=0.8, label="smallest distance to the world")
-                ax.set(xlabel="time [s]", ylabel="distance to the world [cm]")
-            elif kind == "torque_use":
-                use = r.tracks[kind]
-                names = list(joints) or [f"joint {j + 1}" for j in range(use.shape[1])]
-                for j, colour in enumerate(_joint_colours(use.shape[1])):
-                    ax.plot(r.time, use[:, j], linewidth=0.7, color=colour, label=names[j])
-                ax.axhline(1.0, color="r", linestyle="--", label="limit")
-                ax.set(xlabel="time [s]", ylabel="|τ| / τ_max per joint")
-                if col == len(results) - 1:  # the joints named once, beside the last iteration
-                    ax.legend(fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1.0))
-                continue
-            ax.legend(fontsize=7)
-    fig.tight_layout()
-    return save_figure(fig, path, 110)

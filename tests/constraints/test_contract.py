@@ -5,7 +5,7 @@ small problems register every constraint class (the G1 arms standing: joint limi
 zero-moment point, self-collision; a Panda on its table: torque limits, minimum torque use, the
 world, self-collision); a class nobody registers fails the test, and so does a perturbed Jacobian."""
 
-import inspect
+import dataclasses
 
 import numpy as np
 import pytest
@@ -17,7 +17,7 @@ from excite_cli.constraints.constraint import Constraint, FineCheck
 from excite_cli.criteria import NAMES
 from excite_cli.design.resolve import build_excitation
 from excite_cli.design.verify import check_gradient, constraint_jacobian_error
-from excite_cli.plots.optimize import plot_constraint_tracks
+from excite_cli.plots.tracks import PANELS, Drawn
 
 SMALL = {"harmonics": 3, "cost_samples": 10, "cost_period": 0.8, "constraint_period": 0.1}
 
@@ -72,7 +72,8 @@ def test_every_constraint_keeps_the_contract(problems):
         assert isinstance(fine, FineCheck) and np.isfinite(fine.max_violation), c.name
         assert all(isinstance(v, (float, int, str)) for v in fine.details.values()), c.name
         assert c.name and c.field and c.in_words(), c.name
-        assert set(c.drawn()) <= set(inspect.signature(plot_constraint_tracks).parameters), c.name
+        assert set(c.drawn()) <= {f.name for f in dataclasses.fields(Drawn)}, c.name
+        assert set(c.track(alpha, excitation.grid_basis)) <= set(PANELS), c.name  # every track has its panel
         Q = excitation.trajectory.basis(np.linspace(0.0, 1.0, 5)).evaluate(alpha)[0]
         for pair, distance in c.never_apart(Q, 0.05):
             assert len(pair) == 2 and distance < 0.05, c.name

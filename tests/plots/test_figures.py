@@ -7,6 +7,7 @@ import pytest
 import excite_cli.plots.comparison as comparison_plots
 import excite_cli.plots.identification as identification_plots
 import excite_cli.plots.optimize as optimize_plots
+import excite_cli.plots.tracks as tracks_plots
 from excite_cli.config import EnvironmentConfig
 from excite_cli.constraints.world_collision import world_shapes
 from excite_cli.plots.figure import save_figure
@@ -18,7 +19,7 @@ from excite_cli.storage.results import read_iterations
 def kept(monkeypatch):
     """The figures the plot functions save, kept open instead of written."""
     figures = []
-    for module in (optimize_plots, identification_plots, comparison_plots):
+    for module in (optimize_plots, tracks_plots, identification_plots, comparison_plots):
         monkeypatch.setattr(module, "save_figure", lambda fig, path, dpi: figures.append(fig) or path)
     return figures
 
