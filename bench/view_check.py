@@ -23,8 +23,8 @@ import matplotlib.image
 import numpy as np
 import pinocchio as pin
 
+from excite_cli.collision.world import world_shapes
 from excite_cli.config_file import result_problem
-from excite_cli.constraints.world_collision import world_shapes
 from excite_cli.dynamics.robot import load_robot
 from excite_cli.plots.scene import write_scene
 from excite_cli.workflows.export import played_result

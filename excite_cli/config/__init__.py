@@ -23,7 +23,6 @@ from excite_cli.config.constraints import (
     ConstraintsConfig,
     EnvironmentConfig,
     SelfCollisionConfig,
-    ShapeKind,
     WorldShapeConfig,
     ZmpConfig,
 )
@@ -65,7 +64,6 @@ __all__ = [
     "Section",
     "SelfCollisionConfig",
     "SequenceConfig",
-    "ShapeKind",
     "TrajectoryConfig",
     "WorldShapeConfig",
     "ZmpConfig",

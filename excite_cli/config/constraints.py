@@ -5,7 +5,6 @@ around the robot."""
 from __future__ import annotations
 
 import math
-from enum import StrEnum
 from typing import Literal, Optional, Union
 
 from pydantic import Field, PositiveFloat, model_validator
@@ -73,15 +72,6 @@ class SelfCollisionConfig(Section):
     """Smallest allowed distance [m] between capsule surfaces."""
 
 
-class ShapeKind(StrEnum):
-    """The kinds of shape fixed in the world (``constraints.environment.shapes[].type``)."""
-
-    HALF_SPACE = "half_space"
-    SPHERE = "sphere"
-    CAPSULE = "capsule"
-    BOX = "box"
-
-
 class WorldShapeConfig(Section):
     """A shape fixed in the world frame the robot's capsules keep ``margin`` [m] from: a half-space
     (``point`` on its plane, ``normal`` towards the robot's side: a floor, a table top), a sphere
@@ -90,7 +80,7 @@ class WorldShapeConfig(Section):
 
     name: str
     """A name for messages and plots."""
-    type: ShapeKind
+    type: Literal["half_space", "sphere", "capsule", "box"]
     """`half_space`, `sphere`, `capsule` or `box`."""
     point: Optional[tuple[float, float, float]] = None
     """A point [m] on a half-space's plane."""
@@ -114,15 +104,15 @@ class WorldShapeConfig(Section):
     @model_validator(mode="after")
     def _fields_of_its_type(self) -> "WorldShapeConfig":
         needs = {
-            ShapeKind.HALF_SPACE: ("point", "normal"),
-            ShapeKind.SPHERE: ("centre", "radius"),
-            ShapeKind.CAPSULE: ("start", "end", "radius"),
-            ShapeKind.BOX: ("centre", "size"),
+            "half_space": ("point", "normal"),
+            "sphere": ("centre", "radius"),
+            "capsule": ("start", "end", "radius"),
+            "box": ("centre", "size"),
         }
         missing = [f for f in needs[self.type] if getattr(self, f) is None]
         if missing:
             raise ValueError(f"a {self.type} needs {', '.join(missing)}")
-        if self.type is ShapeKind.HALF_SPACE and not 0.0 < math.hypot(*self.normal) < math.inf:
+        if self.type == "half_space" and not 0.0 < math.hypot(*self.normal) < math.inf:
             raise ValueError("the normal of a half_space must not be zero")
         return self
 

@@ -14,15 +14,13 @@ their distances cannot change (the base bolted on the table).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-
 import coal
 import numpy as np
 import pinocchio as pin
 
 from excite_cli.collision.capsules import Capsule, capsule_frames, segment_ends
 from excite_cli.collision.segments import segment_closest_points
-from excite_cli.config import EnvironmentConfig, ShapeKind
+from excite_cli.collision.world import ShapeKind, WorldShape
 from excite_cli.constraints.constraint import Constraint, FineCheck
 from excite_cli.constraints.lse import ACCEPT_MARGIN, smooth_max, smooth_max_value
 from excite_cli.constraints.self_collision import LENGTH_SCALE
@@ -30,52 +28,6 @@ from excite_cli.dynamics.kinematics import BatchKinematics
 from excite_cli.dynamics.robot import Robot
 from excite_cli.memo import once
 from excite_cli.trajectory.fourier import FourierBasis
-
-
-@dataclass(frozen=True)
-class WorldShape:
-    """A shape fixed in the world frame.
-
-    Attributes:
-        name: its name in the config, for messages.
-        kind: a half-space, a sphere, a capsule or a box.
-        start: (3,) a point on the plane, the sphere's centre or the capsule's first end [m].
-        end: (3,) the plane's unit normal (towards the robot's side) or the capsule's second end
-            [m] (the centre again for a sphere).
-        radius: [m], 0 for a half-space or a box.
-        margin: distance every robot capsule keeps [m].
-        size: (3,) a box's side lengths [m] (its centre is ``start`` and ``end``).
-        rotation: (3, 3) a box's orientation in the world frame.
-    """
-
-    name: str
-    kind: ShapeKind
-    start: np.ndarray
-    end: np.ndarray
-    radius: float
-    margin: float
-    size: np.ndarray = field(default_factory=lambda: np.zeros(3))
-    rotation: np.ndarray = field(default_factory=lambda: np.eye(3))
-
-
-def world_shapes(cfg: EnvironmentConfig | None) -> list[WorldShape]:
-    """The shapes of ``constraints.environment`` (their fields checked by the config); none without one."""
-    shapes = []
-    for s in cfg.shapes if cfg else []:
-        if s.type is ShapeKind.HALF_SPACE:
-            normal = np.asarray(s.normal, dtype=float)
-            shapes.append(
-                WorldShape(s.name, s.type, np.asarray(s.point, float), normal / np.linalg.norm(normal), 0.0, s.margin)
-            )
-        elif s.type in (ShapeKind.SPHERE, ShapeKind.BOX):
-            centre, rotation = np.asarray(s.centre, dtype=float), pin.rpy.rpyToMatrix(*s.rpy)
-            size = np.asarray(s.size if s.size else (0.0, 0.0, 0.0), dtype=float)
-            shapes.append(WorldShape(s.name, s.type, centre, centre, s.radius or 0.0, s.margin, size, rotation))
-        else:
-            shapes.append(
-                WorldShape(s.name, s.type, np.asarray(s.start, float), np.asarray(s.end, float), s.radius, s.margin)
-            )
-    return shapes
 
 
 def distance_bound(robot: Robot, capsule: Capsule, shape: WorldShape) -> float:

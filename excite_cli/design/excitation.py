@@ -12,13 +12,14 @@ from functools import cached_property
 import numpy as np
 
 from excite_cli.collision.capsules import capsule_pairs, capsules_from_config
+from excite_cli.collision.world import world_shapes
 from excite_cli.config import ConstraintsConfig, LimitsConfig
 from excite_cli.constraints import Constraint, JointLimits, SelfCollision, accepted
 from excite_cli.constraints.com_region import com_region_from_config
 from excite_cli.constraints.joint_limits import joint_limit_bounds
 from excite_cli.constraints.lse import GRID_MARGIN
 from excite_cli.constraints.torque_limits import TorqueLimits, TorqueUse, torque_limit, torque_use_fraction
-from excite_cli.constraints.world_collision import WorldCollision, world_shapes
+from excite_cli.constraints.world_collision import WorldCollision
 from excite_cli.constraints.zmp import zmp_from_config
 from excite_cli.criteria import criterion_record
 from excite_cli.design.criterion import Criterion, condition_number

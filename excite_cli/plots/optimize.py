@@ -15,7 +15,7 @@ from matplotlib.collections import LineCollection, PolyCollection  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
 
-from excite_cli.constraints.world_collision import WorldShape, world_shapes  # noqa: E402
+from excite_cli.collision.world import WorldShape, world_shapes  # noqa: E402
 from excite_cli.design.excitation import Excitation  # noqa: E402
 from excite_cli.plots.figure import joint_colours, save_figure  # noqa: E402
 from excite_cli.plots.shapes import draw_shape, stadium  # noqa: E402

@@ -13,8 +13,7 @@ import numpy as np
 import pinocchio as pin
 
 from excite_cli.atomic import MARK, atomic_bytes
-from excite_cli.config import ShapeKind
-from excite_cli.constraints.world_collision import WorldShape
+from excite_cli.collision.world import ShapeKind, WorldShape
 from excite_cli.dynamics.robot import Robot
 from excite_cli.errors import ExciteError
 

@@ -6,8 +6,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import ConvexHull
 
-from excite_cli.config import ShapeKind
-from excite_cli.constraints.world_collision import WorldShape
+from excite_cli.collision.world import ShapeKind, WorldShape
 
 
 def stadium(a: np.ndarray, b: np.ndarray, radius: float, points: int = 12) -> np.ndarray:

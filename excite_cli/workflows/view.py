@@ -6,8 +6,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Optional
 
+from excite_cli.collision.world import world_shapes
 from excite_cli.config_file import result_problem
-from excite_cli.constraints.world_collision import world_shapes
 from excite_cli.dynamics.robot import load_robot
 from excite_cli.errors import ExciteError
 from excite_cli.plots.scene import write_scene

@@ -13,9 +13,10 @@ from typer.testing import CliRunner
 from excite_cli.cli import app
 from excite_cli.collision.capsules import capsule_pairs, capsules_from_config, segment_ends
 from excite_cli.collision.geometry import link_points
+from excite_cli.collision.world import world_shapes
 from excite_cli.config import EnvironmentConfig
 from excite_cli.config_file import load_problem
-from excite_cli.constraints.world_collision import WorldCollision, distance_bound, world_shapes
+from excite_cli.constraints.world_collision import WorldCollision, distance_bound
 from excite_cli.design.resolve import build_excitation
 
 runner = CliRunner()

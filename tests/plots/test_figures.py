@@ -8,8 +8,8 @@ import excite_cli.plots.comparison as comparison_plots
 import excite_cli.plots.identification as identification_plots
 import excite_cli.plots.optimize as optimize_plots
 import excite_cli.plots.tracks as tracks_plots
+from excite_cli.collision.world import world_shapes
 from excite_cli.config import EnvironmentConfig
-from excite_cli.constraints.world_collision import world_shapes
 from excite_cli.plots.figure import save_figure
 from excite_cli.plots.shapes import draw_shape, stadium
 from excite_cli.storage.results import read_iterations

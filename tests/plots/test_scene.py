@@ -11,9 +11,9 @@ import pytest
 import umsgpack
 from conftest import CONFIGS, robot_of
 
+from excite_cli.collision.world import world_shapes
 from excite_cli.config import EnvironmentConfig
 from excite_cli.config_file import load_problem
-from excite_cli.constraints.world_collision import world_shapes
 from excite_cli.errors import ExciteError
 from excite_cli.plots.scene import write_scene
 
