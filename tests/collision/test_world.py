@@ -26,4 +26,3 @@ def test_each_shape_is_of_its_kind_with_a_unit_normal_and_a_turned_box():
     np.testing.assert_allclose(shapes[3].rotation @ [1, 0, 0], [0, 1, 0], atol=1e-15)  # yaw π/2 turns x onto y
     assert shapes[3].radius == 0.0 and list(shapes[3].size) == [1, 2, 3]
     assert world_shapes(None) == []
-
