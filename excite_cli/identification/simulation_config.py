@@ -9,7 +9,8 @@ from pydantic import Field, model_validator
 
 from excite_cli.config import COULOMB_VELOCITY, MAX_SEED, Section
 from excite_cli.effects import EFFECTS
-from excite_cli.identification.config import MAX_RATE, Effect, TransmissionConfig
+from excite_cli.identification.config import Effect
+from excite_cli.identification.data_config import MAX_RATE, TransmissionConfig
 
 
 class SimulationConfig(Section):

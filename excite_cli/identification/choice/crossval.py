@@ -35,7 +35,7 @@ import numpy as np
 
 from excite_cli.config import resolve_path
 from excite_cli.errors import ExciteError
-from excite_cli.identification.config import RunConfig
+from excite_cli.identification.data_config import RunConfig
 from excite_cli.identification.effects import Term, nonnegative_columns
 from excite_cli.identification.fitting.dataset import Dataset
 from excite_cli.identification.fitting.normal import NormalEquations, solve

@@ -34,7 +34,8 @@ import numpy as np
 from excite_cli.effects import EFFECTS
 from excite_cli.identification.choice.crossval import CrossValidation
 from excite_cli.identification.choice.search import Search, Step, StepwiseSearch, effect_weights
-from excite_cli.identification.config import IdentificationConfig, TransmissionConfig
+from excite_cli.identification.config import IdentificationConfig
+from excite_cli.identification.data_config import TransmissionConfig
 from excite_cli.identification.effects import Term, rotor_terms
 from excite_cli.identification.fitting.channels import without_dead_rows
 from excite_cli.identification.fitting.dataset import Dataset

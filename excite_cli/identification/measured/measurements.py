@@ -12,7 +12,7 @@ import numpy as np
 
 from excite_cli.config import resolve_path
 from excite_cli.errors import ExciteError, FileNotFound
-from excite_cli.identification.config import ColumnsConfig, DataConfig, RunConfig
+from excite_cli.identification.data_config import ColumnsConfig, DataConfig, RunConfig
 from excite_cli.identification.measured.bags import bag_columns, is_bag, read_bag
 from excite_cli.identification.measured.files import Table, read_table
 from excite_cli.identification.measured.joining import join_tables

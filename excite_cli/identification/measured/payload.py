@@ -9,7 +9,7 @@ import pinocchio as pin
 
 from excite_cli.dynamics.robot import Robot
 from excite_cli.errors import ExciteError
-from excite_cli.identification.config import PayloadConfig
+from excite_cli.identification.data_config import PayloadConfig
 
 
 def payload_parameters(robot: Robot, payload: PayloadConfig, field_name: str) -> np.ndarray:

@@ -9,7 +9,8 @@ import pytest
 import scipy.io
 
 from excite_cli.errors import ExciteError
-from excite_cli.identification.config import IdentifyProblem, RunConfig
+from excite_cli.identification.config import IdentifyProblem
+from excite_cli.identification.data_config import RunConfig
 from excite_cli.identification.measured.files import read_table
 from excite_cli.identification.measured.measurements import in_sample_validation, load_run
 

@@ -8,7 +8,7 @@ from conftest import CONFIGS, robot_of
 
 from excite_cli.config_file import load_problem
 from excite_cli.errors import ExciteError
-from excite_cli.identification.config import PayloadConfig
+from excite_cli.identification.data_config import PayloadConfig
 from excite_cli.identification.measured.payload import payload_parameters
 
 
