@@ -7,8 +7,8 @@ from typing import Sequence
 import numpy as np
 from rich.table import Table
 
+from excite_cli.console.effect_search import search
 from excite_cli.console.tables import titled_table
-from excite_cli.identification.choice.search import MOVE_SIGNS
 from excite_cli.identification.reporting.report import Report
 from excite_cli.identification.validate import RunError
 from excite_cli.workflows.check_identify import IdentifyPlan
@@ -183,9 +183,12 @@ def _selection_tables(report: Report) -> list[Table | str]:
         "validation: data it never saw",
     )
     order = {t: k + 1 for k, t in enumerate(sel.terms)}
+    b, between = len(report.base_names), sel.fit.between
+    spread = ("std, trajectories",) if between is not None else ()
     effects = titled_table(
         "Effects, in the order they were added (declared ones first)",
         ("#", "effect", "joint", "shape [rad/s]", "coefficient", "least squares", "std")
+        + spread
         + (("consistent",) if consistent else ()),
         [
             (
@@ -196,6 +199,7 @@ def _selection_tables(report: Report) -> list[Table | str]:
                 f"{name} [{t.kind.units[0]}]",
                 f"{value:.5g}",
                 f"{std:.2g}" if np.isfinite(std) else "held at 0",
+                *((_std(between[b + k]),) if spread else ()),
                 *((f"{consistent.effects[k]:.5g}",) if consistent else ()),
             )
             for k, (t, name, value, std) in enumerate(report.effect_values())
@@ -203,9 +207,15 @@ def _selection_tables(report: Report) -> list[Table | str]:
     )
     params = titled_table(
         "Identified base parameters",
-        ("base parameter", "least squares", "std") + (("consistent",) if consistent else ()),
+        ("base parameter", "least squares", "std") + spread + (("consistent",) if consistent else ()),
         [
-            (name, f"{value:.5g}", f"{std:.2g}", *((f"{consistent.base[k]:.5g}",) if consistent else ()))
+            (
+                name,
+                f"{value:.5g}",
+                f"{std:.2g}",
+                *((_std(between[k]),) if spread else ()),
+                *((f"{consistent.base[k]:.5g}",) if consistent else ()),
+            )
             for k, (name, value, std) in enumerate(zip(report.base_names, sel.fit.x, sel.fit.std))
         ],
     )
@@ -217,7 +227,24 @@ def _selection_tables(report: Report) -> list[Table | str]:
         if sel.absorbed
         else []
     )
-    return [ladder, *search(report), effects, *absorbed, *_guarded(report), params, *_unresolved(report)]
+    stds = [STDS + (f" {TRAJECTORIES.format(count=sel.fit.trajectories)}" if spread else "")]
+    return [ladder, *search(report), effects, *absorbed, *_guarded(report), params, *stds, *_unresolved(report)]
+
+
+#: What the std columns are.
+STDS = (
+    "std: of the noise the fit residuals show, the model taken as right (an effect the model lacks makes "
+    "recordings of one trajectory agree better, and distinct trajectories worse, than it says)"
+)
+TRAJECTORIES = (
+    "std, trajectories: the spread between the {count} distinct trajectories fitted, the model's error "
+    "included (recordings of one trajectory count once: data.runs[].trajectory)"
+)
+
+
+def _std(value: float) -> str:
+    """A standard deviation as printed: two digits, or why there is none."""
+    return f"{value:.2g}" if np.isfinite(value) else "-"
 
 
 #: A base parameter whose standard deviation is this many times its magnitude is not told from 0.
@@ -243,37 +270,3 @@ def _guarded(report: Report) -> list[str]:
         return ["position effects extrapolate outside the fit data's q range (position_guard off)"]
     ranges = ", ".join(f"{report.joints[j]} [{report.q_range[j, 0]:.3f}, {report.q_range[j, 1]:.3f}]" for j in joints)
     return [f"position effects held at their value at the ends of the fit data's q range [rad]: {ranges}"]
-
-
-def search(report: Report, runners_up: int = 2) -> list[Table | str]:
-    """Each step of the kept search with its gain and the best moves it did not take (every move
-    tried is in the HDF5 report), and the outcome of every start."""
-    sel = report.selection
-    kept = sel.searches[sel.chosen]
-    rows = []
-    for k, step in enumerate(sel.steps, start=1):
-        others = sorted(((v, m, t) for m, t, v in step.tried if (m, t) != (step.move, step.term)), key=lambda o: o[0])[
-            :runners_up
-        ]
-        rows.append(
-            (
-                str(k),
-                step.label(report.joints),
-                f"{step.gain:.1f}",
-                str(len(step.tried)),
-                "; ".join(f"{MOVE_SIGNS[m]} {t.label(report.joints)} {step.gain_of(v):.1f}" for v, m, t in others),
-            )
-        )
-    steps = titled_table(
-        f"Selection steps from the start '{kept.start}' (gain: cut of the cross-validated error [%])",
-        ("step", "move", "gain [%]", "tried", f"next best {runners_up} [gain %]"),
-        rows,
-        "kept at its start: scored with the fits, the start wins (see the models compared)"
-        if sel.at_start
-        else f"stopped: {kept.stop}",
-    )
-    starts = "; ".join(
-        f"{s.start}: {s.cv_error:.2f} % with {len(s.terms)} effects" + (" (kept)" if k == sel.chosen else "")
-        for k, s in enumerate(sel.searches)
-    )
-    return [steps, f"searches (cross-validated error at their end): {starts}"]

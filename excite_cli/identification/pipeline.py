@@ -22,7 +22,8 @@ from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.effects import Term, rotor_terms
 from excite_cli.identification.fitting.channels import dead_channels
 from excite_cli.identification.fitting.dataset import Dataset, build_datasets, fit_position_range
-from excite_cli.identification.fitting.least_squares import joint_weights, least_squares, predict, torque_errors
+from excite_cli.identification.fitting.least_squares import Fit, joint_weights, least_squares, predict, torque_errors
+from excite_cli.identification.fitting.model_error import between_trajectories, trajectory_of_runs
 from excite_cli.identification.fitting.noise import middle
 from excite_cli.identification.fitting.normal import NormalEquations, excited_rank
 from excite_cli.identification.fitting.plausibility import implausible
@@ -207,9 +208,7 @@ def run_identification(
     labels = [r.label for r in problem.data.runs]
     offset_runs = [labels[k] for k in data.fitted]
     selection, choice = choose_fit(selection, robot, base, offset_runs, cfg, consistent_beside)
-    sandwich = middle(fit_data, selection.fit.x, selection.terms, selection.weights, data.rate)  # the stds'
-    fit = least_squares(selection.normal, selection.terms, selection.weights, middle=sandwich)
-    selection = replace(selection, fit=fit)
+    selection = replace(selection, fit=reported_fit(selection, fit_data, data.rate, problem))
     measured = val_data.tau.reshape(-1, val_data.n)
     before = predict(val_data, selection.rigid.x, [])
     plain = predict(val_data, selection.fit.x, selection.terms)
@@ -257,6 +256,22 @@ def run_identification(
         ladder.append((choice.name, float(choice.cv_error[choice.chosen]), report.mean(report.relative_after)))
     report.warnings += report.fit_disagreement()
     return report, robot, base, prior_rows([fit_data, val_data], selection.terms, robot.joint_names)
+
+
+def reported_fit(selection: Selection, fit_data: Dataset, rate: float, problem: IdentifyProblem) -> Fit:
+    """The chosen model's least-squares fit as reported: its standard deviations from the noise the
+    residuals show (the sandwich of :mod:`~excite_cli.identification.fitting.noise`, ``rate`` [Hz]),
+    and beside them the spread between the distinct trajectories of the fit data when there are 3 or
+    more (:mod:`~excite_cli.identification.fitting.model_error`); a coefficient held at its bound has
+    neither."""
+    sandwich = middle(fit_data, selection.fit.x, selection.terms, selection.weights, rate)
+    fit = least_squares(selection.normal, selection.terms, selection.weights, middle=sandwich)
+    clusters = trajectory_of_runs(problem.data.runs, problem.folder)
+    variance = between_trajectories(fit_data, fit.x, selection.terms, selection.weights, clusters)
+    if variance is None:
+        return fit
+    held, count = fit.held if fit.held.size else False, np.unique(clusters[np.unique(fit_data.run)]).size
+    return replace(fit, between=np.where(held, np.nan, np.sqrt(variance)), trajectories=int(count))
 
 
 def write_identified_urdf(

@@ -34,12 +34,17 @@ class Fit:
         sigma: (n,) per-joint residual standard deviation [Nm] of this fit.
         held: (p,) the unknowns held at their bound 0 (friction, armature: ``NONNEGATIVE``), which have
             no two-sided standard deviation; none when empty.
+        between: (p,) the standard deviations over the distinct trajectories fitted, model error
+            included (:mod:`~excite_cli.identification.fitting.model_error`; NaN where undefined), or
+            None: fewer than 3 trajectories, or not computed; trajectories: how many there are.
     """
 
     x: np.ndarray
     std: np.ndarray
     sigma: np.ndarray
     held: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
+    between: np.ndarray | None = None
+    trajectories: int = 0
 
 
 def least_squares(

@@ -1,0 +1,44 @@
+"""What ``identify`` prints of its search for effects: each step of the kept search with its gain and
+the best moves it did not take, and the outcome of every start."""
+
+from __future__ import annotations
+
+from rich.table import Table
+
+from excite_cli.console.tables import titled_table
+from excite_cli.identification.choice.search import MOVE_SIGNS
+from excite_cli.identification.reporting.report import Report
+
+
+def search(report: Report, runners_up: int = 2) -> list[Table | str]:
+    """Each step of the kept search with its gain and the best moves it did not take (every move
+    tried is in the HDF5 report), and the outcome of every start."""
+    sel = report.selection
+    kept = sel.searches[sel.chosen]
+    rows = []
+    for k, step in enumerate(sel.steps, start=1):
+        others = sorted(((v, m, t) for m, t, v in step.tried if (m, t) != (step.move, step.term)), key=lambda o: o[0])[
+            :runners_up
+        ]
+        rows.append(
+            (
+                str(k),
+                step.label(report.joints),
+                f"{step.gain:.1f}",
+                str(len(step.tried)),
+                "; ".join(f"{MOVE_SIGNS[m]} {t.label(report.joints)} {step.gain_of(v):.1f}" for v, m, t in others),
+            )
+        )
+    steps = titled_table(
+        f"Selection steps from the start '{kept.start}' (gain: cut of the cross-validated error [%])",
+        ("step", "move", "gain [%]", "tried", f"next best {runners_up} [gain %]"),
+        rows,
+        "kept at its start: scored with the fits, the start wins (see the models compared)"
+        if sel.at_start
+        else f"stopped: {kept.stop}",
+    )
+    starts = "; ".join(
+        f"{s.start}: {s.cv_error:.2f} % with {len(s.terms)} effects" + (" (kept)" if k == sel.chosen else "")
+        for k, s in enumerate(sel.searches)
+    )
+    return [steps, f"searches (cross-validated error at their end): {starts}"]

@@ -1,0 +1,21 @@
+"""The effects and the search of an identify report as its file holds them: a row per coefficient in
+the fit's order, the spread between trajectories NaN when the fit data hold one, a row per step."""
+
+import h5py
+import numpy as np
+
+from excite_cli.identification.reporting.search_file import write_effects, write_search
+
+
+def test_the_effects_and_steps_are_the_reports(simulated_identification, tmp_path):
+    _, report, *_ = simulated_identification
+    with h5py.File(tmp_path / "r.h5", "w") as f:
+        g = f.create_group("identification")
+        write_effects(g, report)
+        write_search(g, report)
+    with h5py.File(tmp_path / "r.h5") as f:
+        effects, steps = f["identification/effects"][()], f["identification/steps"][()]
+    values = report.effect_values()
+    np.testing.assert_array_equal(effects["value"], [v for _, _, v, _ in values])
+    assert np.all(np.isnan(effects["std_between_trajectories"]))  # one fit run: one trajectory
+    assert report.selection.fit.between is None and len(steps) == len(report.selection.steps)
