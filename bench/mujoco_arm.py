@@ -46,12 +46,14 @@ class ArmPhysics:
             armature: (n,) rotor inertia [kg·m²], per active joint.
         payload: mass [kg], position (3,) [m] in the last active joint's frame, principal moments (3,)
             [kg·m²] about its centre (axes along the frame's).
+        stiffness: (n,) a spring about q = 0 [Nm/rad] per active joint, or None.
     """
 
     damping: np.ndarray
     frictionloss: np.ndarray
     armature: np.ndarray
     payload: tuple[float, tuple[float, float, float], tuple[float, float, float]]
+    stiffness: np.ndarray | None = None
 
     def truth(self, n: int) -> list[tuple[Term, float]]:
         """(term, value) of every effect excite's catalogue names for these fields."""
@@ -82,6 +84,8 @@ def arm_model(urdf: Path, active: list[str], physics: ArmPhysics):
         joint = spec.joint(name)
         joint.damping = [float(physics.damping[j]), 0.0, 0.0]  # linear; MuJoCo 4's higher powers none
         joint.frictionloss, joint.armature = float(physics.frictionloss[j]), float(physics.armature[j])
+        if physics.stiffness is not None:
+            joint.stiffness = [float(physics.stiffness[j]), 0.0, 0.0]  # about springref 0
     mass, position, moments = physics.payload
     spec.joint(active[-1]).parent.add_body(  # its centre of mass at its origin (MuJoCo 4 has no default there)
         name="payload",
@@ -101,29 +105,34 @@ def record(mujoco, model, robot: Robot, result: Path, periods: int, seed: int, f
     problem = result_problem(result)
     trajectory = FourierTrajectory(problem.trajectory.harmonics, problem.trajectory.base_frequency)
     rng = np.random.default_rng(seed)
+    return [
+        play(mujoco, model, robot, trajectory, alpha, periods, rng, folder / f"{prefix}_{k}.csv")
+        for k, alpha in read_alphas(result)
+    ]
+
+
+def play(mujoco, model, robot: Robot, trajectory, alpha: np.ndarray, periods: int, rng, path: Path) -> Path:
+    """Play the Fourier coefficients ``alpha`` (n, 2N+1) of ``trajectory`` ``periods`` times in MuJoCo's
+    arm and write the recording to ``path`` (time, q_<joint>, tau_<joint>; module docstring)."""
     names = robot.joint_names
     qpos = np.array([model.jnt_qposadr[model.joint(name).id] for name in names])
     dofs = np.array([model.jnt_dofadr[model.joint(name).id] for name in names])
     header = ",".join(["time"] + [f"q_{j}" for j in names] + [f"tau_{j}" for j in names])
-    written = []
-    for k, alpha in read_alphas(result):
-        time = np.arange(int(round(periods * trajectory.period * 1000.0)) + 1) / 1000.0
-        q, qd, qdd = trajectory.basis(time).evaluate(alpha)
-        data = mujoco.MjData(model)
-        data.qpos[qpos] = q[0]
-        measured_q, tau = np.zeros_like(q), np.zeros_like(q)
-        for i in range(time.size):
-            measured_q[i] = data.qpos[qpos]
-            error, rate = q[i] - data.qpos[qpos], qd[i] - data.qvel[dofs]
-            tau[i] = robot.torques(q[i], qd[i], qdd[i]) + GAINS[0] * error + GAINS[1] * rate
-            data.qfrc_applied[dofs] = tau[i]
-            mujoco.mj_step(model, data, TICK)
-        tau += rng.normal(0.0, 1.0, tau.shape) * TORQUE_NOISE * np.sqrt(np.mean(tau**2, axis=0))
-        encoder = np.round(measured_q / ENCODER) * ENCODER
-        path = folder / f"{prefix}_{k}.csv"
-        np.savetxt(path, np.column_stack([time, encoder, tau]), delimiter=",", header=header, comments="", fmt="%.10g")
-        written.append(path)
-    return written
+    time = np.arange(int(round(periods * trajectory.period * 1000.0)) + 1) / 1000.0
+    q, qd, qdd = trajectory.basis(time).evaluate(alpha)
+    data = mujoco.MjData(model)
+    data.qpos[qpos] = q[0]
+    measured_q, tau = np.zeros_like(q), np.zeros_like(q)
+    for i in range(time.size):
+        measured_q[i] = data.qpos[qpos]
+        error, rate = q[i] - data.qpos[qpos], qd[i] - data.qvel[dofs]
+        tau[i] = robot.torques(q[i], qd[i], qdd[i]) + GAINS[0] * error + GAINS[1] * rate
+        data.qfrc_applied[dofs] = tau[i]
+        mujoco.mj_step(model, data, TICK)
+    tau += rng.normal(0.0, 1.0, tau.shape) * TORQUE_NOISE * np.sqrt(np.mean(tau**2, axis=0))
+    encoder = np.round(measured_q / ENCODER) * ENCODER
+    np.savetxt(path, np.column_stack([time, encoder, tau]), delimiter=",", header=header, comments="", fmt="%.10g")
+    return path
 
 
 def floor_error(prepared, base, physics: ArmPhysics, robot: Robot, live: np.ndarray) -> float:
