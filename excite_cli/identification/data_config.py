@@ -10,7 +10,7 @@ from typing import Annotated, Literal, Optional, Union
 import numpy as np
 from pydantic import Field, field_validator, model_validator
 
-from excite_cli.config import Section
+from excite_cli.config import Section, resolve_path
 from excite_cli.config.effects import MAX_RATIO
 
 Column = Union[Annotated[int, Field(ge=0, strict=True)], str]  # strict: `time: true` is not column 1
@@ -108,6 +108,10 @@ class RunConfig(Section):
     def files(self) -> list[str]:
         """The run's file or files, as written."""
         return [self.file] if isinstance(self.file, str) else list(self.file)
+
+    def recording(self, folder: Path | None) -> str:
+        """Which recording the run is: its files relative to ``folder``, resolved and joined."""
+        return " + ".join(str(resolve_path(f, folder)) for f in self.files)
 
     @property
     def label(self) -> str:

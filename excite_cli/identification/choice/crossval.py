@@ -33,7 +33,6 @@ from typing import Callable
 
 import numpy as np
 
-from excite_cli.config import resolve_path
 from excite_cli.errors import ExciteError
 from excite_cli.identification.data_config import RunConfig
 from excite_cli.identification.effects import Term, nonnegative_columns
@@ -202,7 +201,7 @@ def fold_groups(runs: list[RunConfig], folder: Path | None, how: str, fitted: li
     Raises:
         ExciteError: ``recording`` or ``run`` folds with fewer than two fit recordings or runs.
     """
-    recordings = [" + ".join(str(resolve_path(f, folder)) for f in r.files) for r in runs]
+    recordings = [r.recording(folder) for r in runs]
     files = np.unique(recordings, return_inverse=True)[1]
     groups = {"auto": files, "recording": files, "run": np.arange(files.size), "time_block": None}[how]
     count = 0 if groups is None else np.unique(groups[fitted]).size

@@ -27,7 +27,6 @@ from pathlib import Path
 
 import numpy as np
 
-from excite_cli.config import resolve_path
 from excite_cli.identification.data_config import RunConfig
 from excite_cli.identification.effects import Term
 from excite_cli.identification.fitting.dataset import Dataset
@@ -37,12 +36,14 @@ from excite_cli.identification.fitting.normal import covariance_diagonal
 #: The fewest distinct trajectories the spread is estimated from (2 give scores s₁ = −s₂: one degree
 #: of freedom).
 FEWEST = 3
+#: Instants of a trajectory taken at a time (memory: a (CHUNK, m) block per joint).
+CHUNK = 1 << 16
 
 
 def trajectory_of_runs(runs: list[RunConfig], folder: Path | None) -> np.ndarray:
     """(R,) the trajectory of each configured run (``data.runs``): its ``trajectory`` name, else its
     recording (files relative to ``folder``), as consecutive integers."""
-    keys = [r.trajectory or " + ".join(str(resolve_path(f, folder)) for f in r.files) for r in runs]
+    keys = [r.trajectory or r.recording(folder) for r in runs]
     return np.unique(keys, return_inverse=True)[1]
 
 
@@ -60,11 +61,14 @@ def trajectory_pieces(
     groups = np.unique(of_instant)
     grams, scores = np.zeros((groups.size, x.size, x.size)), np.zeros((groups.size, x.size))
     for k, g in enumerate(groups):
-        rows = np.flatnonzero(of_instant == g)
-        for j in range(n):
-            A = np.column_stack([data.regressor[rows * n + j]] + [data.blocks[t][rows] * t.rows(n)[j] for t in effects])
-            grams[k] += w[j] ** 2 * (A.T @ A)
-            scores[k] += w[j] ** 2 * (A.T @ residual[rows, j])
+        instants = np.flatnonzero(of_instant == g)
+        for rows in np.array_split(instants, -(-instants.size // CHUNK)):  # memory: CHUNK rows at a time
+            for j in range(n):
+                A = np.column_stack(
+                    [data.regressor[rows * n + j]] + [data.blocks[t][rows] * t.rows(n)[j] for t in effects]
+                )
+                grams[k] += w[j] ** 2 * (A.T @ A)
+                scores[k] += w[j] ** 2 * (A.T @ residual[rows, j])
     return grams, scores
 
 
