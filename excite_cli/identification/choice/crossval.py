@@ -195,13 +195,14 @@ class CrossValidation:
 def fold_groups(runs: list[RunConfig], folder: Path | None, how: str, fitted: list[int]) -> np.ndarray | None:
     """The cross-validation's groups (:class:`CrossValidation`) of ``identification.folds_by``
     (``how``): the recording (file) of each configured run (``data.runs``, files relative to
-    ``folder``), each run its own group, or None for time blocks. ``auto``: recordings when the fit
-    runs (indices ``fitted``) come from two or more files, else time blocks.
+    ``folder``; the recordings of one ``trajectory`` together: held out apart, the model error they
+    share would be seen in training), each run its own group, or None for time blocks. ``auto``:
+    recordings when the fit runs (indices ``fitted``) come from two or more, else time blocks.
 
     Raises:
         ExciteError: ``recording`` or ``run`` folds with fewer than two fit recordings or runs.
     """
-    recordings = [r.recording(folder) for r in runs]
+    recordings = [r.trajectory or r.recording(folder) for r in runs]
     files = np.unique(recordings, return_inverse=True)[1]
     groups = {"auto": files, "recording": files, "run": np.arange(files.size), "time_block": None}[how]
     count = 0 if groups is None else np.unique(groups[fitted]).size

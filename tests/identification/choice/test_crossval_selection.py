@@ -208,3 +208,17 @@ def test_coulomb_data_every_search_ends_at_coulomb_and_the_report_shows_the_firs
     assert all(set(s.terms) == set(truth) for s in selection.searches)
     assert selection.chosen == 0 and [step.term for step in selection.steps] != []
     assert set(step.term for step in selection.steps) == set(truth)  # the declared-effects start adds both
+
+
+def test_recording_folds_hold_out_the_recordings_of_one_trajectory_together(tmp_path):
+    """Two recordings of one trajectory named alike are one fold (apart, the model error they share is
+    seen in training); unnamed, each file is its own; run folds stay one per run."""
+    from excite_cli.identification.choice.crossval import fold_groups
+    from excite_cli.identification.data_config import RunConfig
+
+    runs = [RunConfig(file=f"r{k}.csv", trajectory=name) for k, name in enumerate(["a", "a", "b", "c"])]
+    np.testing.assert_array_equal(fold_groups(runs, tmp_path, "recording", [0, 1, 2, 3]), [0, 0, 1, 2])
+    np.testing.assert_array_equal(fold_groups(runs, tmp_path, "run", [0, 1, 2, 3]), [0, 1, 2, 3])
+    assert fold_groups(runs[:2], tmp_path, "auto", [0, 1]) is None  # one trajectory: time blocks
+    plain = [RunConfig(file=f"r{k}.csv") for k in range(3)]
+    np.testing.assert_array_equal(fold_groups(plain, tmp_path, "recording", [0, 1, 2]), [0, 1, 2])
