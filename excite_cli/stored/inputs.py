@@ -8,9 +8,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from excite_cli.config import resolve_path
-from excite_cli.errors import ExciteError
 from excite_cli.stored.prior import PriorFile, read_prior_file
-from excite_cli.stored.report import StoredReport
+from excite_cli.stored.report import StoredReport, identify_report
 
 
 @dataclass(frozen=True)
@@ -41,8 +40,7 @@ def read_inputs(model: str | None, prior: str | None, folder: Path | None) -> St
     model_path = resolve_path(model, folder) if model else None
     prior_path = resolve_path(prior, folder) if prior else None
     model_file = None if model_path is None else read_prior_file(model_path, "effects.model")
-    if model_file is not None and model_file.report is None:
-        raise ExciteError("effects.model", f"{model_path} is not an identify report (no /identification/effects)")
+    report = None if model_file is None else identify_report(model_file.report, model_path, "effects.model")
     same = prior_path is not None and model_path is not None and prior_path.resolve() == model_path.resolve()
     prior = model_file if same else None if prior_path is None else read_prior_file(prior_path)
-    return StoredInputs(None if model_file is None else model_file.report, model_path, prior)
+    return StoredInputs(report, model_path, prior)

@@ -215,7 +215,15 @@ def read_identify_report(path: Path, field: str) -> StoredReport:
     Raises:
         ExciteError: as :func:`read_report`, and a file without /identification (not an identify report).
     """
-    report = read_report(path, field)
+    return identify_report(read_report(path, field), path, field)
+
+
+def identify_report(report: StoredReport | None, path: Path, field: str) -> StoredReport:
+    """``report`` (read from ``path``), which must be one.
+
+    Raises:
+        ExciteError: (``field``) None: the file has no /identification (not an identify report).
+    """
     if report is None:
         raise ExciteError(field, f"{path} is not an identify report (no /identification/effects)")
     return report

@@ -1,6 +1,6 @@
 """An identify report's rows as the next design's prior data: the base regressor of the fit and
 validation samples, and the columns of the chosen effects a design holds (named as a design names
-them), which the report file writes and :func:`~excite_cli.stored.prior.read_prior` weighs as
+them), which the report file writes and :func:`~excite_cli.stored.prior.prior_rows` weighs as
 identification did (the paper's prior data C₀, Eq. 41)."""
 
 from __future__ import annotations
@@ -53,7 +53,7 @@ def prior_rows(parts: list[Dataset], terms: list[Term], joints: list[str]) -> Pr
 
     Returns:
         Per part, (M_k, b) base regressor rows and (M_k, e) effect columns: the prior data C₀ of the
-        paper's sequential generation (Eq. 41) once :func:`~excite_cli.stored.prior.read_prior` weighs
+        paper's sequential generation (Eq. 41) once :func:`~excite_cli.stored.prior.prior_rows` weighs
         them as identification did.
     """
     names: list[str] = []
