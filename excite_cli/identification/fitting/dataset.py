@@ -42,6 +42,14 @@ class Dataset:
         """(N·n,) joint index of each row."""
         return np.tile(np.arange(self.n), self.time.size)
 
+    def joint_rows(self, instants: np.ndarray, joint: int, terms: list[Term]) -> np.ndarray:
+        """(len(instants), b + Σk) the rows of the model [Y_B, ``terms``] of one joint at ``instants``
+        (indices of ``time``): the base regressor's, then each term's columns on that joint's row."""
+        n = self.n
+        return np.column_stack(
+            [self.regressor[instants * n + joint]] + [self.blocks[t][instants] * t.rows(n)[joint] for t in terms]
+        )
+
     def block(self, term: Term) -> np.ndarray:
         """(N·n, k) columns of ``term``: nonzero only on its joints' rows."""
         cols, weights = self.blocks[term], term.rows(self.n)

@@ -64,9 +64,7 @@ def trajectory_pieces(
         instants = np.flatnonzero(of_instant == g)
         for rows in np.array_split(instants, -(-instants.size // CHUNK)):  # memory: CHUNK rows at a time
             for j in range(n):
-                A = np.column_stack(
-                    [data.regressor[rows * n + j]] + [data.blocks[t][rows] * t.rows(n)[j] for t in effects]
-                )
+                A = data.joint_rows(rows, j, effects)
                 grams[k] += w[j] ** 2 * (A.T @ A)
                 scores[k] += w[j] ** 2 * (A.T @ residual[rows, j])
     return grams, scores

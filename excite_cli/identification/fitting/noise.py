@@ -81,7 +81,7 @@ def middle(data: Dataset, x: np.ndarray, effects: list[Term], weights: np.ndarra
     out = np.zeros((x.size, x.size))
     for rows in stretches:
         for j in np.flatnonzero(w):
-            A = np.column_stack([data.regressor[rows * n + j]] + [data.blocks[t][rows] * t.rows(n)[j] for t in effects])
+            A = data.joint_rows(rows, j, effects)
             spectrum = np.fft.fft(A, axis=0)
             lam = rate * np.interp(np.fft.fftfreq(rows.size, 1.0 / rate), frequency, S[:, j])
             # W Σ W: w_j² on each side
