@@ -9,7 +9,7 @@ from pathlib import Path
 
 from excite_cli.config import resolve_path
 from excite_cli.stored.prior import PriorFile, read_prior_file
-from excite_cli.stored.report import StoredReport, identify_report
+from excite_cli.stored.report import StoredReport, identify_report, read_identify_report
 
 
 @dataclass(frozen=True)
@@ -27,20 +27,24 @@ class StoredInputs:
 
 
 def read_inputs(model: str | None, prior: str | None, folder: Path | None) -> StoredInputs:
-    """The files a problem names, each opened once (one file named by both fields is read once, its
-    errors named under ``effects.model``).
+    """The files a problem names, each opened once: ``effects.model``'s report alone (not its rows),
+    ``sequence.prior``'s rows and report; one file named by both is read once, as the prior (its
+    errors named under ``sequence.prior``).
 
     Args:
         model: ``effects.model``; prior: ``sequence.prior``; each relative to ``folder``, or None.
 
     Raises:
         FileNotFound, ExciteError: a file missing or unreadable; ``effects.model`` not an identify
-            report (:func:`~excite_cli.stored.prior.read_prior_file`).
+            report (:func:`~excite_cli.stored.report.identify_report`).
     """
     model_path = resolve_path(model, folder) if model else None
     prior_path = resolve_path(prior, folder) if prior else None
-    model_file = None if model_path is None else read_prior_file(model_path, "effects.model")
-    report = None if model_file is None else identify_report(model_file.report, model_path, "effects.model")
-    same = prior_path is not None and model_path is not None and prior_path.resolve() == model_path.resolve()
-    prior = model_file if same else None if prior_path is None else read_prior_file(prior_path)
-    return StoredInputs(report, model_path, prior)
+    stored = None if prior_path is None else read_prior_file(prior_path)
+    if model_path is None:
+        report = None
+    elif stored is not None and prior_path.resolve() == model_path.resolve():
+        report = identify_report(stored.report, model_path, "effects.model")
+    else:
+        report = read_identify_report(model_path, "effects.model")
+    return StoredInputs(report, model_path, stored)
