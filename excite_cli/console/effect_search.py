@@ -6,6 +6,7 @@ from __future__ import annotations
 from rich.table import Table
 
 from excite_cli.console.tables import titled_table
+from excite_cli.identification.choice.admission import Admission
 from excite_cli.identification.choice.search import MOVE_SIGNS
 from excite_cli.identification.reporting.report import Report
 
@@ -15,6 +16,7 @@ def search(report: Report, runners_up: int = 2) -> list[Table | str]:
     tried is in the HDF5 report), and the outcome of every start."""
     sel = report.selection
     kept = sel.searches[sel.chosen]
+    paired = sel.admission is Admission.PAIRED
     rows = []
     for k, step in enumerate(sel.steps, start=1):
         others = sorted(((v, m, t) for m, t, v in step.tried if (m, t) != (step.move, step.term)), key=lambda o: o[0])[
@@ -25,13 +27,15 @@ def search(report: Report, runners_up: int = 2) -> list[Table | str]:
                 str(k),
                 step.label(report.joints),
                 f"{step.gain:.1f}",
+                *([f"{step.fold_gain:.1f} > {step.fold_margin:.1f}"] if paired else []),
                 str(len(step.tried)),
                 "; ".join(f"{MOVE_SIGNS[m]} {t.label(report.joints)} {step.gain_of(v):.1f}" for v, m, t in others),
             )
         )
     steps = titled_table(
-        f"Selection steps from the start '{kept.start}' (gain: cut of the cross-validated error [%])",
-        ("step", "move", "gain [%]", "tried", f"next best {runners_up} [gain %]"),
+        f"Selection steps from the start '{kept.start}' (gain: cut of the cross-validated error [%]"
+        + ("; folds: the mean gain over the folds and the margin of the paired test it passed)" if paired else ")"),
+        ("step", "move", "gain [%]", *(["folds [%]"] if paired else []), "tried", f"next best {runners_up} [gain %]"),
         rows,
         "kept at its start: scored with the fits, the start wins (see the models compared)"
         if sel.at_start
@@ -41,4 +45,8 @@ def search(report: Report, runners_up: int = 2) -> list[Table | str]:
         f"{s.start}: {s.cv_error:.2f} % with {len(s.terms)} effects" + (" (kept)" if k == sel.chosen else "")
         for k, s in enumerate(sel.searches)
     )
-    return [steps, f"searches (cross-validated error at their end): {starts}"]
+    return [
+        steps,
+        f"searches (cross-validated error at their end): {starts}",
+        f"effects admitted by: {sel.admission} ({sel.folds} folds by {sel.folds_by})",
+    ]

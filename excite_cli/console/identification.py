@@ -161,9 +161,7 @@ def models(report: Report) -> list[Table]:
         )
     return [
         titled_table(
-            "Models and fits scored together: J = log CV + effects × log(1 + min_improvement) (least squares: "
-            "+ log(1 + least_squares_margin); a consistent fit's effects leave out armature, it holds every "
-            "rotor), the lowest wins",
+            f"Models and fits scored together: {choice.admission.fit_objective}; the lowest wins",
             ("model", "effects", "least squares CV [%]", "best fit", "its CV [%]", "J"),
             rows,
         )

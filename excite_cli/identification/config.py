@@ -57,7 +57,7 @@ class IdentificationConfig(Section):
     folds: int = Field(6, ge=3, le=50)
     """K, time-block folds of the cross-validation."""
     min_improvement: float = Field(0.02, ge=0.0, lt=1.0)
-    """Cut [1] of the cross-validated error every effect must buy (a fraction)."""
+    """Cut [1] of the CV error every effect must buy on time-block folds (distinct recordings: paired test)."""
     coulomb_velocity: PositiveFloat = COULOMB_VELOCITY
     """v_c of the smooth sign tanh(q̇/v_c) [rad/s]."""
     stribeck_velocity: list[PositiveFloat] = Field(default_factory=lambda: list(SHAPE_GRID), min_length=1)
@@ -69,15 +69,15 @@ class IdentificationConfig(Section):
     fit: Literal["auto", "least_squares", "consistent"] = "auto"
     """The reported fit: `auto` (chosen by cross-validation), `least_squares` or `consistent`."""
     least_squares_margin: float = Field(0.5, ge=0.0, lt=10.0)
-    """m [1]: `fit: auto` takes least squares only where the consistent fit's CV error is ≥ (1 + m) × its own."""
+    """m [1]: `fit: auto` on time blocks takes least squares only where the consistent CV error is ≥ (1 + m) × its."""
     regularization: list[NonNegativeFloat] = Field(default_factory=lambda: list(REGULARIZATION), min_length=1)
     """λ [1] of the consistent fit (weight of the distance to the URDF's parameters); a list to pick from."""
     coupling_ratios: list[float] = Field(default_factory=lambda: list(COUPLING_RATIOS))
     """Ratios r [1] of the coupled-motor candidates q_i + r q_(i+1) without a transmission."""
     coupling_improvement: float = Field(0.2, ge=0.0, lt=10.0)
-    """Cut [1] of the cross-validated error a coupled motor effect must buy."""
+    """Cut [1] of the cross-validated error a coupled motor effect must buy (time-block folds only)."""
     position_improvement: float = Field(0.25, ge=0.0, lt=10.0)
-    """Cut [1] of the cross-validated error a position-dependent effect must buy."""
+    """Cut [1] of the cross-validated error a position-dependent effect must buy (time-block folds only)."""
 
     @field_validator("stribeck_velocity", "held_velocity", "regularization", mode="before")
     @classmethod

@@ -11,6 +11,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from excite_cli.identification.choice.admission import Admission  # noqa: E402
 from excite_cli.identification.reporting.report import Report  # noqa: E402
 from excite_cli.plots.figure import save_figure  # noqa: E402
 
@@ -74,7 +75,8 @@ def plot_ladder(path: Path, report: Report) -> Path:
     """Two panels, written to ``path`` (PNG): the mean relative error after each step of the kept
     search (bars: validation data; dots: cross-validated on the fit data, what the search minimizes),
     and every move tried at each step with its gain (cut of the cross-validated error [%]), the one
-    taken marked, the ``min_improvement`` line beside them."""
+    taken marked, the ``min_improvement`` line beside them (or, under the paired test over folds, the
+    margin each move taken passed)."""
     labels, cv, val = zip(*report.ladder)
     sel = report.selection
     fig, (top, bottom) = plt.subplots(
@@ -102,13 +104,17 @@ def plot_ladder(path: Path, report: Report) -> Path:
             np.full(gains.size, k) + np.linspace(-0.25, 0.25, gains.size), gains, ".", color="0.6", markersize=3
         )
         bottom.plot(k, step.gain, "*", color="C3", markersize=9)
-    bottom.axhline(
-        100.0 * (1.0 - 1.0 / (1.0 + sel.min_improvement)),
-        color="k",
-        linewidth=0.8,
-        linestyle="--",
-        label="min_improvement",
-    )
+    if sel.admission is Admission.PRICED:
+        bottom.axhline(
+            100.0 * (1.0 - 1.0 / (1.0 + sel.min_improvement)),
+            color="k",
+            linewidth=0.8,
+            linestyle="--",
+            label="min_improvement",
+        )
+    else:  # each move taken passed the paired test over the folds: its margin
+        margins = [step.fold_margin for step in sel.steps]
+        bottom.plot(np.arange(1, len(margins) + 1), margins, "_", color="k", markersize=12, label="paired-test margin")
     bottom.set_xlabel("step of the search (★ the move taken, dots every move tried)")
     bottom.set_ylabel("gain [%]")
     bottom.set_ylim(bottom=max(-20.0, bottom.get_ylim()[0]))

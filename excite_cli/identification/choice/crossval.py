@@ -130,6 +130,7 @@ class CrossValidation:
             for (G, c), (mG, mc, _) in zip(weighted, margin_parts)
         ]
         self.train_rows = [int(np.sum((fold != k) & ~m)) * self.n for k, m in enumerate(margins)]
+        self.fold_instants = np.bincount(fold, minlength=self.folds)  # (K,) instants each fold holds out
         self.held = held
         measured = sum(s for _, _, s in held)
         self.rms = np.sqrt(measured / max(self.instants, 1))
@@ -187,9 +188,20 @@ class CrossValidation:
     def error(self, terms: list[Term], refit: Callable[[int], np.ndarray] | None = None) -> tuple[float, np.ndarray]:
         """CV(M) [%] (module docstring) and the (n,) per-joint relative errors [%] of the model
         [Y_B, ``terms``], fitted by least squares or ``refit`` (:meth:`fold_sse`)."""
-        sse = self.fold_sse(terms, refit).sum(axis=0)
-        per_joint = 100.0 * np.sqrt(sse / max(self.instants, 1)) / np.where(self.rms > 0, self.rms, 1.0)
-        return float(per_joint[self.scored].mean()), per_joint
+        score = self.score(terms, refit)
+        return score[0], score[1]
+
+    def score(
+        self, terms: list[Term], refit: Callable[[int], np.ndarray] | None = None
+    ) -> tuple[float, np.ndarray, np.ndarray]:
+        """CV(M) [%], the (n,) per-joint errors [%] (:meth:`error`) and the (K,) error of each fold
+        [%]: the mean over the scored joints of √(SSE_kj / N_k) / RMS(τ_j), N_k the fold's instants
+        (what a paired test over folds compares, :mod:`~excite_cli.identification.choice.admission`)."""
+        fold_sse = self.fold_sse(terms, refit)
+        rms = np.where(self.rms > 0, self.rms, 1.0)
+        per_joint = 100.0 * np.sqrt(fold_sse.sum(axis=0) / max(self.instants, 1)) / rms
+        per_fold = 100.0 * np.sqrt(fold_sse / np.maximum(self.fold_instants, 1)[:, None]) / rms
+        return float(per_joint[self.scored].mean()), per_joint, per_fold[:, self.scored].mean(axis=1)
 
 
 def fold_groups(runs: list[RunConfig], folder: Path | None, how: str, fitted: list[int]) -> np.ndarray | None:

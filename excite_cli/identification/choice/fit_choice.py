@@ -6,32 +6,35 @@ physically consistent fit (:mod:`~excite_cli.identification.fitting.physical`) k
 distribution and, with weight λ, near the CAD model; on well-excited data it costs a little. Which
 one transfers depends on the data set, and so do the effects a model needs: the effect search runs
 under least squares with the consistent fit's bounds on friction and armature
-(:mod:`~excite_cli.identification.choice.selection`), where an effect may only be
-standing in for base parameters the data leave free, which the consistent fit pins. So the models
-the search passed through at its ends (each search's start and end) are scored under every
-candidate fit on the folds that chose the effects (:class:`~excite_cli.identification.choice.crossval.
-CrossValidation`: whole runs or time blocks, the same margins and held-out offsets) with the
-search's own objective
+(:mod:`~excite_cli.identification.choice.selection`), where an effect may stand in for base
+parameters the data leave free, which the consistent fit pins. So each search's start and end are
+scored under every candidate fit on the folds that chose the effects (the same margins and held-out
+offsets) under the search's own admission rule (:mod:`~excite_cli.identification.choice.admission`):
+least squares (its CV error is the search's) and the consistent fit at every λ of
+``identification.regularization``, refitted on each fold's training normal equations.
+
+**Folds of distinct recordings** (the paired test): each pair's J(M, fit) is its mean log fold error;
+the consistent pair with the lowest J is reported unless the best least-squares pair beats it by the
+paired test over the folds (the folds agree least squares predicts their recordings better by more
+than they disagree), and then least squares is reported with the consistent fit beside it.
+
+**Time blocks** (the price): the search's own objective
 
     J(M, fit) = log CV(M, fit) + p(M) · log(1 + min_improvement) [+ log(1 + least_squares_margin)],
 
-p(M) the effects M adds beyond the declared ones: least squares (its CV error is the search's) and
-the consistent fit at every λ of ``identification.regularization``, refitted on each fold's training
-normal equations. A consistent fit holds every joint's rotor
+p(M) the effects M adds beyond the declared ones. A consistent fit holds every joint's rotor
 (:mod:`~excite_cli.identification.choice.consistent_model`), so a model's armature terms change
 nothing in it and are not in its p(M): models that differ only by them tie, and the first compared
 (the kept search's end) is kept with the effects the search found. Least squares pays the bracketed
 price when a consistent fit is a candidate: it must cut the CV error of the consistent fit by the
-fraction ``least_squares_margin`` (default 0.5) to be chosen. The folds see motion next to the fit's
-(a neighbouring time block of the same few seconds); least squares is free to use base-parameter
-directions such motion barely excites, which its CV error does not charge and a new motion does:
-fitted on the first 20 % of the real Panda run, least squares scored 6.89 % CV against 9.23 % and
-predicted the rest of the run at 9.89 % against 7.61 % (docs/figures.md, "Which fit transfers"). The
-pair with the lowest J wins
-(``fit: auto``); ``fit: least_squares``
-or ``consistent`` restricts the fits (least squares alone keeps the search's model), and a single
-pair is not cross-validated. The reported model, its validation error and the identified URDF are
-the winner's; the best consistent fit of the winning model stays beside least squares in the report.
+fraction ``least_squares_margin`` (default 0.5) to be chosen. Time blocks see motion next to the fit's,
+which does not charge least squares for base-parameter directions such motion barely excites and a
+new motion does (the real Panda's first 20 %: 6.89 % CV against 9.23 %, 9.89 % against 7.61 % on
+the rest; docs/figures.md, "Which fit transfers"). The pair with the lowest J wins (``fit: auto``).
+``fit: least_squares`` or ``consistent`` restricts the fits (least squares alone keeps the search's
+model); a single pair is not cross-validated. The reported model, its validation error and the
+identified URDF are the winner's; the best consistent fit of the winning model stays beside least
+squares in the report.
 """
 
 from __future__ import annotations
@@ -42,8 +45,9 @@ import numpy as np
 
 from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.dynamics.robot import Robot
+from excite_cli.identification.choice.admission import Admission, paired_choice
 from excite_cli.identification.choice.consistent_model import ConsistentModel
-from excite_cli.identification.choice.search import effect_count, objective
+from excite_cli.identification.choice.search import effect_count, priced_objective
 from excite_cli.identification.choice.selection import Selection
 from excite_cli.identification.config import IdentificationConfig
 from excite_cli.identification.effects import Term
@@ -93,7 +97,9 @@ class FitChoice:
         model: index of the winning model in ``models``; chosen: index of its fit in ``names``.
         consistent: the physically consistent fit of the winning model on all fit data at its best
             consistent λ (the winner's, or the one beside least squares), or None when none was asked for.
-        margin: the fraction least squares had to cut the consistent fit's CV error by (0: none).
+        margin: the fraction least squares had to cut the consistent fit's CV error by (0: none or
+            the paired test).
+        admission: the rule the pairs were compared by (the search's).
     """
 
     models: list[Model]
@@ -105,6 +111,7 @@ class FitChoice:
     chosen: int
     consistent: ConsistentFit | None
     margin: float = 0.0
+    admission: Admission = Admission.PRICED
 
     @property
     def name(self) -> str:
@@ -166,14 +173,18 @@ def _without_rotors(terms: list[Term]) -> frozenset[Term]:
     return frozenset(t for t in terms if t.effect != "armature" or t.coupling is not None)
 
 
-def _scores(selection: Selection, model: Model, lams: list[float | None], programs: dict, known: dict) -> np.ndarray:
-    """(f,) CV error [%] of ``model`` under each fit of ``lams`` (the search's own for least squares);
-    a consistent fit's once per set of terms without rotors (``programs``, ``known``: its scores)."""
+def _scores(
+    selection: Selection, model: Model, lams: list[float | None], programs: dict, known: dict
+) -> tuple[np.ndarray, np.ndarray]:
+    """(f,) CV error [%] and (f, K) fold errors [%] of ``model`` under each fit of ``lams`` (the
+    search's own CV error for least squares); a consistent fit's once per set of terms without rotors
+    (``programs``, ``known``: its scores)."""
     search, cv, key = selection.searches[model.search], selection.cross_validation, _without_rotors(model.terms)
-    out = []
+    out, folds = [], []
     for lam in lams:
         if lam is None:
             out.append(search.initial_error if model.at_start else search.cv_error)
+            folds.append(cv.score(model.terms)[2])
             continue
         if (key, lam) not in known:
             consistent = programs[key]
@@ -181,9 +192,31 @@ def _scores(selection: Selection, model: Model, lams: list[float | None], progra
             def refit(k: int, lam: float = lam) -> np.ndarray:
                 return consistent.coefficients(*cv.training_system(k, consistent.terms), lam)
 
-            known[key, lam] = cv.error(consistent.terms, refit)[0]
-        out.append(known[key, lam])
-    return np.array(out)
+            pooled, _, per_fold = cv.score(consistent.terms, refit)
+            known[key, lam] = (pooled, per_fold)
+        out.append(known[key, lam][0])
+        folds.append(known[key, lam][1])
+    return np.array(out), np.array(folds)
+
+
+def _objective(
+    selection: Selection,
+    models: list[Model],
+    lams: list[float | None],
+    cv: np.ndarray,
+    folds: np.ndarray | None,
+    margin: float,
+    paired: bool,
+) -> tuple[np.ndarray, tuple[int, int]]:
+    """J (m, f) of every pair and the winner (model, fit) (module docstring): under the paired test from
+    the fold errors ``folds`` (m, f, K), else priced from the CV errors ``cv`` (m, f)."""
+    if paired:
+        J = np.log(np.maximum(folds, 1e-12)).mean(axis=2)
+        return J, paired_choice(J, folds, [lam is not None for lam in lams])
+    J = priced_objective(cv, [[m.counted(lam is not None) for lam in lams] for m in models], selection.min_improvement)
+    if any(lam is not None for lam in lams):  # least squares pays its margin (module docstring)
+        J = J + np.log1p(np.array([0.0 if lam is not None else margin for lam in lams]))
+    return J, ((0, 0) if folds is None else np.unravel_index(int(np.nanargmin(J)), J.shape))
 
 
 def kept_selection(selection: Selection, model: Model) -> Selection:
@@ -236,14 +269,13 @@ def choose_fit(
     for m in models if scored else []:  # one program per set of terms without rotors: the first model's
         if _without_rotors(m.terms) not in programs:
             programs[_without_rotors(m.terms)] = ConsistentModel(m.terms, selection, robot, base, offset_runs)
-    cv, known = np.full((len(models), len(lams)), np.nan), {}
+    cv, folds, known = np.full((len(models), len(lams)), np.nan), None, {}
     if not single:
-        cv = np.array([_scores(selection, m, lams, programs, known) for m in models])
-    J = objective(cv, [[m.counted(lam is not None) for lam in lams] for m in models], selection.min_improvement)
-    if any(lam is not None for lam in lams):  # least squares pays its margin (module docstring)
-        J = J + np.log1p(np.array([0.0 if lam is not None else cfg.least_squares_margin for lam in lams]))
-    win, chosen = (0, 0) if single else np.unravel_index(int(np.nanargmin(J)), J.shape)
+        cv, folds = (np.array(x) for x in zip(*[_scores(selection, m, lams, programs, known) for m in models]))
+    paired = selection.admission is Admission.PAIRED and not single
+    J, (win, chosen) = _objective(selection, models, lams, cv, folds, cfg.least_squares_margin, paired)
     consistent = [k for k, lam in enumerate(lams) if lam is not None]
+    margin = cfg.least_squares_margin if consistent and None in lams and not paired else 0.0
     best = min(consistent, key=lambda k: np.nan_to_num(cv[win, k], nan=np.inf)) if consistent else None
     lam = lams[best] if best is not None else (cfg.regularization[0] if consistent_beside else None)
     fit = None
@@ -262,6 +294,7 @@ def choose_fit(
         model=int(win),
         chosen=int(chosen),
         consistent=fit,
-        margin=cfg.least_squares_margin if any(lam is not None for lam in lams) and None in lams else 0.0,
+        margin=margin,
+        admission=selection.admission,
     )
     return kept_selection(selection, models[win]), choice

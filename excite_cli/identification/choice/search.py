@@ -1,21 +1,29 @@
-"""The stepwise search's moves and objective (:mod:`~excite_cli.identification.choice.selection`):
+"""The stepwise search's moves and objective (:mod:`~excite_cli.identification.choice.selection`),
+under the admission rule of its folds (:mod:`~excite_cli.identification.choice.admission`).
 
-    J(M) = log CV(M) + p(M) · log(1 + min_improvement),
+A move adds a candidate whose prerequisites are in the model, removes an added term nothing depends
+on, or moves a Stribeck or held term along its velocity grid or a coupled term along its ratio grid.
 
-p(M) the effects the search added, a coupled one counting as log(1 + coupling_improvement) /
-log(1 + min_improvement) effects and a position-dependent one as log(1 + position_improvement) /
-log(1 + min_improvement). A move adds a candidate whose prerequisites are in the model,
-removes an added term nothing depends on, or moves a Stribeck or held term along its velocity grid
-or a coupled term along its ratio grid (paying an effect's price, or it would chase noise for free);
-the move that lowers J most is taken until none does.
+- **Paired test** (folds that are three or more distinct recordings): an addition or a shape change
+  must pass the paired test over the folds (and gain at least its 0.1 % floor), a removal must lower
+  the mean log fold error; of the
+  moves allowed, the one with the lowest mean log fold error J(M) = mean_k log e_k(M) is taken.
+- **Price** (time blocks of one recording): J(M) = log CV(M) + p(M) · log(1 + min_improvement),
+  p(M) the effects the search added, a coupled one counting as log(1 + coupling_improvement) /
+  log(1 + min_improvement) effects and a position-dependent one as log(1 + position_improvement) /
+  log(1 + min_improvement); a shape change pays an effect's price (or it would chase noise for
+  free); the move that lowers J most is taken.
+
+Either way every move lowers J, and the search stops when no move is allowed.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from excite_cli.identification.choice.admission import Admission, as_percent, paired_gain, passes
 from excite_cli.identification.choice.crossval import CrossValidation
 from excite_cli.identification.config import IdentificationConfig
 from excite_cli.identification.effects import Term
@@ -34,6 +42,8 @@ class Step:
         terms: the model after the move.
         cv_error: CV(M) [%] after the move; before: CV(M) [%] before it.
         tried: every move considered at this step: (move, term, CV after [%]).
+        fold_gain, fold_margin: under the paired test, the move's mean gain over the folds and the
+            margin it passed, as cuts of the error [%] (NaN under the price).
     """
 
     move: str
@@ -42,6 +52,8 @@ class Step:
     cv_error: float
     before: float
     tried: list[tuple[str, Term, float]]
+    fold_gain: float = float("nan")
+    fold_margin: float = float("nan")
 
     def gain_of(self, cv_error: float) -> float:
         """The cut [%] of the CV error before this step that a move to ``cv_error`` [%] makes."""
@@ -89,14 +101,14 @@ def effect_weights(cfg: IdentificationConfig) -> tuple[float, float]:
     return float(np.log1p(cfg.coupling_improvement) / unit), float(np.log1p(cfg.position_improvement) / unit)
 
 
-def objective(cv_error, effects, min_improvement: float):
-    """J = log CV + p · log(1 + min_improvement) (module docstring) of CV errors [%] with p added
-    effects; scalars or arrays that broadcast."""
+def priced_objective(cv_error, effects, min_improvement: float):
+    """J = log CV + p · log(1 + min_improvement) (module docstring: the price) of CV errors [%] with p
+    added effects; scalars or arrays that broadcast."""
     return np.log(np.maximum(cv_error, 1e-12)) + np.asarray(effects) * np.log1p(min_improvement)
 
 
 class StepwiseSearch:
-    """The moves and the objective J of one selection problem."""
+    """The moves and the objective J of one selection problem under ``rule`` (module docstring)."""
 
     def __init__(
         self,
@@ -104,25 +116,44 @@ class StepwiseSearch:
         candidates: list[Term],
         declared: list[Term],
         cfg: IdentificationConfig,
+        rule: Admission = Admission.PRICED,
     ):
-        self.cv, self.candidates, self.declared, self.cfg = cv, candidates, declared, cfg
+        self.cv, self.candidates, self.declared, self.cfg, self.rule = cv, candidates, declared, cfg, rule
         self.fixed = {t.family for t in declared}  # declared: never removed (their shape may move)
         self.penalty = np.log1p(cfg.min_improvement)
-        self.cache: dict[frozenset, float] = {}
+        self.cache: dict[frozenset, tuple[float, np.ndarray]] = {}
 
-    def error(self, terms: list[Term]) -> float:
+    def score(self, terms: list[Term]) -> tuple[float, np.ndarray]:
+        """CV(M) [%] and the (K,) fold errors [%] of the model [Y_B, ``terms``]."""
         key = frozenset(terms)
         if key not in self.cache:
-            self.cache[key] = self.cv.error(terms)[0]
+            cv, _, folds = self.cv.score(terms)
+            self.cache[key] = (cv, folds)
         return self.cache[key]
 
-    def objective(self, terms: list[Term], error: float) -> float:
-        p = effect_count(terms, len(self.declared), effect_weights(self.cfg))
-        return float(objective(error, p, self.cfg.min_improvement))
+    def error(self, terms: list[Term]) -> float:
+        """CV(M) [%] of the model [Y_B, ``terms``]."""
+        return self.score(terms)[0]
 
-    def cost(self, move: str, terms: list[Term], error: float) -> float:
-        """J of the model a move leads to; a shape change pays the price of an effect as well."""
-        return self.objective(terms, error) + (self.penalty if move == "shape" else 0.0)
+    def objective(self, terms: list[Term], score: tuple[float, np.ndarray]) -> float:
+        """J of the model ``terms`` with its ``score`` (module docstring)."""
+        if self.rule is Admission.PAIRED:
+            return float(np.log(np.maximum(score[1], 1e-12)).mean())
+        p = effect_count(terms, len(self.declared), effect_weights(self.cfg))
+        return float(priced_objective(score[0], p, self.cfg.min_improvement))
+
+    def cost(self, move: str, terms: list[Term], score: tuple[float, np.ndarray]) -> float:
+        """J of the model a move leads to; under the price a shape change pays an effect's price as well."""
+        shape_price = self.penalty if move == "shape" and self.rule is Admission.PRICED else 0.0
+        return self.objective(terms, score) + shape_price
+
+    def allowed(self, move: str, before: tuple[float, np.ndarray], after: tuple[float, np.ndarray]) -> bool:
+        """Whether a move from the model scored ``before`` to one scored ``after`` is allowed:
+        under the paired test, an addition or shape change that passes it or a removal that lowers the
+        mean log fold error; under the price, one whose cost is below J (module docstring)."""
+        if self.rule is Admission.PRICED:
+            return True  # the price is in the cost; the best move is then compared with J
+        return paired_gain(before[1], after[1])[0] > 0.0 if move == "remove" else passes(before[1], after[1])
 
     def moves(self, terms: list[Term]) -> list[tuple[str, Term, list[Term]]]:
         """(move, term, model after) of every allowed move from ``terms``."""
@@ -146,26 +177,39 @@ class StepwiseSearch:
                 ]
         return out
 
+    def _stop(self, terms: list[Term]) -> str:
+        """Why the search stops at ``terms`` (no move allowed)."""
+        if len(terms) - len(self.declared) >= self.cfg.max_effects:
+            return f"max_effects ({self.cfg.max_effects}) reached; no removal or shape change helps"
+        if self.rule is Admission.PAIRED:
+            return (
+                "no addition or shape change improves the folds by more than their own spread (paired test "
+                "over distinct recordings, 95 %) and no removal improves them"
+            )
+        return (
+            f"no addition, removal or shape change lowers the cross-validated error by "
+            f"min_improvement ({100 * self.cfg.min_improvement:g} %)"
+        )
+
     def run(self, name: str, start: list[Term]) -> Search:
         terms = list(start)
-        error = self.error(terms)
-        search = Search(name, list(terms), error, terms, error, self.objective(terms, error))
+        score = self.score(terms)
+        search = Search(name, list(terms), score[0], terms, score[0], self.objective(terms, score))
         while True:
-            tried = [(move, term, after, self.error(after)) for move, term, after in self.moves(terms)]
+            tried = [(move, term, after, self.score(after)) for move, term, after in self.moves(terms)]
             if not tried:
                 search.stop = "no move left (every candidate is in the model)"
                 break
-            move, term, after, value = min(tried, key=lambda m: self.cost(m[0], m[2], m[3]))
-            if self.cost(move, after, value) >= search.objective - 1e-12:
-                search.stop = (
-                    f"no addition, removal or shape change lowers the cross-validated error by "
-                    f"min_improvement ({100 * self.cfg.min_improvement:g} %)"
-                )
-                if len(terms) - len(self.declared) >= self.cfg.max_effects:
-                    search.stop = f"max_effects ({self.cfg.max_effects}) reached; no removal or shape change helps"
+            allowed = [m for m in tried if self.allowed(m[0], score, m[3])]
+            best = min(allowed, key=lambda m: self.cost(m[0], m[2], m[3]), default=None)
+            if best is None or self.cost(best[0], best[2], best[3]) >= search.objective - 1e-12:
+                search.stop = self._stop(terms)
                 break
-            search.steps.append(Step(move, term, after, value, error, [(m, t, v) for m, t, _, v in tried]))
-            terms, error = after, value
-            search.objective = self.objective(terms, error)
-        search.terms, search.cv_error = terms, error
+            move, term, after, value = best
+            gain, margin = paired_gain(score[1], value[1]) if self.rule is Admission.PAIRED else (np.nan, np.nan)
+            step = Step(move, term, after, value[0], score[0], [(m, t, v[0]) for m, t, _, v in tried])
+            search.steps.append(replace(step, fold_gain=as_percent(gain), fold_margin=as_percent(margin)))
+            terms, score = after, value
+            search.objective = self.objective(terms, score)
+        search.terms, search.cv_error = terms, score[0]
         return search

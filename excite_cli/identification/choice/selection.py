@@ -3,15 +3,15 @@ terms scored by blocked cross-validation of the fit data (:mod:`~excite_cli.iden
 The validation data (``validation`` runs, odd time blocks) take no part: they stay untouched for
 the reported error.
 
-The search minimizes
-
-    J(M) = log CV(M) + p(M) · log(1 + min_improvement),
-
-p(M) the number of terms the search added: every effect must lower the cross-validated error by
-the fraction ``min_improvement`` (default 2 %) to stay in the model. A move adds a candidate term,
+The search minimizes an objective J(M) under the admission rule its folds allow
+(:mod:`~excite_cli.identification.choice.admission`): with folds of three or more distinct
+recordings, every effect must pass a paired test over the folds (the folds agree it helps by more
+than they disagree); with time blocks of one recording, which cannot judge a new effect, every
+effect must lower the cross-validated error by the fraction ``min_improvement`` (default 2 %;
+:mod:`~excite_cli.identification.choice.search`). A move adds a candidate term,
 removes an added term, or changes the shape velocity of a Stribeck or held term (the profile search
-over its grid; such a move must cut the error by ``min_improvement`` too, or it would chase noise
-for free); the move that lowers J most is taken, and the search stops when none does, so it ends in
+over its grid; such a move is judged as an addition, or it would chase noise
+for free); the allowed move that lowers J most is taken, and the search stops when none does, so it ends in
 a model no single move improves and cannot cycle. Greedy forward selection alone depends on
 its path: a joint whose Coulomb friction is missing bends the shared base parameters, and adding it
 later can make another joint's error worse first. So the search runs from three starts (the declared
@@ -32,6 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from excite_cli.effects import EFFECTS
+from excite_cli.identification.choice.admission import Admission, admission_of
 from excite_cli.identification.choice.crossval import CrossValidation
 from excite_cli.identification.choice.search import Search, Step, StepwiseSearch, effect_weights
 from excite_cli.identification.config import IdentificationConfig
@@ -68,7 +69,9 @@ class Selection:
         absorbed: candidates skipped as not separately identifiable.
         cross_validation: the folds every model was scored on, for scoring other fits of the model.
         min_improvement: the price of an effect (a fraction); effect_weights: the effects a coupled
-            and a position-dependent one count as (:func:`effect_count`).
+            and a position-dependent one count as (:func:`effect_count`); both under the price only.
+        admission: how the search admitted terms: a paired test over folds of distinct recordings,
+            or the price (:mod:`~excite_cli.identification.choice.admission`).
         normal: the fit data's normal equations (every candidate and every joint's armature: the rotors of
             :mod:`~excite_cli.identification.choice.consistent_model`), for refitting other models.
     """
@@ -89,6 +92,7 @@ class Selection:
     normal: NormalEquations
     effect_weights: tuple[float, float] = (1.0, 1.0)
     at_start: bool = False
+    admission: Admission = Admission.PRICED
 
     @property
     def folds(self) -> int:
@@ -187,7 +191,7 @@ def select_effects(
     candidates = [t for t in candidates if t not in absorbed]
     keys = declared + candidates + [t for t in total.size if t not in declared + candidates]
     cv = CrossValidation(fit_data, keys, weights, cfg.folds, margin, recordings, fitted_offsets, scored)
-    search = StepwiseSearch(cv, candidates, declared, cfg)
+    search = StepwiseSearch(cv, candidates, declared, cfg, admission_of(cv.by_recording, cv.folds))
     searches, seen = [], []
     for name, effects in STARTS.items():
         start = declared + [t for t in candidates if t.effect in effects and t.shape is None and t.coupling is None]
@@ -213,4 +217,5 @@ def select_effects(
         min_improvement=cfg.min_improvement,
         normal=total,
         effect_weights=effect_weights(cfg),
+        admission=search.rule,
     )

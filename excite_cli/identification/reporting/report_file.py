@@ -75,7 +75,7 @@ def write_identification(
         g.attrs["fit_samples"], g.attrs["validation_samples"] = report.fit_samples, report.validation_samples
         g.attrs["dropped_rows"] = "; ".join(f"{name}: {rows}" for name, rows in report.dropped) or "none"
         g.attrs["folds"], g.attrs["min_improvement"] = sel.folds, sel.min_improvement
-        g.attrs["folds_by"] = sel.folds_by
+        g.attrs["folds_by"], g.attrs["admission"] = sel.folds_by, str(sel.admission)
         g.attrs["coulomb_velocity_rad_s"] = problem.identification.coulomb_velocity
         g.attrs["cv_error_rigid"], g.attrs["cv_error"] = sel.cv_rigid, report.cv_error
         g.attrs["stop_reason"] = sel.searches[sel.chosen].stop
@@ -128,9 +128,7 @@ def _write_fits(g: h5py.Group, report: Report) -> None:
         "models",
         rows,
         "model:str effects:f8 fit:str cv_error:f8 objective:f8",
-        units="cv_error in %; objective J = log CV + effects × log(1 + min_improvement) "
-        "(+ log(1 + least_squares_margin) for least squares; a consistent fit's effects leave out armature); "
-        "the lowest wins",
+        units=f"cv_error in %; objective {choice.admission.fit_objective}; the lowest wins",
         chosen=choice.model * len(choice.names) + choice.chosen,
     )
     g.attrs["model"] = choice.labels[choice.model]

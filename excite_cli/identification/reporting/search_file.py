@@ -8,6 +8,7 @@ import h5py
 import numpy as np
 
 from excite_cli.h5 import write_strings, write_table
+from excite_cli.identification.choice.admission import Admission
 from excite_cli.identification.reporting.report import Report
 
 STR = h5py.string_dtype()
@@ -83,7 +84,11 @@ def write_search(g: h5py.Group, report: Report) -> None:
         steps.append((k, step.move, *_term_fields(step.term, report.joints), step.cv_error, step.gain))
         tried += [(k, m, *_term_fields(t, report.joints), v, step.gain_of(v)) for m, t, v in step.tried]
     units = "cv_error in %, gain in % of the CV error before the step, shape in rad/s"
-    g.create_dataset("steps", data=np.array(steps, dtype=move)).attrs["units"] = units
+    written = g.create_dataset("steps", data=np.array(steps, dtype=move))
+    written.attrs["units"], written.attrs["admission"] = units, str(sel.admission)
+    if sel.admission is Admission.PAIRED:  # each step's mean gain over the folds and the margin it passed
+        written.attrs["fold_gain_percent"] = [step.fold_gain for step in sel.steps]
+        written.attrs["fold_margin_percent"] = [step.fold_margin for step in sel.steps]
     g.create_dataset("candidates", data=np.array(tried, dtype=move)).attrs["units"] = (
         units + "; every move tried at each step"
     )
@@ -96,5 +101,5 @@ def write_search(g: h5py.Group, report: Report) -> None:
             for k, s in enumerate(sel.searches)
         ],
         "start:str effects:str cv_error:f8 objective:f8 steps:i4 stop_reason:str chosen:?",
-        units="cv_error in %; objective J = log CV + p log(1 + min_improvement)",
+        units=f"cv_error in %; objective {sel.admission.search_objective}",
     )

@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 import scipy.optimize
 
+from excite_cli.identification.choice.admission import Admission
 from excite_cli.identification.choice.crossval import CrossValidation, fold_assignment
 from excite_cli.identification.choice.search import Search, StepwiseSearch
 from excite_cli.identification.choice.selection import STARTS, candidate_terms, kept_search, select_effects
@@ -23,12 +24,14 @@ def _smooth(rng, size, cutoff_steps=40):
     ]
 
 
-def dataset(effects: dict[Term, float], cfg: IdentificationConfig, noise: float = 0.02, seed: int = 0) -> Dataset:
-    """Two runs of two joints; τ = Y φ + Σ effects + noise; blocks for every candidate of ``cfg``."""
+def dataset(
+    effects: dict[Term, float], cfg: IdentificationConfig, noise: float = 0.02, seed: int = 0, runs: int = 2
+) -> Dataset:
+    """``runs`` runs of two joints; τ = Y φ + Σ effects + noise; blocks for every candidate of ``cfg``."""
     rng = np.random.default_rng(seed)
-    n, N = 2, 2 * N_RUN
-    time = np.concatenate([np.arange(N_RUN) / RATE] * 2)
-    run = np.repeat([0, 1], N_RUN)
+    n, N = 2, runs * N_RUN
+    time = np.concatenate([np.arange(N_RUN) / RATE] * runs)
+    run = np.repeat(np.arange(runs), N_RUN)
     t = np.arange(N) / RATE
     q = np.column_stack([np.sin(0.7 * t + j) + 0.3 * np.sin(2.3 * t) for j in range(n)])
     qd = np.gradient(q, 1.0 / RATE, axis=0)
@@ -37,7 +40,7 @@ def dataset(effects: dict[Term, float], cfg: IdentificationConfig, noise: float 
     blocks = {}
     for term in candidate_terms(cfg, n) + list(effects):
         if term.effect == "offset":
-            blocks[term] = np.vstack([run_offset_columns(r, [0, 1], N_RUN, 2) for r in (0, 1)])
+            blocks[term] = np.vstack([run_offset_columns(r, list(range(runs)), N_RUN, runs) for r in range(runs)])
         else:
             blocks[term] = effect_columns(
                 term.effect, q[:, term.joint], qd[:, term.joint], qdd[:, term.joint], 0.01, term.shape
@@ -222,3 +225,33 @@ def test_recording_folds_hold_out_the_recordings_of_one_trajectory_together(tmp_
     assert fold_groups(runs[:2], tmp_path, "auto", [0, 1]) is None  # one trajectory: time blocks
     plain = [RunConfig(file=f"r{k}.csv") for k in range(3)]
     np.testing.assert_array_equal(fold_groups(plain, tmp_path, "recording", [0, 1, 2]), [0, 1, 2])
+
+
+def test_distinct_recordings_admit_a_small_effect_every_fold_shares_and_time_blocks_price_it_out():
+    """Viscous friction on joint 1 worth about 1 % of the error: under the 2 % price, yet every one of
+    four recordings gains from it, so the paired test over recording folds admits it; noise alone
+    admits nothing by either rule (:mod:`~excite_cli.identification.choice.admission`)."""
+    cfg = IdentificationConfig(candidates=["coulomb", "viscous", "offset"])
+    small = {Term("coulomb", 0): 0.5, Term("viscous", 1): 0.006}
+    data = dataset(small, cfg, runs=4)
+    recordings = np.arange(4)
+    paired = select_effects(data, cfg, [], margin=0.05, recordings=recordings)
+    priced = select_effects(data, cfg, [], margin=0.05)
+    assert paired.admission is Admission.PAIRED and priced.admission is Admission.PRICED
+    assert set(paired.terms) == set(small)
+    step = next(s for s in paired.steps if s.term == Term("viscous", 1))
+    assert 0.0 < step.gain < 100 * (1 - 1 / (1 + cfg.min_improvement)) and step.fold_gain > step.fold_margin
+    assert Term("viscous", 1) not in priced.terms
+    noise = dataset({Term("coulomb", 0): 0.5}, cfg, runs=4, seed=1)
+    assert set(select_effects(noise, cfg, [], margin=0.05, recordings=recordings).terms) == {Term("coulomb", 0)}
+
+
+def test_an_effect_of_one_recording_fails_the_paired_test_however_large_its_mean():
+    """Viscous friction on joint 1 in recording 0 alone: the folds disagree, so it is not admitted."""
+    cfg = IdentificationConfig(candidates=["coulomb", "viscous"])
+    data = dataset({Term("coulomb", 0): 0.5}, cfg, runs=4)
+    one_run = np.repeat(data.run == 0, 2) & (np.tile([0, 1], data.time.size) == 1)
+    tau = data.tau + one_run * np.repeat(data.blocks[Term("viscous", 1)][:, 0], 2) * 0.4
+    data = Dataset(data.regressor, tau, data.time, data.run, data.blocks)
+    selection = select_effects(data, cfg, [], margin=0.05, recordings=np.arange(4))
+    assert selection.admission is Admission.PAIRED and set(selection.terms) == {Term("coulomb", 0)}
