@@ -18,7 +18,12 @@ the defaults (nothing declared) and validated on data neither the fit nor the se
   excite trajectories with the feed-forward plus PD; an 18-bit encoder, 1.5 % torque noise; fitted on
   some trajectories, validated on another. Their *true* is the floor: MuJoCo's own parameters through
   excite's preprocessing, nothing fitted; a second line gives the consistent fit's link masses and
-  the effects against MuJoCo's.
+  the effects against MuJoCo's;
+- **effects judged by the folds** (`bench/distinct_recordings.py`): MuJoCo's Panda with a spring of
+  100 Nm/rad on joint 4 recorded on 4 random trajectories, each twice (the folds: a paired test over
+  distinct trajectories), the same Panda without a spring on one periodic run (time blocks: the
+  price), and a simulated Panda with 0.35 Nm of Stribeck friction on joint 2 on 4 optimized
+  trajectories, each twice; each validated on one more trajectory.
 
 Printed per analogue: the mean relative validation error [%] of the rigid body, of the reported
 model (with the fit it chose), of the other fit excite computed, and of the true model (its terms
@@ -35,6 +40,7 @@ import excite_cli  # noqa: F401  (before NumPy: the kernels of the command line,
 
 import sys
 import tempfile
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -42,6 +48,7 @@ import yaml
 from coupled_wrist import JOINTS as UR5_JOINTS
 from coupled_wrist import ROBOT as UR5_ROBOT
 from coupled_wrist import true_error
+from distinct_recordings import mujoco_twins, simulated_twins
 from mujoco_arm import ArmPhysics, arm_model, floor_error, record
 
 from excite_cli.config import RobotConfig
@@ -50,6 +57,7 @@ from excite_cli.design.resolve import build_excitation
 from excite_cli.dynamics.base_parameters import compute_base_parameters
 from excite_cli.dynamics.robot import load_robot
 from excite_cli.dynamics.urdf_source import resolve_urdf
+from excite_cli.identification.choice.admission import Admission
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.effects import Term
 from excite_cli.identification.pipeline import prepare_data, run_identification
@@ -64,6 +72,17 @@ PANDA = [f"panda_joint{k}" for k in range(1, 8)]
 PANDA_ROBOT = {"urdf": "panda_description/urdf/panda.urdf", "source": "example-robot-data", "active_joints": PANDA}
 FRICTION = [Term(e, j) for e in ("coulomb", "viscous") for j in range(7)]
 COLUMNS = {"q": [f"q_{j}" for j in PANDA], "tau": [f"tau_{j}" for j in PANDA]}
+#: MuJoCo's Panda: joint damping, frictionloss and armature, 1 kg 10 cm beyond the flange.
+MUJOCO_PANDA = ArmPhysics(
+    damping=np.array([0.6, 0.6, 0.5, 0.5, 0.2, 0.2, 0.1]),
+    frictionloss=np.array([0.8, 0.8, 0.6, 0.6, 0.3, 0.3, 0.2]),
+    armature=np.array([0.3, 0.3, 0.2, 0.2, 0.05, 0.05, 0.02]),
+    payload=(1.0, (0.0, 0.0, 0.207), (2e-3, 2e-3, 1e-3)),
+)
+#: The spring MuJoCo's Panda has on joint 4 [Nm/rad], about q = 0 (outside the joint's range, −3.07 to
+#: −0.07 rad: a preloaded spring, an offset plus a stiffness), and the Stribeck friction the simulated
+#: one has on joint 2 [Nm] (v_s 0.1 rad/s, the simulator's default).
+SPRING, STRIBECK = 100.0, 0.35
 
 
 def optimized(folder: Path, config: Path, name: str) -> Path:
@@ -84,14 +103,33 @@ def identify(folder: Path, name: str, robot: dict, runs: list[dict], columns: di
     return problem, run_identification(problem)[0]
 
 
-def found(report, joints: list[str]) -> str:
-    """The position-dependent, coupled and dead things the report names."""
-    terms = [t.label(joints) for t in report.selection.terms if t.kind.position or t.coupling is not None]
+def found(report, joints: list[str], watched: tuple[str, ...] = ()) -> str:
+    """The position-dependent, coupled and dead things the report names, the terms of the ``watched``
+    effects, and how the folds admitted them."""
+    terms = [
+        t.label(joints)
+        for t in report.selection.terms
+        if t.kind.position or t.coupling is not None or t.effect in watched
+    ]
     dead = [f"dead {joints[j]}" for j in np.flatnonzero(~report.live)]
-    return "; ".join(terms + dead) or "no position effect, coupling or dead channel"
+    text = "; ".join(terms + dead) or "no position effect, coupling or dead channel"
+    sel = report.selection
+    if sel.admission is Admission.PAIRED:
+        gains = [f"{s.fold_gain:.1f} > {s.fold_margin:.1f}" for s in sel.steps if s.term.label(joints) in terms]
+        text += f" [paired test over {sel.folds} trajectories" + (f"; fold gain % {', '.join(gains)}" if gains else "")
+        text += "]"
+    return text
 
 
-def line(name: str, problem, report, joints: list[str], truth: list[Term] | None, true: float | None = None) -> None:
+def line(
+    name: str,
+    problem,
+    report,
+    joints: list[str],
+    truth: list[Term] | None,
+    true: float | None = None,
+    watched: tuple[str, ...] = (),
+) -> None:
     """The analogue's row: rigid, chosen (fit), the other fit, the true model (``truth``'s terms fitted
     by weighted least squares, or the figure ``true``) and what was found."""
     choice = report.fit_choice
@@ -105,7 +143,7 @@ def line(name: str, problem, report, joints: list[str], truth: list[Term] | None
     true_text = f"{true:6.2f}" if true is not None else "     —"
     print(
         f"{name:<34} {report.mean(report.relative_before):6.2f} {report.mean(report.relative_after):6.2f} "
-        f"({choice.name:<18}) {other_text:<24} {true_text}  {found(report, joints)}",
+        f"({choice.name:<18}) {other_text:<24} {true_text}  {found(report, joints, watched)}",
         flush=True,
     )
 
@@ -268,13 +306,7 @@ def main() -> None:
             truth + [Term("motor", 4, None, (0, 0, 0, 0, 1.0, 1.0))],
         )
 
-        panda = ArmPhysics(
-            damping=np.array([0.6, 0.6, 0.5, 0.5, 0.2, 0.2, 0.1]),
-            frictionloss=np.array([0.8, 0.8, 0.6, 0.6, 0.3, 0.3, 0.2]),
-            armature=np.array([0.3, 0.3, 0.2, 0.2, 0.05, 0.05, 0.02]),
-            payload=(1.0, (0.0, 0.0, 0.207), (2e-3, 2e-3, 1e-3)),  # 10 cm beyond the flange
-        )
-        mujoco_analogue(folder, "panda", PANDA_ROBOT, smoke, panda, ["fit", "validation"])
+        mujoco_analogue(folder, "panda", PANDA_ROBOT, smoke, MUJOCO_PANDA, ["fit", "validation"])
         ur5 = ArmPhysics(
             damping=np.array([0.8, 0.8, 0.5, 0.2, 0.2, 0.1]),
             frictionloss=np.array([1.5, 1.5, 1.0, 0.4, 0.4, 0.3]),
@@ -282,6 +314,28 @@ def main() -> None:
             payload=(1.5, (0.0, 0.15, 0.0), (3e-3, 2e-3, 3e-3)),  # 7 cm beyond the flange (y of wrist_3_link)
         )
         mujoco_analogue(folder, "ur5", UR5_ROBOT, folder / "ur5.h5", ur5, ["fit", "fit", "validation"])
+        admitted_by_folds(folder)
+
+
+def admitted_by_folds(folder: Path) -> None:
+    """Effects judged by what the folds can show: a spring and a low-speed friction term on distinct
+    recordings (a paired test over the folds), and one periodic run without a spring (time blocks,
+    admitted by the price)."""
+    spring = replace(MUJOCO_PANDA, stiffness=np.array([0, 0, 0, SPRING, 0, 0, 0.0]))
+    runs = mujoco_twins(folder, "spring_twins", PANDA_ROBOT, spring)
+    problem, report = identify(folder, "spring_twins", PANDA_ROBOT, runs, COLUMNS)
+    line(f"MuJoCo spring {SPRING:g} Nm/rad j4, 4 traj. x2", problem, report, PANDA, None)
+    runs = mujoco_twins(folder, "periodic", PANDA_ROBOT, MUJOCO_PANDA, trajectories=1, periods=3)
+    problem, report = identify(folder, "periodic", PANDA_ROBOT, runs, COLUMNS)
+    line("MuJoCo no spring, one periodic run", problem, report, PANDA, None)
+    five = yaml.safe_load((ROOT / "configs" / "smoke.yaml").read_text())
+    five["sequence"]["iterations"], five["optimizer"]["max_iterations"] = 5, 40
+    (folder / "five.yaml").write_text(yaml.safe_dump(five))
+    effects = {"coulomb": {"*": 0.6}, "viscous": {"*": 0.4}, "stribeck": {"panda_joint2": STRIBECK}}
+    runs = simulated_twins(folder, "stribeck", optimized(folder, folder / "five.yaml", "five"), effects)
+    problem, report = identify(folder, "stribeck", PANDA_ROBOT, runs, COLUMNS)
+    truth = FRICTION + [Term("stribeck", 1, 0.1)]
+    line(f"Stribeck {STRIBECK:g} Nm on j2, 4 traj. x2", problem, report, PANDA, truth, watched=("stribeck", "held"))
 
 
 if __name__ == "__main__":

@@ -46,7 +46,8 @@ class ArmPhysics:
             armature: (n,) rotor inertia [kg·m²], per active joint.
         payload: mass [kg], position (3,) [m] in the last active joint's frame, principal moments (3,)
             [kg·m²] about its centre (axes along the frame's).
-        stiffness: (n,) a spring about q = 0 [Nm/rad] per active joint, or None.
+        stiffness: (n,) a spring [Nm/rad] per active joint about ``spring_reference`` (n,) [rad]
+            (default q = 0), or None.
     """
 
     damping: np.ndarray
@@ -54,6 +55,7 @@ class ArmPhysics:
     armature: np.ndarray
     payload: tuple[float, tuple[float, float, float], tuple[float, float, float]]
     stiffness: np.ndarray | None = None
+    spring_reference: np.ndarray | None = None
 
     def truth(self, n: int) -> list[tuple[Term, float]]:
         """(term, value) of every effect excite's catalogue names for these fields."""
@@ -85,7 +87,8 @@ def arm_model(urdf: Path, active: list[str], physics: ArmPhysics):
         joint.damping = [float(physics.damping[j]), 0.0, 0.0]  # linear; MuJoCo 4's higher powers none
         joint.frictionloss, joint.armature = float(physics.frictionloss[j]), float(physics.armature[j])
         if physics.stiffness is not None:
-            joint.stiffness = [float(physics.stiffness[j]), 0.0, 0.0]  # about springref 0
+            joint.stiffness = [float(physics.stiffness[j]), 0.0, 0.0]
+            joint.springref = 0.0 if physics.spring_reference is None else float(physics.spring_reference[j])
     mass, position, moments = physics.payload
     spec.joint(active[-1]).parent.add_body(  # its centre of mass at its origin (MuJoCo 4 has no default there)
         name="payload",
