@@ -9,6 +9,7 @@ from rich.table import Table
 
 from excite_cli.console.effect_search import search
 from excite_cli.console.tables import titled_table
+from excite_cli.identification.choice.admission import Admission
 from excite_cli.identification.reporting.report import Report
 from excite_cli.identification.validate import RunError
 from excite_cli.workflows.check_identify import IdentifyPlan
@@ -130,15 +131,22 @@ def fits(report: Report) -> list[Table]:
             ("fit", "cross-validated [%]", "validation [%]"),
             rows,
             f"chosen: {choice.name}, cross-validated {abs(choice.lead):.2f} % points "
-            f"{'below' if choice.lead >= 0 else 'above'} the next"
-            + (
-                f"; least squares must be {100 * choice.margin:.0f} % below the consistent fit's "
-                "(identification.least_squares_margin)"
-                if choice.margin
-                else ""
-            ),
+            f"{'below' if choice.lead >= 0 else 'above'} the next" + _why_not_least_squares(choice),
         ),
     ]
+
+
+def _why_not_least_squares(choice) -> str:
+    """Why least squares, lower on the folds, is not the reported fit (empty when it is, or is not lower)."""
+    if choice.lead >= 0 or not choice.is_consistent:
+        return ""
+    if choice.admission is Admission.PAIRED:
+        return "; least squares is lower on average but the folds disagree by more than its gain (paired test)"
+    return (
+        "; least squares is lower but not chosen: time blocks of one recording see motion next to the fit's and "
+        "do not charge least squares for directions a new motion excites, so it must be "
+        f"{100 * choice.margin:.0f} % below the consistent fit's (identification.least_squares_margin)"
+    )
 
 
 def models(report: Report) -> list[Table]:

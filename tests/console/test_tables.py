@@ -4,6 +4,7 @@ table, the progress lines of a log, and errors worded as the command's options."
 import io
 import re
 import warnings
+from types import SimpleNamespace
 
 import numpy as np
 import pinocchio as pin
@@ -16,9 +17,10 @@ from excite_cli.config_file import load_problem
 from excite_cli.console import tables
 from excite_cli.console.bodies import consistent_bodies
 from excite_cli.console.errors import printed_warnings, spellings, word
-from excite_cli.console.identification import _unresolved, validation
+from excite_cli.console.identification import _unresolved, _why_not_least_squares, validation
 from excite_cli.console.progress import Bars
 from excite_cli.errors import ExciteError, ExciteWarning, OutputExists
+from excite_cli.identification.choice.admission import Admission
 from excite_cli.identification.fitting.physical import ConsistentFit
 from excite_cli.identification.validate import RunError
 from excite_cli.search.kkt import Optimality
@@ -161,3 +163,14 @@ def test_base_parameters_the_data_cannot_tell_from_zero_are_named():
     assert _unresolved(report) == ["std ≥ 10 × the value (the data cannot tell them from 0): a, b"]
     fit.std[1:3] = [0.001, 1e-6]
     assert _unresolved(report) == []
+
+
+def test_a_lower_least_squares_not_chosen_is_explained_by_the_rule_of_the_folds():
+    choice = SimpleNamespace(lead=-0.4, is_consistent=True, margin=0.5, admission=Admission.PRICED)
+    assert "time blocks of one recording" in _why_not_least_squares(choice) and "50 %" in _why_not_least_squares(choice)
+    paired = SimpleNamespace(lead=-0.4, is_consistent=True, margin=0.0, admission=Admission.PAIRED)
+    assert "paired test" in _why_not_least_squares(paired)
+    assert (
+        _why_not_least_squares(SimpleNamespace(lead=0.3, is_consistent=True, margin=0.5, admission=Admission.PRICED))
+        == ""
+    )
