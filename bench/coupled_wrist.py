@@ -35,7 +35,8 @@ from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.effects import Term
 from excite_cli.identification.fitting.least_squares import joint_weights, least_squares, predict, torque_errors
 from excite_cli.identification.fitting.normal import NormalEquations
-from excite_cli.identification.pipeline import prepare_data, run_identification
+from excite_cli.identification.pipeline import run_identification
+from excite_cli.identification.prepared import prepare_data
 from excite_cli.identification.simulation_config import SimulationConfig
 from excite_cli.search.sequence import run_sequence
 from excite_cli.storage.results import write_result

@@ -141,7 +141,7 @@ def play(mujoco, model, robot: Robot, trajectory, alpha: np.ndarray, periods: in
 def floor_error(prepared, base, physics: ArmPhysics, robot: Robot, live: np.ndarray) -> float:
     """Mean relative validation error [%] (over the ``live`` joints) of MuJoCo's own arm through excite's
     preprocessing: the true parameters, nothing fitted (the floor no model of excite's can go below
-    but by fitting the noise). ``prepared``: :func:`~excite_cli.identification.pipeline.prepare_data`
+    but by fitting the noise). ``prepared``: :func:`~excite_cli.identification.prepared.prepare_data`
     with the terms of :meth:`ArmPhysics.truth`."""
     truth = physics.truth(robot.n_joints)
     x = np.concatenate([base.from_standard(physics.standard(robot)), [value for _, value in truth]])

@@ -102,7 +102,7 @@ class RunConfig(Section):
     payload: Optional[PayloadConfig] = None
     """A known payload carried in this run, taken out of τ."""
     trajectory: Optional[str] = None
-    """A name for the motion recorded: runs of one trajectory recorded again share it (default: the file)."""
+    """A name for the motion recorded, shared by its runs (default: the file; recordings of one motion found as one)."""
 
     @property
     def files(self) -> list[str]:

@@ -4,7 +4,7 @@ the validation data, which neither the fit nor the selection saw."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -20,22 +20,13 @@ from excite_cli.identification.choice.fit_choice import choose_fit
 from excite_cli.identification.choice.selection import Selection, candidate_terms, motor_couplings, select_effects
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.effects import Term, rotor_terms
-from excite_cli.identification.fitting.channels import dead_channels
-from excite_cli.identification.fitting.dataset import Dataset, build_datasets, fit_position_range
-from excite_cli.identification.fitting.least_squares import Fit, joint_weights, least_squares, predict, torque_errors
-from excite_cli.identification.fitting.model_error import between_trajectories, trajectory_of_runs
+from excite_cli.identification.fitting.dataset import Dataset
+from excite_cli.identification.fitting.least_squares import Fit, least_squares, predict, torque_errors
+from excite_cli.identification.fitting.model_error import between_trajectories
 from excite_cli.identification.fitting.noise import middle
-from excite_cli.identification.fitting.normal import NormalEquations, excited_rank
 from excite_cli.identification.fitting.plausibility import implausible
-from excite_cli.identification.measured.gaps import split_at_gaps
-from excite_cli.identification.measured.measurements import (
-    check_against_limits,
-    in_sample_validation,
-    load_run,
-    silent_channels,
-)
-from excite_cli.identification.measured.payload import payload_parameters
-from excite_cli.identification.measured.preprocessing import choose_cutoff, preprocess
+from excite_cli.identification.measured.measurements import in_sample_validation
+from excite_cli.identification.prepared import prepare_data
 from excite_cli.identification.reporting.prior_rows import PriorRows, prior_rows
 from excite_cli.identification.reporting.report import Report
 from excite_cli.identification.reporting.urdf_out import urdf_deviation, write_urdf
@@ -82,91 +73,6 @@ def error_ladder(
     return [(label, cv, float(torque_errors(measured, predicted)[2][live].mean())) for label, cv, predicted in fitted]
 
 
-@dataclass
-class Prepared:
-    """The data ``identify`` works on: fit and validation datasets (two-stage columns included), the
-    runs with fit instants, the cut-off [Hz] and its source, rows dropped per run, decimated rate [Hz],
-    the fit data's q range per joint (n, 2) [rad] that guards the position-dependent effects (None
-    with ``identification.position_guard`` off or no position effect among the terms), the joints
-    whose torque channel carries no signal (n,) and why, in words (one line per such joint). A run
-    cut at its gaps is preprocessed piece by piece and stays one run in the datasets."""
-
-    fit: Dataset
-    validation: Dataset
-    fitted: list[int]
-    cutoff: float
-    cutoff_source: str
-    dropped: list[tuple[str, int]]
-    rate: float
-    q_range: np.ndarray | None
-    silent: np.ndarray
-    silence: list[str]
-
-
-def prepare_data(problem: IdentifyProblem, robot: Robot, base: BaseParameters, terms: list[Term]) -> Prepared:
-    """Read every run, choose the cut-off, preprocess, build the fit and validation datasets with the
-    columns of ``terms`` (known payloads taken out), check the fit data excite every base parameter,
-    and add the two-stage load columns from a first rigid-body fit. Runs are released as they are
-    decimated.
-
-    Raises:
-        ExciteError: bad data (see :func:`load_run`, :func:`preprocess`, :func:`build_datasets`), or
-            fit runs that do not excite every base parameter.
-    """
-    cfg = problem.identification
-    runs, payloads, sources = [], [], []  # lists only: the runs are released as they are preprocessed
-    for k, r in enumerate(problem.data.runs):
-        payload = payload_parameters(robot, r.payload, f"data.runs[{k}].payload") if r.payload else None
-        run = load_run(r, problem.data, robot.joint_names, problem.folder)
-        check_against_limits(run, robot.joint_names, robot.lower, robot.upper, robot.velocity_limit)
-        pieces = split_at_gaps(run)  # a recording's gaps are never interpolated across
-        runs += pieces
-        payloads += [payload] * len(pieces)
-        sources += [k] * len(pieces)
-    silent = silent_channels(runs)
-    cutoff, source = choose_cutoff(runs, problem.preprocessing)
-    dropped = [(r.name, r.dropped) for r in runs if r.dropped]
-    samples = [preprocess(runs.pop(0), problem.preprocessing, cutoff) for _ in range(len(runs))]
-    rate = max(s.filter.rate / s.filter.step for s in samples)
-    coulomb = [Term("coulomb", j) for j in range(robot.n_joints)]  # the load column's sign
-    guarded = cfg.position_guard and any(t.kind.position for t in terms)  # the range costs a pass over q
-    q_range = fit_position_range(samples, problem.data.validation_blocks) if guarded else None
-    fit, val, fitted = build_datasets(
-        robot,
-        base,
-        samples,
-        terms + coulomb,
-        cfg.coulomb_velocity,
-        problem.data.validation_blocks,
-        payloads,
-        q_range=q_range,
-        sources=sources,
-    )
-    silent, silence = dead_channels(robot, base, silent, (fit, val))
-    rigid_only = NormalEquations(fit, [])
-    rank = excited_rank(rigid_only.system(None, [])[0])
-    if rank < base.count:
-        raise ExciteError(
-            "data",
-            f"the fit runs excite {rank} of the {base.count} base parameters; the robot must move "
-            "through an exciting trajectory (see `excite optimize`), motionless or small motions cannot identify it",
-        )
-    first = least_squares(rigid_only, [], joint_weights(rigid_only, cfg.method == "wls"))
-    load = [t for t in terms if t.kind.two_stage]
-    return Prepared(
-        fit.with_load_columns(first.x, load),
-        val.with_load_columns(first.x, load),
-        fitted,
-        cutoff,
-        source,
-        dropped,
-        rate,
-        q_range,
-        silent,
-        silence,
-    )
-
-
 def run_identification(
     problem: IdentifyProblem, consistent_beside: bool = False
 ) -> tuple[Report, Robot, BaseParameters, PriorRows]:
@@ -200,7 +106,7 @@ def run_identification(
         cfg,
         declared,
         margin=1.0 / data.cutoff,
-        recordings=fold_groups(problem.data.runs, problem.folder, cfg.folds_by, data.fitted),
+        recordings=fold_groups(data.trajectories, problem.data.runs, cfg.folds_by, data.fitted),
         fitted_offsets=set(np.unique(val_data.run).tolist()) <= set(data.fitted),
         couplings=couplings,
         scored=~data.silent,
@@ -208,7 +114,7 @@ def run_identification(
     labels = [r.label for r in problem.data.runs]
     offset_runs = [labels[k] for k in data.fitted]
     selection, choice = choose_fit(selection, robot, base, offset_runs, cfg, consistent_beside)
-    selection = replace(selection, fit=reported_fit(selection, fit_data, data.rate, problem))
+    selection = replace(selection, fit=reported_fit(selection, fit_data, data.rate, data.trajectories))
     measured = val_data.tau.reshape(-1, val_data.n)
     before = predict(val_data, selection.rigid.x, [])
     plain = predict(val_data, selection.fit.x, selection.terms)
@@ -250,7 +156,8 @@ def run_identification(
         warnings=robot.warnings
         + in_sample_validation(problem.data.runs, problem.folder)
         + implausible(fit_data, base.from_standard(robot.urdf_parameters()), robot, choice.consistent)
-        + data.silence,
+        + data.silence
+        + data.repeats,
     )
     if choice.is_consistent:  # the reported model's step: the same effects, the consistent fit
         ladder.append((choice.name, float(choice.cv_error[choice.chosen]), report.mean(report.relative_after)))
@@ -258,15 +165,15 @@ def run_identification(
     return report, robot, base, prior_rows([fit_data, val_data], selection.terms, robot.joint_names)
 
 
-def reported_fit(selection: Selection, fit_data: Dataset, rate: float, problem: IdentifyProblem) -> Fit:
+def reported_fit(selection: Selection, fit_data: Dataset, rate: float, clusters: np.ndarray) -> Fit:
     """The chosen model's least-squares fit as reported: its standard deviations from the noise the
     residuals show (the sandwich of :mod:`~excite_cli.identification.fitting.noise`, ``rate`` [Hz]),
-    and beside them the spread between the distinct trajectories of the fit data when there are 3 or
-    more (:mod:`~excite_cli.identification.fitting.model_error`); a coefficient held at its bound has
+    and beside them the spread between the distinct trajectories of the fit data (``clusters``: (R,)
+    the trajectory of each configured run) when there are 3 or more
+    (:mod:`~excite_cli.identification.fitting.model_error`); a coefficient held at its bound has
     neither."""
     sandwich = middle(fit_data, selection.fit.x, selection.terms, selection.weights, rate)
     fit = least_squares(selection.normal, selection.terms, selection.weights, middle=sandwich)
-    clusters = trajectory_of_runs(problem.data.runs, problem.folder)
     variance = between_trajectories(fit_data, fit.x, selection.terms, selection.weights, clusters)
     if variance is None:
         return fit

@@ -1,5 +1,6 @@
 """`identify` on several trajectories: the spread between them is reported beside the noise-only std,
-with the recordings of one trajectory (recorded twice, ``data.runs[].trajectory``) counted once. The
+with the recordings of one trajectory (recorded twice: named by ``data.runs[].trajectory``, or found by
+their motion) counted once. The
 spread's calibration against its truth: fitting/test_model_error.py."""
 
 import h5py
@@ -46,8 +47,15 @@ def test_twin_recordings_of_three_trajectories_give_the_spread_between_three(opt
         effects = g["effects"][()]
     assert between.shape == noise.shape and np.all(np.isfinite(between)) and np.all(between > 0)
     assert np.isfinite(effects["std_between_trajectories"]).sum() >= 7  # friction; a run's offset has none
-    for r in runs:  # each recording its own trajectory: 6 of them
+    for r in runs:  # unnamed: the twins are found by their motion (measured.twins), 3 trajectories again
         del r["trajectory"]
+    (tmp_path / "found.yaml").write_text(yaml.safe_dump(config))
+    out = runner.invoke(app, ["identify", str(tmp_path / "found.yaml"), "-o", str(tmp_path / "found.h5")])
+    text = " ".join(out.output.split())
+    assert out.exit_code == 0 and "between the 3 distinct trajectories" in text
+    assert text.count("repeats the motion of") == 3
+    for k, r in enumerate(runs):  # each recording named apart: its own trajectory, 6 of them
+        r["trajectory"] = f"t{k}"
     (tmp_path / "apart.yaml").write_text(yaml.safe_dump(config))
     out = runner.invoke(app, ["identify", str(tmp_path / "apart.yaml"), "-o", str(tmp_path / "apart.h5")])
     assert out.exit_code == 0 and "between the 6 distinct trajectories" in " ".join(out.output.split())

@@ -17,7 +17,8 @@ from excite_cli.identification.effects import Term
 from excite_cli.identification.fitting.least_squares import joint_weights, least_squares, predict, torque_errors
 from excite_cli.identification.fitting.normal import NormalEquations
 from excite_cli.identification.measured.measurements import Run, check_against_limits
-from excite_cli.identification.pipeline import prepare_data, run_identification
+from excite_cli.identification.pipeline import run_identification
+from excite_cli.identification.prepared import prepare_data
 from excite_cli.identification.simulation_config import SimulationConfig
 from excite_cli.workflows.simulate import simulate_runs
 

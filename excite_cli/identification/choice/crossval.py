@@ -28,7 +28,6 @@ of its own size, whatever the number of samples.
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Callable
 
 import numpy as np
@@ -204,19 +203,18 @@ class CrossValidation:
         return float(per_joint[self.scored].mean()), per_joint, per_fold[:, self.scored].mean(axis=1)
 
 
-def fold_groups(runs: list[RunConfig], folder: Path | None, how: str, fitted: list[int]) -> np.ndarray | None:
+def fold_groups(trajectories: np.ndarray, runs: list[RunConfig], how: str, fitted: list[int]) -> np.ndarray | None:
     """The cross-validation's groups (:class:`CrossValidation`) of ``identification.folds_by``
-    (``how``): the recording (file) of each configured run (``data.runs``, files relative to
-    ``folder``; the recordings of one ``trajectory`` together: held out apart, the model error they
-    share would be seen in training), each run its own group, or None for time blocks. ``auto``:
-    recordings when the fit runs (indices ``fitted``) come from two or more, else time blocks.
+    (``how``): the trajectory of each configured run (``trajectories`` (R,): a recording, its crops and
+    the recordings of the same motion together, :mod:`~excite_cli.identification.measured.twins`;
+    held out apart, the model error they share would be seen in training), each run its own group,
+    or None for time blocks. ``auto``: trajectories when the fit runs (indices ``fitted``) hold two
+    or more, else time blocks.
 
     Raises:
-        ExciteError: ``recording`` or ``run`` folds with fewer than two fit recordings or runs.
+        ExciteError: ``recording`` or ``run`` folds with fewer than two fit trajectories or runs.
     """
-    recordings = [r.trajectory or r.recording(folder) for r in runs]
-    files = np.unique(recordings, return_inverse=True)[1]
-    groups = {"auto": files, "recording": files, "run": np.arange(files.size), "time_block": None}[how]
+    groups = {"auto": trajectories, "recording": trajectories, "run": np.arange(len(runs)), "time_block": None}[how]
     count = 0 if groups is None else np.unique(groups[fitted]).size
     if how == "auto":
         return groups if count >= 2 else None

@@ -23,11 +23,8 @@ cluster, never two."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
-from excite_cli.identification.data_config import RunConfig
 from excite_cli.identification.effects import Term
 from excite_cli.identification.fitting.dataset import Dataset
 from excite_cli.identification.fitting.least_squares import predict
@@ -38,13 +35,6 @@ from excite_cli.identification.fitting.normal import covariance_diagonal
 FEWEST = 3
 #: Instants of a trajectory taken at a time (memory: a (CHUNK, m) block per joint).
 CHUNK = 1 << 16
-
-
-def trajectory_of_runs(runs: list[RunConfig], folder: Path | None) -> np.ndarray:
-    """(R,) the trajectory of each configured run (``data.runs``): its ``trajectory`` name, else its
-    recording (files relative to ``folder``), as consecutive integers."""
-    keys = [r.trajectory or r.recording(folder) for r in runs]
-    return np.unique(keys, return_inverse=True)[1]
 
 
 def trajectory_pieces(

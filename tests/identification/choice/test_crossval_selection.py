@@ -214,17 +214,16 @@ def test_coulomb_data_every_search_ends_at_coulomb_and_the_report_shows_the_firs
 
 
 def test_recording_folds_hold_out_the_recordings_of_one_trajectory_together(tmp_path):
-    """Two recordings of one trajectory named alike are one fold (apart, the model error they share is
-    seen in training); unnamed, each file is its own; run folds stay one per run."""
+    """The runs of one trajectory (twins: measured.twins) are one fold; run folds stay one per run."""
     from excite_cli.identification.choice.crossval import fold_groups
     from excite_cli.identification.data_config import RunConfig
 
-    runs = [RunConfig(file=f"r{k}.csv", trajectory=name) for k, name in enumerate(["a", "a", "b", "c"])]
-    np.testing.assert_array_equal(fold_groups(runs, tmp_path, "recording", [0, 1, 2, 3]), [0, 0, 1, 2])
-    np.testing.assert_array_equal(fold_groups(runs, tmp_path, "run", [0, 1, 2, 3]), [0, 1, 2, 3])
-    assert fold_groups(runs[:2], tmp_path, "auto", [0, 1]) is None  # one trajectory: time blocks
-    plain = [RunConfig(file=f"r{k}.csv") for k in range(3)]
-    np.testing.assert_array_equal(fold_groups(plain, tmp_path, "recording", [0, 1, 2]), [0, 1, 2])
+    runs = [RunConfig(file=f"r{k}.csv") for k in range(4)]
+    trajectories = np.array([0, 0, 1, 2])
+    np.testing.assert_array_equal(fold_groups(trajectories, runs, "recording", [0, 1, 2, 3]), [0, 0, 1, 2])
+    np.testing.assert_array_equal(fold_groups(trajectories, runs, "run", [0, 1, 2, 3]), [0, 1, 2, 3])
+    assert fold_groups(trajectories[:2], runs[:2], "auto", [0, 1]) is None  # one trajectory: time blocks
+    assert fold_groups(trajectories, runs, "time_block", [0, 1, 2, 3]) is None
 
 
 def test_distinct_recordings_admit_a_small_effect_every_fold_shares_and_time_blocks_price_it_out():
