@@ -14,8 +14,9 @@ models on the same folds),
     mean(d) > t_{0.95, K−1} · sd(d) / √K   and   mean(d) > 0.001,
 
 whatever kind of effect it adds (no price per kind; the floor of 0.1 % only keeps out moves that
-change nothing, such as a coefficient held at its bound). A removal is taken when it lowers the mean log
-fold error at all. Every move lowers mean_k log e_k, so the search cannot cycle. A gain every fold
+change nothing, such as a coefficient held at its bound). A term whose keeping no longer passes the
+test is removed. Of two models, the one with more terms is kept only when it passes the test against
+the other (:func:`simplest`): the ends of the searches, and the models and fits compared together. A gain every fold
 shares is admitted however small (a spring worth 5 %, a low-speed friction term worth 1.5 %); a gain
 one fold makes and another loses is not, however large its mean.
 
@@ -102,19 +103,32 @@ def as_percent(log_gain: float) -> float:
     return float(100.0 * -np.expm1(-log_gain))
 
 
-def paired_choice(J: np.ndarray, folds: np.ndarray, preferred: list[bool]) -> tuple[int, int]:
+def simplest(J: np.ndarray, folds: np.ndarray, sizes: np.ndarray, columns: list[int]) -> tuple[int, int]:
+    """The (model, fit) of the fits ``columns`` kept by the paired test: each model's lowest-J pair among
+    them, the models in order of their pair's size (ties by index), a larger one replacing the kept one
+    only when it passes the test against it (module docstring).
+
+    Args:
+        J: (m, f) each pair's objective; folds: (m, f, K) each pair's fold errors [%]; sizes: (m, f)
+            the terms each pair adds (a consistent fit does not count the armature it holds anyway).
+    """
+    best = [(k, min(columns, key=lambda f: np.nan_to_num(J[k, f], nan=np.inf))) for k in range(J.shape[0])]
+    order = sorted(range(len(best)), key=lambda k: (sizes[best[k]], k))
+    kept = best[order[0]]
+    for k in order[1:]:
+        if passes(folds[kept], folds[best[k]]):
+            kept = best[k]
+    return kept
+
+
+def paired_choice(J: np.ndarray, folds: np.ndarray, preferred: list[bool], sizes: np.ndarray) -> tuple[int, int]:
     """(model, fit) of the pairs scored J (m, f) on the folds (``folds``: (m, f, K) fold errors [%]):
-    the pair of a ``preferred`` (f,) fit (the consistent ones) with the lowest J, unless the best pair
-    of the others (least squares) beats it by the paired test; the lowest J when one kind is missing."""
-
-    def best(columns: list[int]) -> tuple[int, int]:
-        masked = np.full(J.shape, np.inf)
-        masked[:, columns] = np.nan_to_num(J[:, columns], nan=np.inf)
-        return np.unravel_index(int(np.argmin(masked)), J.shape)
-
+    of the ``preferred`` (f,) fits (the consistent ones) the pair :func:`simplest` keeps, unless the
+    pair it keeps of the others (least squares) beats it by the paired test; with one kind only, that
+    kind's. ``sizes`` (m, f): the terms each pair adds (:func:`simplest`)."""
     first = [f for f, p in enumerate(preferred) if p]
     others = [f for f, p in enumerate(preferred) if not p]
     if not first or not others:
-        return best(first or others)
-    kept, challenger = best(first), best(others)
+        return simplest(J, folds, sizes, first or others)
+    kept, challenger = simplest(J, folds, sizes, first), simplest(J, folds, sizes, others)
     return challenger if passes(folds[kept], folds[challenger]) else kept

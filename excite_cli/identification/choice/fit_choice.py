@@ -14,9 +14,9 @@ least squares (its CV error is the search's) and the consistent fit at every λ 
 ``identification.regularization``, refitted on each fold's training normal equations.
 
 **Folds of distinct recordings** (the paired test): each pair's J(M, fit) is its mean log fold error;
-the consistent pair with the lowest J is reported unless the best least-squares pair beats it by the
-paired test over the folds (the folds agree least squares predicts their recordings better by more
-than they disagree), and then least squares is reported with the consistent fit beside it.
+of the consistent pairs (each model's lowest J) a model with more effects is kept only when it beats
+the kept one by the paired test, and that pair is reported unless least squares, chosen among models
+the same way, beats it by the test too (then least squares, with the consistent fit beside it).
 
 **Time blocks** (the price): the search's own objective
 
@@ -32,9 +32,8 @@ which does not charge least squares for base-parameter directions such motion ba
 new motion does (the real Panda's first 20 %: 6.89 % CV against 9.23 %, 9.89 % against 7.61 % on
 the rest; docs/figures.md, "Which fit transfers"). The pair with the lowest J wins (``fit: auto``).
 ``fit: least_squares`` or ``consistent`` restricts the fits (least squares alone keeps the search's
-model); a single pair is not cross-validated. The reported model, its validation error and the
-identified URDF are the winner's; the best consistent fit of the winning model stays beside least
-squares in the report.
+model); a single pair is not cross-validated. The reported model, its validation error and the identified
+URDF are the winner's; the best consistent fit of the winning model stays beside least squares.
 """
 
 from __future__ import annotations
@@ -212,7 +211,8 @@ def _objective(
     the fold errors ``folds`` (m, f, K), else priced from the CV errors ``cv`` (m, f)."""
     if paired:
         J = np.log(np.maximum(folds, 1e-12)).mean(axis=2)
-        return J, paired_choice(J, folds, [lam is not None for lam in lams])
+        sizes = np.array([[m.counted(lam is not None) for lam in lams] for m in models])
+        return J, paired_choice(J, folds, [lam is not None for lam in lams], sizes)
     J = priced_objective(cv, [[m.counted(lam is not None) for lam in lams] for m in models], selection.min_improvement)
     if any(lam is not None for lam in lams):  # least squares pays its margin (module docstring)
         J = J + np.log1p(np.array([0.0 if lam is not None else margin for lam in lams]))

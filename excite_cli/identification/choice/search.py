@@ -5,16 +5,18 @@ A move adds a candidate whose prerequisites are in the model, removes an added t
 on, or moves a Stribeck or held term along its velocity grid or a coupled term along its ratio grid.
 
 - **Paired test** (folds that are three or more distinct recordings): an addition or a shape change
-  must pass the paired test over the folds (and gain at least its 0.1 % floor), a removal must lower
-  the mean log fold error; of the
-  moves allowed, the one with the lowest mean log fold error J(M) = mean_k log e_k(M) is taken.
+  must pass the paired test over the folds (and gain at least its 0.1 % floor); an added term whose
+  keeping no longer passes it is removed (a start's friction terms the data do not need, a term a
+  later one took over); of the moves allowed to a model not visited before, the one with the lowest
+  mean log fold error J(M) = mean_k log e_k(M) is taken.
 - **Price** (time blocks of one recording): J(M) = log CV(M) + p(M) · log(1 + min_improvement),
   p(M) the effects the search added, a coupled one counting as log(1 + coupling_improvement) /
   log(1 + min_improvement) effects and a position-dependent one as log(1 + position_improvement) /
   log(1 + min_improvement); a shape change pays an effect's price (or it would chase noise for
   free); the move that lowers J most is taken.
 
-Either way every move lowers J, and the search stops when no move is allowed.
+Under the price every move lowers J; under the paired test no model is visited twice. Either way
+the search cannot cycle, and it stops when no move is allowed.
 """
 
 from __future__ import annotations
@@ -72,7 +74,7 @@ class Step:
 @dataclass
 class Search:
     """The search from one start: its name, start model and its CV error [%], end model and its CV
-    error [%] and objective J, the steps and why it stopped."""
+    error [%] and objective J, the steps and why it stopped; the end model's (K,) fold errors [%]."""
 
     start: str
     initial: list[Term]
@@ -82,6 +84,7 @@ class Search:
     objective: float
     steps: list[Step] = field(default_factory=list)
     stop: str = ""
+    folds: np.ndarray | None = None
 
 
 def effect_count(terms: list[Term], declared: int, weights: tuple[float, float]) -> float:
@@ -153,7 +156,7 @@ class StepwiseSearch:
         mean log fold error; under the price, one whose cost is below J (module docstring)."""
         if self.rule is Admission.PRICED:
             return True  # the price is in the cost; the best move is then compared with J
-        return paired_gain(before[1], after[1])[0] > 0.0 if move == "remove" else passes(before[1], after[1])
+        return not passes(after[1], before[1]) if move == "remove" else passes(before[1], after[1])
 
     def moves(self, terms: list[Term]) -> list[tuple[str, Term, list[Term]]]:
         """(move, term, model after) of every allowed move from ``terms``."""
@@ -184,7 +187,7 @@ class StepwiseSearch:
         if self.rule is Admission.PAIRED:
             return (
                 "no addition or shape change improves the folds by more than their own spread (paired test "
-                "over distinct recordings, 95 %) and no removal improves them"
+                "over distinct recordings, 95 %) and every added term passes it"
             )
         return (
             f"no addition, removal or shape change lowers the cross-validated error by "
@@ -193,16 +196,17 @@ class StepwiseSearch:
 
     def run(self, name: str, start: list[Term]) -> Search:
         terms = list(start)
-        score = self.score(terms)
+        score, visited = self.score(terms), {frozenset(start)}
         search = Search(name, list(terms), score[0], terms, score[0], self.objective(terms, score))
         while True:
             tried = [(move, term, after, self.score(after)) for move, term, after in self.moves(terms)]
             if not tried:
                 search.stop = "no move left (every candidate is in the model)"
                 break
-            allowed = [m for m in tried if self.allowed(m[0], score, m[3])]
+            allowed = [m for m in tried if self.allowed(m[0], score, m[3]) and frozenset(m[2]) not in visited]
             best = min(allowed, key=lambda m: self.cost(m[0], m[2], m[3]), default=None)
-            if best is None or self.cost(best[0], best[2], best[3]) >= search.objective - 1e-12:
+            priced_out = self.rule is Admission.PRICED and best is not None
+            if best is None or (priced_out and self.cost(best[0], best[2], best[3]) >= search.objective - 1e-12):
                 search.stop = self._stop(terms)
                 break
             move, term, after, value = best
@@ -210,6 +214,7 @@ class StepwiseSearch:
             step = Step(move, term, after, value[0], score[0], [(m, t, v[0]) for m, t, _, v in tried])
             search.steps.append(replace(step, fold_gain=as_percent(gain), fold_margin=as_percent(margin)))
             terms, score = after, value
+            visited.add(frozenset(terms))
             search.objective = self.objective(terms, score)
-        search.terms, search.cv_error = terms, score[0]
+        search.terms, search.cv_error, search.folds = terms, score[0], score[1]
         return search

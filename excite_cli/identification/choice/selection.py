@@ -16,7 +16,8 @@ a model no single move improves and cannot cycle. Greedy forward selection alone
 its path: a joint whose Coulomb friction is missing bends the shared base parameters, and adding it
 later can make another joint's error worse first. So the search runs from three starts (the declared
 effects alone, plus Coulomb friction on every joint, plus Coulomb and viscous friction on every
-joint) and keeps the end with the lowest J (of searches ending at the same model, the first).
+joint) and keeps the end with the lowest J (under the paired test: the fewest terms, unless a larger
+end passes the test against it; of searches ending at the same model, the first).
 Candidates whose columns lie in the span of the rigid-body model (e.g. the armature of a joint whose
 rotor inertia regroups with a link's) are not separately identifiable and are skipped. Every fit,
 in the folds and the final one, uses the same per-joint weights (WLS: 1/σ_j of the rigid-body fit,
@@ -32,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from excite_cli.effects import EFFECTS
-from excite_cli.identification.choice.admission import Admission, admission_of
+from excite_cli.identification.choice.admission import Admission, admission_of, simplest
 from excite_cli.identification.choice.crossval import CrossValidation
 from excite_cli.identification.choice.search import Search, Step, StepwiseSearch, effect_weights
 from excite_cli.identification.config import IdentificationConfig
@@ -156,6 +157,19 @@ def kept_search(searches: list[Search]) -> int:
     return min(first.values(), key=lambda k: (searches[k].objective, k))
 
 
+def kept_by_test(searches: list[Search]) -> int:
+    """Under the paired test: the index of the search whose end the paired test keeps, the ends in
+    order of their number of terms, a larger one kept only when it passes the test against the kept
+    one (:func:`~excite_cli.identification.choice.admission.simplest`); of ends at one model, the first."""
+    first: dict[frozenset[Term], int] = {}
+    for k, search in enumerate(searches):
+        first.setdefault(frozenset(search.terms), k)
+    index = list(first.values())
+    J = np.array([[searches[k].objective] for k in index])
+    folds = np.array([[searches[k].folds] for k in index])
+    return index[simplest(J, folds, np.array([[len(searches[k].terms)] for k in index]), [0])[0]]
+
+
 def select_effects(
     fit_data: Dataset,
     cfg: IdentificationConfig,
@@ -199,7 +213,7 @@ def select_effects(
             continue
         seen.append(start)
         searches.append(search.run(name, start))
-    chosen = kept_search(searches)
+    chosen = kept_search(searches) if search.rule is Admission.PRICED else kept_by_test(searches)
     terms = searches[chosen].terms
     return Selection(
         terms=terms,

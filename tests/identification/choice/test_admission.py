@@ -12,6 +12,7 @@ from excite_cli.identification.choice.admission import (
     paired_choice,
     paired_gain,
     passes,
+    simplest,
 )
 
 
@@ -43,8 +44,23 @@ def test_least_squares_is_chosen_only_where_every_fold_agrees_it_is_better():
     consistent = np.array([4.0, 5.0, 6.0, 5.0])
     folds = np.stack([np.stack([consistent * 0.9, consistent])])  # (1 model, 2 fits: LS, consistent, 4 folds)
     J = np.log(folds).mean(axis=2)
-    assert paired_choice(J, folds, [False, True]) == (0, 0)  # 10 % better on every fold: least squares
+    assert paired_choice(J, folds, [False, True], np.zeros((1, 2))) == (
+        0,
+        0,
+    )  # 10 % better on every fold: least squares
     mixed = folds.copy()
     mixed[0, 0] = consistent * np.array([0.5, 1.3, 0.8, 1.3])  # better on average, worse on two folds
     J = np.log(mixed).mean(axis=2)
-    assert J[0, 0] < J[0, 1] and paired_choice(J, mixed, [False, True]) == (0, 1)
+    assert J[0, 0] < J[0, 1] and paired_choice(J, mixed, [False, True], np.zeros((1, 2))) == (0, 1)
+
+
+def test_a_larger_model_is_kept_only_when_it_passes_the_test_against_the_smaller():
+    small = np.array([4.0, 5.0, 6.0, 5.0])
+    noisy = small * np.array([0.9, 1.08, 0.95, 1.0])  # lower on average, folds disagree
+    consistent = small * 0.97  # 3 % lower on every fold
+    for larger, kept in ((noisy, 0), (consistent, 1)):
+        folds = np.stack([small, larger])[:, None, :]  # (2 models, 1 fit, 4 folds)
+        J = np.log(folds).mean(axis=2)
+        assert simplest(J, folds, np.array([[0], [3]]), [0]) == (kept, 0)
+    folds = np.stack([consistent, small])[:, None, :]  # the larger model listed first: sizes order them
+    assert simplest(np.log(folds).mean(axis=2), folds, np.array([[3], [0]]), [0]) == (0, 0)
