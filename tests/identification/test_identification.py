@@ -16,7 +16,6 @@ from excite_cli.cli import app
 from excite_cli.config_file import load_problem
 from excite_cli.effects import EFFECTS
 from excite_cli.h5 import read_strings, write_strings
-from excite_cli.identification.choice.admission import Admission
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.effects import effect_columns
 from excite_cli.identification.fitting.dataset import run_offset_columns
@@ -328,14 +327,14 @@ def test_identify_command_writes_report_and_prior(tmp_path, optimized):
         assert ladder["validation_error"][-1] == pytest.approx(g["relative_after"][()].mean(), rel=1e-9)
         assert ladder["cv_error"][-1] == pytest.approx(g.attrs["cv_error"], rel=1e-12)
         assert len(steps) >= 1 and set(tried["step"]) == set(steps["step"]) and len(tried) > 10 * len(steps)
-        # three recordings of distinct trajectories: each addition or shape move passed the paired test
-        # over the folds (its mean gain above the margin and the 0.1 % floor); no price per effect
+        # an addition or a shape move buys its price (min_improvement, 2 %; a coupled effect's
+        # coupling_improvement, 20 %); a removal saves its price and may cost up to it
         grows = np.array([m.decode() != "remove" for m in steps["move"]])
-        written = g["steps"].attrs
-        assert g.attrs["admission"] == str(Admission.PAIRED) and written["admission"] == str(Admission.PAIRED)
-        gain, margin = written["fold_gain_percent"], written["fold_margin_percent"]
-        assert np.all(gain[grows] > np.maximum(margin[grows], 0.1) - 1e-9)
-        assert "paired test" in g.attrs["stop_reason"]
+        coupled = np.array([" + " in j.decode() or " − " in j.decode() for j in steps["joint"]])
+        price = np.where(coupled, 0.2, 0.02)
+        assert np.all(steps["gain"][grows] > 100 * (1 - 1 / (1 + price[grows])) - 1e-9)
+        assert np.all(steps["gain"][~grows] > -100 * price[~grows] - 1e-9)
+        assert "min_improvement" in g.attrs["stop_reason"]
         v = g["validation"]
         assert v["measured"].shape == v["predicted_after"].shape == (g.attrs["validation_samples"], 7)
     assert (tmp_path / "ident_residuals.png").stat().st_size > 20000

@@ -4,7 +4,7 @@ under the admission rule of its folds (:mod:`~excite_cli.identification.choice.a
 A move adds a candidate whose prerequisites are in the model, removes an added term nothing depends
 on, or moves a Stribeck or held term along its velocity grid or a coupled term along its ratio grid.
 
-- **Paired test** (folds that are three or more distinct recordings): an addition or a shape change
+- **Paired test** (folds that are four or more distinct trajectories): an addition or a shape change
   must pass the paired test over the folds (and gain at least its 0.1 % floor); an added term whose
   keeping no longer passes it is removed (a start's friction terms the data do not need, a term a
   later one took over); of the moves allowed to a model not visited before, the one with the lowest
@@ -195,6 +195,7 @@ class StepwiseSearch:
         )
 
     def run(self, name: str, start: list[Term]) -> Search:
+        """The search named ``name`` from the model ``start`` until no move is allowed (module docstring)."""
         terms = list(start)
         score, visited = self.score(terms), {frozenset(start)}
         search = Search(name, list(terms), score[0], terms, score[0], self.objective(terms, score))

@@ -4,7 +4,7 @@ The validation data (``validation`` runs, odd time blocks) take no part: they st
 the reported error.
 
 The search minimizes an objective J(M) under the admission rule its folds allow
-(:mod:`~excite_cli.identification.choice.admission`): with folds of three or more distinct
+(:mod:`~excite_cli.identification.choice.admission`): with folds of four or more distinct
 recordings, every effect must pass a paired test over the folds (the folds agree it helps by more
 than they disagree); with time blocks of one recording, which cannot judge a new effect, every
 effect must lower the cross-validated error by the fraction ``min_improvement`` (default 2 %;
