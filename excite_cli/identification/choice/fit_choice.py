@@ -176,14 +176,14 @@ def _scores(
     selection: Selection, model: Model, lams: list[float | None], programs: dict, known: dict
 ) -> tuple[np.ndarray, np.ndarray]:
     """(f,) CV error [%] and (f, K) fold errors [%] of ``model`` under each fit of ``lams`` (the
-    search's own CV error for least squares); a consistent fit's once per set of terms without rotors
+    search's own for least squares); a consistent fit's once per set of terms without rotors
     (``programs``, ``known``: its scores)."""
     search, cv, key = selection.searches[model.search], selection.cross_validation, _without_rotors(model.terms)
     out, folds = [], []
     for lam in lams:
         if lam is None:
             out.append(search.initial_error if model.at_start else search.cv_error)
-            folds.append(cv.score(model.terms)[2])
+            folds.append(search.initial_folds if model.at_start else search.folds)
             continue
         if (key, lam) not in known:
             consistent = programs[key]

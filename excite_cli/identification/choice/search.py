@@ -74,7 +74,8 @@ class Step:
 @dataclass
 class Search:
     """The search from one start: its name, start model and its CV error [%], end model and its CV
-    error [%] and objective J, the steps and why it stopped; the end model's (K,) fold errors [%]."""
+    error [%] and objective J, the steps and why it stopped; the start's and the end's (K,) fold
+    errors [%]."""
 
     start: str
     initial: list[Term]
@@ -84,6 +85,7 @@ class Search:
     objective: float
     steps: list[Step] = field(default_factory=list)
     stop: str = ""
+    initial_folds: np.ndarray | None = None
     folds: np.ndarray | None = None
 
 
@@ -133,10 +135,6 @@ class StepwiseSearch:
             cv, _, folds = self.cv.score(terms)
             self.cache[key] = (cv, folds)
         return self.cache[key]
-
-    def error(self, terms: list[Term]) -> float:
-        """CV(M) [%] of the model [Y_B, ``terms``]."""
-        return self.score(terms)[0]
 
     def objective(self, terms: list[Term], score: tuple[float, np.ndarray]) -> float:
         """J of the model ``terms`` with its ``score`` (module docstring)."""
@@ -199,6 +197,7 @@ class StepwiseSearch:
         terms = list(start)
         score, visited = self.score(terms), {frozenset(start)}
         search = Search(name, list(terms), score[0], terms, score[0], self.objective(terms, score))
+        search.initial_folds = score[1]
         while True:
             tried = [(move, term, after, self.score(after)) for move, term, after in self.moves(terms)]
             if not tried:
