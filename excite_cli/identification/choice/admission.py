@@ -68,8 +68,8 @@ class Admission(StrEnum):
         """J of the models and fits scored together (:mod:`~excite_cli.identification.choice.fit_choice`)."""
         if self is Admission.PAIRED:
             return (
-                "J = mean over folds of log e_k; least squares only where it beats the best consistent fit "
-                "by a paired test over the folds"
+                "J = mean over folds of log e_k; a model with more effects only where it beats the smaller by "
+                "a paired test over the folds, least squares only where it beats the consistent fit so"
             )
         return (
             "J = log CV + effects × log(1 + min_improvement) (least squares: + log(1 + least_squares_margin); "

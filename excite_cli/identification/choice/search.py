@@ -21,7 +21,7 @@ the search cannot cycle, and it stops when no move is allowed.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -150,8 +150,9 @@ class StepwiseSearch:
 
     def allowed(self, move: str, before: tuple[float, np.ndarray], after: tuple[float, np.ndarray]) -> bool:
         """Whether a move from the model scored ``before`` to one scored ``after`` is allowed:
-        under the paired test, an addition or shape change that passes it or a removal that lowers the
-        mean log fold error; under the price, one whose cost is below J (module docstring)."""
+        under the paired test, an addition or shape change that passes it, or the removal of a term
+        whose keeping no longer passes it; under the price every move (the best one's cost is then
+        compared with J; module docstring)."""
         if self.rule is Admission.PRICED:
             return True  # the price is in the cost; the best move is then compared with J
         return not passes(after[1], before[1]) if move == "remove" else passes(before[1], after[1])
@@ -211,8 +212,10 @@ class StepwiseSearch:
                 break
             move, term, after, value = best
             gain, margin = paired_gain(score[1], value[1]) if self.rule is Admission.PAIRED else (np.nan, np.nan)
-            step = Step(move, term, after, value[0], score[0], [(m, t, v[0]) for m, t, _, v in tried])
-            search.steps.append(replace(step, fold_gain=as_percent(gain), fold_margin=as_percent(margin)))
+            tried_cv = [(m, t, v[0]) for m, t, _, v in tried]
+            search.steps.append(
+                Step(move, term, after, value[0], score[0], tried_cv, as_percent(gain), as_percent(margin))
+            )
             terms, score = after, value
             visited.add(frozenset(terms))
             search.objective = self.objective(terms, score)

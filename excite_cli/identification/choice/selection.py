@@ -6,13 +6,15 @@ the reported error.
 The search minimizes an objective J(M) under the admission rule its folds allow
 (:mod:`~excite_cli.identification.choice.admission`): with folds of four or more distinct
 recordings, every effect must pass a paired test over the folds (the folds agree it helps by more
-than they disagree); with time blocks of one recording, which cannot judge a new effect, every
+than they disagree); with time blocks of one recording or fewer recordings, which cannot judge a
+new effect, every
 effect must lower the cross-validated error by the fraction ``min_improvement`` (default 2 %;
 :mod:`~excite_cli.identification.choice.search`). A move adds a candidate term,
 removes an added term, or changes the shape velocity of a Stribeck or held term (the profile search
 over its grid; such a move is judged as an addition, or it would chase noise
-for free); the allowed move that lowers J most is taken, and the search stops when none does, so it ends in
-a model no single move improves and cannot cycle. Greedy forward selection alone depends on
+for free); the allowed move that lowers J most is taken, and the search stops when none is allowed,
+so it ends in a model no single move improves and cannot cycle (under the paired test no model is
+visited twice). Greedy forward selection alone depends on
 its path: a joint whose Coulomb friction is missing bends the shared base parameters, and adding it
 later can make another joint's error worse first. So the search runs from three starts (the declared
 effects alone, plus Coulomb friction on every joint, plus Coulomb and viscous friction on every
@@ -151,20 +153,22 @@ def kept_search(searches: list[Search]) -> int:
     Raises:
         ValueError: no searches.
     """
+    return min(_distinct_ends(searches), key=lambda k: (searches[k].objective, k))
+
+
+def _distinct_ends(searches: list[Search]) -> list[int]:
+    """The index of the first search ending at each model (the same terms in any order)."""
     first: dict[frozenset[Term], int] = {}
     for k, search in enumerate(searches):
         first.setdefault(frozenset(search.terms), k)
-    return min(first.values(), key=lambda k: (searches[k].objective, k))
+    return list(first.values())
 
 
 def kept_by_test(searches: list[Search]) -> int:
     """Under the paired test: the index of the search whose end the paired test keeps, the ends in
     order of their number of terms, a larger one kept only when it passes the test against the kept
     one (:func:`~excite_cli.identification.choice.admission.simplest`); of ends at one model, the first."""
-    first: dict[frozenset[Term], int] = {}
-    for k, search in enumerate(searches):
-        first.setdefault(frozenset(search.terms), k)
-    index = list(first.values())
+    index = _distinct_ends(searches)
     J = np.array([[searches[k].objective] for k in index])
     folds = np.array([[searches[k].folds] for k in index])
     return index[simplest(J, folds, np.array([[len(searches[k].terms)] for k in index]), [0])[0]]
