@@ -119,24 +119,24 @@ class VirtualDynamics:
         shift = (1.0 + 2.0 * np.abs(blocks[..., 0]).max()) * self._unit_shift.reshape(-1, 10)
         grads = np.zeros((3, T, nv))
         derivatives = np.empty((T, 3, nv, nv))
+        inertias, inertia, rnea = model.inertias, pin.Inertia.FromDynamicParameters, pin.computeRNEADerivatives
+        resting = [inertia(dynamic) for dynamic in shift]  # each body with φ_s alone
         for rows, bodies, weights in self.slots:
-            self._set_inertias(range(len(shift)), shift)  # the bodies outside the slot's subtrees: φ_s alone
-            params, owned = shift[bodies] + blocks[:, rows, bodies], bodies.tolist()  # (T, slot bodies, 10)
+            for joint, held in enumerate(resting, start=1):  # the bodies outside the slot's subtrees
+                inertias[joint] = held
+            params, joints = shift[bodies] + blocks[:, rows, bodies], (bodies + 1).tolist()  # (T, slot bodies, 10)
             for t in range(T):
-                self._set_inertias(owned, params[t])
-                derivatives[t] = pin.computeRNEADerivatives(model, data, q[t], v[t], a[t])
+                for joint, dynamic in zip(joints, params[t]):
+                    inertias[joint] = inertia(dynamic)
+                derivatives[t] = rnea(model, data, q[t], v[t], a[t])
             grads += np.einsum("v,tkvw->ktw", weights, derivatives)
         if not self.shift_free:  # the shift's own derivatives, once per instant and row
-            self._set_inertias(range(len(shift)), shift)
+            for joint, held in enumerate(resting, start=1):
+                inertias[joint] = held
             for t in range(T):
-                derivatives[t] = pin.computeRNEADerivatives(model, data, q[t], v[t], a[t])
+                derivatives[t] = rnea(model, data, q[t], v[t], a[t])
             grads -= np.einsum("v,tkvw->ktw", sum(weights for _, _, weights in self.slots), derivatives)
         return grads[0][:, self.v_idx], grads[1][:, self.v_idx], grads[2][:, self.v_idx]
-
-    def _set_inertias(self, bodies, params: np.ndarray) -> None:
-        """The row model's inertias of ``bodies`` (0-based) set from their dynamic parameters (len(bodies), 10)."""
-        for body, dynamic in zip(bodies, params):
-            self._row_model.inertias[body + 1] = pin.Inertia.FromDynamicParameters(dynamic)
 
     def _row_slots(self) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
         """Regressor rows grouped so that no two rows of a group share a body of their subtrees: per
