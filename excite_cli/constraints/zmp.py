@@ -31,6 +31,7 @@ from excite_cli.constraints.self_collision import LENGTH_SCALE
 from excite_cli.constraints.support import SupportPolygon, support_polygon
 from excite_cli.dynamics.robot import Robot
 from excite_cli.errors import ExciteError
+from excite_cli.memo import once
 from excite_cli.trajectory.fourier import FourierBasis
 
 #: The soles' contact points: collision points within this height of the lowest [m] (a sphere's
@@ -120,16 +121,26 @@ class ZeroMomentPoint(Constraint):
         edges = (p @ self.polygon.normals.T - self.polygon.offsets + self.margin) / LENGTH_SCALE
         return p, edges, -wrench[:, 2] / (FORCE_SCALE * self._weight)
 
+    def _on_grid(self, alpha: np.ndarray) -> tuple[tuple[np.ndarray, np.ndarray, np.ndarray], np.ndarray]:
+        """The full model's states on the grid (:meth:`Robot.states`) and the ground wrench (T, 6) of α,
+        kept for the next call at the same α (a solver asks for the values at a trial point, then the
+        Jacobian at the one it accepts)."""
+
+        def compute():
+            states = self.robot.states(*(B @ alpha.T for B in self._orders))
+            return states, self._wrenches(states)
+
+        return once(self, "grid", alpha, compute)
+
     def values(self, alpha: np.ndarray) -> np.ndarray:
         """The two values of :meth:`evaluate` from RNEA alone, without the derivatives."""
-        _, edges, force = self._normalized(self.wrenches(*(B @ alpha.T for B in self._orders)))
+        _, edges, force = self._normalized(self._on_grid(alpha)[1])
         return np.array([smooth_max_value(edges, (0, 1)), smooth_max_value(force, 0)])
 
     def evaluate(self, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The two aggregated values (ZMP, normal force) and their Jacobian (2, α.size)."""
         r, d = self.robot, self.data
-        states = self.robot.states(*(B @ alpha.T for B in self._orders))
-        wrench = self._wrenches(states)
+        states, wrench = self._on_grid(alpha)
         p, edges, force = self._normalized(wrench)
         g_edges, w_edges = smooth_max(edges, (0, 1))
         g_force, w_force = smooth_max(force, 0)
