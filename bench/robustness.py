@@ -16,11 +16,15 @@ writes them. Printed per robot:
   seed than on the best, in singular values of C: for log det (−log det(CᵀC)/b, of σ²) the ratio of
   the geometric means of σ (that of the excitation ē), exp(Δ/2), for log cond that of cond(C),
   exp(Δ), minus 1;
-- worst novelty: the largest correlation of an iteration's motion with an earlier one's;
+- rises: iterations whose stacked criterion (the one the iteration optimized, C₀ above its regressor)
+  ended above the iteration before's, of all iterations after the first (the sequence never losing
+  ground: 0);
+- worst novelty: the largest correlation of an iteration's motion with an earlier one's (1.00: an
+  earlier motion played again, search/earlier_optimum.py);
 - wall: mean wall time of one seed's run.
 
 One line per robot and criterion: `robust ROBOT (CRITERION): failed F of R restarts, converged C of K
-kept, spread S %, worst novelty N, wall W s`.
+kept, rises U of I, spread S %, worst novelty N, wall W s`.
 
     .venv/bin/python bench/robustness.py [--robots G1 "UR10 lab" ...] [--seeds 0 1 ...] [--criteria log_det log_trace_inverse:urdf ...]
 
@@ -52,6 +56,9 @@ from excite_cli.search.kkt import CONVERGED
 from excite_cli.search.sequence import run_sequence
 
 ROOT = Path(__file__).resolve().parent.parent
+#: A rise of the stacked criterion smaller than this (relative) is rounding: replaying an earlier
+#: motion keeps cond(C) to the last bits.
+RISE = 1e-9
 DEFAULT_OBJECTIVE = OptimizerConfig.model_fields["objective"].default
 SHIPPED = {
     "G1": ROOT / "configs" / "g1_arms.yaml",
@@ -81,7 +88,7 @@ def run_robot(robot: str, config: Path, seeds: list[int], criterion: str = DEFAU
     """The robot's line with ``criterion``, ``OBJECTIVE`` or ``OBJECTIVE:SCALING`` (the config's scaling
     unless given; module docstring), after one row per seed."""
     objective, _, scaling = criterion.partition(":")
-    restarts = failed = converged = kept = 0
+    restarts = failed = converged = kept = rises = steps = 0
     worst_kkt, worst_correlation, values, walls = 0.0, -1.0, [], []
     for seed in seeds:
         problem = load_problem(config)
@@ -103,8 +110,11 @@ def run_robot(robot: str, config: Path, seeds: list[int], criterion: str = DEFAU
             if r.correlations:
                 worst_correlation = max(worst_correlation, r.max_correlation)
         values.append(results[-1].best.objective)
+        path = [r.best.objective for r in results]  # the stacked criterion each iteration optimized
+        rises += sum(b > a + RISE * abs(a) for a, b in zip(path, path[1:]))
+        steps += len(path) - 1
         print(
-            f"  {robot} ({criterion}) seed {seed}: criterion {values[-1]:.4f}, kept KKT "
+            f"  {robot} ({criterion}) seed {seed}: criterion {' → '.join(f'{v:.4f}' for v in path)}, kept KKT "
             f"{' '.join(f'{r.best.optimality.residual:.1e}' for r in results)}, stops "
             f"{', '.join(r.stop for r in results)}, correlations "
             f"{' '.join(f'{r.max_correlation:.2f}' for r in results[1:])}, {walls[-1]:.0f} s",
@@ -114,7 +124,8 @@ def run_robot(robot: str, config: Path, seeds: list[int], criterion: str = DEFAU
     spread = 100.0 * (np.exp(power * (max(values) - min(values))) - 1.0)
     return (
         f"robust {robot} ({criterion}): failed {failed} of {restarts} restarts, converged {converged} of {kept} kept "
-        f"(largest KKT {worst_kkt:.1e}), spread {spread:.1f} %, worst novelty {worst_correlation:.2f}, "
+        f"(largest KKT {worst_kkt:.1e}), rises {rises} of {steps}, spread {spread:.1f} %, "
+        f"worst novelty {worst_correlation:.2f}, "
         f"wall {np.mean(walls):.0f} s"
     )
 

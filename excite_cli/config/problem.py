@@ -218,6 +218,8 @@ class SequenceConfig(Section):
     """Sequential trajectories, each stacking the earlier ones as prior data C₀ (Eq. 41)."""
     prior: Optional[str] = None
     """HDF5 file of prior data C₀: an excite result or a file with /regressor (rows × b), or none."""
+    replay: bool = True
+    """Where an earlier iteration's motion beats every restart, restart from it (it may repeat); false: never."""
 
 
 class Problem(ConfigFile):

@@ -82,14 +82,16 @@ class Bars:
             def hook(restart: int, it: int, value: float) -> None:
                 nonlocal last
                 steps[restart] = it
-                done, status = sum(steps.values()), f"run {restart + 1}/{runs} · {label} {shown(value):.4g}"
+                runs_now = max(runs, restart + 1)  # an earlier optimum's run comes last (search/earlier_optimum.py)
+                done, status = sum(steps.values()), f"run {restart + 1}/{runs_now} · {label} {shown(value):.4g}"
                 bar.update(tasks[k], completed=done, status=status)
                 now = self.clock()
                 if not self.console.is_terminal and now - last >= LOG_PERIOD:
                     last, elapsed = now, now - start
                     left = elapsed * max(opts.planned_iterations - done, 0) / max(done, 1)
                     self.console.print(
-                        f"iteration {k}: run {restart + 1}/{runs}, {done}/{opts.planned_iterations} solver iterations, "
+                        f"iteration {k}: run {restart + 1}/{runs_now}, "
+                        f"{done}/{opts.planned_iterations} solver iterations, "
                         f"{label} {shown(value):.4g}, {elapsed:.0f} s, about {left:.0f} s left",
                         highlight=False,
                     )

@@ -146,7 +146,8 @@ def _restarts(results: Sequence[IterationResult], optimizer: OptimizerConfig) ->
         "*: kept (the best of those that succeeded: a solver failure, or an end at the start or towards "
         "it, is never kept); KKT residual: first-order optimality at the end point (0 at a local optimum); "
         "end point: the feasible point nearest the solver's last iterate (projected), the best iterate "
-        "inside (inside), towards the start (bisection) or the start",
+        "inside (inside), towards the start (bisection), the start, or the earlier iteration's motion it "
+        "started from (earlier optimum: run when every restart ended worse than playing that motion again)",
     )
 
 

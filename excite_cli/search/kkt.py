@@ -77,9 +77,11 @@ class End(StrEnum):
     """Which point a restart kept (:class:`~excite_cli.search.optimizer.RestartResult`): its start, the
     feasible point nearest the solver's last iterate (``PROJECTED``), a point towards the start
     (``BISECTION``: never kept as the solver's own), its best iterate inside every constraint
-    (``INSIDE``), or none (no end point met a constraint that needs motion)."""
+    (``INSIDE``), an earlier iteration's optimum it started from and did not leave (``EARLIER``:
+    :mod:`~excite_cli.search.earlier_optimum`), or none (no end point met a constraint that needs motion)."""
 
     START = "start"
+    EARLIER = "earlier optimum"
     PROJECTED = "projected"
     BISECTION = "bisection"
     INSIDE = "inside"

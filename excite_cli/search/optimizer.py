@@ -58,8 +58,8 @@ class RestartResult:
         stop: why it ended (:func:`~excite_cli.search.kkt.stop_reason`).
         end: which point was kept: ``projected`` (the feasible point nearest the last iterate),
             ``inside`` (the best iterate inside every constraint), ``bisection`` (towards the start),
-            ``start``, or ``none`` (no end point met a constraint that needs motion; ``alpha`` is
-            the start and ``objective`` inf).
+            ``start``, ``earlier optimum`` (the start, an earlier iteration's optimum), or ``none``
+            (no end point met a constraint that needs motion; ``alpha`` is the start and ``objective`` inf).
         scale: the factor [1] the solver's criterion was multiplied by
             (:attr:`~excite_cli.search.solvers.SolverRun.scale`), which a continuation keeps.
         margins: per constraint, the margin [1] of the problem ``optimality`` belongs to, which a
@@ -83,9 +83,9 @@ class RestartResult:
     @property
     def succeeded(self) -> bool:
         """Whether the solver's run gave a result: it did not fail, and the end point is its own (the
-        feasible point nearest its last iterate, or its best iterate inside), not the start or a
-        bisection towards it."""
-        return self.stop not in (SOLVER_FAILED, INFEASIBLE) and self.end in (End.PROJECTED, End.INSIDE)
+        feasible point nearest its last iterate, or its best iterate inside) or an earlier iteration's
+        optimum it started from, not a random start or a bisection towards it."""
+        return self.stop not in (SOLVER_FAILED, INFEASIBLE) and self.end in (End.PROJECTED, End.INSIDE, End.EARLIER)
 
 
 def best_restart(results: Sequence[RestartResult]) -> RestartResult:

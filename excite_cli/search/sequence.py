@@ -1,6 +1,7 @@
 """Sequential generation (Section IV-B): iteration i optimizes with C₀ = [C_prior; C⁽¹⁾; …; C⁽ⁱ⁻¹⁾],
-continues the best restart the robot can play until it converges (:func:`polish_kept`),
-keeps it (:func:`kept_restart`), and describes it."""
+continues the best restart the robot can play until it converges (:func:`polish_kept`), starts once
+more from an earlier iteration's motion where that is better
+(:mod:`~excite_cli.search.earlier_optimum`), keeps the best (:func:`kept_restart`), and describes it."""
 
 from __future__ import annotations
 
@@ -14,6 +15,7 @@ from excite_cli.design.criterion import condition_number
 from excite_cli.design.excitation import Excitation
 from excite_cli.design.playback import check_motion, plan_playback
 from excite_cli.errors import ExciteError, NoSolution
+from excite_cli.search.earlier_optimum import from_earlier_optimum
 from excite_cli.search.engine import Engine
 from excite_cli.search.optimizer import ProgressHook, RestartResult, best_restart
 from excite_cli.search.restarts import RestartContext, polish, run_restarts
@@ -212,9 +214,9 @@ def run_sequence(
     """Generate ``iterations`` trajectories, each stacking the regressors of the earlier ones (Eq. 41).
 
     Every restart starts from its own random start (:class:`~excite_cli.search.restarts.RestartTask`).
-    None starts from the previous optimum: with C₀ holding its rows, the previous optimum is a stationary point of the
-    next iteration's criterion too (stacking C on itself scales CᵀC by 2, which moves log det by a
-    constant and leaves cond unchanged), so a solver started there stops there and the motion repeats.
+    Where every one ends worse than playing an earlier iteration's motion again, one more starts from
+    that motion (:func:`~excite_cli.search.earlier_optimum.from_earlier_optimum`), so the stacked
+    criterion never ends worse than an earlier optimum's (``sequence.replay``).
 
     Args:
         excitation: the problem.
@@ -253,6 +255,8 @@ def run_sequence(
                 expected="more starts or a longer optimizer.time_budget, or limits that leave the robot room",
             )
         runs, best = polish_kept(context, runs)
+        if len(more := from_earlier_optimum(context, runs, best, [r.alpha for r in results])) > len(runs):
+            runs, best = polish_kept(context, more)
         result = describe(excitation, k, best.alpha, stacked, time.perf_counter() - start, runs, results, best.index)
         results.append(result)
         if on_iteration:

@@ -1,0 +1,47 @@
+"""The sequence never loses ground (Sec. IV-B): an iteration whose restarts all end worse than
+playing an earlier iteration's motion again runs one more restart, from that motion.
+
+Stacked on C₀, the motion of an earlier iteration is a point the problem allows (it met every
+constraint on the fine grid, and its transitions were checked) and often a good one: on the G1 with
+the paper's criterion every restart of iteration 2 ended at cond(C) 12.5 and worse, where playing
+iteration 1 again keeps 11.4 (stacking C on itself doubles CᵀC and leaves cond unchanged). A solver
+started there may stop there (for iteration 2 that point is stationary again), and the motion then
+repeats: the correlation with the earlier iteration says so (1: the same motion). ``sequence.replay:
+false`` asks for a new motion every iteration instead, even where the stacked criterion rises.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import Sequence
+
+import numpy as np
+
+from excite_cli.search.kkt import End
+from excite_cli.search.optimizer import RestartResult
+from excite_cli.search.restarts import RestartContext
+
+
+def from_earlier_optimum(
+    context: RestartContext, runs: list[RestartResult], kept: RestartResult, earlier: Sequence[np.ndarray]
+) -> list[RestartResult]:
+    """``runs`` and, where an ``earlier`` iteration's α (n, 2N+1) scores lower in this iteration's
+    criterion (C₀ of the ``context`` stacked above it) than the ``kept`` restart's end point, one more
+    restart of ``max_iterations`` from the lowest of them, its index the next free one. When that
+    restart ends where it started, its end is ``End.EARLIER`` (a result, not a random start: see
+    :attr:`~excite_cli.search.optimizer.RestartResult.succeeded`), so the iteration can keep it.
+
+    Returns:
+        ``runs`` unchanged (the kept restart is at least as good as every earlier optimum, or there is
+        none, or ``sequence.replay`` is false), or ``runs`` with the new restart last.
+    """
+    if not earlier or not context.excitation.spec.sequence.replay:
+        return runs
+    criterion = context.excitation.criterion(context.prior)
+    values = [criterion.value(alpha) for alpha in earlier]
+    best = int(np.argmin(values))
+    if not values[best] < kept.objective:
+        return runs
+    index = max(r.index for r in runs) + 1
+    result = context.run([context.task(index, earlier[best].copy())], context.hook)[0]
+    return [*runs, replace(result, end=End.EARLIER) if result.end == End.START else result]
