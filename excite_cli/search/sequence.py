@@ -168,13 +168,20 @@ def kept_restart(excitation: Excitation, runs: Sequence[RestartResult]) -> Resta
     return next(playable, ranked[0])
 
 
-def polish_kept(context: RestartContext, runs: list[RestartResult]) -> tuple[list[RestartResult], RestartResult]:
+def polish_kept(
+    context: RestartContext, runs: list[RestartResult], polished: set[int] | None = None
+) -> tuple[list[RestartResult], RestartResult]:
     """``runs`` with the restart the iteration keeps (:func:`kept_restart`) polished
     (:func:`~excite_cli.search.restarts.polish`, in the iteration's ``context``), and that restart. A
     polished end point can lose its playable transitions (seen on the G1: the restart polished to KKT
     9.1e-4 could not be played, and the next one was kept as it was, stalled at 4.4e-2); then the
-    restart kept next is polished too, each at most once, so the one kept has always been polished."""
-    polished: set[int] = set()
+    restart kept next is polished too, each at most once, so the one kept has always been polished.
+
+    Args:
+        polished: indices of the restarts of this iteration polished already (by an earlier call, before
+            a restart was added); the ones this call polishes are added to it.
+    """
+    polished = set() if polished is None else polished
     while (kept := kept_restart(context.excitation, runs)).index not in polished:
         runs = polish(context, runs, kept.index)
         polished.add(kept.index)
@@ -254,9 +261,10 @@ def run_sequence(
                 f"{excitation.spec.optimizer.time_budget:g} s ({', '.join(failures)})",
                 expected="more starts or a longer optimizer.time_budget, or limits that leave the robot room",
             )
-        runs, best = polish_kept(context, runs)
+        polished: set[int] = set()
+        runs, best = polish_kept(context, runs, polished)
         if len(more := from_earlier_optimum(context, runs, best, [r.alpha for r in results])) > len(runs):
-            runs, best = polish_kept(context, more)
+            runs, best = polish_kept(context, more, polished)  # not the one polished above again
         result = describe(excitation, k, best.alpha, stacked, time.perf_counter() - start, runs, results, best.index)
         results.append(result)
         if on_iteration:
