@@ -6,20 +6,22 @@ Y(x_t) X, and Y(x_t) φ = τ(x_t; φ) is inverse dynamics, so (Eqs. 45–47)
 
     ∂c/∂x_t = Σ_{r∈{1,b}} w_r u_{r,t}ᵀ ∂τ(x_t; φ = X v_r)/∂x_t,   w₁ = 1/σ_b,  w_b = −σ₁/σ_b².
 
-∂τ/∂x_t comes from pinocchio's analytic RNEA derivatives evaluated with the "virtual" inertial
-parameters X v_r (:mod:`excite_cli.dynamics.virtual_dynamics`). The result is chained with the constant
-Fourier basis (Eq. 49).
+Every criterion's gradient in C is Σ_r a_r (C v_r) v_rᵀ = C A, so the sum is Σ_k ∂τ_k(x_t; φ_{t,k})/∂x_t with
+"virtual" inertial parameters φ_{t,k} = X A C_tᵀ e_k per instant and row, one reverse pass of RNEA per
+instant (:mod:`excite_cli.dynamics.regressor_adjoint`). The result is chained with the constant Fourier
+basis (Eq. 49).
 
-D- and E-optimality have gradients of the same form, Σ_r a_r (C v_r) v_rᵀ over eigenvectors v_r of
-CᵀC (:meth:`~excite_cli.criteria.record.CriterionRecord.terms`): −log σ_min needs one pass, −log det(CᵀC)/b all b.
+D-, E- and A-optimality have gradients of the same form, Σ_r a_r (C v_r) v_rᵀ over eigenvectors v_r
+of CᵀC (:meth:`~excite_cli.criteria.record.CriterionRecord.terms`): −log σ_min needs one, −log det(CᵀC)/b
+all b; the reverse pass costs the same for any number.
 
 With a frame L (b, b) every criterion is that of C L instead of C (``optimizer.scaling: urdf``, the
 regressor in a basis of the identifiable subspace that does not depend on the choice of base columns,
 :func:`~excite_cli.design.information.scaled_frame`); with eigenvectors ṽ_r of LᵀCᵀCL the
-gradient in C is Σ_r a_r (C L ṽ_r)(L ṽ_r)ᵀ, so the passes take the virtual parameters X L ṽ_r.
+gradient in C is Σ_r a_r (C L ṽ_r)(L ṽ_r)ᵀ, so A = Σ_r a_r L ṽ_r (L ṽ_r)ᵀ.
 
 With effect columns (``effects``: friction, armature, offsets, coupled motors) C = [Y_B | Y_E] per row
-and v_r = (v_{r,B}, v_{r,E}): the base part goes through the RNEA passes as above, the effect part
+and v_r = (v_{r,B}, v_{r,E}): the base part goes through the reverse pass as above, the effect part
 through the effect columns' own derivatives in q̇ and q̈
 (:meth:`~excite_cli.dynamics.effect_columns.EffectColumns.chain`; Coulomb friction through the smooth
 sign tanh(q̇/v_c) with the config's ``effects.coulomb_velocity``).
@@ -37,8 +39,8 @@ from excite_cli.criteria.record import RANK_FLOOR
 from excite_cli.design.noise import RowNoise
 from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.dynamics.effect_columns import EffectColumns
+from excite_cli.dynamics.regressor_adjoint import RegressorAdjoint
 from excite_cli.dynamics.robot import Robot
-from excite_cli.dynamics.virtual_dynamics import VirtualDynamics
 from excite_cli.errors import ExciteError
 from excite_cli.memo import once
 from excite_cli.trajectory.fourier import FourierBasis
@@ -83,7 +85,7 @@ class Criterion:
     frame: np.ndarray | None = None
     effects: EffectColumns | None = None
     noise: RowNoise | None = None
-    _dynamics: VirtualDynamics = field(init=False, repr=False)
+    _dynamics: RegressorAdjoint = field(init=False, repr=False)
     _data: pin.Data = field(init=False, repr=False)
     _prior_gram: np.ndarray = field(init=False, repr=False)
 
@@ -96,7 +98,7 @@ class Criterion:
                 f"{self.prior.shape[1]} columns, but the design has {self.base.count} base parameters"
                 + (f" and {self.effects.count} effect columns" if self.effects else ""),
             )
-        self._dynamics = VirtualDynamics(self.robot)
+        self._dynamics = RegressorAdjoint(self.robot)
         self._data = self.robot.model.createData()  # this criterion's own, so no result depends on other users
         self._prior_gram = self.prior.T @ self.prior
 
@@ -142,7 +144,7 @@ class Criterion:
         Q, QD, QDD, own, _, _ = self._motion(alpha)
         if Q.shape[0] * self.robot.n_rows + self.prior.shape[0] < self.columns:
             return float("inf")
-        eig = np.linalg.eigvalsh(self._gram(own)) if from_gram else None
+        eig = np.linalg.eigvalsh(self._gram(alpha)) if from_gram else None
         if eig is None or eig[0] < GRAM_ACCURATE * eig[-1]:
             eig = np.linalg.svd(self.framed(self.stacked(own)), compute_uv=False)[::-1] ** 2
         return self.objective.terms(eig)[0]
@@ -158,10 +160,16 @@ class Criterion:
 
         return once(self, "motion", alpha, compute)
 
-    def _gram(self, own: np.ndarray) -> np.ndarray:
-        """CᵀC = C₀ᵀC₀ + ŶᵀŶ (b×b, Eq. 41), or Lᵀ CᵀC L with the frame."""
-        gram = self._prior_gram + own.T @ own
-        return gram if self.frame is None else self.frame.T @ gram @ self.frame
+    def _gram(self, alpha: np.ndarray) -> np.ndarray:
+        """CᵀC = C₀ᵀC₀ + ŶᵀŶ (b×b, Eq. 41) at α, or Lᵀ CᵀC L with the frame; kept for the next call at
+        the same α (a solver's trial point's value, then its gradient)."""
+
+        def compute() -> np.ndarray:
+            own = self._motion(alpha)[3]
+            gram = self._prior_gram + own.T @ own
+            return gram if self.frame is None else self.frame.T @ gram @ self.frame
+
+        return once(self, "gram", alpha, compute)
 
     def value_and_gradient(self, alpha: np.ndarray) -> tuple[float, np.ndarray]:
         """f(α) and its gradient, shaped like α (n, 2N+1) (Eqs. 17, 45–49).
@@ -171,13 +179,13 @@ class Criterion:
         """
         motion = self._motion(alpha)
         # eigenpairs of the b×b Gram matrix CᵀC = C₀ᵀC₀ + ŶᵀŶ give σ² and v; C v = σ u (Eqs. 8, 16)
-        eig, V = np.linalg.eigh(self._gram(motion[3]))
+        eig, V = np.linalg.eigh(self._gram(alpha))
         value, used, coefficients = self.objective.terms(eig)
         return value, self._chained(motion, V[:, used], coefficients)
 
     def singular_values(self, alpha: np.ndarray) -> np.ndarray:
         """σ (b,) of C (of C L with the frame), ascending, from the eigenvalues of CᵀC."""
-        return np.sqrt(np.maximum(np.linalg.eigvalsh(self._gram(self._motion(alpha)[3])), 0.0))
+        return np.sqrt(np.maximum(np.linalg.eigvalsh(self._gram(alpha)), 0.0))
 
     def floored_singular_values(self, alpha: np.ndarray) -> np.ndarray:
         """σ (b,) as :meth:`singular_values`, floored as the criterion floors them
@@ -191,7 +199,7 @@ class Criterion:
         at a time; a multiple σ_i has the gradient of the eigenbasis numpy returns). λ is floored as the
         criterion floors it (:data:`~excite_cli.criteria.record.RANK_FLOOR`): rank loss gives finite values."""
         motion = self._motion(alpha)
-        eig, V = np.linalg.eigh(self._gram(motion[3]))
+        eig, V = np.linalg.eigh(self._gram(alpha))
         lam = np.maximum(eig[indices], max((RANK_FLOOR**2) * eig[-1], np.finfo(float).tiny))
         gradients = np.array([self._chained(motion, V[:, [i]], np.array([1.0 / x])) for i, x in zip(indices, lam)])
         return 0.5 * np.log(lam), gradients.reshape(len(indices), *alpha.shape)
@@ -204,7 +212,7 @@ class Criterion:
         an eigenvalue of multiplicity k, Overton 1992); h_aa's alone are the gradients of each log σ_a.
         Each off-diagonal pair is two passes: v_aᵀGv_b = ½(u₊ᵀGu₊ − u₋ᵀGu₋), u± = (v_a ± v_b)/√2."""
         motion = self._motion(alpha)
-        eig, V = np.linalg.eigh(self._gram(motion[3]))
+        eig, V = np.linalg.eigh(self._gram(alpha))
         mean = float(max(eig[indices].mean(), np.finfo(float).tiny))
         k = len(indices)
         out = np.zeros((k, k, *alpha.shape))
@@ -224,27 +232,16 @@ class Criterion:
         the motion (:meth:`_motion`), eigenvectors V (b, R) of the (framed) CᵀC and a_r (R,)."""
         Q, QD, QDD, own, s, ds = motion
         directions = V if self.frame is None else self.frame @ V  # v_r, or L ṽ_r
-        T, rows, b, R = Q.shape[0], self.robot.n_rows, self.base.count, V.shape[1]
-        projected = own @ directions  # C v_r (M, R)
-        weighted = projected * coefficients  # a_r (C v_r): ∂f/∂C = Σ_r a_r (C v_r) v_rᵀ, the rows' weights
-        torque_weights = None
+        T, rows, b = Q.shape[0], self.robot.n_rows, self.base.count
+        G = own @ ((directions * coefficients) @ directions.T)  # ∂f/∂C = Σ_r a_r (C v_r) v_rᵀ (M, b+e)
+        phis = np.zeros((T * rows, self.robot.n_parameters))  # φ_{t,k} = X (∂f/∂C)_{t,k} (Eq. 47)
         if s is not None:  # C = diag(s) Y: ∂f/∂Y = s ∂f/∂C, and ∂f/∂s = Σ_r a_r (C v_r)(Y v_r)
-            torque_weights = (weighted * projected).sum(axis=1) / s * ds if self.noise.varying else None
-            weighted = weighted * s[:, None]
-        if R > len(self._dynamics.slots):  # fewer passes with a virtual parameter per instant and row
-            phis = np.zeros((T, rows, self.robot.n_parameters))
-            phis[:, :, self.base.independent] = (weighted @ directions[:b].T).reshape(T, rows, -1)
-            dq, dqd, dqdd = self._dynamics.row_derivatives(phis, Q, QD, QDD)
-        else:
-            phis = np.zeros((self.robot.n_parameters, R))
-            phis[self.base.independent] = directions[:b]  # X v_r
-            weights = weighted.T.reshape(R, T, rows)  # row weights a_r (Ŷ_B v_r) at each instant
-            dq, dqd, dqdd = self._dynamics.weighted_derivatives(phis, weights, Q, QD, QDD)
-        if torque_weights is not None:  # through the weights: ∂f/∂τ ∂τ(x_t; φ_URDF)/∂x_t
-            weights = torque_weights.reshape(1, T, rows)
-            extra = self._dynamics.weighted_derivatives(self.noise.reference[:, None], weights, Q, QD, QDD)
-            dq, dqd, dqdd = dq + extra[0], dqd + extra[1], dqdd + extra[2]
-        if self.effects is not None:  # ∂f/∂Y_E = Σ_r a_r (C v_r) v_{r,E}ᵀ, through the effect columns' motion
-            effect_qd, effect_qdd = self.effects.chain(weighted @ directions[b:].T, QD, QDD)
+            if self.noise.varying:  # through the weights: ∂f/∂τ ∂τ(x_t; φ_URDF)/∂x_t
+                phis += ((G * own).sum(axis=1) / s * ds)[:, None] * self.noise.reference
+            G = G * s[:, None]
+        phis[:, self.base.independent] += G[:, :b]
+        dq, dqd, dqdd = self._dynamics.row_derivatives(phis.reshape(T, rows, -1), Q, QD, QDD)
+        if self.effects is not None:  # ∂f/∂Y_E, through the effect columns' motion
+            effect_qd, effect_qdd = self.effects.chain(G[:, b:], QD, QDD)
             dqd, dqdd = dqd + effect_qd, dqdd + effect_qdd
         return self.basis.chain(dq, dqd, dqdd)
