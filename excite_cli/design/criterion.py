@@ -46,9 +46,9 @@ from excite_cli.memo import once
 from excite_cli.trajectory.fourier import FourierBasis
 
 #: The smallest eigenvalue of CᵀC, relative to the largest, down to which the eigenvalues of CᵀC give
-#: the criterion (cond(C) ≤ 10³; their relative error is about 1e-16 λ_max/λ_min, so ≤ 1e-10 there);
-#: below it the singular values of C do.
-GRAM_ACCURATE = 1e-6
+#: the criterion (cond(C) ≤ 10⁴; their relative error is about 1e-16 λ_max/λ_min, so ≤ 1e-8 there, below a
+#: line search's steps: the default's cond(CL) is 1600–1800 on the G1); below it the singular values of C do.
+GRAM_ACCURATE = 1e-8
 
 
 def condition_number(C: np.ndarray) -> float:
@@ -136,7 +136,7 @@ class Criterion:
 
         Args:
             from_gram: from the eigenvalues of the b×b matrix CᵀC instead, as :meth:`value_and_gradient`
-                takes them, where they are accurate to about 1e-10 relative (cond(C) ≤ 10³,
+                takes them, where they are accurate to about 1e-8 relative (cond(C) ≤ 10⁴,
                 :data:`GRAM_ACCURATE`; else still from the singular values): a solver's line search, in
                 about half the time (G1, 560 × 90: 0.9 ms against 1.7 ms with the regressor, one BLAS
                 thread); finite differences need the singular values.

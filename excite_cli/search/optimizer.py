@@ -25,19 +25,16 @@ from excite_cli.config import OptimizerConfig
 from excite_cli.constraints import Constraint, accepted
 from excite_cli.design.criterion import Criterion
 from excite_cli.search.feasible import onto_fine_grid, project, repair
-from excite_cli.search.kkt import INFEASIBLE, SOLVER_FAILED, End, Optimality, stationary, stop_reason, until_done
+from excite_cli.search.kkt import INFEASIBLE, SOLVER_FAILED, End, Optimality, stop_reason, until_done
 from excite_cli.search.nlp import Epigraph, Evaluations, NlpForm
 from excite_cli.search.smoothing import Smoothed
-from excite_cli.search.solvers import SolverRun, criterion_scale, solve
+from excite_cli.search.solver_runs import solve_warmed
+from excite_cli.search.solvers import criterion_scale
 from excite_cli.trajectory.boundary import BoundaryConditions
 from excite_cli.trajectory.fourier import FourierBasis
 
 #: Progress hook: (restart index, solver iteration, objective at the current iterate).
 ProgressHook = Callable[[int, int, float], None]
-#: Runs of the solver after one that failed or stopped on its own test short of stationarity
-#: (:func:`_solve_recovering`); the factor on the criterion's scale after a failure, and on the
-#: solver's tolerance after its own test.
-RECOVERIES, RECOVERY_SCALE, RECOVERY_TOLERANCE = 2, 0.5, 1e-3
 
 
 @dataclass(frozen=True)
@@ -94,51 +91,6 @@ def best_restart(results: Sequence[RestartResult]) -> RestartResult:
     ties go to the lower index (so the choice does not depend on the order results arrive in)."""
     candidates = [r for r in results if r.succeeded] or list(results)
     return min(candidates, key=lambda r: (r.objective, r.index))
-
-
-def _solve_recovering(
-    options: OptimizerConfig,
-    nlp: Evaluations | Epigraph | Smoothed,
-    z0: np.ndarray,
-    iterations: int,
-    on_iterate: Callable[[np.ndarray], None],
-    scale: Optional[float],
-) -> SolverRun:
-    """:func:`~excite_cli.search.solvers.solve`, run again (up to ``RECOVERIES`` times, a fresh
-    quasi-Newton matrix each, for the iterations left; they add up) where it ended neither at its
-    limit nor at the KKT test of :func:`~excite_cli.search.kkt.until_done`:
-
-    - it failed on its own (SLSQP's "More than 3*n iterations in LSQ subproblem" or "Positive
-      directional derivative for linesearch", IPOPT's restoration): from the best iterate inside
-      every constraint so far (the start if none), the criterion's scale times ``RECOVERY_SCALE``. A
-      first step that drove two capsules through each other (their segments crossing) left SLSQP's
-      linearized constraints inconsistent; with half the scale the same UR10 start (a lab's limits)
-      reached the best criterion of its 16 screened starts;
-    - its own convergence test passed (SLSQP: the criterion changed by less than its tolerance) at a
-      point whose KKT residual is above ``optimality_tolerance``: from its last iterate, its tolerance
-      times ``RECOVERY_TOLERANCE``. With C₀ stacked the criterion's gradient is small beside the
-      trajectory's own, which sets the scale (:func:`own_scale`), so the first step of a later
-      iteration can change the criterion by less than the tolerance: on the G1 (seed 1, iteration 3)
-      a restart ended after 1 iteration at its start, 3.047 against the other restart's 2.835."""
-
-    variables, problem = nlp.start, nlp.problem  # the epigraph's bounds start at their extremes
-
-    tolerance = options.tolerance
-    run = solve(options.method, nlp, variables(z0), iterations, tolerance, on_iterate, scale)
-    done = run.iterations
-    for _ in range(RECOVERIES):
-        short = run.failed or not stationary(problem, run.z[: z0.size], options.optimality_tolerance)
-        if run.limit or done >= iterations or not short:
-            break
-        if run.failed:
-            inside = problem.best_inside
-            w = variables(z0 if inside is None else problem.boundary.to_variables(inside))
-            scale = run.scale * RECOVERY_SCALE
-        else:
-            w, scale, tolerance = run.z, run.scale, tolerance * RECOVERY_TOLERANCE
-        run = solve(options.method, nlp, w, iterations - done, tolerance, on_iterate, scale)
-        done += run.iterations
-    return replace(run, iterations=done)
 
 
 def own_scale(criterion: Criterion, boundary: BoundaryConditions, start: np.ndarray) -> float:
@@ -225,9 +177,8 @@ def optimize_restart(
     nlp = (Smoothed if smoothed else Epigraph)(problem) if criterion.objective.extremes else problem
     if scale is None and nlp.form is NlpForm.PLAIN:  # the epigraph's criterion is its bounds' weights
         scale = own_scale(criterion, boundary, start)
-    run = _solve_recovering(
-        options, nlp, z0, max_iterations or options.max_iterations, lambda w: done(w[: z0.size]), scale
-    )
+    limit = max_iterations or options.max_iterations
+    run = solve_warmed(options, nlp, z0, limit, lambda w: done(w[: z0.size]), scale)
     run = replace(run, z=run.z[: z0.size])
     out_of_time = time.perf_counter() > deadline
     if len(history) < run.iterations:  # a solver that ends inside an iteration calls back no more: its last iterate

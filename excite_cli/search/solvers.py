@@ -31,6 +31,7 @@ from scipy.optimize import BFGS, NonlinearConstraint, minimize
 
 from excite_cli.errors import ExciteError
 from excite_cli.memo import once
+from excite_cli.search.screening import screened
 
 #: The methods of ``optimizer.method``.
 METHODS = ("SLSQP", "trust-constr", "ipopt")
@@ -134,7 +135,8 @@ def solve(
     if method not in methods:
         raise ExciteError("optimizer.method", f"unknown '{method}', expected one of {', '.join(METHODS)}")
     scaled = _ScaledCriterion(nlp, z0, scale)
-    run = methods[method](scaled, z0, max_iterations, tolerance * scaled.scale, on_iterate)
+    seen = screened(scaled, z0) if method == "SLSQP" else scaled  # its QP's cost grows with the rows
+    run = methods[method](seen, z0, max_iterations, tolerance * scaled.scale, on_iterate)
     return replace(run, scale=scaled.scale)
 
 
