@@ -36,6 +36,7 @@ import pinocchio as pin
 
 from excite_cli.criteria import CriterionRecord
 from excite_cli.criteria.record import RANK_FLOOR
+from excite_cli.design.information import PriorInformation
 from excite_cli.design.noise import RowNoise
 from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.dynamics.effect_columns import EffectColumns
@@ -69,7 +70,8 @@ class Criterion:
         base: its base parameters (composition matrix X).
         basis: Fourier basis at the T cost samples.
         objective: the criterion's record (:data:`~excite_cli.criteria.CRITERIA`).
-        prior: C₀, (m₁, b) rows stacked above the trajectory's regressor (Eq. 41), or an empty array.
+        prior: what the criterion needs of C₀, the (m₁, b+e) rows stacked above the trajectory's
+            regressor (Eq. 41): their Gram matrix and triangular factor, or None: no prior rows.
         frame: L (b+e, b+e): the criterion is that of C L (module docstring); None: of C, the paper's.
         effects: e effect columns beside the b base columns, C = [Y_B | Y_E] per row
             (:mod:`~excite_cli.dynamics.effect_columns`), or None: the rigid body alone.
@@ -81,26 +83,24 @@ class Criterion:
     base: BaseParameters
     basis: FourierBasis
     objective: CriterionRecord
-    prior: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    prior: PriorInformation | None = None
     frame: np.ndarray | None = None
     effects: EffectColumns | None = None
     noise: RowNoise | None = None
     _dynamics: RegressorAdjoint = field(init=False, repr=False)
     _data: pin.Data = field(init=False, repr=False)
-    _prior_gram: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
-        if self.prior.size == 0:
-            self.prior = np.zeros((0, self.columns))
-        if self.prior.shape[1] != self.columns:
+        if self.prior is None:
+            self.prior = PriorInformation.of(np.zeros((0, self.columns)))
+        if self.prior.gram.shape[1] != self.columns:
             raise ExciteError(
                 "sequence.prior",
-                f"{self.prior.shape[1]} columns, but the design has {self.base.count} base parameters"
+                f"{self.prior.gram.shape[1]} columns, but the design has {self.base.count} base parameters"
                 + (f" and {self.effects.count} effect columns" if self.effects else ""),
             )
         self._dynamics = RegressorAdjoint(self.robot)
         self._data = self.robot.model.createData()  # this criterion's own, so no result depends on other users
-        self._prior_gram = self.prior.T @ self.prior
 
     @property
     def columns(self) -> int:
@@ -128,8 +128,8 @@ class Criterion:
         return own * s[:, None], s, ds
 
     def stacked(self, own: np.ndarray) -> np.ndarray:
-        """C = [C₀; Ŷ_B] (Eq. 41)."""
-        return np.vstack([self.prior, own])
+        """[R; Ŷ_B], R the triangular factor of C₀: the singular values of C = [C₀; Ŷ_B] (Eq. 41)."""
+        return np.vstack([self.prior.factor, own])
 
     def value(self, alpha: np.ndarray, from_gram: bool = False) -> float:
         """f(α), from the singular values of C (accurate also where CᵀC is not).
@@ -142,7 +142,7 @@ class Criterion:
                 thread); finite differences need the singular values.
         """
         Q, QD, QDD, own, _, _ = self._motion(alpha)
-        if Q.shape[0] * self.robot.n_rows + self.prior.shape[0] < self.columns:
+        if Q.shape[0] * self.robot.n_rows + self.prior.rows < self.columns:
             return float("inf")
         eig = np.linalg.eigvalsh(self._gram(alpha)) if from_gram else None
         if eig is None or eig[0] < GRAM_ACCURATE * eig[-1]:
@@ -166,7 +166,7 @@ class Criterion:
 
         def compute() -> np.ndarray:
             own = self._motion(alpha)[3]
-            gram = self._prior_gram + own.T @ own
+            gram = self.prior.gram + own.T @ own
             return gram if self.frame is None else self.frame.T @ gram @ self.frame
 
         return once(self, "gram", alpha, compute)

@@ -23,7 +23,7 @@ from excite_cli.constraints.world_collision import WorldCollision
 from excite_cli.constraints.zmp import zmp_from_config
 from excite_cli.criteria import criterion_record
 from excite_cli.design.criterion import Criterion, condition_number
-from excite_cli.design.information import excitation_level, parameter_magnitudes
+from excite_cli.design.information import PriorInformation, excitation_level, parameter_magnitudes
 from excite_cli.design.noise import RowNoise, row_noise
 from excite_cli.design.spec import DesignSpec, needs_collision
 from excite_cli.dynamics.base_parameters import BaseParameters
@@ -87,10 +87,14 @@ class Excitation:
         return self.spec.measured
 
     def criterion(
-        self, prior: np.ndarray | None = None, objective: str | None = None, scaling: str | None = None
+        self,
+        prior: np.ndarray | PriorInformation | None = None,
+        objective: str | None = None,
+        scaling: str | None = None,
     ) -> Criterion:
-        """The criterion of ``objective`` (default ``optimizer.objective``) with C₀ = ``prior`` (m₁, b)
-        (Eq. 41), of C (``scaling`` ``none``) or of C L (``urdf``; default ``optimizer.scaling``, else
+        """The criterion of ``objective`` (default ``optimizer.objective``) with C₀ = ``prior`` (m₁, b+e)
+        (Eq. 41), the rows or their information (a restart is sent the b+e-square blocks, not the
+        rows), of C (``scaling`` ``none``) or of C L (``urdf``; default ``optimizer.scaling``, else
         the criterion's own, :attr:`~excite_cli.criteria.record.CriterionRecord.scaling`)."""
         objective = objective or self.spec.optimizer.objective
         scaling = scaling or self.spec.optimizer.scaling_of(objective)
@@ -98,7 +102,7 @@ class Excitation:
             self.robot,
             self.base,
             self.cost_basis,
-            prior=np.zeros((0, self.columns)) if prior is None else prior,
+            prior=PriorInformation.of(prior) if isinstance(prior, np.ndarray) else prior,
             objective=criterion_record(objective),
             frame=self.scaled_frame if scaling == "urdf" else None,
             effects=self.effects,

@@ -24,6 +24,8 @@ the worst determined direction of the standard parameters, each measured in its 
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from excite_cli.dynamics.base_parameters import BaseParameters
@@ -89,3 +91,26 @@ def predicted_std(C: np.ndarray, noise: float) -> np.ndarray:
     variance = (V[:, seen] ** 2 / lam[seen]).sum(axis=1)
     unseen = (V[:, ~seen] ** 2).sum(axis=1) > 1e-6
     return np.where(unseen, np.inf, noise * np.sqrt(variance))
+
+
+@dataclass(frozen=True)
+class PriorInformation:
+    """What a criterion needs of prior rows C₀ (m, b+e) stacked above a trajectory's (Eq. 41), in
+    (b+e)-square blocks however many rows C₀ has: what a restart is sent instead of the rows.
+
+    Attributes:
+        gram: C₀ᵀC₀ (b+e, b+e), computed from the rows (the criterion's CᵀC = C₀ᵀC₀ + ŶᵀŶ).
+        factor: R (min(m, b+e), b+e) of C₀ = Q R (Householder QR, LAPACK ``geqrf``): [R; Ŷ] has the
+            singular values of [C₀; Ŷ] (RᵀR = C₀ᵀC₀), which the criterion takes where CᵀC is not accurate.
+        rows: m, the rows C₀ counts (C has fewer rows than columns below b+e − m trajectory rows).
+    """
+
+    gram: np.ndarray
+    factor: np.ndarray
+    rows: int
+
+    @classmethod
+    def of(cls, rows: np.ndarray) -> "PriorInformation":
+        """The information of C₀ = ``rows`` (m, b+e); m may be 0."""
+        factor = np.linalg.qr(rows, mode="r") if rows.shape[0] else rows
+        return cls(rows.T @ rows, factor, rows.shape[0])

@@ -104,7 +104,7 @@ def own_scale(criterion: Criterion, boundary: BoundaryConditions, start: np.ndar
     quasi-Newton matrix with it. On the UR10 with a lab's limits, iteration 2 (A-optimality), 11 of
     16 screened starts ended "More than 3*n iterations in LSQ subproblem", most where they began;
     scaled by the trajectory's own gradient, which does not depend on the prior, none did."""
-    own = replace(criterion, prior=np.zeros((0, 0))) if criterion.prior.size else criterion
+    own = replace(criterion, prior=None) if criterion.prior.rows else criterion
     return criterion_scale(boundary.chain(own.value_and_gradient(start)[1].ravel()))
 
 

@@ -10,6 +10,7 @@ from typing import Optional
 import numpy as np
 
 from excite_cli.design.excitation import Excitation
+from excite_cli.design.information import PriorInformation
 from excite_cli.search.engine import Engine
 from excite_cli.search.kkt import CONVERGED, SCREENED_OUT, STALLED, TIME_BUDGET
 from excite_cli.search.optimizer import ProgressHook, RestartResult, optimize_restart
@@ -26,7 +27,8 @@ class RestartTask:
     Attributes:
         iteration: k, 1-based; index: the restart's number, 0-based.
         seed: the run's seed (``optimizer.seed``).
-        prior: C₀ (m, b), the rows stacked above the trajectory's regressor (Eq. 41).
+        prior: what the criterion needs of C₀, the rows stacked above the trajectory's regressor
+            (Eq. 41): b+e-square blocks, however many rows C₀ has.
         warm_start: (n, 2N+1) accepted α to start from instead of a random start (a screened start
             that continues), or None.
         iterations: solver iterations (default ``optimizer.max_iterations``).
@@ -41,7 +43,7 @@ class RestartTask:
     iteration: int
     index: int
     seed: int
-    prior: np.ndarray
+    prior: PriorInformation
     warm_start: Optional[np.ndarray] = None
     iterations: Optional[int] = None
     time_limit: Optional[float] = None
@@ -80,7 +82,7 @@ class RestartContext:
     Attributes:
         excitation: the design; engine: where the restarts run.
         k: the iteration, 1-based; seed: the run's seed (``optimizer.seed``).
-        prior: C₀ (m, b), the rows stacked above the trajectory's regressor (Eq. 41).
+        prior: what the criterion needs of C₀ (:class:`RestartTask`).
         deadline: the iteration's time budget ends here [s, ``time.perf_counter``].
         hook: progress (restart index, solver iteration, objective), or None.
     """
@@ -89,13 +91,13 @@ class RestartContext:
     engine: Engine
     k: int
     seed: int
-    prior: np.ndarray
+    prior: PriorInformation
     deadline: float
     hook: Optional[ProgressHook] = None
 
     @classmethod
     def starting(
-        cls, excitation: Excitation, engine: Engine, k: int, seed: int, prior: np.ndarray, hook=None
+        cls, excitation: Excitation, engine: Engine, k: int, seed: int, prior: PriorInformation, hook=None
     ) -> "RestartContext":
         """The context of iteration k beginning now: its deadline ``optimizer.time_budget`` seconds away."""
         return cls(

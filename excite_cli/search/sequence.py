@@ -13,6 +13,7 @@ import numpy as np
 
 from excite_cli.design.criterion import condition_number
 from excite_cli.design.excitation import Excitation
+from excite_cli.design.information import PriorInformation
 from excite_cli.design.playback import check_motion, plan_playback
 from excite_cli.errors import ExciteError, NoSolution
 from excite_cli.search.earlier_optimum import from_earlier_optimum
@@ -251,7 +252,7 @@ def run_sequence(
     for k in range(len(finished) + 1, iterations + 1):
         start, stacked = time.perf_counter(), stacked_regressors(excitation, prior, results)
         hook = progress(k) if progress else None
-        context = RestartContext.starting(excitation, engine, k, seed, stacked, hook)
+        context = RestartContext.starting(excitation, engine, k, seed, PriorInformation.of(stacked), hook)
         runs = run_restarts(context)
         if not any(r.succeeded for r in runs):
             failures = sorted({f"{r.stop} ({r.end})" for r in runs})

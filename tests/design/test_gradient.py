@@ -9,6 +9,7 @@ from conftest import small
 from excite_cli.config import EffectsConfig, MotorConfig
 from excite_cli.criteria import CRITERIA, NAMES
 from excite_cli.design.criterion import Criterion, condition_number
+from excite_cli.design.information import PriorInformation
 from excite_cli.design.noise import RowNoise
 from excite_cli.design.resolve import build_excitation
 from excite_cli.design.verify import check_gradient, finite_difference_gradient
@@ -99,7 +100,11 @@ def test_value_is_the_condition_number_of_the_stacked_regressor(panda_problem):
     a, b = _feasible_alpha(excitation, 1), _feasible_alpha(excitation, 2)
     prior = excitation.criterion().regressor(a)
     criterion = Criterion(
-        excitation.robot, excitation.base, excitation.cost_basis, prior=prior, objective=CRITERIA["cond"]
+        excitation.robot,
+        excitation.base,
+        excitation.cost_basis,
+        prior=PriorInformation.of(prior),
+        objective=CRITERIA["cond"],
     )
     stacked = np.vstack([prior, criterion.regressor(b)])
     s = np.linalg.svd(stacked, compute_uv=False)
@@ -215,7 +220,7 @@ def test_gradient_with_row_weights_matches_finite_differences(ur5_problem):
         excitation.base,
         excitation.cost_basis,
         CRITERIA["log_det"],
-        prior,
+        PriorInformation.of(prior),
         effects=excitation.effects,
         noise=noise,
     )

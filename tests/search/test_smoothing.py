@@ -78,9 +78,7 @@ def test_a_restart_that_stalled_in_epigraph_form_converges_on_the_smoothing():
     stalled = RestartResult(0, stalled_alpha, value, 1032, "", 0.0, value, optimality=optimality, stop=STALLED)
     stalled = RestartResult(**{**stalled.__dict__, "end": "projected", "scale": 0.1, "margins": (0.0,) * 4})
     with Engine(excitation, 1) as engine:
-        context = RestartContext(
-            excitation, engine, 1, 0, np.zeros((0, criterion.prior.shape[1])), time.perf_counter() + 600
-        )
+        context = RestartContext(excitation, engine, 1, 0, criterion.prior, time.perf_counter() + 600)
         polished = _smoothed_round(context, stalled)
     assert polished.stop == CONVERGED and "smoothing" in polished.message
     assert evaluations.optimality(polished.alpha).residual <= tolerance
