@@ -55,7 +55,8 @@ class Screened:
         values = self.nlp.constraint_values(z)
         inside = np.zeros(values.size, dtype=bool)
         inside[self.slots] = True
-        for row in np.flatnonzero(~inside & (values > -ENTER))[np.argsort(-values[~inside & (values > -ENTER)])]:
+        outside = np.flatnonzero(~inside & (values > -ENTER))  # rows that can bind, not in a slot
+        for row in outside[np.argsort(-values[outside])]:
             lowest = int(np.argmin(values[self.slots]))
             if values[self.slots[lowest]] >= values[row]:
                 break
