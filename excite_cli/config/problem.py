@@ -219,7 +219,7 @@ class SequenceConfig(Section):
     prior: Optional[str] = None
     """HDF5 file of prior data C₀: an excite result or a file with /regressor (rows × b), or none."""
     replay: bool = True
-    """Where an earlier iteration's motion beats every restart, restart from it (it may repeat); false: never."""
+    """Where an earlier motion beats every restart, restart from it and from the earlier motions' mean; false: never."""
 
 
 class Problem(ConfigFile):

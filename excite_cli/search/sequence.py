@@ -1,6 +1,6 @@
 """Sequential generation (Section IV-B): iteration i optimizes with C₀ = [C_prior; C⁽¹⁾; …; C⁽ⁱ⁻¹⁾],
-continues the best restart the robot can play until it converges (:func:`polish_kept`), starts once
-more from an earlier iteration's motion where that is better
+continues the best restart the robot can play until it converges (:func:`polish_kept`), starts again
+from an earlier iteration's motion (and from the earlier motions' mean) where that is better
 (:mod:`~excite_cli.search.earlier_optimum`), keeps the best (:func:`kept_restart`), and describes it."""
 
 from __future__ import annotations
@@ -222,9 +222,10 @@ def run_sequence(
     """Generate ``iterations`` trajectories, each stacking the regressors of the earlier ones (Eq. 41).
 
     Every restart starts from its own random start (:class:`~excite_cli.search.restarts.RestartTask`).
-    Where every one ends worse than playing an earlier iteration's motion again, one more starts from
-    that motion (:func:`~excite_cli.search.earlier_optimum.from_earlier_optimum`), so the stacked
-    criterion never ends worse than an earlier optimum's (``sequence.replay``).
+    Where every one ends worse than playing an earlier iteration's motion again, more start from
+    that motion and from the earlier motions' mean
+    (:func:`~excite_cli.search.earlier_optimum.from_earlier_optimum`), so the stacked criterion never
+    ends worse than an earlier optimum's (``sequence.replay``).
 
     Args:
         excitation: the problem.

@@ -1,7 +1,8 @@
 """The sequence never loses ground: an iteration whose restarts all end worse than playing an earlier
 motion again plays that motion again (or better), and with ``sequence.replay: false`` it does not.
 Truth: stacking a regressor on itself doubles CᵀC and leaves cond unchanged, so replaying iteration
-1 keeps iteration 1's stacked cond(C) exactly."""
+1 keeps iteration 1's stacked cond(C) exactly; with two motions stacked, the motion of their mean
+α keeps it to second order in their distance."""
 
 import copy
 
@@ -10,8 +11,10 @@ import pytest
 from conftest import UR5, write_config
 
 from excite_cli.config_file import load_problem
+from excite_cli.design.information import PriorInformation
 from excite_cli.design.resolve import build_excitation
 from excite_cli.search.earlier_optimum import from_earlier_optimum
+from excite_cli.search.engine import Engine
 from excite_cli.search.kkt import End
 from excite_cli.search.optimizer import RestartResult
 from excite_cli.search.restarts import RestartContext
@@ -62,3 +65,45 @@ def test_no_restart_more_where_the_kept_one_is_as_good_or_replay_is_off(tmp_path
     kept = RestartResult(0, earlier, value - margin, 10, "", 1.0, stop="converged", end=End.PROJECTED)
     context = RestartContext(excitation, None, 2, 1, prior, float("inf"))
     assert from_earlier_optimum(context, [kept], kept, [earlier]) == [kept]
+
+
+def _log_cond(*rows: np.ndarray) -> float:
+    return float(np.log(np.linalg.cond(np.vstack(rows))))
+
+
+def test_the_mean_motion_keeps_cond_to_second_order_where_replaying_one_keeps_it_to_first(tmp_path):
+    """Two motions ε apart stacked: playing one again moves log cond by O(ε), playing the motion of
+    their mean α moves it by O(ε²) (CᵀC is smooth in α and stacking a multiple of C₀ᵀC₀ keeps cond):
+    halving ε halves the first and quarters the second."""
+    excitation = _small_ur5(tmp_path, True)
+    regressor = excitation.criterion().regressor
+    alpha = excitation.random_start(np.random.default_rng(3))
+    direction = excitation.random_start(np.random.default_rng(4)) - alpha
+    moved = {}
+    for eps in (2e-3, 1e-3):
+        C1, C2 = regressor(alpha), regressor(alpha + eps * direction)
+        before = _log_cond(C1, C2)
+        moved[eps] = (
+            abs(_log_cond(C1, C2, C1) - before),
+            abs(_log_cond(C1, C2, regressor(alpha + 0.5 * eps * direction)) - before),
+        )
+    replay, mean = moved[2e-3][0] / moved[1e-3][0], moved[2e-3][1] / moved[1e-3][1]
+    assert replay == pytest.approx(2.0, rel=0.1) and mean == pytest.approx(4.0, rel=0.1)
+    assert moved[1e-3][1] < 0.05 * moved[1e-3][0]
+
+
+def test_with_two_earlier_motions_the_guard_starts_from_the_better_one_and_from_their_mean(tmp_path):
+    excitation = _small_ur5(tmp_path, True)
+    excitation.spec.optimizer.max_iterations = 2
+    excitation.spec.optimizer.polish_rounds = 0
+    earlier = [excitation.random_start(np.random.default_rng(seed)) for seed in (5, 6)]
+    prior = np.vstack([excitation.criterion().regressor(alpha) for alpha in earlier])
+    criterion = excitation.criterion(prior)
+    kept = RestartResult(0, earlier[0], 1e9, 10, "", 1.0, stop="converged", end=End.PROJECTED)
+    with Engine(excitation) as engine:
+        context = RestartContext(excitation, engine, 3, 1, PriorInformation.of(prior), float("inf"))
+        runs = from_earlier_optimum(context, [kept], kept, earlier)
+    lower = min(criterion.value(alpha) for alpha in earlier)
+    assert [r.index for r in runs] == [0, 1, 2]
+    assert runs[1].start_objective == pytest.approx(lower, rel=1e-9)
+    assert runs[2].start_objective == pytest.approx(criterion.value(np.mean(earlier, axis=0)), rel=1e-9)
