@@ -13,6 +13,10 @@ $(STAMP): pyproject.toml constraints.txt
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -c constraints.txt -e ".[test,mujoco,docs,cluster,view]"
 	$(MAKE) --no-print-directory ipopt
+	@# the gradient's and the capsule distances' numba kernels compiled (and cached) here, checked
+	@# against finite differences on the default robot, so the first `make optimize` runs at full speed
+	$(VENV)/bin/excite verify-gradient $(CONFIG) --objective log_trace_inverse > /dev/null || \
+	  { echo "excite verify-gradient $(CONFIG) failed: run it to see which gradient"; exit 1; }
 	touch $(STAMP)
 
 # IPOPT for optimizer.method: ipopt. cyipopt has no Linux wheel on PyPI, so it is built against
