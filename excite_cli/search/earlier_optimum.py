@@ -4,8 +4,8 @@ of the earlier motions.
 
 Stacked on C₀, the motion of an earlier iteration is a point the problem allows (it met every
 constraint on the fine grid, and its transitions were checked) and often a good one: on the G1 with
-the paper's criterion every restart of iteration 2 ended at cond(C) 12.5 and worse, where playing
-iteration 1 again keeps 11.4 (stacking C on itself doubles CᵀC and leaves cond unchanged). A solver
+the paper's criterion every restart of iteration 2 ended above the cond(C) that playing iteration 1
+again keeps (11.38 and 13.13 against 11.23; stacking C on itself doubles CᵀC and leaves cond unchanged). A solver
 started there may stop there (for iteration 2 that point is stationary again), and the motion then
 repeats: the correlation with the earlier iteration says so (1: the same motion).
 
