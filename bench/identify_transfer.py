@@ -56,7 +56,7 @@ from excite_cli.config_file import load_problem
 from excite_cli.design.resolve import build_excitation
 from excite_cli.dynamics.base_parameters import compute_base_parameters
 from excite_cli.dynamics.robot import load_robot
-from excite_cli.dynamics.urdf_source import resolve_urdf
+from excite_cli.dynamics.robot_files import resolve_urdf
 from excite_cli.identification.choice.admission import Admission
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.effects import Term

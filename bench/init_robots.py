@@ -27,7 +27,7 @@ import numpy as np
 import pinocchio as pin
 
 from excite_cli.config_file import load_problem
-from excite_cli.dynamics.urdf_source import example_robot_data_root, robot_model
+from excite_cli.dynamics.robot_files import example_robot_data_root, open_source
 
 ROBOTS = {
     "UR10": "ur_description/urdf/ur10_robot.urdf",
@@ -62,7 +62,7 @@ def _independent_check(config: Path, csv: Path) -> tuple[float, float, float, fl
     problem = load_problem(config)
     share = example_robot_data_root()
     urdf = str(share / "example-robot-data" / "robots" / problem.robot.urdf)
-    model = robot_model(Path(urdf))  # continuous joints as revolute: one angle each, as the export writes them
+    model = open_source(Path(urdf)).model()  # continuous joints as revolute: one angle each, as the export writes them
     geometry = pin.buildGeomFromUrdf(model, urdf, pin.COLLISION, package_dirs=[str(share)])
     data, gdata = model.createData(), pin.GeometryData(geometry)
     header, table = _exported(csv)

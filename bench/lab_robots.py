@@ -31,7 +31,7 @@ sys.path.insert(0, str(ROOT / "tests"))  # the tests' builders of robot files
 
 from conftest import CHAIN_INERTIAL, chain_urdf, panda_mjcf  # noqa: E402
 
-from excite_cli.dynamics.urdf_source import example_robot_data_root  # noqa: E402
+from excite_cli.dynamics.robot_files import example_robot_data_root  # noqa: E402
 
 EXCITE = [sys.executable, "-m", "excite_cli"]
 ROBOTS = example_robot_data_root() / "example-robot-data" / "robots"

@@ -259,7 +259,7 @@ def panda_mjcf(folder: Path, frames: bool = False) -> Path:
     ``frames``, MuJoCo's fixed links as ``<frame>`` elements (what ``MjSpec.to_xml`` writes by default)."""
     import mujoco
 
-    from excite_cli.dynamics.urdf_source import example_robot_data_root
+    from excite_cli.dynamics.robot_files import example_robot_data_root
 
     share = example_robot_data_root()
     text = (share / "example-robot-data/robots/panda_description/urdf/panda.urdf").read_text()

@@ -13,7 +13,7 @@ from typer.testing import CliRunner
 
 from excite_cli.cli import app
 from excite_cli.console.app import EXAMPLES
-from excite_cli.dynamics.urdf_source import installed_share
+from excite_cli.dynamics.robot_files import installed_share
 
 MARKUP = re.compile(r"(?<!\\)\[[^\]]*\]")
 

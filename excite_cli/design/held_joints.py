@@ -35,7 +35,7 @@ from excite_cli.config.constraints import ZmpConfig
 from excite_cli.constraints.support import sole_points
 from excite_cli.constraints.zmp import CONTACT_HEIGHT, has_floating_base
 from excite_cli.dynamics.robot import Robot
-from excite_cli.dynamics.urdf_source import resolve_urdf, robot_model
+from excite_cli.dynamics.robot_files import robot_source
 from excite_cli.errors import ExciteError
 
 #: A contact force counts as inside its cone within this relative tolerance (of μ f_z, rounding).
@@ -191,7 +191,7 @@ def held_joints(robot_cfg, folder, constraints: ConstraintsConfig, robot: Robot)
     None for a fixed base or a problem that names no soles.
 
     Raises:
-        ExciteError: as :func:`~excite_cli.dynamics.urdf_source.robot_model`,
+        ExciteError: as :meth:`~excite_cli.dynamics.source.RobotSource.model`,
             :func:`~excite_cli.constraints.support.sole_points` and :class:`HeldJoints`.
     """
     zmp, com = constraints.zmp, constraints.com
@@ -200,6 +200,6 @@ def held_joints(robot_cfg, folder, constraints: ConstraintsConfig, robot: Robot)
         return None
     field = "constraints.zmp.support_links" if zmp else "constraints.com.support_links"
     friction = zmp.friction if zmp else ZmpConfig.model_fields["friction"].default
-    full = robot_model(resolve_urdf(robot_cfg, folder)[0], True)
+    full = robot_source(robot_cfg, folder).model(True)
     soles = sole_points(robot, links, CONTACT_HEIGHT, field)
     return HeldJoints(full, robot, links, soles, friction, dict(robot_cfg.locked_joints), field)

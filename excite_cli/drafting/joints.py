@@ -13,12 +13,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 
-from excite_cli.dynamics.urdf_source import joint_couplings
+from excite_cli.dynamics.source import RobotSource
 from excite_cli.errors import ExciteError
 
 #: Words that name a gripper's or a hand's joints, and a mobile base's wheels.
@@ -64,19 +63,20 @@ def _first_movable_above(model: pin.Model, joint: int, ids: list[int]) -> int:
     return parent
 
 
-def joint_choice(path: Path, given: list[str] | None, model: pin.Model) -> JointChoice:
+def joint_choice(source: RobotSource, given: list[str] | None, model: pin.Model) -> JointChoice:
     """The active joints of a starting config and the others held (module docstring).
 
     Args:
-        path: the URDF or MJCF; given: the active joints, or None (module docstring).
-        model: pinocchio's model of it (:func:`~excite_cli.dynamics.urdf_source.robot_model`).
+        source: the URDF or MJCF; given: the active joints, or None (module docstring).
+        model: pinocchio's model of it (:meth:`~excite_cli.dynamics.source.RobotSource.model`).
 
     Raises:
         ExciteError: a given joint that is not a 1-DoF joint of the file; no joint given and no
             revolute joint to move (naming the joints there are).
     """
     one_dof = [n for i, n in enumerate(model.names) if i > 0 and model.joints[i].nq == 1]
-    mimics = set(joint_couplings(path))
+    mimics = set(source.couplings())
+    path = source.path
     revolute = [n for n in one_dof if "R" in model.joints[model.getJointId(n)].shortname().replace("JointModel", "")]
     gripper = [] if given else gripper_joints(model, one_dof)
     bodies = {f.name for f in model.frames if f.type == pin.FrameType.BODY}

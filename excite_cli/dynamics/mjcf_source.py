@@ -27,15 +27,17 @@ may have no range: ``limits.velocity`` and ``robot.joint_ranges`` give them
 
 from __future__ import annotations
 
-import functools
 import warnings
+from dataclasses import dataclass
 from pathlib import Path
-from xml.etree import ElementTree
 
 import coal
 import numpy as np
 import pinocchio as pin
 
+from excite_cli.dynamics.mjcf_compiled import compiled
+from excite_cli.dynamics.mjcf_compiled import mjcf_name as _name
+from excite_cli.dynamics.source import RobotSource
 from excite_cli.dynamics.urdf_checks import check_couplings
 from excite_cli.errors import ExciteError, ExciteWarning
 
@@ -44,46 +46,6 @@ ROOT_JOINT = "root_joint"
 FREE, BALL, SLIDE, HINGE = 0, 1, 2, 3  # mjtJoint
 SPHERE, CAPSULE, ELLIPSOID, CYLINDER, BOX, MESH = 2, 3, 4, 5, 6, 7  # mjtGeom
 MOTOR_GAIN, NO_BIAS, JOINT_TRANSMISSION, JOINT_EQUALITY = 0, 0, 0, 2  # mjtGain fixed, mjtBias none, mjtTrn, mjtEq
-
-
-def is_mjcf(path: Path) -> bool:
-    """Whether the XML file at ``path`` is an MJCF (its root element is ``<mujoco>``); False for a file
-    that is not XML (the URDF reader names that)."""
-    try:
-        return ElementTree.parse(path).getroot().tag == "mujoco"
-    except (ElementTree.ParseError, OSError):
-        return False
-
-
-@functools.lru_cache(maxsize=8)
-def _compiled(path: str, mtime: float):
-    try:
-        import mujoco
-    except ImportError:
-        raise ExciteError(
-            "robot.urdf",
-            f"{Path(path).name} is an MJCF, which excite reads with MuJoCo's compiler: MuJoCo is not installed",
-            expected="pip install 'excite-cli[mujoco]' (make install has it)",
-        ) from None
-    try:
-        return mujoco.MjModel.from_xml_path(path)
-    except ValueError as exc:
-        problem = f"MuJoCo cannot compile {Path(path).name}: {' '.join(str(exc).split())[:300]}"
-        raise ExciteError("robot.urdf", problem) from None
-
-
-def compiled(path: Path):
-    """MuJoCo's ``MjModel`` of the MJCF at ``path`` (cached while the file is unchanged).
-
-    Raises:
-        ExciteError: (``robot.urdf``) MuJoCo is not installed, or its compiler refuses the file (a
-            missing include is named by MuJoCo's message).
-    """
-    return _compiled(str(Path(path).resolve()), Path(path).stat().st_mtime)
-
-
-def _name(mj, kind: str, index: int) -> str:
-    return getattr(mj, kind)(index).name or f"{kind}{index}"
 
 
 def _placement(quat: np.ndarray, pos: np.ndarray) -> pin.SE3:
@@ -115,8 +77,18 @@ def _add_joints(mj, model: pin.Model, b: int, parent: tuple[int, pin.SE3], float
     if any(mj.jnt_type[j] == FREE for j in joints):
         if mj.body_parentid[b] != 0 or mj.body_jntnum[b] > 1:
             raise ExciteError("robot.urdf", f"body '{_name(mj, 'body', b)}' has a free joint but is not a root body")
+        if floating and model.existJointName(ROOT_JOINT):
+            raise ExciteError(
+                "robot.floating_base",
+                f"body '{_name(mj, 'body', b)}' has a free joint of its own: the file holds more than one free "
+                "body, and excite's floating base is one root",
+                True,
+                "one free body (the robot's root); a loose object belongs in constraints.environment",
+            )
         if floating:
-            return model.addJoint(0, pin.JointModelFreeFlyer(), pin.SE3.Identity(), ROOT_JOINT), pin.SE3.Identity()
+            root = model.addJoint(0, pin.JointModelFreeFlyer(), pin.SE3.Identity(), ROOT_JOINT)
+            model.addJointFrame(root, -1)
+            return root, pin.SE3.Identity()
         return 0, pin.SE3.Identity()
     here = placement * _placement(mj.body_quat[b], mj.body_pos[b])
     last = np.zeros(3)
@@ -150,7 +122,7 @@ def mjcf_model(path: Path, floating: bool = False) -> pin.Model:
     Raises:
         ExciteError: (``robot.urdf``) see :func:`compiled`; a free joint below the root.
     """
-    mj = compiled(path)
+    mj = compiled(path, meshes=False)
     model = pin.Model()
     model.name = Path(path).stem
     placed: dict[int, tuple[int, pin.SE3]] = {0: (0, pin.SE3.Identity())}
@@ -198,7 +170,7 @@ def joint_torque_limits(mj) -> dict[str, float]:
 def mjcf_couplings(path: Path) -> dict[str, tuple[str, str]]:
     """{follower: (leader, how)} of the MJCF's joint equality constraints (``joint1`` follows
     ``joint2``; ``how``: the polynomial's coefficients in words)."""
-    mj = compiled(path)
+    mj = compiled(path, meshes=False)
     out = {}
     for e in range(mj.neq):
         if mj.eq_type[e] == JOINT_EQUALITY and mj.eq_obj2id[e] >= 0:
@@ -274,3 +246,45 @@ def check_mjcf(path: Path, active: list[str], locked: list[str] = ()) -> None:
         ExciteError: see :func:`~excite_cli.dynamics.urdf_checks.check_couplings`.
     """
     check_couplings(mjcf_couplings(path), active, locked)
+
+
+@dataclass(frozen=True)
+class MjcfSource(RobotSource):
+    """An MJCF as MuJoCo compiles it (module docstring; :class:`~excite_cli.dynamics.source.RobotSource`)."""
+
+    @property
+    def kind(self) -> str:
+        return "MJCF"
+
+    def model(self, floating: bool = False) -> pin.Model:
+        """See :func:`mjcf_model`."""
+        return mjcf_model(self.path, floating)
+
+    def geometry(self, model: pin.Model) -> pin.GeometryModel:
+        """See :func:`mjcf_geometry`."""
+        return mjcf_geometry(model, self.path)
+
+    def couplings(self) -> dict[str, tuple[str, str]]:
+        """See :func:`mjcf_couplings`."""
+        return mjcf_couplings(self.path)
+
+    def check(self, active: list[str], locked: list[str] = (), physical: bool = True) -> list[str]:
+        """The joint couplings (:func:`check_mjcf`); MuJoCo's compiler has checked the bodies."""
+        check_mjcf(self.path, list(active), list(locked))
+        return []
+
+    def named_states(self) -> dict[str, dict[str, float]]:
+        """The keyframes (``<keyframe><key qpos>``), hinge and slide joints only (a free joint's pose is
+        left out: excite holds the base at the identity)."""
+        mj = compiled(self.path, meshes=False)
+        hinges = [j for j in range(mj.njnt) if mj.jnt_type[j] in (HINGE, SLIDE)]
+        return {
+            _name(mj, "key", k): {_name(mj, "joint", j): float(mj.key_qpos[k][mj.jnt_qposadr[j]]) for j in hinges}
+            for k in range(mj.nkey)
+        }
+
+    def free_root(self) -> str | None:
+        """The first free joint of a root body, or None."""
+        mj = compiled(self.path, meshes=False)
+        free = [j for j in range(mj.njnt) if mj.jnt_type[j] == FREE and mj.body_parentid[mj.jnt_bodyid[j]] == 0]
+        return _name(mj, "joint", free[0]) if free else None

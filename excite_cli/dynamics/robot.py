@@ -17,11 +17,9 @@ import numpy as np
 import pinocchio as pin
 
 from excite_cli.config import RobotConfig
-from excite_cli.dynamics.mjcf_source import check_mjcf, is_mjcf
-from excite_cli.dynamics.urdf_checks import check_urdf
+from excite_cli.dynamics.robot_files import open_source, robot_source
+from excite_cli.dynamics.source import apply_joint_ranges
 from excite_cli.dynamics.urdf_meshes import package_folders
-from excite_cli.dynamics.urdf_rounding import angle_rounding
-from excite_cli.dynamics.urdf_source import apply_joint_ranges, resolve_urdf, robot_geometry, robot_model
 from excite_cli.errors import ExciteError
 
 #: Order of pinocchio's 10 dynamic parameters of one body (``Inertia.toDynamicParameters``).
@@ -231,19 +229,15 @@ def load_robot(
 
     Raises:
         ExciteError: missing URDF, unknown joint name, a joint that is not 1-DoF, a locked value
-            outside the joint's limits, a body or active joint that cannot be (:func:`check_urdf`,
-            :func:`check_mjcf`), a joint range that cannot be (:func:`apply_joint_ranges`).
+            outside the joint's limits, a body or active joint that cannot be
+            (:meth:`~excite_cli.dynamics.source.RobotSource.check`), a joint range that cannot be
+            (:func:`~excite_cli.dynamics.source.apply_joint_ranges`).
     """
-    path, package_dirs = (
-        resolve_urdf(cfg, folder) if urdf is None else (urdf, package_folders(urdf, [str(urdf.parent)]))
-    )
+    source = robot_source(cfg, folder) if urdf is None else open_source(urdf, package_folders(urdf, [str(urdf.parent)]))
     active, locked = list(cfg.active_joints), list(cfg.locked_joints)
-    mjcf = is_mjcf(path)
-    problems = [] if mjcf else check_urdf(path, active, physical, locked)  # before urdfdom prints what it cannot parse
-    full = robot_model(path, cfg.floating_base)
-    if mjcf:
-        check_mjcf(path, active, locked)
-    apply_joint_ranges(full, cfg.joint_ranges, path.name)
+    problems = source.check(active, locked, physical)  # before urdfdom prints what it cannot parse
+    full = source.model(cfg.floating_base)
+    apply_joint_ranges(full, cfg.joint_ranges, source.path.name)
 
     movable = _check_joints(cfg, full)
     q_full = pin.neutral(full)
@@ -252,12 +246,12 @@ def load_robot(
     lock_ids = [full.getJointId(n) for n in movable if n not in cfg.active_joints]
     geometry = None
     if collision:
-        geometry = robot_geometry(full, path, package_dirs)
+        geometry = source.geometry(full)
         try:
             model, geometry = pin.buildReducedModel(full, geometry, lock_ids, q_full)
         except ValueError as exc:  # a joint and a link of one name (so100's "gripper"): pinocchio cannot reduce
             if lock_ids:
-                problem = f"pinocchio cannot hold joints of {path.name}: {exc}"
+                problem = f"pinocchio cannot hold joints of {source.path.name}: {exc}"
                 raise ExciteError("robot.locked_joints", problem) from None
             model = full  # nothing to hold
     else:
@@ -288,6 +282,6 @@ def load_robot(
         home=np.clip(home, lower, upper),
         collision_model=geometry,
         links=joint_frame_links(full),
-        warnings=[f"{p} in {path.name}: kept as the identification's reference only" for p in problems],
-        angle_rounding=0.0 if mjcf else angle_rounding(path),
+        warnings=[f"{p} in {source.path.name}: kept as the identification's reference only" for p in problems],
+        angle_rounding=source.angle_rounding(),
     )

@@ -11,7 +11,7 @@ import numpy as np
 
 from excite_cli.dynamics.base_parameters import BaseParameters, compute_base_parameters
 from excite_cli.dynamics.robot import Robot, load_robot
-from excite_cli.dynamics.urdf_source import resolve_urdf
+from excite_cli.dynamics.robot_files import resolve_urdf
 from excite_cli.effects import EFFECTS
 from excite_cli.errors import ExciteError
 from excite_cli.identification.choice.consistent_model import consistent_model

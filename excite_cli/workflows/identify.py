@@ -8,7 +8,7 @@ from typing import Optional
 
 from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.dynamics.robot import Robot
-from excite_cli.dynamics.urdf_source import resolve_urdf
+from excite_cli.dynamics.robot_files import resolve_urdf
 from excite_cli.errors import ExciteError
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.pipeline import run_identification, write_identified_urdf

@@ -15,7 +15,7 @@ from excite_cli.config_file import load_problem
 from excite_cli.constraints.zmp import zero_moment_point
 from excite_cli.design.held_joints import held_joints
 from excite_cli.design.resolve import build_excitation
-from excite_cli.dynamics.urdf_source import resolve_urdf
+from excite_cli.dynamics.robot_files import resolve_urdf
 from excite_cli.errors import ExciteError
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))

@@ -79,7 +79,7 @@ def test_a_per_joint_position_margin_narrows_that_joint_alone(ur5_problem):
 
     from excite_cli.constraints.joint_limits import joint_limit_bounds
     from excite_cli.dynamics.robot import load_robot
-    from excite_cli.dynamics.urdf_source import example_robot_data_root
+    from excite_cli.dynamics.robot_files import example_robot_data_root
 
     ur5_problem.limits.position_margin = {"elbow_joint": 0.6283}
     robot = load_robot(ur5_problem.robot, ur5_problem.folder, False)

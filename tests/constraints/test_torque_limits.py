@@ -15,7 +15,7 @@ from excite_cli.cli import app
 from excite_cli.constraints.lse import GRID_MARGIN
 from excite_cli.constraints.torque_limits import TorqueLimits, TorqueUse
 from excite_cli.design.resolve import build_excitation
-from excite_cli.dynamics.urdf_source import example_robot_data_root
+from excite_cli.dynamics.robot_files import example_robot_data_root
 
 runner = CliRunner()
 PANDA_JOINTS = [f"panda_joint{k}" for k in range(1, 8)]

@@ -15,7 +15,7 @@ from scipy.spatial import ConvexHull
 from excite_cli.config_file import load_problem, with_overrides
 from excite_cli.design.held_joints import held_joints
 from excite_cli.design.resolve import build_excitation
-from excite_cli.dynamics.urdf_source import resolve_urdf
+from excite_cli.dynamics.robot_files import resolve_urdf
 from excite_cli.storage.export import Played, export_trajectory
 from excite_cli.storage.export_files import write_export
 

@@ -16,7 +16,7 @@ from excite_cli.constraints import JointLimits
 from excite_cli.constraints.lse import GRID_MARGIN
 from excite_cli.design.playback import RESOLUTION, Transition, approach_duration, plan_transition
 from excite_cli.design.resolve import build_excitation
-from excite_cli.dynamics.urdf_source import example_robot_data_root
+from excite_cli.dynamics.robot_files import example_robot_data_root
 from excite_cli.storage.rosbag import TOPIC
 from excite_cli.workflows.export import played_result
 

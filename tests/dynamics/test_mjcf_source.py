@@ -9,8 +9,10 @@ from conftest import JOINTS, included_arm_mjcf, panda_mjcf
 
 from excite_cli.config import RobotConfig
 from excite_cli.dynamics.base_parameters import compute_base_parameters
-from excite_cli.dynamics.mjcf_source import is_mjcf, mjcf_couplings
+from excite_cli.dynamics.mjcf_compiled import is_mjcf
+from excite_cli.dynamics.mjcf_source import mjcf_couplings
 from excite_cli.dynamics.robot import load_robot
+from excite_cli.dynamics.robot_files import open_source
 from excite_cli.errors import ExciteError, ExciteWarning
 
 ARM = """<mujoco model="arm">{compiler}
@@ -149,3 +151,60 @@ def test_a_floor_in_the_worldbody_is_the_world_s(tmp_path):
     (tmp_path / "arm.xml").write_text(ON_A_FLOOR)
     robot = load_robot(RobotConfig(urdf=str(tmp_path / "arm.xml"), active_joints=["j1"]), collision=True)
     assert [robot.model.frames[o.parentFrame].name for o in robot.collision_model.geometryObjects] == ["link1"]
+
+
+FLOATING = """<mujoco model="walker">
+  <asset><mesh name="shell" file="absent/shell.stl"/></asset>
+  <worldbody>
+    <body name="pelvis" pos="0 0 0.5">
+      <freejoint name="floating_base_joint"/>
+      <inertial pos="0 0 0" mass="5" diaginertia="0.05 0.05 0.05"/>
+      <geom type="mesh" mesh="shell"/>
+      <body name="leg" pos="0 0 -0.1">
+        <joint name="hip" axis="0 1 0" range="-1 1"/>
+        <inertial pos="0 0 -0.2" mass="1" diaginertia="0.01 0.01 0.001"/>
+        <geom type="sphere" pos="0 0 -0.4" size="0.01"/>
+      </body>
+    </body>{loose}
+  </worldbody>
+  <keyframe><key name="crouch" qpos="0 0 0.45 1 0 0 0 0.3"/></keyframe>
+</mujoco>
+"""
+LOOSE = """
+    <body name="box" pos="1 0 0.1"><freejoint/><inertial pos="0 0 0" mass="1" diaginertia="0.01 0.01 0.01"/></body>"""
+
+
+def test_a_free_root_its_keyframes_and_no_mesh_read_for_the_model(tmp_path):
+    """The free joint is named, a keyframe is a named posture (the free joint's pose left out), and the model
+    (floating or not) compiles without the absent mesh: the bodies' inertias are given, so no mesh changes
+    them (the collision geometry still needs it, and says so)."""
+    path = tmp_path / "walker.xml"
+    path.write_text(FLOATING.format(loose=""))
+    source = open_source(path)
+    assert source.kind == "MJCF" and source.free_root() == "floating_base_joint"
+    assert source.named_states() == {"crouch": {"hip": pytest.approx(0.3)}}
+    floating = source.model(floating=True)
+    assert floating.names[1] == "root_joint" and floating.nq == 8 and source.model().nq == 1
+    with pytest.raises(ExciteError, match="robot.urdf: MuJoCo cannot compile walker.xml"):
+        source.geometry(floating)
+
+
+def test_a_second_free_body_is_one_line_not_a_traceback(tmp_path):
+    path = tmp_path / "walker.xml"
+    path.write_text(FLOATING.format(loose=LOOSE))
+    with pytest.raises(ExciteError) as raised:
+        open_source(path).model(floating=True)
+    assert raised.value.describe().startswith(
+        "robot.floating_base: body 'box' has a free joint of its own: the file holds more than one free body"
+    )
+
+
+def test_a_body_whose_inertia_comes_from_its_mesh_needs_the_mesh(tmp_path):
+    """Without <inertial>, MuJoCo takes a body's inertia from its geoms: without the mesh it would change,
+    so the mesh is read (and its absence named)."""
+    path = tmp_path / "walker.xml"
+    path.write_text(
+        FLOATING.format(loose="").replace('<inertial pos="0 0 0" mass="5" diaginertia="0.05 0.05 0.05"/>', "")
+    )
+    with pytest.raises(ExciteError, match="MuJoCo cannot compile walker.xml"):
+        open_source(path).model()

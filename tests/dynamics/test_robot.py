@@ -8,7 +8,7 @@ from conftest import CONFIGS, GOOD, PENDULUM
 
 from excite_cli.config_file import load_problem
 from excite_cli.dynamics.robot import load_robot
-from excite_cli.dynamics.urdf_source import resolve_urdf
+from excite_cli.dynamics.robot_files import resolve_urdf
 from excite_cli.errors import ExciteError
 
 

@@ -7,8 +7,8 @@ import pinocchio as pin
 import pytest
 
 from excite_cli.config import RobotConfig
+from excite_cli.dynamics.robot_files import example_robot_data_root, resolve_urdf
 from excite_cli.dynamics.urdf_meshes import MAX_MESH_BYTES, check_meshes, collision_geometry, mesh_path, package_folders
-from excite_cli.dynamics.urdf_source import example_robot_data_root, resolve_urdf
 from excite_cli.errors import ExciteError
 
 #: An ASCII STL of one triangle.

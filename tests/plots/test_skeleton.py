@@ -5,7 +5,7 @@ import pinocchio as pin
 from conftest import CONFIGS, robot_of, write_config
 
 from excite_cli.config_file import load_problem
-from excite_cli.dynamics.urdf_source import example_robot_data_root
+from excite_cli.dynamics.robot_files import example_robot_data_root
 from excite_cli.plots.skeleton import skeleton
 
 

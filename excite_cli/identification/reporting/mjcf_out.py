@@ -23,7 +23,7 @@ import numpy as np
 import pinocchio as pin
 
 from excite_cli.atomic import MARK, atomic_path
-from excite_cli.dynamics.mjcf_source import is_mjcf
+from excite_cli.dynamics.mjcf_compiled import is_mjcf
 from excite_cli.dynamics.robot import Robot
 from excite_cli.dynamics.urdf_meshes import mesh_path
 from excite_cli.errors import ExciteError

@@ -21,7 +21,7 @@ import pinocchio as pin
 
 from excite_cli.atomic import atomic_path
 from excite_cli.config import RobotConfig
-from excite_cli.dynamics.mjcf_source import is_mjcf
+from excite_cli.dynamics.mjcf_compiled import is_mjcf
 from excite_cli.dynamics.robot import Robot, load_robot
 from excite_cli.errors import ExciteError
 

@@ -6,7 +6,7 @@ import h5py
 import numpy as np
 from conftest import rows_copy
 
-from excite_cli.dynamics.urdf_source import resolve_urdf
+from excite_cli.dynamics.robot_files import resolve_urdf
 from excite_cli.identification.reporting.mjcf_check import check_mjcf
 from excite_cli.identification.reporting.mjcf_out import write_mjcf
 from excite_cli.identification.reporting.report_file import write_identification

@@ -12,7 +12,7 @@ from conftest import CONFIGS, JOINTS, panda_mjcf
 
 from excite_cli.config_file import load_problem
 from excite_cli.dynamics.robot import load_robot
-from excite_cli.dynamics.urdf_source import resolve_urdf
+from excite_cli.dynamics.robot_files import resolve_urdf
 from excite_cli.errors import ExciteError
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.effects import Term

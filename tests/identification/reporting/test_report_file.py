@@ -8,7 +8,7 @@ import numpy as np
 import pinocchio as pin
 from conftest import rows_copy
 
-from excite_cli.dynamics.urdf_source import resolve_urdf
+from excite_cli.dynamics.robot_files import resolve_urdf
 from excite_cli.h5 import read_strings
 from excite_cli.identification.reporting.report import Report
 from excite_cli.identification.reporting.report_file import write_identification

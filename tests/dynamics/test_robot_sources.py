@@ -7,9 +7,11 @@ import pytest
 from conftest import assert_refused, pendulum_config
 from typer.testing import CliRunner
 
-import excite_cli.dynamics.urdf_source as urdf_source
+import excite_cli.dynamics.robot_files as robot_files
 from excite_cli.cli import app
-from excite_cli.dynamics.urdf_source import apply_joint_ranges, robot_model
+from excite_cli.config import RobotConfig
+from excite_cli.dynamics.robot_files import open_source
+from excite_cli.dynamics.source import apply_joint_ranges
 from excite_cli.errors import ExciteError
 
 runner = CliRunner()
@@ -25,7 +27,7 @@ def without_example_robot_data(monkeypatch):
             raise metadata.PackageNotFoundError(name)
         return real(name)
 
-    monkeypatch.setattr(urdf_source.metadata, "distribution", distribution)
+    monkeypatch.setattr(robot_files.metadata, "distribution", distribution)
 
 
 def test_a_urdf_of_one_s_own_is_optimized_without_example_robot_data(tmp_path, without_example_robot_data):
@@ -33,8 +35,8 @@ def test_a_urdf_of_one_s_own_is_optimized_without_example_robot_data(tmp_path, w
     result = runner.invoke(app, ["optimize", str(config), "-o", str(tmp_path / "out.h5")])
     assert result.exit_code == 0, result.output
     assert (tmp_path / "out.h5").is_file()
-    path, folders = urdf_source.resolve_urdf(
-        urdf_source.RobotConfig(urdf="pendulum.urdf", source="file", active_joints=["hinge"]), tmp_path
+    path, folders = robot_files.resolve_urdf(
+        RobotConfig(urdf="pendulum.urdf", source="file", active_joints=["hinge"]), tmp_path
     )
     assert path == tmp_path / "pendulum.urdf" and "cmeel.prefix" not in " ".join(folders)
 
@@ -54,9 +56,33 @@ def test_a_shipped_config_without_example_robot_data_is_one_line(tmp_path, witho
 )
 def test_a_joint_range_that_cannot_be_is_named(tmp_path, ranges, expected):
     pendulum_config(tmp_path)
-    model = robot_model(tmp_path / "pendulum.urdf")
+    model = open_source(tmp_path / "pendulum.urdf").model()
     with pytest.raises(ExciteError) as raised:
         apply_joint_ranges(model, ranges, "pendulum.urdf")
     assert raised.value.describe().startswith(expected)
     apply_joint_ranges(model, {"hinge": (-1.0, 0.5)}, "pendulum.urdf")  # narrower: taken
     assert (model.lowerPositionLimit[0], model.upperPositionLimit[0]) == (-1.0, 0.5)
+
+
+def test_one_record_per_format_gives_the_same_robot(tmp_path):
+    """The Panda as its URDF and as the MJCF MuJoCo writes of it: each format's record gives the same
+    pinocchio model (masses and joint limits); an SRDF names a URDF's states, and an MJCF's refuses it."""
+    from conftest import panda_mjcf
+
+    from excite_cli.dynamics.mjcf_source import MjcfSource
+    from excite_cli.dynamics.robot_files import example_robot_data_root
+    from excite_cli.dynamics.urdf_source import UrdfSource
+
+    urdf = example_robot_data_root() / "example-robot-data/robots/panda_description/urdf/panda.urdf"
+    sources = [open_source(urdf), open_source(panda_mjcf(tmp_path))]
+    assert [type(s) for s in sources] == [UrdfSource, MjcfSource]
+    models = [s.model() for s in sources]
+    masses = [[m.inertias[j].mass for j in range(1, 8)] for m in models]
+    assert masses[0] == pytest.approx(masses[1], abs=1e-5)  # MuJoCo writes 6 significant digits
+    assert list(models[0].lowerPositionLimit[:7]) == pytest.approx(list(models[1].lowerPositionLimit[:7]))
+    srdf = tmp_path / "panda.srdf"
+    ready = '<group_state name="ready" group="arm"><joint name="panda_joint4" value="-2.4"/></group_state>'
+    srdf.write_text(f'<robot name="panda">{ready}</robot>')
+    assert sources[0].with_srdf(srdf).named_states() == {"ready": {"panda_joint4": -2.4}}
+    with pytest.raises(ExciteError, match="srdf: names the states of a URDF; panda.xml is an MJCF"):
+        sources[1].with_srdf(srdf)
