@@ -10,7 +10,7 @@ from excite_cli.dynamics.robot import Robot
 from excite_cli.errors import ExciteError
 
 
-def _shape_points(shape: coal.CollisionGeometry) -> np.ndarray:
+def shape_points(shape: coal.CollisionGeometry) -> np.ndarray:
     """(k, 3) points on the surface of one collision shape, in its own frame [m]."""
     if hasattr(shape, "vertices") and hasattr(shape, "num_vertices"):
         return np.asarray(shape.vertices(), dtype=float)
@@ -56,7 +56,7 @@ def link_points(robot: Robot, link: str, field: str = "constraints.self_collisio
     parts, joint = [], None
     for obj in robot.collision_model.geometryObjects:
         if robot.model.frames[obj.parentFrame].name == link:
-            local = _shape_points(obj.geometry)  # a mesh is loaded at its URDF scale already
+            local = shape_points(obj.geometry)  # a mesh is loaded at its URDF scale already
             parts.append(local @ obj.placement.rotation.T + obj.placement.translation)
             joint = obj.parentJoint
     if joint is None:

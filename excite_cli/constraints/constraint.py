@@ -44,6 +44,7 @@ class Constraint(ABC):
             the stance's compliance moves): the optimizer keeps it, ``export`` warns instead of refusing.
         bounds_torque: whether it bounds the joint torques (|τ| ≤ τ_max), which a transition
             (:mod:`~excite_cli.design.playback`) must keep as well.
+        home_clearance: what a drafted home posture keeps beyond the margin of :meth:`clearance` [m].
     """
 
     name: str
@@ -54,6 +55,7 @@ class Constraint(ABC):
     needs_motion: bool = False
     advisory: bool = False
     bounds_torque: bool = False
+    home_clearance: float = 0.005
     capsules: Sequence = ()
 
     @abstractmethod
@@ -100,6 +102,11 @@ class Constraint(ABC):
         """Link pairs whose capsules are never farther apart than ``apart`` [m] at the postures Q
         (K, n) [rad], with the largest distance [m] (a self-collision's; default none): pairs no motion
         separates, which ``init`` excludes."""
+        return []
+
+    def out_of_reach(self) -> list[tuple[tuple[str, str], float]]:
+        """Link pairs no motion brings within the margin, with a bound on their distance [m] (a
+        self-collision's; default none): pairs ``init`` excludes, as they cost time and bind nothing."""
         return []
 
     def always_within(self, Q: np.ndarray) -> list[tuple[str, float]]:

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import coal
 import numpy as np
+import pinocchio as pin
 
 import excite_cli.constraints.lse as lse
 from excite_cli.collision.capsules import Capsule, capsule_frames, segment_ends
@@ -29,6 +30,13 @@ from excite_cli.trajectory.fourier import FourierBasis
 LENGTH_SCALE = 0.05
 #: The fine check asks coal for every sample screened within this of the smallest distance [m].
 CONFIRM = 1e-3
+
+
+def _point_segment(point: np.ndarray, start: np.ndarray, end: np.ndarray) -> float:
+    """Distance [m] from ``point`` (3,) to the segment [start, end]."""
+    along = end - start
+    t = np.clip((point - start) @ along / max(along @ along, 1e-300), 0.0, 1.0)
+    return float(np.linalg.norm(point - start - t * along))
 
 
 class SelfCollision(Constraint):
@@ -75,6 +83,42 @@ class SelfCollision(Constraint):
             for k, (i, j) in enumerate(self.pairs)
             if d[k] < apart
         ]
+
+    def out_of_reach(self) -> list[tuple[tuple[str, str], float]]:
+        """Link pairs whose capsules no motion of the active joints brings within the margin, with the
+        smallest distance [m] they could have (a bound, not a sample): every point of a capsule lies within
+        its reach of the origin of the first active joint that moves it (the offsets between the joints
+        of the chain summed, plus the capsule's farthest end from its joint and its radius), and a capsule no
+        active joint moves stays where it is (the triangle inequality)."""
+        model, data = self.robot.model, self.robot.model.createData()
+        pin.forwardKinematics(model, data, self.robot.q_reference)
+        active = {model.getJointId(name) for name in self.robot.joint_names}
+        where = []
+        for c in self.capsules:
+            chain = [j for j in model.supports[c.joint].tolist() if j in active]
+            far = max(np.linalg.norm(c.start), np.linalg.norm(c.end)) + c.radius
+            offsets = sum(np.linalg.norm(model.jointPlacements[j].translation) for j in chain[1:])
+            if chain:
+                where.append((chain[0], data.oMi[chain[0]].translation.copy(), offsets + far))
+            else:
+                placement = data.oMi[c.joint]
+                ends = [placement.act(np.asarray(e, float)) for e in (c.start, c.end)]
+                where.append((None, ends, c.radius))
+        found = []
+        for i, j in self.pairs:
+            (first_i, at_i, reach_i), (first_j, at_j, reach_j) = where[i], where[j]
+            if first_i is not None and first_j is not None:
+                gap = np.inf if first_i == first_j else np.linalg.norm(at_i - at_j) - reach_i - reach_j
+            elif first_i is None and first_j is None:
+                continue
+            else:
+                (origin, reach), (ends, radius) = (
+                    ((at_i, reach_i), (at_j, reach_j)) if first_i is not None else ((at_j, reach_j), (at_i, reach_i))
+                )
+                gap = _point_segment(origin, *ends) - radius - reach
+            if np.isfinite(gap) and gap > self.margin:
+                found.append(((self.capsules[i].link, self.capsules[j].link), float(gap)))
+        return found
 
     def drawn(self) -> dict[str, object]:
         """The margin under the closest capsule distance's track."""

@@ -37,6 +37,8 @@ from excite_cli.trajectory.fourier import FourierBasis
 #: The soles' contact points: collision points within this height of the lowest [m] (a sphere's
 #: bottom, a box's lower face), the polygon the centre of pressure can reach.
 CONTACT_HEIGHT = 0.001
+#: What a drafted home posture keeps beyond the margin [m] (or half the room beyond it on small soles).
+HOME_CLEARANCE = 0.02
 #: Standard gravity [m/s²], which pinocchio's models carry.
 GRAVITY = 9.81
 #: The normal force's row is normalized by this fraction of the weight m g: −F_z / (0.1 m g) ≤ 0, so
@@ -93,6 +95,9 @@ class ZeroMomentPoint(Constraint):
                 f"less than {room:.3g} m",
             )
         self.robot, self.basis, self.polygon, self.margin = robot, basis, polygon, float(margin)
+        # a drafted home keeps 2 cm beyond the margin (half the room there is on small soles): the arms'
+        # accelerations move the ZMP from where it stands
+        self.home_clearance = min(HOME_CLEARANCE, (room - self.margin) / 2)
         self.data = robot.model.createData()
         self._orders = (basis.q, basis.qd, basis.qdd)
         self._weight = GRAVITY * sum(inertia.mass for inertia in robot.model.inertias)
@@ -103,6 +108,14 @@ class ZeroMomentPoint(Constraint):
         return (
             f"ZMP inside the support polygon less {1000 * self.margin:g} mm "
             f"(standing at home: {1000 * float(home.details['zmp_min_margin_m']):.1f} mm inside); F_z > 0"
+        )
+
+    def clearance(self, Q: np.ndarray) -> np.ndarray:
+        """(K,) the distance [m] beyond the margin of the ZMP of the robot standing still at each posture
+        Q (K, n) [rad] (there, the centre of mass's ground projection)."""
+        still = np.zeros_like(Q)
+        return (
+            self.polygon.margins(zero_moment_point(self.wrenches(Q, still, still), self.polygon.height)) - self.margin
         )
 
     def wrenches(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:

@@ -19,7 +19,15 @@ from excite_cli.design.excitation import Excitation
 from excite_cli.design.resolve import build_excitation
 from excite_cli.drafting.home_posture import home_posture
 from excite_cli.drafting.joints import joint_choice
-from excite_cli.dynamics.urdf_source import apply_joint_ranges, robot_geometry, robot_model
+from excite_cli.drafting.stance import Stance
+from excite_cli.drafting.standing import (
+    StandOptions,
+    stance_for,
+    standing_assumptions,
+    standing_choice,
+    standing_constraints,
+)
+from excite_cli.dynamics.source import RobotSource, apply_joint_ranges
 from excite_cli.errors import ExciteError
 
 #: Random postures the capsule overlaps and the home posture are searched over.
@@ -94,10 +102,10 @@ def _limits(model: pin.Model, active: list[str], draft: StartingConfig) -> dict:
     return limits
 
 
-def _base_floor(model: pin.Model, path: Path, package_dirs: list[str]) -> float:
+def _base_floor(model: pin.Model, source: RobotSource) -> float:
     """Height [m] of the lowest point of the root link's collision geometry (0 without any), from the
-    URDF ``path`` and its ``model``."""
-    geometry = robot_geometry(model, path, package_dirs)
+    robot's ``source`` and its ``model``."""
+    geometry = source.geometry(model)
     data, gdata = model.createData(), pin.GeometryData(geometry)
     pin.updateGeometryPlacements(model, data, geometry, gdata, pin.neutral(model))
     lowest = 0.0
@@ -116,9 +124,9 @@ def _random_postures(excitation: Excitation, rng: np.random.Generator) -> np.nda
 
 
 def _always_overlapping(excitation: Excitation, Q: np.ndarray, draft: StartingConfig) -> None:
-    """Capsule pairs never farther apart than :data:`NEVER_APART` over the postures Q: excluded (as
-    link pairs), with why; links within a world shape's margin at every posture: ignored by the world
-    constraint, with why."""
+    """Capsule pairs never farther apart than :data:`NEVER_APART` over the postures Q, or that no motion
+    brings within their margin: excluded (as link pairs), with why; links within a world shape's margin at
+    every posture: ignored by the world constraint, with why."""
     for c in excitation.constraints:
         for pair, distance in c.never_apart(Q, NEVER_APART):
             if pair not in [(x, y) for x, y, _ in draft.excluded]:
@@ -129,92 +137,130 @@ def _always_overlapping(excitation: Excitation, Q: np.ndarray, draft: StartingCo
                     else f"overlapping by at least {-farthest:.1f} cm at all {len(Q)} random postures"
                 ) + ": the capsules of neighbouring links, which touch at every posture"
                 draft.excluded.append((*pair, why))
+        for pair, gap in c.out_of_reach():
+            if pair not in [(x, y) for x, y, _ in draft.excluded]:
+                draft.excluded.append(
+                    (*pair, f"out of reach: never closer than {100 * gap:.1f} cm, whatever the joints do")
+                )
         for link, margin in c.always_within(Q):
             if link not in [x for x, _ in draft.ignored]:
-                draft.ignored.append((link, f"within {margin:g} m of the mounting plane at all postures"))
+                draft.ignored.append((link, f"within {margin:g} m of the plane under it at all postures"))
 
 
 #: The trajectory, optimizer and sequence a starting config gets: the shipped lab arms' (10 s, 5 harmonics),
-#: with up to 400 solver iterations instead of 200 (a restart stops where it converges; on the UR10 a
-#: kept restart stuck at KKT 0.12 after 200 converged at 292).
+#: the constraint grid sampling the highest harmonic 40 times per period, as the shipped G1 problem's does
+#: (10 harmonics of π/4 rad/s on 0.02 s): 0.05 s. The optimizer's sizes are fitted to the budget by ``init``
+#: (:func:`~excite_cli.search.run_time.sizes_within`), up to 400 solver iterations per restart (a restart
+#: stops where it converges; on the UR10 a kept restart stuck at KKT 0.12 after 200 converged at 292).
+HARMONICS, BASE_FREQUENCY, SAMPLES_PER_PERIOD = 5, 2 * math.pi / 10, 40
 TRAJECTORY = {
-    "harmonics": 5,
-    "base_frequency": 2 * math.pi / 10,
+    "harmonics": HARMONICS,
+    "base_frequency": BASE_FREQUENCY,
     "cost_samples": 50,
     "cost_period": 0.2,
-    "constraint_period": 0.02,
+    "constraint_period": math.floor(100 * 2 * math.pi / (HARMONICS * BASE_FREQUENCY) / SAMPLES_PER_PERIOD) / 100,
     "boundary": "rest",
 }
 OPTIMIZER = {"max_iterations": 400, "restarts": 4, "starts": 16, "screen_iterations": 40}
 
 
-def _choose_joints(robot: dict, urdf: Path, joints: list[str] | None, draft: StartingConfig) -> pin.Model:
-    """The robot section's joints and ranges (:func:`~excite_cli.drafting.joints.joint_choice`) in
-    ``draft``; the file's model, with those ranges."""
-    model = robot_model(urdf)
-    choice = joint_choice(urdf, joints, model)
-    apply_joint_ranges(model, {n: tuple(r) for n, r in choice.ranges.items()}, urdf.name)
+def _choose_joints(
+    source: RobotSource, model: pin.Model, joints: list[str] | None, stance: Stance | None, draft: StartingConfig
+) -> None:
+    """The robot section's joints and ranges in ``draft``: a standing robot's
+    (:func:`~excite_cli.drafting.standing.standing_choice`), else
+    :func:`~excite_cli.drafting.joints.joint_choice`'s; ``model`` given those ranges."""
+    choice = standing_choice(stance, joints, model) if stance else joint_choice(source, joints, model)
+    apply_joint_ranges(model, {n: tuple(r) for n, r in choice.ranges.items()}, source.path.name)
+    if stance:
+        draft.config["robot"]["floating_base"] = True
     draft.config["robot"].update(active_joints=choice.active, locked_joints=choice.held)
     if choice.ranges:
         draft.config["robot"]["joint_ranges"] = choice.ranges
     draft.config["robot"]["home_posture"] = {}
     draft.assumptions.update(choice.assumptions)
-    return model
+
+
+def _constraints(model: pin.Model, source: RobotSource, stance: Stance | None, draft: StartingConfig) -> None:
+    """A standing robot's constraints (:func:`~excite_cli.drafting.standing.standing_constraints`), else
+    capsules and a mounting plane under the base, in ``draft``."""
+    if stance:
+        draft.config["constraints"] = standing_constraints(stance, CAPSULE_MARGIN)
+        draft.assumptions.update(standing_assumptions(stance))
+        return
+    floor = round(_base_floor(model, source), 4) + 0.0  # no -0
+    plane = {"name": "mounting_plane", "type": "half_space", "point": [0.0, 0.0, floor], "normal": [0.0, 0.0, 1.0]}
+    draft.config["constraints"] = {
+        "self_collision": {"capsules": "auto", "margin": CAPSULE_MARGIN, "exclude_pairs": []},
+        "environment": {"shapes": [{**plane, "margin": PLANE_MARGIN}]},
+    }
+    draft.assumptions["constraints.environment"] = (
+        f"a plane under the base (z = {floor:g} m, the base's lowest collision point): the table top or floor"
+    )
 
 
 def draft_config(
-    robot: dict, urdf: Path, package_dirs: list[str], joints: list[str] | None, target: Path, collision: bool = True
+    robot: dict,
+    source: RobotSource,
+    joints: list[str] | None,
+    target: Path,
+    collision: bool = True,
+    options: StandOptions = StandOptions(),
 ) -> StartingConfig:
     """A starting config for the URDF or MJCF of ``robot`` (the section's ``urdf`` and ``source``), to be
-    written to ``target``. When no home posture holds, the best one found is written and
-    ``StartingConfig.problem`` says what binds there (the file's comments too).
+    written to ``target``: a standing problem for a legged robot
+    (:func:`~excite_cli.drafting.standing.stance_for`), else a fixed base. When no home posture holds, the
+    best one found is written and ``StartingConfig.problem`` says what binds there (the file's comments too).
 
     Args:
         robot: {"urdf": ..., "source": ...} as the config will say them.
-        urdf: the robot's file; package_dirs: where its meshes are.
-        joints: the active joints, or None (see :func:`~excite_cli.drafting.joints.joint_choice`).
-        collision: fit capsules to the collision meshes and draft a mounting plane; False: neither
-            (no meshes are read).
+        source: the robot's file (and where its meshes are).
+        joints: the active joints, or None (the arms of a standing robot, else see
+            :func:`~excite_cli.drafting.joints.joint_choice`).
+        collision: fit capsules to the collision meshes and draft a mounting plane or the floor; False:
+            neither (no meshes are read, and no standing problem drafted).
+        options: what the user said of the stance (:func:`~excite_cli.drafting.standing.stance_for`).
 
     Raises:
-        ExciteError: an unknown joint; a mesh that cannot be read.
+        ExciteError: an unknown joint; a mesh that cannot be read; see
+            :func:`~excite_cli.drafting.standing.stance_for`.
     """
     draft = StartingConfig({"robot": dict(robot)})
-    model = _choose_joints(robot, urdf, joints, draft)
+    model = source.model()
+    stance, draft.assumptions["robot.floating_base"] = stance_for(source, model, options, collision, joints)
+    _choose_joints(source, model, joints, stance, draft)
     active = draft.config["robot"]["active_joints"]
     draft.config["trajectory"] = dict(TRAJECTORY)
     draft.config["limits"] = _limits(model, active, draft)
     if collision:
-        floor = round(_base_floor(model, urdf, package_dirs), 4) + 0.0  # no -0
-        plane = {"name": "mounting_plane", "type": "half_space", "point": [0.0, 0.0, floor], "normal": [0.0, 0.0, 1.0]}
-        draft.config["constraints"] = {
-            "self_collision": {"capsules": "auto", "margin": CAPSULE_MARGIN, "exclude_pairs": []},
-            "environment": {"shapes": [{**plane, "margin": PLANE_MARGIN}]},
-        }
-        draft.assumptions["constraints.environment"] = (
-            f"a plane under the base (z = {floor:g} m, the base's lowest collision point): the table top or floor"
-        )
+        _constraints(model, source, stance, draft)
     draft.config["optimizer"] = dict(OPTIMIZER)
     draft.config["sequence"] = {"iterations": 3}
-    draft.config["output"] = f"results/{urdf.stem}.h5"
+    draft.config["output"] = f"results/{source.path.stem}.h5"
     excitation = build_excitation(drafted_problem(draft.config, target), check_home=False)
     if not any(len(c.capsules) for c in excitation.constraints):
-        draft.config.pop("constraints", None)
+        for section in ("self_collision", "environment"):
+            draft.config.get("constraints", {}).pop(section, None)
+        if not draft.config.get("constraints"):
+            draft.config.pop("constraints", None)
         draft.assumptions.pop("constraints.environment", None)
-        draft.assumptions["constraints"] = (
+        which = "constraints.self_collision" if "constraints" in draft.config else "constraints"
+        draft.assumptions[which] = (
             "none: "
             + ("the file has no collision geometry on a moving link" if collision else "collision geometry not read")
             + " (give capsules in constraints.self_collision)"
         )
     Q = _random_postures(excitation, np.random.default_rng(0))
     _always_overlapping(excitation, Q, draft)
-    if "constraints" in draft.config:
-        draft.config["constraints"]["self_collision"]["exclude_pairs"] = [[a, b] for a, b, _ in draft.excluded]
+    capsules = draft.config.get("constraints", {}).get("self_collision")
+    if capsules:
+        capsules["exclude_pairs"] = [[a, b] for a, b, _ in draft.excluded]
     if draft.ignored:
         draft.config["constraints"]["environment"]["ignore_links"] = [link for link, _ in draft.ignored]
     # the same robot: its base parameters need not be computed again
     excitation = build_excitation(drafted_problem(draft.config, target), excitation.base, check_home=False)
-    home, why, found = home_posture(excitation, Q, np.random.default_rng(1))
+    first = np.array([stance.posture[n] for n in active]) if stance else None
+    home, why, found = home_posture(excitation, Q, np.random.default_rng(1), first)
     draft.config["robot"]["home_posture"] = {n: round(float(q), 4) for n, q in zip(active, home)}
     draft.assumptions["robot.home_posture"] = f"searched: {why}" if found else f"FIX FIRST: {why}"
     draft.problem = "" if found else why

@@ -5,6 +5,7 @@ from conftest import GOOD, PENDULUM
 
 from excite_cli.drafting.home_posture import HOME_ROUNDS
 from excite_cli.drafting.starting_config import draft_config
+from excite_cli.dynamics.robot_files import open_source
 
 
 def test_no_home_posture_names_the_joints_it_chose_what_binds_and_what_to_change(tmp_path):
@@ -16,7 +17,9 @@ def test_no_home_posture_names_the_joints_it_chose_what_binds_and_what_to_change
         .replace('effort="20"', 'effort="0.01"')
         .replace('effort="5"', 'effort="0.01"')
     )
-    draft = draft_config({"urdf": "weak.urdf", "source": "file"}, urdf, [str(tmp_path)], None, tmp_path / "weak.yaml")
+    draft = draft_config(
+        {"urdf": "weak.urdf", "source": "file"}, open_source(urdf, [str(tmp_path)]), None, tmp_path / "weak.yaml"
+    )
     assert f"in {HOME_ROUNDS} rounds with the 2 active joints hinge, tip_joint;" in draft.problem
     assert "clearance" not in draft.problem  # no capsule: no clearance to speak of
     assert "at the best posture found (written), limits.torque fails:" in draft.problem  # what binds, not a guess

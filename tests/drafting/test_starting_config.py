@@ -4,6 +4,7 @@ import pytest
 from conftest import GOOD, PENDULUM
 
 from excite_cli.drafting.starting_config import draft_config
+from excite_cli.dynamics.robot_files import open_source
 from excite_cli.errors import ExciteError
 
 
@@ -13,4 +14,6 @@ def test_a_joint_the_urdf_gives_no_range_is_named(tmp_path):
     urdf = tmp_path / "still.urdf"
     urdf.write_text(PENDULUM.format(**{**GOOD, "mimic": "", "lower": "2.0"}))  # upper is 2.0 too
     with pytest.raises(ExciteError, match="the URDF gives hinge no position range"):
-        draft_config({"urdf": "still.urdf", "source": "file"}, urdf, [str(tmp_path)], ["hinge"], tmp_path / "s.yaml")
+        draft_config(
+            {"urdf": "still.urdf", "source": "file"}, open_source(urdf, [str(tmp_path)]), ["hinge"], tmp_path / "s.yaml"
+        )
