@@ -55,7 +55,7 @@ def optimize(
         },
     )
     if dry_run:
-        return say(console.tables.plan(workflows.plan_optimize(problem)))
+        return say(console.plans.plan(workflows.plan_optimize(problem)))
     with Bars(console.app.busy) as bars:
         run = workflows.run_optimize(
             problem, output or Path(problem.output), force, resume, *bars.iterations(problem.optimizer)
@@ -73,18 +73,23 @@ def optimize(
 def init(
     urdf: str = console.app.ROBOT_FILE,
     joints: Optional[list[str]] = JOINTS,
-    kind: str = typer.Option("optimize", "--kind", help="Config kind: optimize or identify."),
+    kind: str = console.app.KIND,
     runs: Optional[list[str]] = RUNS,
-    output: Optional[Path] = typer.Option(None, "--output", "-o", help="Config file (default: <file name>.yaml)."),
+    output: Optional[Path] = console.app.CONFIG_OUTPUT,
     force: bool = FORCE,
     collision: bool = console.app.COLLISION,
     package_dir: Optional[list[str]] = console.app.PACKAGE_DIRS,
+    stand: Optional[bool] = console.app.STAND,
+    srdf: Optional[Path] = console.app.SRDF,
+    posture: Optional[str] = console.app.POSTURE,
+    soles: Optional[list[str]] = console.app.SOLES,
+    budget: float = console.app.BUDGET,
 ) -> None:
-    """A starting config for your robot from its URDF or MJCF: joints, limits, capsules, mounting plane, home."""
-    with console.app.busy.status("fitting capsules and searching postures ..."):
-        target = output or Path(f"{Path(urdf).stem}.yaml")
-        run = workflows.run_init(urdf, target, joints, kind, force, runs, collision, package_dir)
-    say(console.tables.initialized(run))
+    """A starting config for your robot from its URDF or MJCF: joints, limits, capsules, floor, stance, home, sizes."""
+    with console.app.busy.status("finding the stance, fitting capsules and searching postures ..."):
+        stance = {"stand": stand, "srdf": srdf, "posture": posture, "soles": soles}
+        run = workflows.run_init(urdf, output, joints, kind, force, runs, collision, package_dir, stance, 60 * budget)
+    say(console.plans.initialized(run))
 
 
 @command()
@@ -106,18 +111,14 @@ def check(
     overrides = {"sequence.iterations": iterations, "optimizer.workers": workers}
     with console.app.busy.status("building the problem ..."):
         plan = workflows.plan_check(config, overrides)
-    say(console.identification.plan(plan) if hasattr(plan, "runs") else console.tables.plan(plan))
+    say(console.identification.plan(plan) if hasattr(plan, "runs") else console.plans.plan(plan))
 
 
 @command("compare-random")
 def compare_random(
     config: Path = typer.Argument(..., help="Problem YAML file."),
-    optimized: Optional[Path] = typer.Option(
-        None, "--optimized", help="Optimized result to compare with; computed when not given."
-    ),
-    output: Optional[Path] = typer.Option(
-        None, "--output", "-o", help="Random selection HDF5 (default: <output>_random.h5)."
-    ),
+    optimized: Optional[Path] = console.app.OPTIMIZED,
+    output: Optional[Path] = console.app.RANDOM_OUTPUT,
     pool: Optional[int] = typer.Option(None, "--pool", help="Feasible random candidates (random_baseline.pool_size)."),
     seed: Optional[int] = typer.Option(None, "--seed", help="Seed of the candidates (random_baseline.seed)."),
     equal_effort: bool = typer.Option(False, "--equal-effort", help="Draw for as long as the optimizer took."),
@@ -152,9 +153,7 @@ def compare_random(
 @command("verify-gradient")
 def verify_gradient(
     config: Path = typer.Argument(..., help="Problem YAML file."),
-    result: Optional[Path] = typer.Option(
-        None, "--result", "-r", help="Also check at the last optimum of this result."
-    ),
+    result: Optional[Path] = console.app.CHECKED_RESULT,
     step: float = typer.Option(1e-6, help="Finite-difference step (rad)."),
     seed: int = typer.Option(0, help="Seed of the random α."),
     objective: Optional[list[str]] = typer.Option(

@@ -13,7 +13,17 @@ TESTS = Path(__file__).resolve().parent
 PACKAGE = TESTS.parent / "excite_cli"
 PRINTING = {"excite_cli.cli"} | {
     f"excite_cli.console.{m}"
-    for m in ("app", "tables", "identification", "effect_search", "bodies", "model_files", "progress", "errors")
+    for m in (
+        "app",
+        "tables",
+        "plans",
+        "identification",
+        "effect_search",
+        "bodies",
+        "model_files",
+        "progress",
+        "errors",
+    )
 }
 
 

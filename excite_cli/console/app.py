@@ -64,13 +64,30 @@ PACKAGE_DIRS = typer.Option(
     None, "--package-dir", help="Folder holding the packages of package:// meshes (robot.package_dirs), repeatable."
 )
 COLLISION = typer.Option(
-    True, "--collision/--no-collision", help="Fit capsules and a mounting plane to the collision meshes."
+    True,
+    "--collision/--no-collision",
+    help="Fit capsules, a mounting plane or the floor and find soles in the collision geometry.",
 )
-PACKAGE_DIRS = typer.Option(
-    None, "--package-dir", help="Folder holding the packages of package:// meshes (robot.package_dirs), repeatable."
+OPTIMIZED = typer.Option(None, "--optimized", help="Optimized result to compare with; computed when not given.")
+RANDOM_OUTPUT = typer.Option(None, "--output", "-o", help="Random selection HDF5 (default: <output>_random.h5).")
+CHECKED_RESULT = typer.Option(None, "--result", "-r", help="Also check at the last optimum of this result.")
+KIND = typer.Option("optimize", "--kind", help="Config kind: optimize or identify.")
+CONFIG_OUTPUT = typer.Option(None, "--output", "-o", help="Config file (default: <file name>.yaml).")
+STAND = typer.Option(
+    None,
+    "--stand/--no-stand",
+    help="A standing problem (floating base on its soles, the arms moving) or a fixed base; default: standing "
+    "where legs ending in soles and an arm are found.",
 )
-COLLISION = typer.Option(
-    True, "--collision/--no-collision", help="Fit capsules and a mounting plane to the collision meshes."
+SRDF = typer.Option(None, "--srdf", help="The SRDF whose group state the robot stands in (default: the one beside it).")
+POSTURE = typer.Option(
+    None,
+    "--posture",
+    help="The named state to stand in (default: half_sitting, else standing*, else home; else searched).",
+)
+SOLES = typer.Option(None, "--soles", help="The links that touch the floor, comma-separated (default: found).")
+BUDGET = typer.Option(
+    5.0, "--budget", help="Minutes the whole optimization may take (check's estimate): the optimizer's sizes fit it."
 )
 
 

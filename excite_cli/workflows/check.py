@@ -1,10 +1,9 @@
 """``check``: what an ``optimize`` config will do, without optimizing: the problem is built exactly as
 ``optimize`` builds it (so it refuses what the run would refuse), then summarized with a run time
-estimated from timed evaluations of the criterion and the constraints."""
+estimated from real solver iterations of it, timed (:mod:`~excite_cli.search.run_time`)."""
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -14,13 +13,8 @@ from excite_cli.design.excitation import Excitation
 from excite_cli.design.resolve import build_excitation
 from excite_cli.search.engine import default_workers
 from excite_cli.search.kkt import ACTIVE_TOLERANCE
+from excite_cli.search.run_time import Timing, measure, sequence_seconds
 from excite_cli.search.solvers import criterion_scale
-
-#: Evaluations timed for the estimate (the median is kept).
-TIMED = 5
-#: Solver work per iteration beyond the criterion and constraints (line search, QP): a factor
-#: measured on the shipped configs (the estimate against the run's wall time).
-SOLVER_OVERHEAD = 1.5
 
 
 @dataclass
@@ -66,11 +60,11 @@ class Plan:
         excluded_pairs: capsule pairs (link, link) excluded by the config.
         scaling: the criterion's and the constraints' scale at the first random start.
         variables: Fourier coefficients the optimizer moves (n × (2N + 1)).
-        seconds_per_iteration: one solver iteration [s] (criterion and gradient, every constraint
-            and its Jacobian, times :data:`SOLVER_OVERHEAD`).
+        timing: one solver iteration, one run's own time and one evaluation of each piece, measured [s].
         iterations: solver iterations of one sequential iteration at most (starts and restarts).
         workers: processes the restarts share.
-        estimate: the whole run at most [s] (every restart to ``max_iterations``).
+        estimate: the whole run [s], expected (:func:`~excite_cli.search.run_time.sequence_seconds`).
+        at_most: the whole run [s] with every polish round.
     """
 
     excitation: Excitation
@@ -78,20 +72,23 @@ class Plan:
     excluded_pairs: list[tuple[str, str]]
     scaling: Scaling
     variables: int
-    seconds_per_iteration: float
+    timing: Timing
     iterations: int
     workers: int
     estimate: float
+    at_most: float
 
 
-def plan_optimize(problem: Problem) -> Plan:
-    """Build ``problem`` as ``optimize`` does and time one solver iteration.
+def plan_optimize(problem: Problem, timing: Timing | None = None, base=None) -> Plan:
+    """Build ``problem`` as ``optimize`` does and time its solver iterations
+    (:func:`~excite_cli.search.run_time.measure`), unless ``timing`` gives them (the same problem's, sized
+    otherwise); ``base``: its base parameters, when known.
 
     Raises:
         ExciteError: what ``optimize`` would refuse before optimizing (see :func:`build_excitation`):
             a bad robot, limits that leave no motion, a constraint violated at the home posture.
     """
-    excitation = build_excitation(problem)
+    excitation = build_excitation(problem, base)
     alpha = excitation.random_start(np.random.default_rng(problem.optimizer.seed))
     criterion = excitation.criterion()
     chain = excitation.boundary.chain
@@ -114,16 +111,9 @@ def plan_optimize(problem: Problem) -> Plan:
         if singular.size and singular[-1] > 0
         else (np.inf if singular.size else np.nan),
     )
-    timings = []
-    for _ in range(TIMED):
-        start = time.perf_counter()
-        criterion.value_and_gradient(alpha)
-        for c in excitation.constraints:
-            c.evaluate(alpha)
-        timings.append(time.perf_counter() - start)
+    timing = timing or measure(excitation, problem.optimizer, alpha)
     cfg = problem.optimizer
     workers = 1 if cfg.workers == 1 else min(cfg.workers or default_workers(), max(cfg.restarts, cfg.screened))
-    per_iteration = SOLVER_OVERHEAD * float(np.median(timings))
     self_collision = problem.constraints.self_collision
     excluded = [tuple(p) for p in self_collision.exclude_pairs] if self_collision else []
     return Plan(
@@ -132,8 +122,9 @@ def plan_optimize(problem: Problem) -> Plan:
         excluded_pairs=excluded,
         scaling=scaling,
         variables=int(alpha.size),
-        seconds_per_iteration=per_iteration,
+        timing=timing,
         iterations=cfg.planned_iterations,
         workers=workers,
-        estimate=per_iteration * cfg.planned_iterations * problem.sequence.iterations / workers,
+        estimate=sequence_seconds(cfg, problem.sequence.iterations, workers, timing),
+        at_most=sequence_seconds(cfg, problem.sequence.iterations, workers, timing, cfg.polish_rounds),
     )

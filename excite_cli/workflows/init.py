@@ -4,7 +4,7 @@ in the file; an ``optimize`` config passes the dry run (:func:`plan_optimize`) b
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from datetime import date
 from pathlib import Path
 from typing import Optional
@@ -15,17 +15,22 @@ from excite_cli.atomic import atomic_path
 from excite_cli.config import RobotConfig
 from excite_cli.config_file import drafted_problem
 from excite_cli.drafting.joints import joint_choice
+from excite_cli.drafting.standing import StandOptions
 from excite_cli.drafting.starting_config import StartingConfig, draft_config
-from excite_cli.dynamics.mjcf_source import is_mjcf
-from excite_cli.dynamics.urdf_checks import check_urdf
-from excite_cli.dynamics.urdf_source import installed_share, resolve_urdf, robot_model
+from excite_cli.dynamics.robot_files import installed_share, open_source, resolve_urdf
+from excite_cli.dynamics.source import RobotSource
 from excite_cli.errors import ExciteError, FileNotFound
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.measured.bags import is_bag
+from excite_cli.inputs import input_file
+from excite_cli.search.engine import default_workers
+from excite_cli.search.run_time import sizes_within
 from excite_cli.storage.paths import check_target
 from excite_cli.workflows.check import Plan, plan_optimize
 
 KINDS = ("optimize", "identify")
+#: What an optimize config's whole run may take by default [s].
+BUDGET = 300.0
 
 
 class _Dumper(yaml.SafeDumper):
@@ -64,13 +69,13 @@ def robot_source(urdf: str, target: Path) -> dict:
 
 
 def _identify_config(
-    robot: dict, urdf: Path, joints: Optional[list[str]], draft: StartingConfig, runs: list[str], target: Path
+    robot: dict, source: RobotSource, joints: Optional[list[str]], draft: StartingConfig, runs: list[str], target: Path
 ) -> None:
     """The identify config of the robot: its joints, and the data section of ``runs`` (files as the
     user named them, written relative to ``target``'s folder; default a CSV ``runs/run_1.csv``): ROS
     bags need no columns (joints matched by name), other files the columns ``excite simulate`` writes
     (which, among bags, are the files' only)."""
-    choice = joint_choice(urdf, joints, robot_model(urdf))
+    choice = joint_choice(source, joints, source.model())
     active, held = choice.active, choice.held
     draft.assumptions.update(choice.assumptions)
     files = [os.path.relpath(Path(r).resolve(), target.resolve().parent) for r in runs] or ["runs/run_1.csv"]
@@ -79,7 +84,7 @@ def _identify_config(
         "robot": {**robot, "active_joints": active, "locked_joints": held},
         "data": {"runs": [{"file": f, "role": "blocks"} for f in files]},
         "identification": {"method": "wls"},
-        "output": f"results/{urdf.stem}_identify.h5",
+        "output": f"results/{source.path.stem}_identify.h5",
     }
     draft.assumptions["data.runs"] = (
         "each run fitted and validated on alternate time blocks; give others role: fit / validation"
@@ -127,7 +132,7 @@ def _text(draft: StartingConfig, urdf: str, kind: str) -> str:
     lines = [f"# excite init {urdf} ({kind} config), {date.today().isoformat()}: a starting config. What it assumed:"]
     lines += [f"#   {name}: {why}" for name, why in draft.assumptions.items()]
     lines += [f"#   excluded pair {a} – {b}: {why}" for a, b, why in draft.excluded]
-    lines += [f"#   mounting plane ignores {link}: {why}" for link, why in draft.ignored]
+    lines += [f"#   environment ignores {link}: {why}" for link, why in draft.ignored]
     lines.append(
         "# Check it with `excite check` before a run; change what your lab knows better."
         if kind == "optimize"
@@ -139,17 +144,38 @@ def _text(draft: StartingConfig, urdf: str, kind: str) -> str:
     return "\n".join(lines) + "\n" + body
 
 
+def _sized(draft: StartingConfig, urdf: str, target: Path, plan: Plan, budget: float) -> tuple[str, Plan]:
+    """The draft's optimizer sized to ``budget`` [s] (:func:`~excite_cli.search.run_time.sizes_within`, on
+    the measured ``plan``'s timing), its text and plan."""
+    options, sequence = plan.excitation.spec.optimizer, draft.config["sequence"]["iterations"]
+    workers = options.workers or default_workers()
+    sized, seconds = sizes_within(budget, options, sequence, workers, plan.timing)
+    draft.config["optimizer"].update(sized)
+    shape = f"{sized.get('starts', 0)} starts screened, {sized['restarts']} restarts of {sized['max_iterations']}"
+    fits = "within" if seconds <= budget else "MORE than"
+    draft.assumptions["optimizer"] = (
+        f"{shape} solver iterations, one polish round: the sequence is expected to take {seconds / 60:.1f} min, "
+        f"{fits} the budget of {budget / 60:g} min on {workers} core(s) ({plan.timing.iteration * 1e3:.0f} ms per "
+        "solver iteration, timed); more starts find better optima where time allows"
+    )
+    text = _text(draft, urdf, "optimize")
+    return text, plan_optimize(drafted_problem(yaml.safe_load(text), target), plan.timing, plan.excitation.base)
+
+
 def run_init(
     urdf: str,
-    target: Path,
+    target: Optional[Path],
     joints: Optional[list[str]] = None,
     kind: str = "optimize",
     force: bool = False,
     runs: Optional[list[str]] = None,
     collision: bool = True,
     package_dirs: Optional[list[str]] = None,
+    stance: Optional[dict] = None,
+    budget: float = BUDGET,
 ):
-    """Write a starting config of ``kind`` for ``urdf`` to ``target``. An ``optimize`` config passes the
+    """Write a starting config of ``kind`` for ``urdf`` to ``target`` (default ``<file name>.yaml``). An
+    ``optimize`` config passes the
     dry run before it is written, unless no home posture was found: then it is written with what binds
     commented (``StartingConfig.problem``) and not checked.
 
@@ -161,33 +187,45 @@ def run_init(
         runs: ``identify``: the measured runs (files or ROS 2 bag folders), each must exist.
         collision: fit capsules and draft a mounting plane from the collision meshes (False: none).
         package_dirs: folders that hold the packages ``package://`` meshes name (``robot.package_dirs``).
+        budget: what the whole optimization may take [s] (``check``'s estimate on this machine): the
+            optimizer's sizes fit it (:func:`~excite_cli.search.run_time.sizes_within`).
+        stance: what the user said of a legged robot's stance, the fields of
+            :class:`~excite_cli.drafting.standing.StandOptions` (``soles`` also comma-separated).
 
     Raises:
         ExciteError: unknown kind or joint, a URDF not found or that no model can have
-            (:func:`~excite_cli.dynamics.urdf_checks.check_urdf`), an output that may not be written, no
+            (:meth:`~excite_cli.dynamics.source.RobotSource.check`), an output that may not be written, no
             joint to move (see :func:`draft_config`).
     """
     if kind not in KINDS:
         raise ExciteError("kind", f"'{kind}' is not a config kind", kind, " or ".join(KINDS))
+    if not budget > 0:
+        raise ExciteError("budget", f"{budget / 60:g} min leaves no time to optimize", budget / 60, "minutes > 0")
     if runs and kind != "identify":
         raise ExciteError("runs", "are the measured runs of an identify config", runs[0], "kind identify")
-    target = check_target(Path(target), "output", force)
+    target = check_target(Path(target or f"{Path(urdf).stem}.yaml"), "output", force)
     joints = [j.strip() for given in joints or [] for j in given.split(",") if j.strip()] or None
     robot = robot_source(urdf, target)
     if package_dirs:
         robot["package_dirs"] = [os.path.relpath(Path(d).resolve(), target.resolve().parent) for d in package_dirs]
+    stance = StandOptions(**(stance or {}))
     path, folders = resolve_urdf(RobotConfig.model_construct(**robot), target.resolve().parent)
-    if not is_mjcf(path):
-        check_urdf(path, [], physical=False)  # before pinocchio, which crashes on some
+    source = open_source(path, folders)
+    if stance.srdf:
+        source = source.with_srdf(input_file(stance.srdf, "srdf", "SRDF"))
+    source.check([], physical=False)  # before pinocchio, which crashes on some URDFs
     plan = None
     if kind == "optimize":
-        draft = draft_config(robot, path, folders, joints, target, collision)
+        soles = [s.strip() for given in stance.soles or [] for s in given.split(",") if s.strip()] or None
+        draft = draft_config(robot, source, joints, target, collision, replace(stance, soles=soles))
         text = _text(draft, urdf, kind)
         problem = drafted_problem(yaml.safe_load(text), target)
         plan = None if draft.problem else plan_optimize(problem)
+        if plan is not None:
+            text, plan = _sized(draft, urdf, target, plan, budget)
     else:
         draft = StartingConfig({})
-        _identify_config(robot, path, joints, draft, _existing(runs or []), target)
+        _identify_config(robot, source, joints, draft, _existing(runs or []), target)
         text = _text(draft, urdf, kind)
         IdentifyProblem.model_validate(yaml.safe_load(text))
     with atomic_path(target, "output") as tmp:

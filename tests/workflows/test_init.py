@@ -14,7 +14,7 @@ from typer.testing import CliRunner
 
 from excite_cli.cli import app
 from excite_cli.config_file import load_problem
-from excite_cli.dynamics.urdf_source import example_robot_data_root
+from excite_cli.dynamics.robot_files import example_robot_data_root
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.workflows.init import run_init
 
