@@ -25,7 +25,7 @@ stance and speed.
 
     .venv/bin/python bench/balance.py [--config configs/g1_arms.yaml] [--seeds 0 1 2] [--result R.h5]
         [--results-dir DIR] [--workers W] [--stances welded pd1000/40 ...] [--stabilizer 2 1]
-        [--joint-losses 0.5 0.01 0.1]
+        [--joint-losses 0.5 0.01 0.1] [--no-push]
 
 With --result the iterations of that result are played instead of optimizing; --results-dir keeps the
 optimized results (and plays those already there). The stabilizer's gains were chosen on the push
@@ -44,15 +44,18 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
+import pinocchio as pin
 from mujoco_stance import TIMESTEP, Stance, play_standing, standing_model
 from scipy.signal import find_peaks
+from scipy.spatial import ConvexHull
 
 from excite_cli.config_file import load_problem
-from excite_cli.constraints.zmp import GRAVITY, zero_moment_point
+from excite_cli.constraints.support import sole_points
+from excite_cli.constraints.zmp import CONTACT_HEIGHT, GRAVITY, zero_moment_point
 from excite_cli.design.held_joints import held_joints
 from excite_cli.design.playback import plan_playback
 from excite_cli.design.resolve import build_excitation
-from excite_cli.dynamics.urdf_source import resolve_urdf
+from excite_cli.dynamics.robot_files import resolve_urdf
 from excite_cli.storage.results import read_alphas
 from excite_cli.workflows.optimize import run_optimize
 
@@ -132,6 +135,20 @@ def push_test(
     return found
 
 
+def mesh_soles(robot, links: list[str]) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """{link: (the corners of its contact points' hull (k, 3) [m], the world's up (3,))} in each support
+    link's frame at the home posture: excite's soles (:func:`~excite_cli.constraints.support.sole_points`),
+    for MuJoCo's spheres where a sole is a mesh."""
+    found = {}
+    data = robot.model.createData()
+    pin.framesForwardKinematics(robot.model, data, robot.state(robot.home, 0 * robot.home, 0 * robot.home)[0])
+    for link, points in zip(links, sole_points(robot, links, CONTACT_HEIGHT, "constraints.zmp.support_links")):
+        placement = data.oMf[robot.model.getFrameId(link)]
+        corners = points[ConvexHull(points[:, :2]).vertices] if len(points) > 2 else points
+        found[link] = ((corners - placement.translation) @ placement.rotation, placement.rotation[2].copy())
+    return found
+
+
 def setup(config: Path):
     """The problem of ``config``, its excitation, its ZMP constraint, its URDF and locked joints."""
     problem = load_problem(config)
@@ -151,6 +168,7 @@ def main() -> None:
     parser.add_argument("--result", type=Path, help="play this result's iterations instead of optimizing")
     parser.add_argument("--results-dir", type=Path, help="keep the optimized results here (and reuse them)")
     parser.add_argument("--workers", type=int, help="optimizer processes (default: the config's, else every core)")
+    parser.add_argument("--no-push", action="store_true", help="leave out the push test")
     args = parser.parse_args()
     problem, excitation, zmp, urdf, locked = setup(args.config)
     joints, robot = excitation.robot.joint_names, excitation.robot
@@ -158,7 +176,8 @@ def main() -> None:
     weight = GRAVITY * sum(inertia.mass for inertia in robot.model.inertias)
     stances = [parse_stance(label, tuple(args.stabilizer), weight) for label in args.stances]
     links, losses = problem.constraints.zmp.support_links, tuple(args.joint_losses)
-    models = [standing_model(urdf, joints, locked, links, s, losses) for s in stances]
+    soles = mesh_soles(robot, links)
+    models = [standing_model(urdf, joints, locked, links, s, losses, soles) for s in stances]
     print(f"joints: damping {losses[0]:g} Nm·s/rad, armature {losses[1]:g} kg·m², frictionloss {losses[2]:g} Nm")
     with tempfile.TemporaryDirectory() as folder:
         alphas = results(args.config, args.seeds, args.result, args.results_dir or Path(folder), args.workers)
@@ -185,7 +204,7 @@ def main() -> None:
                         flush=True,
                     )
     at_home = hold.torques(robot.home[None], 0 * robot.home[None], 0 * robot.home[None])
-    for stance, model in zip(stances, models):
+    for stance, model in zip(stances, models) if not args.no_push else ():
         given = (at_home.joint_names, at_home.tau) if stance.feedforward else None
         static = robot.torques(robot.home, 0 * robot.home, 0 * robot.home)
         (f_x, z_x), (f_y, z_y) = push_test(model, joints, robot.home, static, locked, given, stance)

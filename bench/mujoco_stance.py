@@ -36,6 +36,8 @@ FALL_DROP = 0.05
 FALL_SOLE_TILT = 5.0
 #: ... or its root more than this [deg].
 FALL_ROOT_TILT = 20.0
+#: Radius [m] of the spheres a mesh sole's contact points get (as the G1's foot spheres in Menagerie).
+SOLE_SPHERE = 0.005
 #: Geometry MuJoCo keeps as the soles' contacts (a URDF's meshes are visual or collision hulls).
 CONTACT_GEOMS = ("sphere", "box", "capsule", "cylinder", "ellipsoid")
 
@@ -115,6 +117,7 @@ def standing_model(
     support_links: list[str],
     stance: Stance,
     joint_losses: tuple[float, float, float] = (0.0, 0.0, 0.0),
+    soles: dict[str, tuple[np.ndarray, np.ndarray]] | None = None,
 ):
     """MuJoCo's model of the robot of ``urdf`` standing on the contact geometry of ``support_links``.
 
@@ -127,6 +130,9 @@ def standing_model(
         joint_losses: what every joint of the robot has that its URDF does not say: MuJoCo's joint
             ``damping`` [Nm·s/rad], ``armature`` [kg·m²] and ``frictionloss`` [Nm] (MuJoCo
             documentation, XML reference, joint).
+        soles: {support link: ((k, 3) its contact points [m], (3,) the world's up)} in the link's frame at
+            the standing posture, for the links whose sole is a mesh (no sphere, box or capsule): each
+            point gets a sphere of ``SOLE_SPHERE`` radius whose bottom it is.
 
     Returns:
         The compiled ``mujoco.MjModel``: the root's free joint first, then the joints of the URDF less
@@ -142,6 +148,12 @@ def standing_model(
             spec.delete(geom)
     for mesh in list(spec.meshes):
         spec.delete(mesh)
+    bodies = {b.name: b for b in spec.bodies}
+    for link, (points, up) in (soles or {}).items():
+        if not any(g.parent.name == link for g in spec.geoms):
+            for point in points:
+                centre = point + SOLE_SPHERE * up
+                bodies[link].add_geom(type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[SOLE_SPHERE, 0, 0], pos=centre)
     if not spec.geoms:
         raise ExciteError("constraints.zmp.support_links", "MuJoCo finds no sphere, box or capsule on these links")
     spec.option.timestep = TIMESTEP
