@@ -42,8 +42,9 @@ class Constraint(ABC):
             posture and the random starts need not; the solver moves into it).
         advisory: whether it predicts what the robot's own control decides (the zero-moment point, which
             the stance's compliance moves): the optimizer keeps it, ``export`` warns instead of refusing.
-        bounds_torque: whether it bounds the joint torques (|τ| ≤ τ_max), which a transition
-            (:mod:`~excite_cli.design.playback`) must keep as well.
+        eased_by_slowing: whether the same path played slower keeps it better (it bounds what the
+            accelerations cause: |τ| ≤ τ_max, the zero-moment point): a transition
+            (:mod:`~excite_cli.design.playback`) is lengthened until it holds.
         home_clearance: what a drafted home posture keeps beyond the margin of :meth:`clearance` [m].
     """
 
@@ -54,7 +55,7 @@ class Constraint(ABC):
     track_units: dict[str, str] = {}
     needs_motion: bool = False
     advisory: bool = False
-    bounds_torque: bool = False
+    eased_by_slowing: bool = False
     home_clearance: float = 0.005
     capsules: Sequence = ()
 

@@ -35,7 +35,7 @@ class TorqueLimits(Constraint):
     name = "torque_limits"
     field = "limits.torque"
     grid_margin = ACCEPT_MARGIN
-    bounds_torque = True
+    eased_by_slowing = True
     track_units = {"torque_use": "fraction of the limit"}
 
     def __init__(self, robot: Robot, basis: FourierBasis, limit: np.ndarray):
@@ -114,7 +114,7 @@ class TorqueUse(TorqueLimits):
     name = "min_torque_use"
     field = "limits.min_torque_use"
     needs_motion = True
-    bounds_torque = False  # a lower bound on the torque's peak, which a transition need not reach
+    eased_by_slowing = False  # a lower bound on the torque's peak, which a transition need not reach
 
     def __init__(self, robot: Robot, basis: FourierBasis, limit: np.ndarray, fraction: np.ndarray):
         super().__init__(robot, basis, limit)

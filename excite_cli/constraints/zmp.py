@@ -80,6 +80,7 @@ class ZeroMomentPoint(Constraint):
     grid_margin = ACCEPT_MARGIN
     track_units = {"zmp_xy": "m"}
     advisory = True
+    eased_by_slowing = True
 
     def __init__(self, robot: Robot, basis: FourierBasis, polygon: SupportPolygon, margin: float):
         if not has_floating_base(robot):

@@ -10,8 +10,10 @@ both ends (so the played motion is C² everywhere). With s = t/D ∈ [0, 1] and 
 
 with h = q₁ − (c₀ + c₁ + c₂), e = Dq̇₁ − (c₁ + 2c₂), f = D²q̈₁ − 2c₂ (Hermite interpolation). Rest to
 rest it is the minimum-jerk profile, peak speed 15Δ/(8D) and peak acceleration 10Δ/(√3 D²); D is the
-shortest multiple of ``RESOLUTION`` for which every sample keeps the joint limits (Eq. 51) and the
-torque limits, where the problem has them.
+shortest multiple of ``RESOLUTION`` for which every sample keeps the joint limits (Eq. 51) and what a
+slower motion keeps better, where the problem has it: the torque limits and a standing robot's
+zero-moment point (a humanoid's arms brought to the trajectory's start in 0.68 s tipped it; slower, the
+ZMP stays where standing still puts it).
 """
 
 from __future__ import annotations
@@ -110,12 +112,13 @@ def approach_duration(excitation: Excitation) -> float:
 
 
 def plan_transition(
-    start: np.ndarray, end: np.ndarray, limits: JointLimits, name: str, torque: Constraint | None = None
+    start: np.ndarray, end: np.ndarray, limits: JointLimits, name: str, slowed: Sequence[Constraint] = ()
 ) -> Transition | None:
     """The shortest quintic from ``start`` to ``end`` ((3, n) states) whose samples keep the joint
-    limits and, when given, the ``torque`` limits with the optimizer's acceptance margin (a slower
-    transition needs less torque); None when the states are the same. When no duration keeps the
-    torque limits (gravity alone exceeds them on the way), the shortest that keeps the joint limits.
+    limits and every constraint of ``slowed`` (those a slower motion keeps better: torque limits, the
+    zero-moment point) with the optimizer's acceptance margin; None when the states are the same.
+    When no duration keeps ``slowed`` (gravity alone exceeds a torque limit on the way), the shortest
+    that keeps the joint limits.
 
     The search starts at the rest-to-rest bound max_j(15|Δ_j|/(8 v_j), (10|Δ_j|/(√3 a_j))^½) with
     the limits tightened by the grid margin, and lengthens by 10 % steps.
@@ -141,7 +144,7 @@ def plan_transition(
         t = np.linspace(0.0, transition.duration, PLANNING_SAMPLES)
         samples = transition.evaluate(t)
         if limits.check_samples(t, *samples).max_violation <= -ACCEPT_MARGIN / 2:
-            if torque is None or torque.check_samples(t, *samples).max_violation <= -ACCEPT_MARGIN / 2:
+            if all(c.check_samples(t, *samples).max_violation <= -ACCEPT_MARGIN / 2 for c in slowed):
                 return transition
             within_limits = within_limits or transition
         duration *= 1.1
@@ -198,13 +201,13 @@ def plan_playback(excitation: Excitation, alpha: np.ndarray, periods: int = 1) -
     trajectory = FourierSegment(excitation.trajectory, alpha, excitation.spec.trajectory.duration)
     first, last = trajectory.state(0.0), trajectory.state(trajectory.duration)
     limits = excitation.limits
-    torque = next((c for c in excitation.constraints if c.bounds_torque), None)
-    pieces: list[Segment | None] = [plan_transition(home, first, limits, "transition in", torque)]
+    slowed = [c for c in excitation.constraints if c.eased_by_slowing]
+    pieces: list[Segment | None] = [plan_transition(home, first, limits, "transition in", slowed)]
     for p in range(periods):
         pieces.append(trajectory)
         if p < periods - 1:
-            pieces.append(plan_transition(last, first, limits, "link", torque))
-    pieces.append(plan_transition(last, home, limits, "transition out", torque))
+            pieces.append(plan_transition(last, first, limits, "link", slowed))
+    pieces.append(plan_transition(last, home, limits, "transition out", slowed))
     return Playback(tuple(s for s in pieces if s is not None))
 
 

@@ -277,3 +277,27 @@ def test_rest_to_rest_transition_is_as_short_as_the_velocity_limit_allows():
     _, qd, _ = transition.evaluate(np.linspace(0.0, transition.duration, 2001))
     assert np.abs(qd).max() <= 1.0 - GRID_MARGIN + 1e-12
     assert plan_transition(start, start, limits, "none") is None
+
+
+def test_a_standing_robot_s_transition_is_slowed_until_its_zero_moment_point_holds(g1_problem):
+    """The G1 problem with its arms' limits at 40 rad/s and 400 rad/s²: brought from home to both arms
+    stretched forward as fast as those limits allow, the ZMP leaves the soles (excite's ZMP, which
+    tests/bench/test_mujoco_stance.py holds against MuJoCo's contact forces); the transition planned with it
+    takes longer and keeps it."""
+    g1_problem.limits.velocity, g1_problem.limits.acceleration = 40.0, 400.0
+    excitation = build_excitation(g1_problem)
+    zmp = next(c for c in excitation.constraints if c.eased_by_slowing)
+    start = np.zeros((3, excitation.robot.n_joints))
+    start[0] = excitation.home
+    end = start.copy()
+    for k, joint in enumerate(excitation.robot.joint_names):
+        if "shoulder_pitch" in joint:
+            end[0, k] = -1.5  # both arms stretched forward
+    fast = plan_transition(start, end, excitation.limits, "fast")
+    slowed = plan_transition(start, end, excitation.limits, "slowed", [zmp])
+
+    def margin(transition):
+        t = np.linspace(0.0, transition.duration, 400)
+        return zmp.check_samples(t, *transition.evaluate(t)).details["zmp_min_margin_m"]
+
+    assert margin(fast) < zmp.margin < margin(slowed) and slowed.duration > fast.duration
