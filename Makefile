@@ -51,6 +51,8 @@ smoke: $(STAMP)
 	  --mjcf-out results/smoke_identify.xml
 	$(VENV)/bin/excite init ur_description/urdf/ur3_robot.urdf --output results/smoke_ur3.yaml --force
 	$(VENV)/bin/excite check results/smoke_ur3.yaml
+	$(VENV)/bin/excite init g1_description/urdf/g1_29dof_rev_1_0.urdf --output results/smoke_g1.yaml --force
+	$(VENV)/bin/excite check results/smoke_g1.yaml
 
 # `pip install .` without extras (a user's own environment): the command line optimizes a shipped
 # config; the extras (cluster, view, mujoco, ipopt) are only needed by the options that say so

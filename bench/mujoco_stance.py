@@ -77,7 +77,8 @@ class StandingRun:
         time: (S,) [s] from the start of the motion.
         cop: (S, 2) centre of pressure [m], world x, y (NaN while no foot touches).
         com: (S, 2) centre of mass [m], world x, y.
-        polygon: the support polygon of MuJoCo's contact points standing still.
+        polygon: the support polygon of MuJoCo's contact points standing still (of the most contacts
+            while settling, where the robot fell while standing still).
         tilt_deg: (S,) the largest tilt of a support link from its standing orientation [deg].
         root_tilt_deg: (S,) the root's tilt from its standing orientation [deg].
         drop: (S,) how far the root is below its standing height [m].
@@ -156,6 +157,10 @@ def standing_model(
                 bodies[link].add_geom(type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[SOLE_SPHERE, 0, 0], pos=centre)
     if not spec.geoms:
         raise ExciteError("constraints.zmp.support_links", "MuJoCo finds no sphere, box or capsule on these links")
+    # a URDF's massless links (romeo's finger frames) and zero or singular inertias (iCub's ankle, b1's base
+    # frame), which MuJoCo refuses on a moving body: bounded to the least MuJoCo accepts (compiler
+    # boundmass, boundinertia, balanceinertia: MuJoCo documentation, XML reference, compiler)
+    spec.compiler.boundmass, spec.compiler.boundinertia, spec.compiler.balanceinertia = 1e-6, 1e-9, True
     spec.option.timestep = TIMESTEP
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
     if stance.stiffness is None:
@@ -261,12 +266,21 @@ def play_standing(
                 data.qfrc_applied[model.jnt_dofadr[joint]] += data.xaxis[joint] @ moment
         mujoco.mj_step(model, data)
 
+    mujoco.mj_forward(model, data)
+    posed = float(data.qpos[2])
+    contacts = np.zeros((0, 2))
     for _ in range(int(round(SETTLE / model.opt.timestep))):
         step(0, 0.0)
+        if data.ncon > len(contacts):  # the soles' contacts while most of them touch
+            contacts = np.array([data.contact[i].pos[:2] for i in range(data.ncon)])
     standing_height = float(data.qpos[2])
     com_start = com_before = data.subtree_com[1, :2].copy()
     upright = [data.xmat[b].reshape(3, 3)[:, 2].copy() for b in supports + [1]]
-    polygon = SupportPolygon.from_points(np.array([data.contact[i].pos[:2] for i in range(data.ncon)]), 0.0)
+    if data.ncon < 3:  # fell while standing still (a stance that cannot hold its own weight): the drop from where
+        standing_height = posed  # it was posed, the polygon of its contacts before
+    else:
+        contacts = np.array([data.contact[i].pos[:2] for i in range(data.ncon)])
+    polygon = SupportPolygon.from_points(contacts, 0.0)
     count = len(q)
     cop, com = np.full((count, 2), np.nan), np.zeros((count, 2))
     tilt, drop, tracking = np.zeros((count, len(upright))), np.zeros(count), np.zeros(count)

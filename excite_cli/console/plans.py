@@ -6,7 +6,7 @@ from __future__ import annotations
 from rich.table import Table
 
 from excite_cli.console.tables import titled_table
-from excite_cli.search.run_time import EXPECTED_POLISH_ROUNDS, rounds
+from excite_cli.search.run_time import ITERATIONS_PER_COEFFICIENT, expected_rounds
 from excite_cli.workflows.check import Plan
 from excite_cli.workflows.init import InitRun
 
@@ -52,15 +52,17 @@ def plan(p: Plan) -> list[Table | str]:
 def _time(p: Plan) -> list[str]:
     """The estimated time, what it is made of and what would cut it."""
     cfg, t, e = p.excitation.spec.optimizer, p.timing, p.excitation
-    solver, runs = rounds(cfg, p.workers, min(EXPECTED_POLISH_ROUNDS, cfg.polish_rounds))
+    solver, runs = expected_rounds(cfg, p.workers, t)
     total = sum(t.pieces.values())
     shares = sorted(t.pieces.items(), key=lambda item: -item[1])
     screened = f"{cfg.screened} starts screened for {cfg.screen_iterations}, " if cfg.screened else ""
     return [
-        f"estimated time: about {_duration(p.estimate)}, at most {_duration(p.at_most)} with every polish round "
+        f"estimated time: about {_duration(p.estimate)}, at most {_duration(p.at_most)} "
         f"({t.iteration * 1e3:.0f} ms per solver iteration and {t.run:.1f} s per run, timed on this problem; "
         f"{solver} solver iterations and {runs} runs per sequential iteration on the busiest of {p.workers} "
-        f"worker(s): {screened}{cfg.restarts} restart(s) to {cfg.max_iterations}, the kept one polished once)",
+        f"worker(s): {screened}{cfg.restarts} restart(s) of at most {cfg.max_iterations}, expected to converge "
+        f"after {ITERATIONS_PER_COEFFICIENT} per Fourier coefficient; at most: every restart to its limit and "
+        f"{cfg.polish_rounds} polish round(s))",
         "of one evaluation (criterion and constraints with their derivatives, "
         f"{total * 1e3:.0f} ms on the {e.grid_basis.q.shape[0]}-instant grid): "
         + ", ".join(f"{name} {100 * share / total:.0f} %" for name, share in shares),

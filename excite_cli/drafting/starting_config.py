@@ -34,6 +34,8 @@ from excite_cli.errors import ExciteError
 POSTURES = 300
 #: Joint velocity limit as a fraction of the URDF's; acceleration limit per rad/s of it [1/s].
 VELOCITY_FRACTION, ACCELERATION_PER_VELOCITY = 0.5, 3.0
+#: A standing robot's velocity [rad/s] and acceleration [rad/s²] limits at most: the shipped G1 problem's.
+STANDING_LIMITS = (2.0, 8.0)
 #: Margins [m]: between capsules, and from the mounting plane.
 CAPSULE_MARGIN, PLANE_MARGIN = 0.01, 0.02
 #: A capsule pair never farther apart than this over the random postures [m] is left out: two
@@ -54,9 +56,9 @@ class StartingConfig:
     problem: str = ""
 
 
-def _limits(model: pin.Model, active: list[str], draft: StartingConfig) -> dict:
-    """Position margin, velocity and acceleration limits per joint, torque limits where the URDF (its
-    ``model``) has them.
+def _limits(model: pin.Model, active: list[str], draft: StartingConfig, standing: bool = False) -> dict:
+    """Position margin, velocity and acceleration limits per joint (a ``standing`` robot's at most
+    :data:`STANDING_LIMITS`), torque limits where the URDF (its ``model``) has them.
 
     Raises:
         ExciteError: an active joint whose URDF limits leave no range.
@@ -68,6 +70,8 @@ def _limits(model: pin.Model, active: list[str], draft: StartingConfig) -> dict:
     missing = [n for n, v in velocity.items() if not 0 < v < math.inf]
     for name in missing:
         velocity[name] = 1.0
+    if standing:
+        velocity = {n: min(v, STANDING_LIMITS[0]) for n, v in velocity.items()}
     ranges = [model.upperPositionLimit[model.idx_qs[i]] - model.lowerPositionLimit[model.idx_qs[i]] for i in ids]
     still = [n for n, r in zip(active, ranges) if not r > 0]
     if still:
@@ -83,11 +87,20 @@ def _limits(model: pin.Model, active: list[str], draft: StartingConfig) -> dict:
         "velocity": velocity,
         "acceleration": {n: round(ACCELERATION_PER_VELOCITY * v, 3) for n, v in velocity.items()},
     }
+    if standing:
+        limits["acceleration"] = {n: min(a, STANDING_LIMITS[1]) for n, a in limits["acceleration"].items()}
     draft.assumptions["limits.position_margin"] = "0.1 rad inside every limit of the file (less for a short range)"
     draft.assumptions["limits.velocity"] = f"{VELOCITY_FRACTION:g} × the file's velocity limit" + (
         f" (1 rad/s where it has none: {', '.join(missing)})" if missing else ""
     )
     draft.assumptions["limits.acceleration"] = f"{ACCELERATION_PER_VELOCITY:g} × the velocity limit per second"
+    if standing:
+        draft.assumptions["limits.velocity"] += f", at most {STANDING_LIMITS[0]:g} rad/s"
+        draft.assumptions["limits.acceleration"] += (
+            f", at most {STANDING_LIMITS[1]:g} rad/s²: a standing robot's arms as the shipped G1 problem moves them "
+            "(a lab's stance sways under faster arms: the G1 drafted at half its URDF's 22-37 rad/s put the centre "
+            "of pressure 13 mm from its soles' edge in MuJoCo, iCub at its URDF's 50 rad/s 2 mm)"
+        )
     data = model.createData()
     pin.computeSubtreeMasses(model, data)
     idle = [n for n, i in zip(active, ids) if not data.mass[i] > 0.0]
@@ -231,7 +244,7 @@ def draft_config(
     _choose_joints(source, model, joints, stance, draft)
     active = draft.config["robot"]["active_joints"]
     draft.config["trajectory"] = dict(TRAJECTORY)
-    draft.config["limits"] = _limits(model, active, draft)
+    draft.config["limits"] = _limits(model, active, draft, stance is not None)
     if collision:
         _constraints(model, source, stance, draft)
     draft.config["optimizer"] = dict(OPTIMIZER)

@@ -1,10 +1,16 @@
 """How long an ``optimize`` run takes, measured rather than bounded: real solver iterations of the problem
 timed from its first random start, and the solver iterations a run is expected to spend, counted as the
 restarts spend them (:mod:`~excite_cli.search.restarts`): the screened starts run ``screen_iterations``
-each, the restarts kept run on to ``max_iterations`` (on drafted standing problems they end there or
-stall near it), the tasks spread over the workers in rounds, then the kept restart's polish, one round
-expected (:data:`EXPECTED_POLISH_ROUNDS`), every round at most. And the sizes a starting config gets so
-that the whole sequence fits a budget (:func:`sizes_within`)."""
+each, the restarts kept run on until they converge, expected after :data:`ITERATIONS_PER_COEFFICIENT`
+iterations per Fourier coefficient or at ``max_iterations``, the tasks spread over the workers in rounds,
+then, where the restarts reach their limit, one polish round of the kept one; at most, every restart to
+its limit and every polish round. And the sizes a starting config gets so that the whole sequence fits a
+budget (:func:`sizes_within`).
+
+Both constants are measured on the runs of bench/standing_robots.py (five legged robots drafted by
+``init``, 66 and 154 Fourier coefficients, 15 sequential iterations): a solver iteration in a run costs
+0.48–0.81 of the first ones' (median 0.59; a run's later iterations search their line less), and a kept
+restart that converged took 2.4–5.2 iterations per coefficient (median 2.9)."""
 
 from __future__ import annotations
 
@@ -21,8 +27,12 @@ from excite_cli.search.optimizer import optimize_restart
 #: Solver iterations of the timed run: the time between the first and the last gives one iteration's, the
 #: rest a run's own (its start, the projection onto the constraints, the fine check).
 TIMED_ITERATIONS = 12
-#: Polish rounds the kept restart is expected to run (measured: one, on the drafted Talos, G1 and b1-z1).
+#: Polish rounds the kept restart is expected to run where the restarts reach their limit (module docstring).
 EXPECTED_POLISH_ROUNDS = 1
+#: A run's solver iteration costs this share of the first ones' timed here (module docstring).
+LATER_ITERATIONS = 0.6
+#: Solver iterations a restart is expected to converge in, per Fourier coefficient (module docstring).
+ITERATIONS_PER_COEFFICIENT = 3
 #: The sizes a starting config may get, largest first: (starts screened, restarts, max_iterations).
 SIZES = ((16, 4, 400), (8, 2, 400), (8, 2, 300), (6, 2, 250), (4, 2, 200), (0, 2, 150), (0, 1, 100))
 
@@ -32,14 +42,17 @@ class Timing:
     """Measured times of one problem [s].
 
     Attributes:
-        iteration: one solver iteration (line search and subproblem included).
+        iteration: one solver iteration of a run (line search and subproblem included): the first ones'
+            times :data:`LATER_ITERATIONS`.
         run: one run's own time beyond its iterations.
         pieces: one evaluation (value and Jacobian) of the criterion and of each constraint, by name.
+        coefficients: the Fourier coefficients the solver moves.
     """
 
     iteration: float
     run: float
     pieces: dict[str, float]
+    coefficients: int = 0
 
 
 def measure(excitation: Excitation, options: OptimizerConfig, alpha: np.ndarray) -> Timing:
@@ -63,7 +76,8 @@ def measure(excitation: Excitation, options: OptimizerConfig, alpha: np.ndarray)
     criterion = excitation.criterion()
     pieces = {"criterion": _median(lambda: criterion.value_and_gradient(alpha))}
     pieces |= {c.name: _median(lambda c=c: c.evaluate(alpha)) for c in excitation.constraints}
-    return Timing(iteration, max(total - len(stamps) * iteration, 0.0), pieces)
+    run = max(total - len(stamps) * iteration, 0.0)
+    return Timing(LATER_ITERATIONS * iteration, run, pieces, int(alpha.size))
 
 
 def _median(call) -> float:
@@ -75,31 +89,42 @@ def _median(call) -> float:
     return float(np.median(times))
 
 
-def rounds(options: OptimizerConfig, workers: int, polish: int) -> tuple[int, int]:
+def rounds(options: OptimizerConfig, workers: int, polish: int, length: int | None = None) -> tuple[int, int]:
     """(solver iterations, runs) one sequential iteration spends on its slowest worker: the screened starts
-    and the restarts kept, each a task of one worker, in rounds of ``workers``, then ``polish`` rounds."""
+    and the restarts kept, each a task of one worker, in rounds of ``workers``, the kept ones ending after
+    ``length`` iterations (default ``max_iterations``), then ``polish`` rounds."""
     screen = min(options.screen_iterations, options.max_iterations) if options.screened else 0
+    length = options.max_iterations if length is None else min(max(length, screen), options.max_iterations)
     screening = math.ceil(options.screened / workers)
     kept = math.ceil(options.restarts / workers)
-    iterations = screening * screen + kept * (options.max_iterations - screen) + polish * options.max_iterations
+    iterations = screening * screen + kept * (length - screen) + polish * options.max_iterations
     return iterations, screening + kept + polish
 
 
+def expected_rounds(options: OptimizerConfig, workers: int, timing: Timing) -> tuple[int, int]:
+    """:func:`rounds` as a run is expected to spend them: restarts converging after
+    :data:`ITERATIONS_PER_COEFFICIENT` per coefficient (or at their limit, then one polish round)."""
+    length = ITERATIONS_PER_COEFFICIENT * timing.coefficients
+    polish = min(EXPECTED_POLISH_ROUNDS, options.polish_rounds) if length >= options.max_iterations else 0
+    return rounds(options, workers, polish, length)
+
+
 def sequence_seconds(
-    options: OptimizerConfig, iterations: int, workers: int, timing: Timing, polish: int | None = None
+    options: OptimizerConfig, iterations: int, workers: int, timing: Timing, most: bool = False
 ) -> float:
-    """The whole sequence of ``iterations`` [s] (:func:`rounds`), with ``polish`` rounds (default
-    :data:`EXPECTED_POLISH_ROUNDS`, at most ``options.polish_rounds``)."""
-    polish = min(EXPECTED_POLISH_ROUNDS if polish is None else polish, options.polish_rounds)
-    solver, runs = rounds(options, workers, polish)
+    """The whole sequence of ``iterations`` [s]: as expected (:func:`expected_rounds`), or at ``most``
+    (every restart to its limit, every polish round)."""
+    solver, runs = (
+        rounds(options, workers, options.polish_rounds) if most else expected_rounds(options, workers, timing)
+    )
     return iterations * (solver * timing.iteration + runs * timing.run)
 
 
 def sizes_within(
     budget: float, options: OptimizerConfig, iterations: int, workers: int, timing: Timing
 ) -> tuple[dict, float]:
-    """The largest of :data:`SIZES` whose expected sequence (:func:`sequence_seconds`, one polish round)
-    fits ``budget`` [s], else the smallest: {starts, restarts, max_iterations, polish_rounds} and its
+    """The largest of :data:`SIZES` whose expected sequence (:func:`sequence_seconds`) fits ``budget`` [s],
+    else the smallest: {starts, restarts, max_iterations, polish_rounds} and its
     expected time [s]."""
     for starts, restarts, max_iterations in SIZES:
         sized = {"starts": starts, "restarts": restarts, "max_iterations": max_iterations, "polish_rounds": 1}

@@ -64,7 +64,7 @@ class Plan:
         iterations: solver iterations of one sequential iteration at most (starts and restarts).
         workers: processes the restarts share.
         estimate: the whole run [s], expected (:func:`~excite_cli.search.run_time.sequence_seconds`).
-        at_most: the whole run [s] with every polish round.
+        at_most: the whole run [s] with every restart to its limit and every polish round.
     """
 
     excitation: Excitation
@@ -126,5 +126,5 @@ def plan_optimize(problem: Problem, timing: Timing | None = None, base=None) -> 
         iterations=cfg.planned_iterations,
         workers=workers,
         estimate=sequence_seconds(cfg, problem.sequence.iterations, workers, timing),
-        at_most=sequence_seconds(cfg, problem.sequence.iterations, workers, timing, cfg.polish_rounds),
+        at_most=sequence_seconds(cfg, problem.sequence.iterations, workers, timing, most=True),
     )

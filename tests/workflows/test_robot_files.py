@@ -152,3 +152,39 @@ def test_init_and_check_draft_an_included_framed_mjcf_arm_with_its_actuators_tor
     assert "optimize would start" in _ok(["check", "arm.yaml"])
     included_arm_mjcf(tmp_path, "hand.xml", "missing.xml")
     assert_refused(tmp_path, ["init", "missing.xml"], "MuJoCo cannot compile missing.xml")
+
+
+def test_init_without_collision_reads_no_mesh_of_an_mjcf_either(tmp_path, monkeypatch):
+    """An MJCF whose mesh files are absent (as a lab's copy of a Menagerie model often is), its bodies'
+    inertias given: refused naming the mesh with collision, drafted without it (MuJoCo compiles the
+    model with the mesh geoms left out), and the draft checks and runs."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "arm.xml").write_text(MESHED_ARM)
+    assert_refused(tmp_path, ["init", "arm.xml"], "absent/shell.stl")
+    said = _ok(["init", "arm.xml", "--no-collision"])
+    assert "constraints: none: collision geometry not read" in said and "optimize would start" in said
+    assert "robot.floating_base: a fixed base: no collision geometry read" in said
+
+
+#: A three-joint arm whose first link's geometry is a mesh file that is not there; every body's inertia given.
+MESHED_ARM = """<mujoco model="arm">
+  <asset><mesh name="shell" file="absent/shell.stl"/></asset>
+  <worldbody>
+    <body name="upper" pos="0 0 0.1">
+      <inertial pos="0 0 0.1" mass="1" diaginertia="0.01 0.01 0.001"/>
+      <joint name="shoulder" axis="0 0 1" range="-2 2"/>
+      <geom type="mesh" mesh="shell"/>
+      <body name="fore" pos="0 0 0.2">
+        <inertial pos="0 0 0.1" mass="0.8" diaginertia="0.008 0.008 0.001"/>
+        <joint name="elbow" axis="0 1 0" range="-2 2"/>
+        <geom type="capsule" fromto="0 0 0 0 0 0.2" size="0.03"/>
+        <body name="hand" pos="0 0 0.2">
+          <inertial pos="0 0 0.05" mass="0.3" diaginertia="0.001 0.001 0.0005"/>
+          <joint name="wrist" axis="0 1 0" range="-2 2"/>
+          <geom type="box" size="0.02 0.02 0.05" pos="0 0 0.05"/>
+        </body>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>
+"""
