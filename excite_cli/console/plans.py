@@ -61,8 +61,8 @@ def _time(p: Plan) -> list[str]:
         f"({t.iteration * 1e3:.0f} ms per solver iteration and {t.run:.1f} s per run, timed on this problem; "
         f"{solver} solver iterations and {runs} runs per sequential iteration on the busiest of {p.workers} "
         f"worker(s): {screened}{cfg.restarts} restart(s) of at most {cfg.max_iterations}, expected to converge "
-        f"after {ITERATIONS_PER_COEFFICIENT} per Fourier coefficient; at most: every restart to its limit and "
-        f"{cfg.polish_rounds} polish round(s))",
+        f"after {ITERATIONS_PER_COEFFICIENT} per Fourier coefficient, no polish round; at most: every restart to "
+        f"its limit and {cfg.polish_rounds} polish round(s))",
         "of one evaluation (criterion and constraints with their derivatives, "
         f"{total * 1e3:.0f} ms on the {e.grid_basis.q.shape[0]}-instant grid): "
         + ", ".join(f"{name} {100 * share / total:.0f} %" for name, share in shares),

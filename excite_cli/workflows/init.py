@@ -154,9 +154,10 @@ def _sized(draft: StartingConfig, urdf: str, target: Path, plan: Plan, budget: f
     shape = f"{sized.get('starts', 0)} starts screened, {sized['restarts']} restarts of {sized['max_iterations']}"
     fits = "within" if seconds <= budget else "MORE than"
     draft.assumptions["optimizer"] = (
-        f"{shape} solver iterations, one polish round: the sequence is expected to take {seconds / 60:.1f} min, "
-        f"{fits} the budget of {budget / 60:g} min on {workers} core(s) ({plan.timing.iteration * 1e3:.0f} ms per "
-        "solver iteration, timed); more starts find better optima where time allows"
+        f"{shape} solver iterations, at most one polish round: the sequence is expected to take "
+        f"{seconds / 60:.1f} min, {fits} the budget of {budget / 60:g} min on {workers} core(s) "
+        f"({plan.timing.iteration * 1e3:.0f} ms per solver iteration, timed); more starts find better optima where "
+        "time allows"
     )
     text = _text(draft, urdf, "optimize")
     return text, plan_optimize(drafted_problem(yaml.safe_load(text), target), plan.timing, plan.excitation.base)

@@ -27,12 +27,11 @@ def test_the_busiest_worker_counts_the_screened_starts_the_restarts_and_the_poli
 
 
 def test_the_sequence_takes_its_iterations_times_a_timed_iteration_and_run():
-    """Restarts of 400 at most: with 154 coefficients they are expected at their limit (3 × 154 ≥ 400), then
-    one polish round; with 66 after 198 iterations, with no polish. At most: every restart to 400, every
-    polish round (3)."""
+    """Restarts of 400 at most: with 154 coefficients they are expected at their limit (3 × 154 ≥ 400), with
+    66 after 198 iterations; no polish round expected. At most: every restart to 400, every polish round (3)."""
     options = _options(starts=16, restarts=4, max_iterations=400, screen_iterations=40, polish_rounds=3)
     wide, narrow = Timing(0.1, 1.0, {}, coefficients=154), Timing(0.1, 1.0, {}, coefficients=66)
-    assert sequence_seconds(options, 3, 2, wide) == pytest.approx(3 * (1440 * 0.1 + 11 * 1.0))
+    assert sequence_seconds(options, 3, 2, wide) == pytest.approx(3 * (1040 * 0.1 + 10 * 1.0))
     assert sequence_seconds(options, 3, 2, narrow) == pytest.approx(3 * ((320 + 2 * 158) * 0.1 + 10 * 1.0))
     assert sequence_seconds(options, 3, 2, narrow, most=True) == pytest.approx(3 * (2240 * 0.1 + 13 * 1.0))
 
@@ -41,8 +40,8 @@ def test_the_largest_sizes_that_fit_the_budget_are_chosen():
     options = _options(starts=16, restarts=4, max_iterations=400, screen_iterations=40)
     timing = Timing(iteration=0.1, run=0.0, pieces={}, coefficients=154)
     sized, seconds = sizes_within(250.0, options, 3, 2, timing)
-    assert (sized["starts"], sized["restarts"], sized["max_iterations"], sized["polish_rounds"]) == (8, 2, 300, 1)
-    larger = _options(starts=8, restarts=2, max_iterations=400, screen_iterations=40, polish_rounds=1)
+    assert (sized["starts"], sized["restarts"], sized["max_iterations"], sized["polish_rounds"]) == (8, 2, 400, 1)
+    larger = _options(starts=16, restarts=4, max_iterations=400, screen_iterations=40, polish_rounds=1)
     assert sequence_seconds(larger, 3, 2, timing) > 250.0 >= seconds  # the size before it does not fit
     smallest, over = sizes_within(1.0, options, 3, 2, timing)
     assert "starts" not in smallest and (smallest["restarts"], smallest["max_iterations"]) == SIZES[-1][1:]
