@@ -37,7 +37,7 @@ from excite_cli.trajectory.fourier import FourierBasis
 #: The soles' contact points: collision points within this height of the lowest [m] (a sphere's
 #: bottom, a box's lower face), the polygon the centre of pressure can reach.
 CONTACT_HEIGHT = 0.001
-#: What a drafted home posture keeps beyond the margin [m] (or half the room beyond it on small soles).
+#: What a drafted home posture keeps beyond the margin [m] (or a third of the room beyond it on small soles).
 HOME_CLEARANCE = 0.02
 #: Standard gravity [m/s²], which pinocchio's models carry.
 GRAVITY = 9.81
@@ -96,9 +96,10 @@ class ZeroMomentPoint(Constraint):
                 f"less than {room:.3g} m",
             )
         self.robot, self.basis, self.polygon, self.margin = robot, basis, polygon, float(margin)
-        # a drafted home keeps 2 cm beyond the margin (half the room there is on small soles): the arms'
-        # accelerations move the ZMP from where it stands
-        self.home_clearance = min(HOME_CLEARANCE, (room - self.margin) / 2)
+        # a drafted home keeps 2 cm beyond the margin (a third of the room there is on small soles: iCub's
+        # locked legs leave its arms' home at most 4 mm beyond its 20 mm margin): the arms' accelerations move
+        # the ZMP from where it stands
+        self.home_clearance = min(HOME_CLEARANCE, (room - self.margin) / 3)
         self.data = robot.model.createData()
         self._orders = (basis.q, basis.qd, basis.qdd)
         self._weight = GRAVITY * sum(inertia.mass for inertia in robot.model.inertias)
