@@ -1,5 +1,5 @@
 """Does the standing robot stay on its feet? Each iteration of the shipped G1 problem, optimized for
-every seed, played in MuJoCo on a floor (bench/mujoco_stance.py: MuJoCo compiles the
+every seed, played in MuJoCo on a floor (bench/mujoco_stance.py on excite_cli/rehearsal: MuJoCo compiles the
 URDF itself; the soles' contact spheres, the free root, MuJoCo's integrator and soft contacts, and
 every joint given the damping, armature and dry friction of MuJoCo Menagerie's G1, which the URDF and
 excite's model do not have), as `excite export` plays it (home → one period → home, at 2 kHz, speed 1
@@ -44,18 +44,16 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
-import pinocchio as pin
 from mujoco_stance import TIMESTEP, Stance, play_standing, standing_model
 from scipy.signal import find_peaks
-from scipy.spatial import ConvexHull
 
 from excite_cli.config_file import load_problem
-from excite_cli.constraints.support import sole_points
-from excite_cli.constraints.zmp import CONTACT_HEIGHT, GRAVITY, zero_moment_point
+from excite_cli.constraints.zmp import GRAVITY, zero_moment_point
 from excite_cli.design.held_joints import held_joints
 from excite_cli.design.playback import plan_playback
 from excite_cli.design.resolve import build_excitation
 from excite_cli.dynamics.robot_files import resolve_urdf
+from excite_cli.rehearsal.soles import mesh_soles
 from excite_cli.storage.results import read_alphas
 from excite_cli.workflows.optimize import run_optimize
 
@@ -106,9 +104,7 @@ def parse_stance(label: str, stabilizer: tuple[float, float], weight: float) -> 
     return Stance(float(found.group(1)), float(found.group(2)), added == "+feedforward", gains)
 
 
-def push_test(
-    model, joints: list[str], home: np.ndarray, tau: np.ndarray, locked: dict[str, float], held, stance: Stance
-):
+def push_test(model, home: np.ndarray, tau: np.ndarray, held, stance: Stance):
     """[(frequency [Hz], damping ratio)] fore-aft and sideways of the standing robot's centre of mass
         swinging freely after a push of the root: 60 N for 50 ms after 2 s standing at ``home`` (the arms
     given their static torques ``tau``, the held joints ``held``'s), then 5.9 s.
@@ -120,9 +116,7 @@ def push_test(
         push = np.zeros((count, 3))
         push[:100, axis] = 60.0
         given = (held[0], np.repeat(held[1], count, axis=0)) if held else None
-        run = play_standing(
-            model, joints, locked, still + home, still, still + tau, None, given, stance.stabilizer, push
-        )
+        run = play_standing(model, still + home, still, still + tau, given, stance.stabilizer, push)
         swing = run.com[200:, axis] - run.com[-4000:, axis].mean()
         peaks = find_peaks(np.abs(swing))[0]
         peaks = peaks[np.abs(swing[peaks]) > 0.05 * np.abs(swing).max()]
@@ -135,26 +129,12 @@ def push_test(
     return found
 
 
-def mesh_soles(robot, links: list[str]) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """{link: (the corners of its contact points' hull (k, 3) [m], the world's up (3,))} in each support
-    link's frame at the home posture: excite's soles (:func:`~excite_cli.constraints.support.sole_points`),
-    for MuJoCo's spheres where a sole is a mesh."""
-    found = {}
-    data = robot.model.createData()
-    pin.framesForwardKinematics(robot.model, data, robot.state(robot.home, 0 * robot.home, 0 * robot.home)[0])
-    for link, points in zip(links, sole_points(robot, links, CONTACT_HEIGHT, "constraints.zmp.support_links")):
-        placement = data.oMf[robot.model.getFrameId(link)]
-        corners = points[ConvexHull(points[:, :2]).vertices] if len(points) > 2 else points
-        found[link] = ((corners - placement.translation) @ placement.rotation, placement.rotation[2].copy())
-    return found
-
-
 def setup(config: Path):
-    """The problem of ``config``, its excitation, its ZMP constraint, its URDF and locked joints."""
+    """The problem of ``config``, its excitation, its ZMP constraint and its URDF."""
     problem = load_problem(config)
     excitation = build_excitation(problem)
     zmp = next(c for c in excitation.constraints if c.name == "zmp")
-    return problem, excitation, zmp, resolve_urdf(problem.robot, problem.folder)[0], dict(problem.robot.locked_joints)
+    return problem, excitation, zmp, resolve_urdf(problem.robot, problem.folder)[0]
 
 
 def main() -> None:
@@ -170,14 +150,14 @@ def main() -> None:
     parser.add_argument("--workers", type=int, help="optimizer processes (default: the config's, else every core)")
     parser.add_argument("--no-push", action="store_true", help="leave out the push test")
     args = parser.parse_args()
-    problem, excitation, zmp, urdf, locked = setup(args.config)
-    joints, robot = excitation.robot.joint_names, excitation.robot
+    problem, excitation, zmp, urdf = setup(args.config)
+    robot = excitation.robot
     hold = held_joints(problem.robot, problem.folder, problem.constraints, robot)
     weight = GRAVITY * sum(inertia.mass for inertia in robot.model.inertias)
     stances = [parse_stance(label, tuple(args.stabilizer), weight) for label in args.stances]
     links, losses = problem.constraints.zmp.support_links, tuple(args.joint_losses)
     soles = mesh_soles(robot, links)
-    models = [standing_model(urdf, joints, locked, links, s, losses, soles) for s in stances]
+    models = [standing_model(problem, urdf, s, losses, soles) for s in stances]
     print(f"joints: damping {losses[0]:g} Nm·s/rad, armature {losses[1]:g} kg·m², frictionloss {losses[2]:g} Nm")
     with tempfile.TemporaryDirectory() as folder:
         alphas = results(args.config, args.seeds, args.result, args.results_dir or Path(folder), args.workers)
@@ -193,21 +173,21 @@ def main() -> None:
                 expected = zmp.polygon.margins(predicted).min()
                 for stance, model in zip(stances, models):
                     given = (held.joint_names, held.tau) if stance.feedforward else None
-                    run = play_standing(model, joints, locked, q, qd, tau, None, given, stance.stabilizer)
+                    run = play_standing(model, q, qd, tau, given, stance.stabilizer)
                     gap = np.sqrt(np.nanmean(np.sum((run.cop - predicted) ** 2, axis=1)))
                     margin = run.margin.min()
                     summary.setdefault((str(stance), speed), []).append((margin, gap, run.fell))
                     print(
                         f"balance {args.config.stem} stance {stance} seed {seed} iteration {k} speed {speed:.2f}: "
                         f"CoP margin {1000 * margin:.1f} mm (predicted {1000 * expected:.1f} mm, RMS gap "
-                        f"{1000 * gap:.1f} mm), tilt {run.tilt_deg.max():.2f} deg, {'falls' if run.fell else 'stands'}",
+                        f"{1000 * gap:.1f} mm), tilt {run.sole_tilt.max():.2f} deg, {'falls' if run.fell else 'stands'}",
                         flush=True,
                     )
     at_home = hold.torques(robot.home[None], 0 * robot.home[None], 0 * robot.home[None])
     for stance, model in zip(stances, models) if not args.no_push else ():
         given = (at_home.joint_names, at_home.tau) if stance.feedforward else None
         static = robot.torques(robot.home, 0 * robot.home, 0 * robot.home)
-        (f_x, z_x), (f_y, z_y) = push_test(model, joints, robot.home, static, locked, given, stance)
+        (f_x, z_x), (f_y, z_y) = push_test(model, robot.home, static, given, stance)
         fore_aft, sideways = (
             "no free swing" if np.isnan(f) else f"{f:.2f} Hz, damping ratio {z:.2f}"
             for f, z in ((f_x, z_x), (f_y, z_y))

@@ -14,10 +14,12 @@ from excite_cli.storage.formats import FORMATS
 
 
 def _load(path: Path, overrides: Optional[dict] = None, kind: str = "optimize"):
-    """The ``kind`` config at ``path`` with the options' ``overrides`` (:func:`load_config`)."""
+    """The ``kind`` config at ``path`` with the options' ``overrides`` (:func:`load_config`), a path given
+    on the command line made absolute."""
     from excite_cli.config_file import ConfigKind, load_config  # here, not at start-up
 
-    return load_config(path, overrides, ConfigKind(kind))
+    given = {field: str(v.resolve()) if isinstance(v, Path) else v for field, v in (overrides or {}).items()}
+    return load_config(path, given, ConfigKind(kind))
 
 
 @app.callback()
@@ -43,16 +45,9 @@ def optimize(
     dry_run: bool = typer.Option(False, "--dry-run", help="Build the problem and say what would run (as `check`)."),
 ) -> None:
     """Optimize exciting Fourier trajectories by optimizer.objective (default A-optimality; log_cond: the paper's)."""
+    overrides = {"sequence.iterations": iterations, "optimizer.seed": seed, "optimizer.workers": workers}
     problem = _load(
-        config,
-        {
-            "sequence.iterations": iterations,
-            "optimizer.seed": seed,
-            "optimizer.workers": workers,
-            "optimizer.scheduler": scheduler,
-            "sequence.prior": prior and str(prior.resolve()),
-            "effects.model": model and str(model.resolve()),
-        },
+        config, overrides | {"optimizer.scheduler": scheduler, "sequence.prior": prior, "effects.model": model}
     )
     if dry_run:
         return say(console.plans.plan(workflows.plan_optimize(problem)))
@@ -127,26 +122,12 @@ def compare_random(
     force: bool = FORCE,
 ) -> None:
     """The conventional baseline (ref. [16]): random feasible trajectories, greedy selection, beside the optimum."""
-    problem = _load(
-        config,
-        {
-            "random_baseline.pool_size": pool,
-            "random_baseline.seed": seed,
-            "optimizer.workers": workers,
-            "optimizer.scheduler": scheduler,
-        },
-    )
+    overrides = {"random_baseline.pool_size": pool, "random_baseline.seed": seed, "optimizer.workers": workers}
+    problem = _load(config, overrides | {"optimizer.scheduler": scheduler})
     with Bars(console.app.busy) as bars:
         progress = bars.iterations(problem.optimizer)[0] if optimized is None else None
-        comparison = workflows.run_compare_random(
-            problem,
-            optimized,
-            output,
-            equal_effort,
-            force,
-            progress,
-            bars.draws(None if equal_effort else problem.random_baseline.pool_size),
-        )
+        draws = bars.draws(None if equal_effort else problem.random_baseline.pool_size)
+        comparison = workflows.run_compare_random(problem, optimized, output, equal_effort, force, progress, draws)
     say(console.tables.comparison(comparison), f"wrote {comparison.target} and {comparison.plot}")
 
 
@@ -156,25 +137,20 @@ def verify_gradient(
     result: Optional[Path] = console.app.CHECKED_RESULT,
     step: float = typer.Option(1e-6, help="Finite-difference step (rad)."),
     seed: int = typer.Option(0, help="Seed of the random α."),
-    objective: Optional[list[str]] = typer.Option(
-        None, "--objective", help=f"Criteria (repeatable; default all: {', '.join(OBJECTIVES)})."
-    ),
+    objective: Optional[list[str]] = console.app.OBJECTIVE,
     tolerance: float = typer.Option(1e-6, help="Largest relative error against central differences that passes."),
 ) -> None:
     """Analytic gradients (Eq. 49) and constraint Jacobians against finite differences; exit 1 above the tolerance."""
     verification = workflows.run_verify(_load(config), result, objective or OBJECTIVES, step, seed, tolerance)
     say(console.tables.verification(verification, tolerance))
-    if verification.worst > tolerance:
-        raise typer.Exit(1)
+    raise typer.Exit(int(verification.worst > tolerance))
 
 
 @command()
 def identify(
     config: Path = typer.Argument(..., help="Identification YAML: robot, data, preprocessing, identification."),
     output: Optional[Path] = typer.Option(None, "--output", "-o", help="HDF5 report (overrides config 'output')."),
-    fit: Optional[str] = typer.Option(
-        None, "--fit", help="auto (the cross-validation's choice), least_squares or consistent (identification.fit)."
-    ),
+    fit: Optional[str] = console.app.FIT,
     urdf_out: Optional[Path] = typer.Option(None, "--urdf-out", help="Write the identified URDF (consistent fit)."),
     mjcf_out: Optional[Path] = typer.Option(None, "--mjcf-out", help="Write the identified MJCF, checked by MuJoCo."),
     force: bool = FORCE,
@@ -212,6 +188,28 @@ def export(
         result, iteration, rate, periods, fmt, output, force, speed, effort, approach, joint_names
     )
     say(console.export_lines.export_lines(exported, rate, target, fmt, effort))
+
+
+@command()
+def rehearse(
+    result: Path = console.app.RESULT,
+    iteration: Optional[int] = console.app.EVERY_ITERATION,
+    speed: float = console.app.SPEED,
+    mjcf: Optional[Path] = console.app.MJCF,
+    record: Optional[Path] = console.app.RECORD,
+    plot: Optional[Path] = console.app.PLOT,
+    controller: Optional[Path] = console.app.CONTROLLER,
+    joints: Optional[str] = console.app.MJCF_JOINTS,
+    force: bool = FORCE,
+) -> None:
+    """The export played in MuJoCo on the lab's controller before the robot moves; exit 1 if it falls, passes a
+    torque limit or touches something."""
+    with console.app.busy.status("playing in MuJoCo ...") as status:
+        done = workflows.run_rehearse(
+            result, iteration, speed, mjcf, record, plot, force, status.update, controller, joints
+        )
+    say(console.rehearsal.rehearsal(done))
+    raise typer.Exit(int(done.failed))
 
 
 @command()

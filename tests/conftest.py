@@ -336,3 +336,31 @@ def included_arm_mjcf(folder: Path, include: str = "parts.xml", name: str = "arm
         (folder / include).write_text(PARTS)
     (folder / name).write_text(ARM_WITH_PARTS.format(include=include))
     return folder / name
+
+
+def made_rehearsal(standing: bool = True, fell: bool = False, tau_peak: float = 1.0):
+    """A :class:`~excite_cli.rehearsal.report.Rehearsal` of one iteration made by hand: two joints (limit
+    2 N·m, ``tau_peak`` reached on the second), 1 s at 100 Hz; standing, a centre of pressure circling 3 cm
+    inside a 10 cm square, beside PD alone circling 6 cm, the base dropping 6 cm where it ``fell``."""
+    from excite_cli.config.rehearsal import RehearsalConfig
+    from excite_cli.constraints.support import SupportPolygon
+    from excite_cli.rehearsal.playing import Played
+    from excite_cli.rehearsal.report import IterationRehearsal, Rehearsal
+    from excite_cli.storage.export import Export
+
+    time = np.arange(100) / 100.0
+    q = np.column_stack([np.sin(time), np.cos(time)])
+    tau = np.column_stack([0.5 * np.sin(time), tau_peak * np.cos(time)])
+    export = Export(["a", "b"], time, q, q, q, tau, 100.0, 1, 1, [("trajectory", 0.0, 1.0)], -1.0, "")
+    none = np.zeros((100, 0))
+    circle = np.column_stack([np.cos(2 * np.pi * time), np.sin(2 * np.pi * time)])
+    fields = {}
+    if standing:
+        square = SupportPolygon.from_points(np.array([[-0.1, -0.1], [0.1, -0.1], [0.1, 0.1], [-0.1, 0.1]]), 0.0)
+        drop = time * (0.06 if fell else 0.0)
+        fields = dict(com=0 * circle, polygon=square, sole_tilt=0 * time, root_tilt=0 * time, drop=drop)
+    played = Played(time, q + 1e-3, q, tau, none, {}, (), cop=0.07 * circle if standing else None, **fields)
+    alone = Played(time, q, q, tau, none, {}, (), cop=0.04 * circle, **fields) if standing else None
+    predicted = 0.07 * circle if standing else None
+    it = IterationRehearsal(1, export, played, alone, np.array([2.0, 2.0]), np.zeros(0), predicted)
+    return Rehearsal(Path("r.h5"), RehearsalConfig(), [it], Path("robot.urdf"), plot=Path("r_rehearsal.png"))

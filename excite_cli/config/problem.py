@@ -24,6 +24,7 @@ from excite_cli.config.base import (
 )
 from excite_cli.config.constraints import ConstraintsConfig
 from excite_cli.config.effects import EffectsConfig
+from excite_cli.config.rehearsal import RehearsalConfig
 from excite_cli.criteria import NAMES, criterion_record
 
 
@@ -243,6 +244,8 @@ class Problem(ConfigFile):
     """The torque noise the regressor rows are weighed by; none: every row weighs the same."""
     random_baseline: RandomBaselineConfig = RandomBaselineConfig()
     """compare-random's candidates."""
+    rehearsal: RehearsalConfig = RehearsalConfig()
+    """The lab's controller, as `excite rehearse` plays the export in MuJoCo."""
     output: str = "results/excite.h5"
     """Path of the HDF5 result (relative to the working directory)."""
 

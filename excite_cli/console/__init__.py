@@ -5,7 +5,7 @@ print, which ``excite --help`` and ``--version`` need not load."""
 
 from importlib import import_module
 
-_LAZY = ("bodies", "export_lines", "identification", "model_files", "plans", "tables")
+_LAZY = ("bodies", "export_lines", "identification", "model_files", "plans", "rehearsal", "tables")
 
 
 def __getattr__(name: str):

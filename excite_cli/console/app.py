@@ -11,6 +11,7 @@ from rich.markup import escape
 
 from excite_cli.console.errors import printed_warnings, spellings, word
 from excite_cli.console.progress import wide_console
+from excite_cli.criteria import NAMES
 from excite_cli.errors import ExciteError, Interrupted, Terminated, exit_status, sigterm_as_interrupt
 
 app = typer.Typer(no_args_is_help=True)
@@ -86,6 +87,20 @@ POSTURE = typer.Option(
     help="The named state to stand in (default: half_sitting, else standing*, else home; else searched).",
 )
 SOLES = typer.Option(None, "--soles", help="The links that touch the floor, comma-separated (default: found).")
+OBJECTIVE = typer.Option(None, "--objective", help=f"Criteria (repeatable; default all: {', '.join(NAMES)}).")
+FIT = typer.Option(
+    None, "--fit", help="auto (the cross-validation's choice), least_squares or consistent (identification.fit)."
+)
+RESULT = typer.Argument(..., help="An optimize (or compare-random) HDF5 result.")
+EVERY_ITERATION = typer.Option(None, "--iteration", "-k", help="Iteration (default: every one).")
+SPEED = typer.Option(1.0, "--speed", help="Times the optimized speed, as export plays it.")
+MJCF = typer.Option(None, "--mjcf", help="The lab's MuJoCo model of the robot (default: the robot's file).")
+RECORD = typer.Option(None, "--record", help="Folder for each played run as a recording identify reads.")
+PLOT = typer.Option(None, "--plot", help="PNG file (default: <result>_rehearsal.png beside it).")
+MJCF_JOINTS = typer.Option(
+    None, "--joint-names", help="Joints as the MJCF names them: robot=mjcf pairs, or a YAML map file."
+)
+CONTROLLER = typer.Option(None, "--config", help="A config whose rehearsal section replaces the result's.")
 BUDGET = typer.Option(
     5.0, "--budget", help="Minutes the whole optimization may take (check's estimate): the optimizer's sizes fit it."
 )

@@ -99,6 +99,11 @@ class Constraint(ABC):
         (a distance constraint's; default inf: it keeps no distance)."""
         return np.full(len(Q), np.inf)
 
+    def ground_point(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray | None:
+        """(S, 2) the point on the ground [m] it predicts at the samples q, q̇, q̈ (S, n) (the zero-moment
+        point's; default None: it predicts none), for comparison with a physics engine's centre of pressure."""
+        return None
+
     def never_apart(self, Q: np.ndarray, apart: float) -> list[tuple[tuple[str, str], float]]:
         """Link pairs whose capsules are never farther apart than ``apart`` [m] at the postures Q
         (K, n) [rad], with the largest distance [m] (a self-collision's; default none): pairs no motion

@@ -120,6 +120,10 @@ class ZeroMomentPoint(Constraint):
             self.polygon.margins(zero_moment_point(self.wrenches(Q, still, still), self.polygon.height)) - self.margin
         )
 
+    def ground_point(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
+        """(S, 2) the zero-moment point [m], world x, y, at the samples q, q̇, q̈ (S, n) (Kajita et al. 2014, ch. 3)."""
+        return zero_moment_point(self.wrenches(q, qd, qdd), self.polygon.height)
+
     def wrenches(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
         """(T, 6) ground wrench [N, N·m] (force, moment about the world origin, world frame) at the
         samples q, q̇, q̈ (T, n) of the active joints, base at rest."""

@@ -31,7 +31,7 @@ def _import_mujoco(path: str):
     return mujoco
 
 
-def _without_meshes(mujoco, path: str):
+def without_meshes(mujoco, path: str):
     """The file's spec with its mesh geoms and mesh assets removed, or None where a body's inertia
     comes from its geoms (no ``<inertial>``, or ``inertiafromgeom="true"``): without the meshes it
     would change."""
@@ -52,7 +52,7 @@ def _without_meshes(mujoco, path: str):
 def _compiled(path: str, mtime: float, meshes: bool = True):
     mujoco = _import_mujoco(path)
     try:
-        spec = None if meshes else _without_meshes(mujoco, path)
+        spec = None if meshes else without_meshes(mujoco, path)
         return spec.compile() if spec is not None else mujoco.MjModel.from_xml_path(path)
     except ValueError as exc:
         problem = f"MuJoCo cannot compile {Path(path).name}: {' '.join(str(exc).split())[:300]}"

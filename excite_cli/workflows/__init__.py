@@ -14,6 +14,7 @@ _MODULES = {
     "run_identify": "identify",
     "run_init": "init",
     "run_optimize": "optimize",
+    "run_rehearse": "rehearse",
     "run_schema": "schema",
     "run_validate": "validate",
     "run_verify": "verify_gradient",

@@ -82,7 +82,7 @@ def import_mujoco():
     return mujoco
 
 
-def _resolve_meshes(spec, urdf: Path, package_dirs: list[str], notes: list[str]) -> None:
+def resolve_meshes(spec, urdf: Path, package_dirs: list[str], notes: list[str]) -> None:
     """Give every mesh an absolute file name (:func:`~excite_cli.dynamics.urdf_meshes.mesh_path`); a
     mesh that is missing or in a format MuJoCo does not read is removed with the geoms using it."""
     for mesh in list(spec.meshes):
@@ -210,7 +210,7 @@ def _motors(mujoco, spec, robot: Robot) -> None:
             motor.ctrlrange, motor.ctrllimited = limit, mujoco.mjtLimited.mjLIMITED_TRUE
 
 
-def _clear_controls(spec, notes: list[str]) -> None:
+def clear_controls(spec, notes: list[str]) -> None:
     """An MJCF's own actuators, tendons (and their equalities), sensors and keyframes, removed: the
     motors written here replace the actuators, and the rest would name joints that are welded or
     states of another size."""
@@ -252,8 +252,8 @@ def write_mjcf(
     model = MjcfModel(Path(target), list(robot.joint_names))
     if is_mjcf(urdf):  # meshes are in the file's meshdir
         package_dirs = [*package_dirs, str(urdf.parent / spec.meshdir)]
-        _clear_controls(spec, model.notes)
-    _resolve_meshes(spec, urdf, package_dirs, model.notes)
+        clear_controls(spec, model.notes)
+    resolve_meshes(spec, urdf, package_dirs, model.notes)
     weld_joints(mujoco, spec, robot.joint_names, locked, model.notes)
     _inertias(spec, robot, standard, model.notes)
     _joint_fields(spec, robot, effects, model)
