@@ -46,6 +46,8 @@ lint: $(STAMP)
 smoke: $(STAMP)
 	$(VENV)/bin/excite optimize configs/smoke.yaml --output results/smoke.h5 --force
 	$(VENV)/bin/excite export results/smoke.h5 --rate 1000 --force
+	$(VENV)/bin/excite rehearse results/smoke.h5 --record results/smoke_rehearsal --force
+	$(VENV)/bin/excite identify configs/panda_identify_rehearsal.yaml --output results/smoke_identify_rehearsal.h5 --force
 	$(VENV)/bin/excite verify-gradient configs/smoke.yaml
 	$(VENV)/bin/excite identify configs/panda_identify_simulated.yaml --output results/smoke_identify.h5 --force \
 	  --mjcf-out results/smoke_identify.xml
@@ -62,6 +64,7 @@ bare:
 	.venv-bare/bin/python -m pip install --quiet --upgrade pip
 	.venv-bare/bin/python -m pip install --quiet -c constraints.txt .
 	cd /tmp && $(CURDIR)/.venv-bare/bin/excite optimize $(CURDIR)/configs/smoke.yaml --output $(CURDIR)/results/bare.h5 --force
+	$(CURDIR)/.venv-bare/bin/excite rehearse $(CURDIR)/results/bare.h5 2>&1 | grep "pip install 'excite\[mujoco\]'"
 	rm -rf .venv-bare
 
 # `excite view` opened in headless Chromium: the screenshot must show the robot (bench/view_check.py).
