@@ -112,7 +112,11 @@ def rehearsal_robot(
     names = {j.name for j in spec.joints}
     missing = [j for j in robot.active_joints if j not in names]
     if missing:
-        raise ExciteError("mjcf", f"{urdf.name} has no joint {', '.join(missing)}", expected="the result's robot")
+        raise ExciteError(
+            "mjcf",
+            f"{urdf.name} has no joint {', '.join(missing)}",
+            expected="the result's joints, or a map of their names",
+        )
     zmp = constraints.zmp
     standing = robot.floating_base and zmp is not None
     links = list(zmp.support_links) if standing else []

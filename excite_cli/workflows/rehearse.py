@@ -51,7 +51,8 @@ def run_rehearse(
     dry friction (``rehearsal.joint_losses`` is for a URDF, which has none).
 
     Raises:
-        ExciteError: MuJoCo is missing, not an excite result or an iteration it lacks, a speed its
+        ExciteError: MuJoCo is missing, not an excite result or an iteration it lacks (checked first, with
+            the inputs, then the outputs), a speed its
             limits refuse (:func:`~excite_cli.workflows.export.played_result`), a missing ``mjcf``, an
             existing recording without ``force``, and as
             :func:`~excite_cli.rehearsal.mujoco_robot.rehearsal_robot`.
@@ -61,16 +62,21 @@ def run_rehearse(
     controller = load_problem(config).rehearsal if config else problem.rehearsal
     if mjcf and controller.joint_losses is not None:  # the lab's model of its own joints wins
         controller = controller.model_copy(update={"joint_losses": None})
-    iterations = sorted(dict(read_alphas(result))) if iteration is None else [iteration]
+    stored = sorted(dict(read_alphas(result)))
+    if iteration is not None and iteration not in stored:
+        raise ExciteError(
+            "iteration", f"{result} has iterations {stored}, not {iteration}", iteration, f"one of {stored}"
+        )
+    iterations = stored if iteration is None else [iteration]
+    urdf, package_dirs = resolve_urdf(problem.robot, problem.folder)
+    robot_file = input_file(mjcf, "mjcf") if mjcf else urdf
+    mapping = read_joint_map(joint_names) if joint_names else {}
     names = [f"rehearsal_{k}.csv" for k in iterations]
     picture = check_target(plot or result.with_name(f"{result.stem}_rehearsal.png"), "plot", force)
     targets = [check_folder(record, names, "record", force) / n for n in names] if record else []
     excitation = build_excitation(problem)
-    urdf, package_dirs = resolve_urdf(problem.robot, problem.folder)
-    robot_file = input_file(mjcf, "mjcf") if mjcf else urdf
     zmp = problem.constraints.zmp
     soles = mesh_soles(excitation.robot, list(zmp.support_links)) if problem.robot.floating_base and zmp else None
-    mapping = read_joint_map(joint_names) if joint_names else {}
     robot = rehearsal_robot(
         problem.robot, problem.constraints, robot_file, package_dirs, controller, soles, False, mapping
     )
