@@ -123,7 +123,7 @@ def standing(tmp_path_factory):
     folder = tmp_path_factory.mktemp("g1")
     problem = small(load_problem(CONFIGS / "g1_arms.yaml"), harmonics=3)
     problem.sequence.iterations, problem.optimizer.restarts, problem.optimizer.max_iterations = 1, 1, 60
-    problem.optimizer.polish_rounds = 0
+    problem.optimizer.polish_rounds, problem.rehearsal.rate = 0, 500.0  # a 500 Hz controller
     run_optimize(problem, folder / "g1.h5", force=True)
     return run_rehearse(folder / "g1.h5", plot=folder / "g1.png"), folder
 
@@ -142,7 +142,7 @@ def test_a_standing_robot_stands_on_its_feed_forward_where_excite_predicts(stand
 def test_a_config_gives_the_controller_without_optimizing_again(standing, tmp_path):
     done, folder = standing
     data = yaml.safe_load((CONFIGS / "g1_arms.yaml").read_text())
-    data["rehearsal"]["held_feedforward"] = False
+    data["rehearsal"].update(held_feedforward=False, rate=500.0)
     config = write_config(tmp_path, data)
     alone = run_rehearse(folder / "g1.h5", plot=tmp_path / "a.png", config=config)
     assert alone.controller.held_feedforward is False and alone.iterations[0].alone is None
