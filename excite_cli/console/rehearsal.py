@@ -83,7 +83,7 @@ def _lines(it: IterationRehearsal, feedforward: bool) -> list[str]:
         worst = int(np.argmax(use))
         lines.append(
             f"held joints: largest torque {100 * use[worst]:.0f} % of its limit "
-            f"({it.export.held.joint_names[worst]}, {np.abs(p.held_tau[:, worst]).max():.1f} N·m)"
+            f"({it.held_names[worst]}, {np.abs(p.held_tau[:, worst]).max():.1f} N·m)"
         )
     lines.append(_balance("with the held joints' feed-forward" if feedforward else "PD alone", p, it.predicted))
     if it.alone is not None:

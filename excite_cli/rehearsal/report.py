@@ -24,8 +24,9 @@ class IterationRehearsal:
         alone: the same with PD alone on the held joints (a standing robot whose controller adds the
             held joints' feed-forward), else None.
         effort: (n,) the active joints' torque limits [N·m] (inf where the file gives none).
-        held_effort: (h,) the held joints' [N·m].
+        held_effort: (h,) the held joints' [N·m], in ``held_names``' order (0: none given).
         predicted: (S, 2) excite's zero-moment point at the samples [m] (standing), else None.
+        held_names: (h,) the held joints, the columns of ``played.held_tau``.
     """
 
     iteration: int
@@ -35,11 +36,12 @@ class IterationRehearsal:
     effort: np.ndarray
     held_effort: np.ndarray
     predicted: np.ndarray | None = None
+    held_names: tuple[str, ...] = ()
 
     @property
     def over_limit(self) -> list[tuple[str, float, float]]:
         """(joint, peak [N·m], limit [N·m]) of every joint whose applied torque passed its limit."""
-        names = list(self.export.joint_names) + list(self.export.held.joint_names if self.export.held else [])
+        names = [*self.export.joint_names, *self.held_names]
         peaks = np.r_[np.abs(self.played.tau).max(axis=0), np.abs(self.played.held_tau).max(axis=0, initial=0.0)]
         limits = np.r_[self.effort, self.held_effort]
         return [(n, p, lim) for n, p, lim in zip(names, peaks, limits) if 0 < lim < p]

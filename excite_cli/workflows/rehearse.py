@@ -90,8 +90,11 @@ def run_rehearse(
             alone = play(robot, _commands(export, robot, False, controller.rate))
         points = [c.ground_point(export.q, export.qd, export.qdd) for c in excitation.constraints]
         predicted = next((p for p in points if p is not None), None) if robot.standing else None
-        held_effort = export.held.effort if export.held is not None else np.zeros(0)
-        rehearsals.append(IterationRehearsal(k, export, played, alone, effort, held_effort, predicted))
+        given = dict(zip(export.held.joint_names, export.held.effort)) if export.held is not None else {}
+        held_effort = np.array([given.get(j, 0.0) for j in robot.held])
+        rehearsals.append(
+            IterationRehearsal(k, export, played, alone, effort, held_effort, predicted, tuple(robot.held))
+        )
         if progress:
             progress(f"played iteration {k} ...")
     done = Rehearsal(result, controller, rehearsals, robot_file, robot.notes)

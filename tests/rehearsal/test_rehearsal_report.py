@@ -30,3 +30,12 @@ def test_a_contact_or_a_fall_fails():
     assert iteration(tau, np.ones(2), {("panda_link7", "world"): 0.4}).failed
     assert iteration(tau, np.ones(2), drop=np.array([0.0, 0.06])).failed
     assert not iteration(tau, np.ones(2), drop=np.array([0.0, 0.04])).failed
+
+
+def test_a_held_joint_over_its_limit_is_named_as_the_played_columns_are():
+    tau, time = np.zeros((2, 2)), np.arange(2) * 1e-3
+    export = Export(["a", "b"], time, tau, tau, tau, tau, 1000.0, 1, 1, [], -1.0, "")
+    held = np.array([[6.0, 100.0], [1.0, 1.0]])  # the waist has no limit in its file
+    played = Played(time, tau, tau, tau, held, {}, (), sole_tilt=time, root_tilt=time, drop=time)
+    it = IterationRehearsal(1, export, played, None, np.ones(2), np.array([5.0, 0.0]), None, ("knee", "waist"))
+    assert it.over_limit == [("knee", 6.0, 5.0)] and it.failed
