@@ -119,7 +119,8 @@ def test_a_contact_in_the_lab_scene_is_refused_naming_the_bodies(optimized, pand
 
 @pytest.fixture(scope="module")
 def standing(tmp_path_factory):
-    """A short optimization of the shipped G1 problem (3 harmonics, one iteration), rehearsed."""
+    """A short optimization of the shipped G1 problem (3 harmonics, one iteration), rehearsed (35 s: its
+    tests run with make end-to-end)."""
     folder = tmp_path_factory.mktemp("g1")
     problem = small(load_problem(CONFIGS / "g1_arms.yaml"), harmonics=3)
     problem.sequence.iterations, problem.optimizer.restarts, problem.optimizer.max_iterations = 1, 1, 60
@@ -128,6 +129,7 @@ def standing(tmp_path_factory):
     return run_rehearse(folder / "g1.h5", plot=folder / "g1.png"), folder
 
 
+@pytest.mark.end_to_end
 def test_a_standing_robot_stands_on_its_feed_forward_where_excite_predicts(standing):
     done, _ = standing
     [it] = done.iterations
@@ -139,6 +141,7 @@ def test_a_standing_robot_stands_on_its_feed_forward_where_excite_predicts(stand
     assert it.export.held is not None and fed.held_tau.shape[1] == len(it.export.held.joint_names)
 
 
+@pytest.mark.end_to_end
 def test_a_config_gives_the_controller_without_optimizing_again(standing, tmp_path):
     done, folder = standing
     data = yaml.safe_load((CONFIGS / "g1_arms.yaml").read_text())
