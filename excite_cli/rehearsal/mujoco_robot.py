@@ -150,9 +150,6 @@ def rehearsal_robot(
     if standing and not any(j.type == mujoco.mjtJoint.mjJNT_FREE for j in spec.joints):
         spec.worldbody.first_body().add_freejoint()
     model = _compile(spec, urdf)
-    if not standing:
-        excluded = constraints.self_collision.exclude_pairs if constraints.self_collision else []
-        model = _excluded(mujoco, spec, model, locked | dict(robot.home_posture), excluded, urdf, notes)
     if standing:
         spec.worldbody.add_geom(
             name="floor",
@@ -161,6 +158,9 @@ def rehearsal_robot(
             pos=[0.0, 0.0, _lowest(mujoco, model, locked)],
         )
         model = _compile(spec, urdf)
+    else:
+        excluded = constraints.self_collision.exclude_pairs if constraints.self_collision else []
+        model = _excluded(mujoco, spec, model, locked | dict(robot.home_posture), excluded, urdf, notes)
     return RehearsalRobot(model, list(robot.active_joints), held, gains, standing, links, notes)
 
 
