@@ -74,6 +74,8 @@ def _lines(it: IterationRehearsal, feedforward: bool) -> list[str]:
             )
             + (f" (touching at rest, not counted: {', '.join(f'{a}-{b}' for a, b in p.at_rest)})" if p.at_rest else ""),
         ]
+    if it.refused:
+        lines.append(f"excite export refuses this speed (played here all the same): {it.refused}")
     for name, peak, limit in it.over_limit:
         lines.append(f"over its limit: {name} {peak:.2f} N·m against {limit:g} N·m")
     if p.drop is None:

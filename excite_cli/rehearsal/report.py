@@ -47,9 +47,15 @@ class IterationRehearsal:
         return [(n, p, lim) for n, p, lim in zip(names, peaks, limits) if 0 < lim < p]
 
     @property
+    def refused(self) -> str | None:
+        """The limit ``excite export`` refuses these samples for (played here all the same), in words."""
+        return self.export.worst if self.export.max_violation > 0.0 else None
+
+    @property
     def failed(self) -> bool:
-        """It fell, a torque passed its limit or a contact appeared (with the configured controller)."""
-        return self.played.fell or bool(self.over_limit) or bool(self.played.contacts)
+        """It fell, a torque passed its limit, a contact appeared (with the configured controller) or the
+        export refuses the samples."""
+        return self.played.fell or bool(self.over_limit) or bool(self.played.contacts) or bool(self.refused)
 
 
 @dataclass

@@ -80,7 +80,9 @@ class Export:
 class Played(NamedTuple):
     """How one iteration of a result is exported: ``result`` (named in the messages), its ``iteration``,
     the ``rate`` [Hz], the ``periods`` of the trajectory, the ``speed`` (times the optimized) and the
-    ``approach`` [s] before the first point (None: :func:`~excite_cli.design.playback.approach_duration`)."""
+    ``approach`` [s] before the first point (None: :func:`~excite_cli.design.playback.approach_duration`);
+    ``refuse``: a violated limit refuses the samples (False: it is kept in the export's
+    ``max_violation`` and ``worst``, for a rehearsal that plays what the export would refuse)."""
 
     result: Path
     iteration: int
@@ -88,6 +90,7 @@ class Played(NamedTuple):
     periods: int
     speed: float
     approach: float | None = None
+    refuse: bool = True
 
 
 def check_playback(rate: float, periods: int, speed: float) -> None:
@@ -113,10 +116,11 @@ def export_trajectory(excitation: Excitation, alpha: np.ndarray, how: Played, he
 
     Raises:
         ExciteError: α of another shape than the excitation's, a rate below the trajectory's Nyquist
-            rate, more than ``MAX_SAMPLES`` samples, samples that violate a constraint that is not
-            advisory (the message names it), or a held joint's feed-forward above its URDF effort limit.
+            rate, more than ``MAX_SAMPLES`` samples, and where ``how.refuse``: samples that violate a
+            constraint that is not advisory (the message names it), or a held joint's feed-forward above
+            its URDF effort limit.
     """
-    result, k, rate, periods, speed, approach = how
+    result, k, rate, periods, speed, approach, refuse = how
     if approach is not None and not (np.isfinite(approach) and 0.0 <= approach <= MAX_APPROACH):
         raise ExciteError("approach", f"{approach:g} s is out of range", approach, f"0 to {MAX_APPROACH:g} s")
     if alpha.shape != (excitation.robot.n_joints, excitation.trajectory.n_coefficients):
@@ -150,13 +154,13 @@ def export_trajectory(excitation: Excitation, alpha: np.ndarray, how: Played, he
     binding = [c for c in excitation.constraints if not c.advisory]
     violation, worst = check_motion(binding, time, q, qd, qdd)
     played = f" at speed {speed:g}" if speed != 1.0 else ""
-    if violation > 0.0:
+    if violation > 0.0 and refuse:
         raise ExciteError(
             "result", f"{result}: iteration {k} played{played} at {rate:g} Hz violates {worst}; no file written"
         )
     advisory = [(c, c.check_samples(time, q, qd, qdd)) for c in excitation.constraints if c.advisory]
     stance = None if held is None else held.torques(q, qd, qdd)
-    if stance is not None:
+    if stance is not None and refuse:
         _check_held_efforts(stance, f"{result}: iteration {k} played{played} at {rate:g} Hz")
     robot = excitation.robot
     tau = np.array([robot.torques(*x) for x in zip(q, qd, qdd)])

@@ -24,13 +24,15 @@ def played_result(
     periods: int = 1,
     speed: float = 1.0,
     approach: float | None = None,
+    refuse: bool = True,
 ) -> Export:
     """Iteration ``iteration`` (default: the last) of an ``optimize`` result sampled at ``rate`` [Hz]
     with the transitions from and to the home posture, played ``speed`` times as fast as optimized,
     and its feed-forward torques (:func:`~excite_cli.storage.export.export_trajectory` on the design
     the result stores, its regressor rows the joints' torques), the held joints' too for a standing
     robot (:func:`~excite_cli.design.held_joints.held_joints`); ``approach`` [s] before a controller's
-    first point (default: :func:`~excite_cli.design.playback.approach_duration`).
+    first point (default: :func:`~excite_cli.design.playback.approach_duration`); ``refuse``: as
+    :class:`~excite_cli.storage.export.Played`'s (False for a rehearsal of what the export would refuse).
 
     Raises:
         ExciteError: not an excite result, an iteration it does not have, a rate, speed or period count
@@ -48,7 +50,7 @@ def played_result(
         )
     excitation = build_excitation(problem)
     held = held_joints(problem.robot, problem.folder, problem.constraints, excitation.robot)
-    return export_trajectory(excitation, alphas[k], Played(result, k, rate, periods, speed, approach), held)
+    return export_trajectory(excitation, alphas[k], Played(result, k, rate, periods, speed, approach, refuse), held)
 
 
 def run_export(

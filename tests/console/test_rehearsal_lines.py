@@ -1,6 +1,8 @@
 """What rehearse prints: the joints' tracking and torques, a standing robot's balance beside PD alone, and
 the verdict naming what would not play safely."""
 
+from dataclasses import replace
+
 from conftest import made_rehearsal
 
 from excite_cli.console.rehearsal import rehearsal
@@ -24,3 +26,12 @@ def test_a_fall_or_a_torque_over_its_limit_is_the_verdict():
     lines = text(rehearsal(made_rehearsal(standing=False, tau_peak=2.5)))
     assert "over its limit: b 2.50 N·m against 2 N·m" in lines
     assert lines[-1] == "refused: iteration 1 would not play safely" and "contacts: none" in lines
+
+
+def test_a_speed_the_export_refuses_is_named_with_its_limit_and_refused():
+    done = made_rehearsal(standing=False)
+    it = done.iterations[0]
+    it.export = replace(it.export, max_violation=0.5, worst="joint_limits: velocity of b at 1.5 of its half-range")
+    lines = text(rehearsal(done))
+    assert "excite export refuses this speed (played here all the same): joint_limits: velocity of b" in lines[-3]
+    assert lines[-1] == "refused: iteration 1 would not play safely"
