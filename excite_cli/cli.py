@@ -200,13 +200,15 @@ def rehearse(
     plot: Optional[Path] = console.app.PLOT,
     controller: Optional[Path] = console.app.CONTROLLER,
     joints: Optional[str] = console.app.MJCF_JOINTS,
+    effects: Optional[Path] = console.app.NOISE,
     force: bool = FORCE,
 ) -> None:
     """The export played in MuJoCo on the lab's controller before the robot moves; exit 1 if it falls, passes a
-    torque limit or touches something."""
+    limit or touches something."""
+    noise = _load(effects, kind="effects") if effects else None
     with console.app.busy.status("playing in MuJoCo ...") as status:
         done = workflows.run_rehearse(
-            result, iteration, speed, mjcf, record, plot, force, status.update, controller, joints
+            result, iteration, speed, mjcf, record, plot, force, status.update, controller, joints, noise
         )
     say(console.rehearsal.rehearsal(done))
     raise typer.Exit(int(done.failed))

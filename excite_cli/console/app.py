@@ -96,6 +96,7 @@ EVERY_ITERATION = typer.Option(None, "--iteration", "-k", help="Iteration (defau
 SPEED = typer.Option(1.0, "--speed", help="Times the optimized speed, as export plays it.")
 MJCF = typer.Option(None, "--mjcf", help="The lab's MuJoCo model of the robot (default: the robot's file).")
 RECORD = typer.Option(None, "--record", help="Folder for each played run as a recording identify reads.")
+NOISE = typer.Option(None, "--effects", help="An effects file whose torque and position noise --record adds.")
 PLOT = typer.Option(None, "--plot", help="PNG file (default: <result>_rehearsal.png beside it).")
 MJCF_JOINTS = typer.Option(
     None, "--joint-names", help="Joints as the MJCF names them: robot=mjcf pairs, or a YAML map file."

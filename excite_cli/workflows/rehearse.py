@@ -13,6 +13,7 @@ from excite_cli.config_file import load_problem, result_problem
 from excite_cli.design.resolve import build_excitation
 from excite_cli.dynamics.robot_files import resolve_urdf
 from excite_cli.errors import ExciteError
+from excite_cli.identification.simulation_config import SimulationConfig
 from excite_cli.inputs import input_file
 from excite_cli.plots.rehearsal import plot_rehearsal
 from excite_cli.rehearsal.mujoco_robot import RehearsalRobot, rehearsal_robot, require_mujoco
@@ -24,6 +25,9 @@ from excite_cli.storage.joint_map import read_joint_map
 from excite_cli.storage.paths import check_folder, check_target
 from excite_cli.storage.results import read_alphas
 from excite_cli.workflows.export import played_result
+
+#: The fields of an effects file a rehearsal's recording takes.
+NOISE = ("torque_noise", "position_noise", "seed")
 
 
 def run_rehearse(
@@ -37,6 +41,7 @@ def run_rehearse(
     progress=None,
     config: Path | None = None,
     joint_names: str | None = None,
+    noise: SimulationConfig | None = None,
 ) -> Rehearsal:
     """Play each iteration (or ``iteration``) of ``result`` as ``excite export`` writes it, ``speed`` times
     as fast, in MuJoCo (``mjcf``: the lab's MJCF, else the robot's file compiled by MuJoCo) with the
@@ -48,13 +53,17 @@ def run_rehearse(
     controller tuned after optimizing). ``joint_names``: the problem's joints as ``mjcf`` names them
     (robot=mjcf pairs, or a YAML map file: :func:`~excite_cli.storage.joint_map.read_joint_map`). With
     ``mjcf`` its joints keep the MJCF's damping, armature and
-    dry friction (``rehearsal.joint_losses`` is for a URDF, which has none).
+    dry friction (``rehearsal.joint_losses`` is for a URDF, which has none). ``noise``: an effects file
+    (``excite simulate``'s) whose ``torque_noise`` [N·m] and ``position_noise`` [rad], drawn from its
+    ``seed``, are added to the recording (the effects themselves are MuJoCo's joints').
 
     Raises:
         ExciteError: MuJoCo is missing, not an excite result or an iteration it lacks (checked first, with
-            the inputs, then the outputs), a speed its
-            limits refuse (:func:`~excite_cli.workflows.export.played_result`), a missing ``mjcf``, an
-            existing recording without ``force``, and as
+            the inputs, then the outputs), a speed out of range
+            (:func:`~excite_cli.workflows.export.played_result`; one the limits refuse is played and
+            reported, :attr:`~excite_cli.rehearsal.report.IterationRehearsal.refused`), a missing ``mjcf``, an
+            existing recording without ``force``, ``noise`` without ``record`` or giving more than the
+            noise, and as
             :func:`~excite_cli.rehearsal.mujoco_robot.rehearsal_robot`.
     """
     require_mujoco()
@@ -68,6 +77,7 @@ def run_rehearse(
             "iteration", f"{result} has iterations {stored}, not {iteration}", iteration, f"one of {stored}"
         )
     iterations = stored if iteration is None else [iteration]
+    _check_noise(noise, record)
     urdf, package_dirs = resolve_urdf(problem.robot, problem.folder)
     robot_file = input_file(mjcf, "mjcf") if mjcf else urdf
     mapping = read_joint_map(joint_names) if joint_names else {}
@@ -83,7 +93,7 @@ def run_rehearse(
     effort = excitation.robot.model.effortLimit[excitation.robot.v_idx].astype(float)
     rehearsals = []
     for k in iterations:
-        export = played_result(result, k, controller.rate, 1, speed)
+        export = played_result(result, k, controller.rate, 1, speed, refuse=False)
         played = play(robot, _commands(export, robot, controller.held_feedforward, controller.rate))
         alone = None
         if robot.standing and controller.held_feedforward:
@@ -99,7 +109,7 @@ def run_rehearse(
             progress(f"played iteration {k} ...")
     done = Rehearsal(result, controller, rehearsals, robot_file, robot.notes)
     if record:
-        done.recordings = _record(done, targets)
+        done.recordings = _record(done, targets, noise)
     done.plot = plot_rehearsal(picture, done)
     return done
 
@@ -118,13 +128,32 @@ def _commands(export: Export, robot: RehearsalRobot, feedforward: bool, rate: fl
     return Commands(export.q, export.qd, export.tau, held_tau, rate)
 
 
-def _record(done: Rehearsal, targets: list[Path]) -> list[Path]:
-    """Each played run written as a recording (module docstring of :func:`run_rehearse`)."""
+def _check_noise(noise: SimulationConfig | None, record: Path | None) -> None:
+    """Refuse an effects file that gives more than the recording's noise, or no recording to add it to."""
+    if noise is None:
+        return
+    if record is None:
+        raise ExciteError("effects", "the noise is added to a recording", expected="a record folder beside it")
+    extra = sorted(noise.model_fields_set - set(NOISE))
+    if extra:
+        raise ExciteError(
+            "effects",
+            f"gives {', '.join(extra)}: a rehearsal takes only the file's noise, its robot's damping, friction "
+            "and armature are MuJoCo's joints' and its rate the controller's",
+            expected=f"only {', '.join(NOISE)}",
+        )
+
+
+def _record(done: Rehearsal, targets: list[Path], noise: SimulationConfig | None) -> list[Path]:
+    """Each played run written as a recording (:func:`run_rehearse`), with ``noise``'s added."""
+    rng = np.random.default_rng(noise.seed if noise else 0)
+    sigma_q, sigma_tau = (noise.position_noise, noise.torque_noise) if noise else (0.0, 0.0)
     with atomic_paths(targets, "record") as temporary:
         for r, tmp in zip(done.iterations, temporary):
             names = r.export.joint_names
             header = ["time"] + [f"q_{j}" for j in names] + [f"tau_{j}" for j in names]
-            table = np.column_stack([r.played.time, r.played.q, r.played.tau])
+            q = r.played.q + rng.normal(0.0, sigma_q, r.played.q.shape)
+            table = np.column_stack([r.played.time, q, r.played.tau + rng.normal(0.0, sigma_tau, r.played.tau.shape)])
             with open(tmp, "w") as f:
                 np.savetxt(f, table, delimiter=",", header=",".join(header), comments="", fmt="%.10g")
                 f.write(f"# {MARK} rehearse: iteration {r.iteration} of {done.result.name} played in MuJoCo\n")

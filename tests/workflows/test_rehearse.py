@@ -17,8 +17,11 @@ from excite_cli.cli import app
 from excite_cli.config_file import load_problem
 from excite_cli.design.resolve import build_excitation
 from excite_cli.dynamics.robot_files import example_robot_data_root
+from excite_cli.errors import ExciteError
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.pipeline import run_identification
+from excite_cli.identification.simulation_config import SimulationConfig
+from excite_cli.workflows.export import played_result
 from excite_cli.workflows.optimize import run_optimize
 from excite_cli.workflows.rehearse import run_rehearse
 
@@ -70,6 +73,33 @@ def test_the_lab_mjcf_of_the_same_robot_plays_the_same(optimized, panda, tmp_pat
     ours, theirs = done.iterations[0].played, mjcf.iterations[0].played
     assert not mjcf.failed
     assert rms(theirs.tau - ours.tau) < 1e-3 * rms(ours.tau)
+
+
+def test_a_speed_the_export_refuses_is_played_and_named_with_the_limit(optimized, tmp_path):
+    with pytest.raises(ExciteError) as refused:
+        played_result(optimized, 1, speed=1.5)
+    done = run_rehearse(optimized, 1, speed=1.5, plot=tmp_path / "fast.png")
+    [it] = done.iterations
+    assert done.failed and it.refused and it.refused in refused.value.problem
+    assert not it.played.contacts and np.abs(it.played.q - it.export.q).max() < np.radians(0.5)  # played all the same
+
+
+def test_the_recording_carries_the_effects_file_s_noise_and_nothing_else(optimized, panda, tmp_path):
+    done, _ = panda
+    noise = SimulationConfig(torque_noise=0.05, position_noise=1e-4, seed=3)
+    noisy = run_rehearse(optimized, 1, record=tmp_path / "runs", plot=tmp_path / "n.png", noise=noise)
+    table = np.genfromtxt(noisy.recordings[0], delimiter=",", names=True, comments="#")
+    names = done.iterations[0].export.joint_names
+    clean = done.iterations[0].played  # MuJoCo is deterministic: the same run, without noise
+    q_noise = np.column_stack([table[f"q_{j}"] for j in names]) - clean.q
+    tau_noise = np.column_stack([table[f"tau_{j}"] for j in names]) - clean.tau
+    assert q_noise.std() == pytest.approx(1e-4, rel=0.05) and tau_noise.std() == pytest.approx(0.05, rel=0.05)
+    assert abs(tau_noise.mean()) < 0.05 * 0.05
+    for given, field in [(dict(effects={"viscous": {"*": 0.1}}), "effects"), (dict(sample_rate=500.0), "sample_rate")]:
+        with pytest.raises(ExciteError, match=field):
+            run_rehearse(optimized, 1, record=tmp_path / "x", noise=SimulationConfig(**given))
+    with pytest.raises(ExciteError, match="a record folder"):
+        run_rehearse(optimized, 1, noise=noise)
 
 
 def changed_result(result, folder, change) -> str:
