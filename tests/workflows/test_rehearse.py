@@ -102,6 +102,13 @@ def test_the_recording_carries_the_effects_file_s_noise_and_nothing_else(optimiz
         run_rehearse(optimized, 1, noise=noise)
 
 
+def test_the_command_reads_the_effects_file_and_names_what_it_lacks(optimized, tmp_path):
+    (tmp_path / "noise.yaml").write_text("torque_noise: 0.1\n")
+    result = CliRunner().invoke(app, ["rehearse", str(optimized), "--effects", str(tmp_path / "noise.yaml")])
+    assert result.exit_code == 2 and "--effects: the noise is added to a recording" in result.output, result.output
+    assert not optimized.with_name("smoke_rehearsal.png").exists()  # refused before anything is played
+
+
 def changed_result(result, folder, change) -> str:
     """A copy of ``result`` whose stored config ``change`` edits."""
     copy = folder / "changed.h5"
