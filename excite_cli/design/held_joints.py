@@ -56,6 +56,7 @@ class HeldTorques:
         effort: (h,) the URDF's effort limits [Nm] (0 or inf: none given).
         slipping: how many samples no split of the ground wrench keeps every force in its friction
             cone (the robot would tip or slip): their forces are the least-norm split.
+        friction: μ of the cones the forces were split in.
     """
 
     joint_names: tuple[str, ...]
@@ -65,6 +66,7 @@ class HeldTorques:
     points: np.ndarray
     effort: np.ndarray
     slipping: int
+    friction: float = 0.0
 
     def peak(self) -> tuple[int, float]:
         """The held joint (its index) whose |τ| is the largest share of its effort limit (of |τ| where no
@@ -150,7 +152,7 @@ class HeldJoints:
             slipping += not inside
             forces[k] = f.reshape(-1, 3)
             tau[k] = rnea[self.held_v] - self.G @ f
-        return HeldTorques(self.names, self.positions, tau, forces, self.points, self.effort, slipping)
+        return HeldTorques(self.names, self.positions, tau, forces, self.points, self.effort, slipping, self.friction)
 
     def contact_forces(self, wrench: np.ndarray) -> tuple[np.ndarray, bool]:
         """The contact forces f (3C,) [N] (world frame, point by point) that give the ground wrench

@@ -106,22 +106,43 @@ def _write_npz(path: Path, export: Export, effort: bool) -> Path:
 def _write_csv(path: Path, export: Export, effort: bool) -> Path:
     held = export.held
     table = np.column_stack([export.time, export.q, export.qd, export.qdd, export.tau] + ([held.tau] if held else []))
-    comments = [
-        f"excite export: iteration {export.iteration}, {export.rate:g} Hz, {export.periods} period(s)",
+    with atomic_path(path, "output") as tmp, open(tmp, "w") as f:  # the column names first, for any reader
+        header = ",".join(columns(export.joint_names, held.joint_names if held else ()))
+        np.savetxt(f, table, delimiter=",", header=header, comments="", fmt="%.10g")
+        f.write("".join(f"# {line}\n" for line in csv_notes(export)))
+    return path
+
+
+def csv_notes(export: Export) -> list[str]:
+    """What the CSV's ``#`` lines after its rows say: the export, its segments, what each group of
+    torque columns is (for held joints the rule that split the ground force between the soles), the
+    held joints' peak against its URDF limit and their positions, the largest constraint violation."""
+    held = export.held
+    at_rest = " with the base and the held joints at rest" if held else ""
+    notes = [
+        f"excite export: iteration {export.iteration}, {export.rate:g} Hz, {export.periods} period(s), "
+        f"speed {export.speed:g} ({MARK})",
         "segments: " + "; ".join(f"{n} {t0:.3f}-{t0 + d:.3f} s" for n, t0, d in export.segments),
-        "tau: feed-forward RNEA torque of the URDF model",
+        f"tau of the active joints ({len(export.joint_names)} columns after qdd): inverse dynamics (RNEA) of the "
+        f"URDF's rigid model at the row's q, qd, qdd{at_rest}",
         f"largest constraint violation (normalized, <= 0 satisfied): {export.max_violation:.3g}",
     ]
     if held:
-        comments.append(
-            "held joints (not moved; their tau keeps the base and them at rest, feet flat): "
-            + ", ".join(f"{name} at {value:.6g} rad" for name, value in zip(held.joint_names, held.positions))
-        )
-    with atomic_path(path, "output") as tmp, open(tmp, "w") as f:
-        f.write("".join(f"# {line}\n" for line in comments))
-        header = ",".join(columns(export.joint_names, held.joint_names if held else ()))
-        np.savetxt(f, table, delimiter=",", header=header, comments="", fmt="%.10g")
-    return path
+        k, share = held.peak()
+        limited = 0 < held.effort[k] < np.inf
+        peak = np.abs(held.tau[:, k]).max()
+        notes += [
+            f"tau of the held joints ({len(held.joint_names)} columns after the active joints'): the feed-forward "
+            "that keeps the base and them at rest, feet flat: inverse dynamics of their rows minus the torques of "
+            f"the contact forces at the soles' {len(held.points)} points, the ground wrench split as the "
+            f"least-norm forces, or where one leaves its friction cone (mu {held.friction:g}) the least-norm "
+            "forces inside the cones; another split moves these torques, not the active joints'",
+            f"held joints' peak: {held.joint_names[k]} {peak:.4g} Nm"
+            + (f", {100 * share:.0f} % of its URDF limit {held.effort[k]:g} Nm" if limited else " (no URDF limit)"),
+            "held joints (not moved): "
+            + ", ".join(f"{name} at {value:.6g} rad" for name, value in zip(held.joint_names, held.positions)),
+        ]
+    return notes
 
 
 #: What writes each format (:data:`~excite_cli.storage.formats.FORMATS`), by its name.

@@ -39,7 +39,7 @@ def exported(g1, tmp_path_factory):
         excitation, alpha, Played(tmp_path_factory.mktemp("g1") / "r.h5", 1, 100.0, 1, 1.0), held
     )
     path = write_export(tmp_path_factory.mktemp("csv") / "g1.csv", export, "csv")
-    table = np.genfromtxt(path, delimiter=",", names=True, skip_header=5)
+    table = np.genfromtxt(path, delimiter=",", names=True)
     return export, table
 
 

@@ -40,7 +40,7 @@ def export():
 
 
 def test_csv_and_npz_hold_the_same_samples_under_their_column_names(export, tmp_path):
-    table = np.genfromtxt(write_export(tmp_path / "m.csv", export, "csv"), delimiter=",", names=True, skip_header=4)
+    table = np.genfromtxt(write_export(tmp_path / "m.csv", export, "csv"), delimiter=",", names=True)
     assert (
         list(table.dtype.names)
         == columns(JOINTS)
@@ -157,13 +157,32 @@ def test_a_standing_robot_s_held_joints_are_columns_and_arrays_beside_the_active
     path = write_export(tmp_path / "m.csv", standing, "csv")
     header = [line for line in path.read_text().splitlines() if line.startswith("#")]
     assert header[-1].endswith("knee at 0.1 rad, hip at -0.2 rad")
-    table = np.genfromtxt(path, delimiter=",", names=True, skip_header=5)
+    table = np.genfromtxt(path, delimiter=",", names=True)
     assert list(table.dtype.names) == columns(JOINTS) + ["tau_knee_Nm", "tau_hip_Nm"]
     np.testing.assert_allclose(table["tau_hip_Nm"], standing.held.tau[:, 1], rtol=1e-9)
     archive = np.load(write_export(tmp_path / "m.npz", standing, "npz"))
     assert archive["held_joint_names"].tolist() == ["knee", "hip"]
     np.testing.assert_array_equal(archive["tau_held"], standing.held.tau)
     np.testing.assert_array_equal(archive["held_positions"], [0.1, -0.2])
+
+
+def test_a_standing_export_reads_with_numpy_and_pandas_and_says_what_each_torque_is(standing, tmp_path):
+    """The column names are the first line (numpy's ``names=True`` takes the first line, commented or
+    not); the notes after the rows say what the active and held torques are, the ground force's split
+    and the held joints' peak against its limit (knee: 2 Nm of 50 Nm; hip has none)."""
+    import pandas
+
+    path = write_export(tmp_path / "m.csv", standing, "csv")
+    table = np.genfromtxt(path, delimiter=",", names=True)
+    frame = pandas.read_csv(path, comment="#")
+    assert list(table.dtype.names) == list(frame.columns) == columns(JOINTS) + ["tau_knee_Nm", "tau_hip_Nm"]
+    np.testing.assert_allclose(frame["tau_knee_Nm"], standing.held.tau[:, 0], rtol=1e-9)
+    assert len(frame) == table.size == standing.time.size
+    notes = [line for line in path.read_text().splitlines() if line.startswith("#")]
+    assert any("tau of the active joints (2 columns after qdd): inverse dynamics (RNEA)" in n for n in notes)
+    [rule] = [n for n in notes if n.startswith("# tau of the held joints (2 columns")]
+    assert "least-norm forces" in rule and "friction cone" in rule
+    assert "# held joints' peak: knee 2 Nm, 4 % of its URDF limit 50 Nm" in notes
 
 
 def test_held_joints_reach_an_effort_controller_s_trajectory_and_stay_out_of_a_position_controller_s(
