@@ -42,11 +42,7 @@ def export_lines(e: Export, rate: float, target: Path, fmt: str, effort: bool = 
             "(excite identify reads that bag folder as a data.runs file)",
         ]
     if form.controller:
-        lines.append(
-            f"first point (home, at rest) at {e.approach:g} s: the controller moves the robot there from where it "
-            "stands in that time (from anywhere in its joint range within the velocity and acceleration limits; "
-            "--approach sets it)"
-        )
+        lines += approach_lines(e)
         lines.append(
             "effort: the feed-forward torque, for an effort-controlled joint_trajectory_controller (Jazzy on)"
             if effort
@@ -54,6 +50,25 @@ def export_lines(e: Export, rate: float, target: Path, fmt: str, effort: bool = 
             "(--effort adds the feed-forward torque, for an effort-controlled one)"
         )
     return lines
+
+
+def approach_lines(e: Export) -> list[str]:
+    """When a controller's first point comes, and a warning where a given ``--approach`` is shorter than
+    the time from anywhere in the joint range, naming that time and how near home each joint must start."""
+    line = (
+        f"first point (home, at rest) at {e.approach:g} s: the controller moves the robot there from where it "
+        "stands in that time"
+    )
+    if not e.reach:
+        anywhere = " (from anywhere in its joint range within the velocity and acceleration limits; --approach sets it)"
+        return [line + anywhere]
+    near = ", ".join(f"{name} {d:.3g} rad" for name, d in e.reach)
+    return [
+        line,
+        f"warning: --approach {e.approach:g} s is shorter than the {e.approach_needed:g} s the controller needs from "
+        f"anywhere in the joint range within the velocity and acceleration limits; in {e.approach:g} s it brings "
+        f"home only a robot that starts within {near} of it (start it nearer home, or leave --approach out)",
+    ]
 
 
 def held_lines(e: Export) -> list[str]:

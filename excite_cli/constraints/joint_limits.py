@@ -31,6 +31,7 @@ class JointLimits(Constraint):
     Args:
         lower, upper: (3, n) bounds of q [rad], q̇ [rad/s], q̈ [rad/s²].
         basis: Fourier basis on the constraint grid.
+        names: (n,) the joints, as the messages name them (default: joint 1 … n).
 
     Raises:
         ValueError: a lower bound is not below its upper bound.
@@ -40,8 +41,9 @@ class JointLimits(Constraint):
     field = "robot.home_posture"  # the limits come from the URDF; what violates them is the home posture
     grid_margin = ACCEPT_MARGIN
 
-    def __init__(self, lower: np.ndarray, upper: np.ndarray, basis: FourierBasis):
+    def __init__(self, lower: np.ndarray, upper: np.ndarray, basis: FourierBasis, names: list[str] | None = None):
         self.lower = np.asarray(lower, dtype=float)
+        self.names = list(names) if names is not None else [f"joint {j + 1}" for j in range(self.lower.shape[1])]
         self.upper = np.asarray(upper, dtype=float)
         if np.any(self.upper <= self.lower):
             raise ValueError("joint limits: an upper bound is not above its lower bound")
@@ -80,7 +82,7 @@ class JointLimits(Constraint):
             x = z[d] * self.half[d] + self.centre[d]
             details[f"max_violation_{order}"] = float(np.max(np.maximum(x - self.upper[d], self.lower[d] - x)))
         d, j = np.unravel_index(np.argmax(normalized), normalized.shape)
-        where = f"{ORDERS[d].split('_')[0]} of joint {j + 1} at {normalized[d, j] + 1:.3f} of its half-range"
+        where = f"{ORDERS[d].split('_')[0]} of {self.names[j]} at {normalized[d, j] + 1:.3f} of its half-range"
         return FineCheck(max_violation=float(normalized.max()), details=details, where=where)
 
     def coefficient_scale(self) -> np.ndarray:

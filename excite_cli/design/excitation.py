@@ -206,7 +206,7 @@ def build_design(spec: DesignSpec, robot: Robot | None = None, check_home: bool 
     trajectory = FourierTrajectory(tcfg.harmonics, tcfg.base_frequency)
     fine_period = tcfg.constraint_period / spec.limits.check_refinement
     grid_basis = trajectory.basis(sample_times(tcfg.duration, tcfg.constraint_period, include_end=True))
-    limits = JointLimits(*joint_limit_bounds(spec.limits, robot), grid_basis)
+    limits = JointLimits(*joint_limit_bounds(spec.limits, robot), grid_basis, robot.joint_names)
     excitation = Excitation(
         spec=spec,
         robot=robot,

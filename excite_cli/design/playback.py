@@ -111,6 +111,16 @@ def approach_duration(excitation: Excitation) -> float:
     return round(float(np.ceil(bound / RESOLUTION - 1e-9) * RESOLUTION), 6)
 
 
+def approach_reach(excitation: Excitation, duration: float) -> np.ndarray:
+    """(n,) [rad] How far from home each joint can start and still be brought there at rest in
+    ``duration`` [s] within the problem's velocity and acceleration limits, on the same quintic as
+    :func:`approach_duration` (its bound solved for Δ: min(8 v T / 15, √3 a T² / 10))."""
+    limits = excitation.limits
+    velocity = np.minimum(-limits.lower[1], limits.upper[1])
+    acceleration = np.minimum(-limits.lower[2], limits.upper[2])
+    return np.minimum(8.0 * velocity * duration / 15.0, np.sqrt(3.0) * acceleration * duration**2 / 10.0)
+
+
 def plan_transition(
     start: np.ndarray, end: np.ndarray, limits: JointLimits, name: str, slowed: Sequence[Constraint] = ()
 ) -> Transition | None:

@@ -20,9 +20,10 @@ from typing import NamedTuple
 
 import numpy as np
 
+from excite_cli.constraints.constraint import Constraint
 from excite_cli.design.excitation import Excitation
 from excite_cli.design.held_joints import HeldJoints, HeldTorques
-from excite_cli.design.playback import approach_duration, check_motion, plan_playback
+from excite_cli.design.playback import Playback, approach_duration, approach_reach, check_motion, plan_playback
 from excite_cli.errors import ExciteError
 
 #: Highest export rate accepted [Hz] (memory grows with rate × duration).
@@ -31,6 +32,8 @@ MAX_RATE = 100_000.0
 MAX_PERIODS = 1000
 #: Fastest and slowest playback accepted (times the optimized speed).
 MAX_SPEED, MIN_SPEED = 10.0, 0.01
+#: Resolution of the largest passing speed a refusal names.
+SPEED_STEP = 0.01
 #: Longest approach accepted [s].
 MAX_APPROACH = 600.0
 #: Most samples in one file (about 1.3 GB of CSV with 7 joints).
@@ -56,6 +59,9 @@ class Export:
         approach: [s] what a controller's trajectory waits before its first point (the home posture at
             rest), its time to bring the robot there from where it stands; the ROS 2 formats start
             their points' ``time_from_start`` there (:func:`~excite_cli.design.playback.approach_duration`).
+        approach_needed: [s] that time from anywhere in the joint range (``approach`` unless one was given).
+        reach: (joint, [rad]) of the joints a shorter given ``approach`` brings home only from within that
+            distance of it (:func:`~excite_cli.design.playback.approach_reach`), else empty.
     """
 
     joint_names: list[str]
@@ -75,6 +81,8 @@ class Export:
     warnings: tuple[str, ...] = ()
     held: HeldTorques | None = None
     approach: float = 0.0
+    approach_needed: float = 0.0
+    reach: tuple[tuple[str, float], ...] = ()
 
 
 class Played(NamedTuple):
@@ -155,8 +163,11 @@ def export_trajectory(excitation: Excitation, alpha: np.ndarray, how: Played, he
     violation, worst = check_motion(binding, time, q, qd, qdd)
     played = f" at speed {speed:g}" if speed != 1.0 else ""
     if violation > 0.0 and refuse:
+        fastest = fastest_passing(playback, binding, rate, speed)
+        passes = f"; the largest speed that passes: {fastest:.2f}" if fastest else ""
         raise ExciteError(
-            "result", f"{result}: iteration {k} played{played} at {rate:g} Hz violates {worst}; no file written"
+            "result",
+            f"{result}: iteration {k} played{played} at {rate:g} Hz violates {worst}{passes}; no file written",
         )
     advisory = [(c, c.check_samples(time, q, qd, qdd)) for c in excitation.constraints if c.advisory]
     stance = None if held is None else held.torques(q, qd, qdd)
@@ -164,6 +175,10 @@ def export_trajectory(excitation: Excitation, alpha: np.ndarray, how: Played, he
         _check_held_efforts(stance, f"{result}: iteration {k} played{played} at {rate:g} Hz")
     robot = excitation.robot
     tau = np.array([robot.torques(*x) for x in zip(q, qd, qdd)])
+    needed = approach_duration(excitation)
+    approach = needed if approach is None else float(approach)
+    farthest = np.maximum(robot.upper - robot.home, robot.home - robot.lower)
+    reach = approach_reach(excitation, approach) if approach < needed else farthest
     starts = np.cumsum([0.0] + [s.duration for s in playback.segments])
     return Export(
         joint_names=list(robot.joint_names),
@@ -187,8 +202,28 @@ def export_trajectory(excitation: Excitation, alpha: np.ndarray, how: Played, he
         )
         + _slipping(stance),
         held=stance,
-        approach=approach_duration(excitation) if approach is None else float(approach),
+        approach=approach,
+        approach_needed=needed,
+        reach=tuple((name, float(d)) for name, d, far in zip(robot.joint_names, reach, farthest) if d < far),
     )
+
+
+def fastest_passing(playback: Playback, constraints: list[Constraint], rate: float, speed: float) -> float | None:
+    """The largest speed in [1, ``speed``) (times the optimized, to ``SPEED_STEP``) whose samples at
+    ``rate`` [Hz] keep ``constraints``, found by bisection (velocities scale with the speed, accelerations
+    with its square, torques and the zero-moment point with neither alone); None where ``speed`` ≤ 1 or
+    the optimized speed itself does not pass."""
+
+    def passes(s: float) -> bool:
+        return check_motion(constraints, *playback.sample(rate, speed=s))[0] <= 0.0
+
+    if speed <= 1.0 or not passes(1.0):
+        return None
+    lo, hi = 1.0, speed
+    while hi - lo > SPEED_STEP:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if passes(mid) else (lo, mid)
+    return float(np.floor(lo / SPEED_STEP + 1e-9) * SPEED_STEP)
 
 
 def _check_held_efforts(stance: HeldTorques, what: str) -> None:

@@ -37,3 +37,13 @@ def test_a_standing_robot_s_largest_held_torque_is_said_against_its_effort_limit
     assert f"{said} 4.0 Nm (80 % of its effort limit 5 Nm)" in lines
     position = export_lines(replace(EXPORT, held=held), 10.0, Path("g.yaml"), "ros2")
     assert any(line.startswith("held joints: not in the trajectory") for line in position)
+
+
+def test_an_approach_shorter_than_needed_is_warned_with_the_time_and_the_reach():
+    short = replace(EXPORT, approach=0.5, approach_needed=3.07, reach=(("j", 0.217),))
+    lines = export_lines(short, 10.0, Path("run/bag"), "rosbag2")
+    [warning] = [line for line in lines if line.startswith("warning: --approach 0.5 s")]
+    assert "shorter than the 3.07 s" in warning and "starts within j 0.217 rad of it" in warning
+    full = export_lines(replace(EXPORT, approach=3.07, approach_needed=3.07), 10.0, Path("run/bag"), "rosbag2")
+    assert any("(from anywhere in its joint range" in line for line in full)
+    assert not any(line.startswith("warning") for line in full)

@@ -1,6 +1,8 @@
 """From an optimized trajectory to a robot: rest at both ends on the Panda, quintic transitions, the
 exported file at 1 kHz against pinocchio's RNEA and the URDF's limits, the posture strip."""
 
+import re
+
 import h5py
 import numpy as np
 import pinocchio as pin
@@ -14,9 +16,10 @@ from excite_cli.cli import app
 from excite_cli.config_file import result_problem
 from excite_cli.constraints import JointLimits
 from excite_cli.constraints.lse import GRID_MARGIN
-from excite_cli.design.playback import RESOLUTION, Transition, approach_duration, plan_transition
+from excite_cli.design.playback import RESOLUTION, Transition, approach_duration, approach_reach, plan_transition
 from excite_cli.design.resolve import build_excitation
 from excite_cli.dynamics.robot_files import example_robot_data_root
+from excite_cli.errors import ExciteError
 from excite_cli.storage.rosbag import TOPIC
 from excite_cli.workflows.export import played_result
 
@@ -214,9 +217,41 @@ def test_the_approach_brings_the_robot_home_from_anywhere_in_its_range_within_th
     assert max(peaks(0.9 * approach)[0].max(), peaks(0.9 * approach)[1].max()) > 1.0
 
 
+def test_a_shorter_approach_brings_home_only_a_robot_within_its_reach_of_it(panda_runs):
+    """Half a second: the quintic over each joint's reach peaks at its velocity or acceleration limit
+    (sampled, as above), 1 % farther passes it; the export names those joints and the time needed."""
+    excitation = build_excitation(result_problem(panda_runs["rest"]))
+    limits, s = excitation.limits, np.linspace(0.0, 1.0, 20001)[:, None]
+    reach = approach_reach(excitation, 0.5)
+
+    def peak(distance):
+        speed = np.abs(distance * (30 * s**2 - 60 * s**3 + 30 * s**4) / 0.5).max(axis=0) / limits.upper[1]
+        acceleration = np.abs(distance * (60 * s - 180 * s**2 + 120 * s**3) / 0.25).max(axis=0) / limits.upper[2]
+        return np.maximum(speed, acceleration)
+
+    np.testing.assert_allclose(peak(reach), 1.0, rtol=1e-6)
+    assert np.all(peak(1.01 * reach) > 1.0)
+    played = played_result(panda_runs["rest"], approach=0.5)
+    assert played.approach_needed == approach_duration(excitation) > 0.5
+    assert [name for name, _ in played.reach] == excitation.robot.joint_names
+    assert not played_result(panda_runs["rest"]).reach  # the default reaches home from anywhere
+
+
+def test_a_speed_the_limits_refuse_names_the_joint_and_the_largest_speed_that_passes(panda_runs):
+    with pytest.raises(ExciteError) as refused:
+        played_result(panda_runs["rest"], 1, rate=200.0, speed=3.0)
+    message = refused.value.problem
+    assert re.search(r"violates joint_limits: \w+ of panda_joint\d at [\d.]+ of its half-range", message), message
+    fastest = float(re.search(r"the largest speed that passes: ([\d.]+);", message).group(1))
+    assert 1.0 <= fastest < 3.0
+    assert played_result(panda_runs["rest"], 1, rate=200.0, speed=fastest).max_violation <= 0.0
+    with pytest.raises(ExciteError):
+        played_result(panda_runs["rest"], 1, rate=200.0, speed=fastest + 0.02)
+
+
 def _csv(path):
     """time (S,), q, q̇, q̈, τ (S, n) of an ``excite export`` CSV."""
-    table = np.genfromtxt(path, delimiter=",", skip_header=5)
+    table = np.genfromtxt(path, delimiter=",", skip_header=1)  # the column names, then the rows; notes last
     n = (table.shape[1] - 1) // 4
     return (table[:, 0], *(table[:, 1 + k * n : 1 + (k + 1) * n] for k in range(4)))
 
