@@ -14,6 +14,7 @@ import yaml
 from excite_cli.atomic import atomic_path
 from excite_cli.config import RobotConfig
 from excite_cli.config_file import drafted_problem
+from excite_cli.drafting.data_columns import recognized_columns
 from excite_cli.drafting.joints import joint_choice
 from excite_cli.drafting.standing import StandOptions
 from excite_cli.drafting.starting_config import StartingConfig, draft_config
@@ -22,6 +23,7 @@ from excite_cli.dynamics.source import RobotSource
 from excite_cli.errors import ExciteError, FileNotFound
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.measured.bags import is_bag
+from excite_cli.identification.measured.files import read_table
 from excite_cli.inputs import input_file
 from excite_cli.search.engine import default_workers
 from excite_cli.search.run_time import sizes_within
@@ -96,14 +98,22 @@ def _identify_config(
         draft.assumptions["data.topic"] = "/joint_states: the bags' sensor_msgs/JointState, joints matched by name"
     if runs and len(bags) == len(runs):
         return
-    draft.config["data"]["columns"] = {
-        "time": "time",
-        "q": [f"q_{j}" for j in active],
-        "tau": [f"tau_{j}" for j in active],
-    }
+    files_read = [r for r in runs if not is_bag(Path(r))]
+    found = recognized_columns(read_table(Path(files_read[0])).names, active) if files_read else {}
+    default = {"time": "time", "q": [f"q_{j}" for j in active], "tau": [f"tau_{j}" for j in active]}
+    draft.config["data"]["columns"] = {**default, **found}
+    missing = [signal for signal in default if signal not in found]
+    named = ", ".join(signal for signal in found)
     draft.assumptions["data.columns"] = (
-        "FILL IN: the column names of your files (these are the ones `excite simulate` writes); "
-        "add qd (and qdd) if you record them, factors for units other than rad and Nm"
+        (f"{named} recognized in {Path(files_read[0]).name}; " if found else "")
+        + (
+            f"FILL IN: the column names of your files for {', '.join(missing)} (these are the ones "
+            "`excite simulate` writes); "
+            if missing
+            else "check them; "
+        )
+        + ("add qdd" if "qd" in found else "add qd (and qdd)")
+        + " if you record them, factors for units other than rad and Nm"
         + ("; the bags' joints are matched by name" if bags else "")
     )
 
@@ -133,10 +143,12 @@ def _text(draft: StartingConfig, urdf: str, kind: str) -> str:
     lines += [f"#   {name}: {why}" for name, why in draft.assumptions.items()]
     lines += [f"#   excluded pair {a} – {b}: {why}" for a, b, why in draft.excluded]
     lines += [f"#   environment ignores {link}: {why}" for link, why in draft.ignored]
+    to_fill = any("FILL IN" in why for why in draft.assumptions.values())
     lines.append(
         "# Check it with `excite check` before a run; change what your lab knows better."
         if kind == "optimize"
-        else "# Fill in what is marked FILL IN, then run `excite identify`; change what your lab knows better."
+        else f"# {'Fill in what is marked FILL IN' if to_fill else 'Check it'}, then run `excite identify`; "
+        "change what your lab knows better."
     )
     body = yaml.dump(
         draft.config, Dumper=_Dumper, sort_keys=False, default_flow_style=False, width=100, allow_unicode=True

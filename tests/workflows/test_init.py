@@ -84,6 +84,23 @@ def test_the_identify_kind_names_the_columns_simulate_writes_and_what_to_fill_in
     assert_refused(tmp_path, ["identify", str(run.target)], "runs/run_1.csv")  # not there yet
 
 
+def test_a_file_with_the_columns_gets_them_filled_in_and_nothing_to_fill(tmp_path):
+    """A lab file whose columns are time_s, <joint>_pos, <joint>_vel, Effort_<joint> (any case)."""
+    names = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint"]
+    names += ["wrist_3_joint"]
+    header = ["time_s"] + [f"{j}_pos" for j in names] + [f"{j}_vel" for j in names] + [f"Effort_{j}" for j in names]
+    (tmp_path / "lab.csv").write_text(",".join(header) + "\n" + ",".join(["0"] * len(header)) + "\n")
+    run = run_init(UR3, tmp_path / "id.yaml", kind="identify", runs=[str(tmp_path / "lab.csv")])
+    columns = load_problem(run.target, IdentifyProblem).data.columns
+    assert columns.time == "time_s" and columns.q == [f"{j}_pos" for j in names]
+    assert columns.qd == [f"{j}_vel" for j in names] and columns.tau == [f"Effort_{j}" for j in names]
+    text = run.target.read_text()
+    assert "FILL IN" not in text and "time, q, qd, tau recognized in lab.csv" in text
+    (tmp_path / "other.csv").write_text("time,a,b\n0,1,2\n")
+    other = run_init(UR3, tmp_path / "id2.yaml", kind="identify", runs=[str(tmp_path / "other.csv")])
+    assert "FILL IN: the column names of your files for q, tau" in other.target.read_text()
+
+
 def test_recorded_bags_get_a_config_without_columns_that_identifies_the_friction(tmp_path, monkeypatch):
     """A pendulum run simulated as ``ros2 bag record /joint_states`` writes it (viscous 0.2 Nm·s/rad),
     ``init --kind identify --runs``, then ``identify``: the bag is read by joint name and the viscous
