@@ -1,11 +1,14 @@
 """Progress of long commands on the terminal: a bar per iteration with the objective at the current
 iterate, the restart, elapsed time and an ETA; where the output is a log rather than a terminal, a line
-every ``LOG_PERIOD`` seconds of work (iteration, run, solver iterations, objective, elapsed, estimate)
-and one per finished iteration (with the optimizer's stop reason); a bar for random draws."""
+every ``LOG_PERIOD`` seconds of work (iteration, run, solver iterations, objective, elapsed, estimate),
+also while worker processes run restarts and report nothing until one ends (a heartbeat thread: the runs
+reported, the lowest objective reported, elapsed), and one per finished iteration (with the optimizer's
+stop reason); a bar for random draws."""
 
 from __future__ import annotations
 
 import sys
+import threading
 import time
 from typing import TYPE_CHECKING, Callable
 
@@ -19,8 +22,9 @@ if TYPE_CHECKING:  # annotations only: the command line's frame imports this mod
     from excite_cli.search.optimizer import ProgressHook
     from excite_cli.search.sequence import IterationResult
 
-#: [s] between two progress lines in a log (no terminal).
-LOG_PERIOD = 30.0
+#: [s] between two progress lines in a log (no terminal); a heartbeat checks ten times a period, so
+#: two lines are at most 1.1 periods (27.5 s) apart while an iteration runs.
+LOG_PERIOD = 25.0
 #: Width of printed tables where the output is not a terminal (a log, a pipe): rich's default of 80
 #: columns would cut their numbers.
 LOG_WIDTH = 200
@@ -36,8 +40,9 @@ class Bars:
     """One live display of bars on ``console`` (a context manager); it appears with the first bar, so
     an error found before any work is the only thing printed."""
 
-    def __init__(self, console: Console, clock: Callable[[], float] = time.monotonic):
-        self.console, self.clock = console, clock
+    def __init__(self, console: Console, clock: Callable[[], float] = time.monotonic, period: float = LOG_PERIOD):
+        self.console, self.clock, self.period = console, clock, period
+        self._beats: list[threading.Event] = []
         self.bar = Progress(
             TextColumn("{task.description}"),
             BarColumn(),
@@ -53,6 +58,8 @@ class Bars:
         return self
 
     def __exit__(self, *exc) -> None:
+        for beat in self._beats:
+            beat.set()
         if self._live:
             self.bar.__exit__(*exc)
 
@@ -72,22 +79,35 @@ class Bars:
         record = CRITERIA[opts.objective]
         label, shown = record.label, record.shown
         tasks: dict[int, int] = {}
+        beats: dict[int, threading.Event] = {}  # a log's heartbeat per running iteration
 
         def progress(k: int) -> ProgressHook:
             tasks[k] = self._task(f"iteration {k}", opts.planned_iterations, "starting")
             steps: dict[int, int] = {}
-            start = last = self.clock()
+            start = self.clock()
             runs = opts.screened + opts.restarts if opts.screened else opts.restarts
+            seen = {"last": start, "lowest": float("inf"), "runs": runs}
+
+            def heartbeat() -> None:
+                elapsed = self.clock() - start
+                lowest = f", lowest {label} reported {shown(seen['lowest']):.4g}" if steps else ""
+                self.console.print(
+                    f"iteration {k}: working, {len(steps)}/{seen['runs']} runs reported{lowest}, {elapsed:.0f} s",
+                    highlight=False,
+                )
+
+            if not self.console.is_terminal:
+                beats[k] = self._heartbeat(seen, heartbeat, k)
 
             def hook(restart: int, it: int, value: float) -> None:
-                nonlocal last
                 steps[restart] = it
-                runs_now = max(runs, restart + 1)  # an earlier optimum's run comes last (search/earlier_optimum.py)
+                seen["lowest"] = min(seen["lowest"], value)
+                runs_now = seen["runs"] = max(runs, restart + 1)  # an earlier optimum's run comes last
                 done, status = sum(steps.values()), f"run {restart + 1}/{runs_now} · {label} {shown(value):.4g}"
                 bar.update(tasks[k], completed=done, status=status)
                 now = self.clock()
-                if not self.console.is_terminal and now - last >= LOG_PERIOD:
-                    last, elapsed = now, now - start
+                if not self.console.is_terminal and now - seen["last"] >= self.period:
+                    seen["last"], elapsed = now, now - start
                     left = elapsed * max(opts.planned_iterations - done, 0) / max(done, 1)
                     self.console.print(
                         f"iteration {k}: run {restart + 1}/{runs_now}, "
@@ -99,6 +119,7 @@ class Bars:
             return hook
 
         def done(result: IterationResult) -> None:
+            beats.pop(result.index, threading.Event()).set()
             bar.update(
                 tasks[result.index],
                 completed=opts.planned_iterations,
@@ -112,6 +133,22 @@ class Bars:
                 )
 
         return progress, done
+
+    def _heartbeat(self, seen: dict, say: Callable[[], None], k: int) -> threading.Event:
+        """A daemon thread that calls ``say`` when ``period`` has passed since ``seen["last"]`` (a line
+        printed), until the returned event is set (iteration ``k`` done) or the bars close."""
+        stop = threading.Event()
+        self._beats.append(stop)
+
+        def beat() -> None:
+            while not stop.wait(self.period / 10):
+                now = self.clock()
+                if now - seen["last"] >= self.period:
+                    seen["last"] = now
+                    say()
+
+        threading.Thread(target=beat, name=f"progress-heartbeat-{k}", daemon=True).start()
+        return stop
 
     def draws(self, total: int | None) -> Callable[[int, int], None]:
         """The (kept, drawn) hook of ``compare-random``'s random draws."""

@@ -3,6 +3,7 @@ table, the progress lines of a log, and errors worded as the command's options."
 
 import io
 import re
+import time
 import warnings
 from types import SimpleNamespace
 
@@ -18,7 +19,7 @@ from excite_cli.console import tables
 from excite_cli.console.bodies import consistent_bodies
 from excite_cli.console.errors import printed_warnings, spellings, word
 from excite_cli.console.identification import _unresolved, _why_not_least_squares, validation
-from excite_cli.console.progress import Bars
+from excite_cli.console.progress import LOG_PERIOD, Bars
 from excite_cli.errors import ExciteError, ExciteWarning, OutputExists
 from excite_cli.identification.choice.admission import Admission
 from excite_cli.identification.fitting.physical import ConsistentFit
@@ -106,15 +107,40 @@ def test_a_log_gets_a_progress_line_every_log_period_while_an_iteration_runs():
     problem = load_problem(CONFIGS / "smoke.yaml")
     with Bars(Console(file=out, width=200, force_terminal=False), clock=lambda: now[0]) as bars:
         hook = bars.iterations(problem.optimizer)[0](1)
-        for t, it in ((10.0, 5), (29.0, 10), (31.0, 20), (40.0, 25)):
+        for t, it in ((10.0, 5), (LOG_PERIOD - 1, 10), (LOG_PERIOD + 1, 20), (LOG_PERIOD + 10, 25)):
             now[0] = t
             hook(0, it, -3.0)
     lines = [line for line in out.getvalue().splitlines() if line.startswith("iteration 1:")]
     planned = problem.optimizer.planned_iterations
-    left = 31.0 * (planned - 20) / 20
+    left = (LOG_PERIOD + 1) * (planned - 20) / 20
     objective = problem.optimizer.objective
-    expected = f"iteration 1: run 1/1, 20/{planned} solver iterations, {objective} -3, 31 s, about {left:.0f} s left"
+    expected = (
+        f"iteration 1: run 1/1, 20/{planned} solver iterations, {objective} -3, {LOG_PERIOD + 1:.0f} s, "
+        f"about {left:.0f} s left"
+    )
     assert lines == [expected]
+
+
+def test_a_log_hears_from_an_iteration_whose_workers_report_nothing_for_a_while():
+    """Worker processes report a restart only when it ends: a heartbeat line every period meanwhile
+    (here 0.1 s of real time), with the runs reported and the lowest objective, none once it is done."""
+    out = io.StringIO()
+    problem = load_problem(CONFIGS / "smoke.yaml")
+    with Bars(Console(file=out, width=200, force_terminal=False), period=0.1) as bars:
+        progress, done = bars.iterations(problem.optimizer)
+        hook = progress(1)
+        time.sleep(0.35)
+        hook(0, 40, -3.0)  # a restart ends
+        time.sleep(0.35)
+        done(_iteration())
+        printed = out.getvalue()
+        time.sleep(0.3)
+    beats = [line for line in printed.splitlines() if line.startswith("iteration 1: working")]
+    opts = problem.optimizer
+    runs = opts.screened + opts.restarts if opts.screened else opts.restarts
+    assert len(beats) >= 4 and beats[0].startswith(f"iteration 1: working, 0/{runs} runs reported, 0 s")
+    assert f"1/{runs} runs reported, lowest {problem.optimizer.objective} reported -3," in beats[-1]
+    assert out.getvalue().count("working") == printed.count("working")  # silent once done
 
 
 def test_the_command_line_words_fields_as_its_options():
