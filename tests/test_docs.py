@@ -157,3 +157,20 @@ def test_every_section_of_how_it_works_cited_elsewhere_is_a_heading_its_links_re
     assert cited == []  # every citation by section is a link
     assert len({a for _, a in linked}) >= 8
     assert sorted((name, a) for name, a in linked if a not in anchors) == []
+
+
+def test_the_readme_and_index_quote_the_figures_page_and_state_no_test_count():
+    """Times of `make optimize` and the other ready problems ("43 s of iterations", "50 s wall") and the
+    README's Table I are the figures page's; a count of tests would be stale at the next test."""
+    figures = (ROOT / "docs" / "figures.md").read_text()
+    pages = {page.name: page.read_text() for page in (ROOT / "README.md", ROOT / "docs" / "index.md")}
+    quoted = {(name, t) for name, text in pages.items() for t in re.findall(r"\b\d+ s (?:of iterations|wall)", text)}
+    assert ("README.md", "43 s of iterations") in quoted  # the pattern sees them
+    assert {(name, t) for name, t in quoted if t not in figures} == set()
+    rows = re.findall(r"^\| (\d) \| ([\d.]+) \| (\d+) \| ([\d.]+) \| ([\d.]+ mm) \|", pages["README.md"], re.M)
+    assert len(rows) == 3
+    for k, *numbers in rows:
+        [row] = [line for line in figures.splitlines() if line.startswith(f"| {k} | ")][:1]
+        assert all(f"| {x} |" in row for x in numbers), (row, numbers)
+    for page in ("README.md", "docs/index.md", "docs/development.md"):
+        assert not re.search(r"\b\d+ tests\b", (ROOT / page).read_text()), page
