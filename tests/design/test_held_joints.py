@@ -40,7 +40,22 @@ def exported(g1, tmp_path_factory):
     )
     path = write_export(tmp_path_factory.mktemp("csv") / "g1.csv", export, "csv")
     table = np.genfromtxt(path, delimiter=",", names=True)
-    return export, table
+    return export, table, path
+
+
+def test_the_g1_csv_reads_with_numpy_and_pandas_and_names_the_held_peak_and_the_split(exported):
+    import pandas
+
+    export, table, path = exported
+    frame = pandas.read_csv(path, comment="#")
+    held = [f"tau_{j}_Nm" for j in export.held.joint_names]
+    assert len(held) == 15 and list(frame.columns)[-15:] == held == list(table.dtype.names)[-15:]
+    k, share = export.held.peak()
+    peak = np.abs(frame[held[k]]).max()
+    notes = [line for line in path.read_text().splitlines() if line.startswith("#")]
+    said = f"# held joints' peak: {export.held.joint_names[k]} {peak:.4g} Nm, {100 * share:.0f} % of its URDF limit"
+    assert any(n.startswith(said) for n in notes), notes
+    assert any("the ground wrench split as the least-norm forces" in n and "friction cone (mu 0.5)" in n for n in notes)
 
 
 def _sole_points(urdf) -> list[np.ndarray]:
@@ -64,7 +79,7 @@ def _sole_points(urdf) -> list[np.ndarray]:
 
 def test_the_csv_s_held_torques_balance_the_floating_base_s_equations_of_motion(g1, exported):
     problem, excitation, _ = g1
-    export, table = exported
+    export, table, _ = exported
     held = export.held
     assert len(held.joint_names) == 15 and all(f"tau_{j}_Nm" in table.dtype.names for j in held.joint_names)
     urdf = resolve_urdf(problem.robot, problem.folder)[0]
