@@ -39,6 +39,11 @@ def plan(p: Plan) -> list[Table | str]:
         f"({t.boundary}), {p.variables} Fourier coefficients; cost: {t.cost_samples} samples × "
         f"{e.robot.n_rows} rows = C of {t.cost_samples * e.robot.n_rows} × {e.columns}",
         *(f"excluded capsule pair: {a} – {b}" for a, b in p.excluded_pairs),
+        *(
+            f"environment shape {name}: out of every moving capsule's reach by more than its margin, in any "
+            "posture: no rows (nothing to keep)"
+            for name in p.unreached
+        ),
         f"optimizer: {cfg.optimizer.method} on {cfg.optimizer.objective}, {cfg.sequence.iterations} sequential "
         f"iteration(s) of at most {p.iterations} solver iterations each, on {p.workers} worker(s)",
         f"scaling: the criterion's largest gradient component {s.gradient:.3g} per half-range, scaled by "

@@ -4,11 +4,13 @@ estimated from real solver iterations of it, timed (:mod:`~excite_cli.search.run
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
+from excite_cli.collision.world import world_shapes
 from excite_cli.config import Problem
+from excite_cli.constraints.world_collision import WorldCollision
 from excite_cli.design.excitation import Excitation
 from excite_cli.design.resolve import build_excitation
 from excite_cli.search.engine import default_workers
@@ -58,6 +60,8 @@ class Plan:
         excitation: the problem as ``optimize`` builds it.
         constraints: one :class:`ConstraintSize` per constraint.
         excluded_pairs: capsule pairs (link, link) excluded by the config.
+        unreached: environment shapes no moving capsule can come within the margin of, whatever the
+            posture (:func:`~excite_cli.constraints.world_collision.distance_bound`): they add no rows.
         scaling: the criterion's and the constraints' scale at the first random start.
         variables: Fourier coefficients the optimizer moves (n × (2N + 1)).
         timing: one solver iteration, one run's own time and one evaluation of each piece, measured [s].
@@ -77,6 +81,7 @@ class Plan:
     workers: int
     estimate: float
     at_most: float
+    unreached: list[str] = field(default_factory=list)
 
 
 def plan_optimize(problem: Problem, timing: Timing | None = None, base=None) -> Plan:
@@ -116,6 +121,9 @@ def plan_optimize(problem: Problem, timing: Timing | None = None, base=None) -> 
     workers = 1 if cfg.workers == 1 else min(cfg.workers or default_workers(), max(cfg.restarts, cfg.screened))
     self_collision = problem.constraints.self_collision
     excluded = [tuple(p) for p in self_collision.exclude_pairs] if self_collision else []
+    world = [c for c in excitation.constraints if isinstance(c, WorldCollision)]
+    reached = {world[0].shapes[s].name for _, s in world[0].pairs} if world else set()
+    shapes = world_shapes(problem.constraints.environment)
     return Plan(
         excitation=excitation,
         constraints=sizes,
@@ -127,4 +135,5 @@ def plan_optimize(problem: Problem, timing: Timing | None = None, base=None) -> 
         workers=workers,
         estimate=sequence_seconds(cfg, problem.sequence.iterations, workers, timing),
         at_most=sequence_seconds(cfg, problem.sequence.iterations, workers, timing, most=True),
+        unreached=[s.name for s in shapes if s.name not in reached],
     )

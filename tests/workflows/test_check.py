@@ -14,9 +14,16 @@ from excite_cli.workflows.check import plan_optimize
 runner = CliRunner()
 
 
-def test_the_plan_counts_what_optimize_would_build():
-    problem = load_problem(CONFIGS / "panda.yaml")
+def test_the_plan_counts_what_optimize_would_build(tmp_path):
+    """The Panda as shipped, plus a ceiling 3 m up that no link of an arm about 1.2 m long can come near:
+    named as adding no rows (the table does)."""
+    config = yaml.safe_load((CONFIGS / "panda.yaml").read_text())
+    ceiling = {"name": "ceiling", "type": "half_space", "point": [0, 0, 3], "normal": [0, 0, -1], "margin": 0.02}
+    config["constraints"]["environment"]["shapes"].append(ceiling)
+    (tmp_path / "panda.yaml").write_text(yaml.safe_dump(config))
+    problem = load_problem(tmp_path / "panda.yaml")
     plan = plan_optimize(problem)
+    assert plan.unreached == ["ceiling"]
     robot = plan.excitation.robot
     Y = np.vstack([robot.regressor(*x) for x in zip(*robot.random_states(30, np.random.default_rng(0)))])
     assert plan.excitation.base.count == np.linalg.matrix_rank(Y) == 43  # the Panda's base parameters
