@@ -20,6 +20,8 @@ from excite_cli.design.playback import RESOLUTION, Transition, approach_duration
 from excite_cli.design.resolve import build_excitation
 from excite_cli.dynamics.robot_files import example_robot_data_root
 from excite_cli.errors import ExciteError
+from excite_cli.storage.export import Played, export_trajectory
+from excite_cli.storage.results import read_alphas
 from excite_cli.storage.rosbag import TOPIC
 from excite_cli.workflows.export import played_result
 
@@ -217,10 +219,20 @@ def test_the_approach_brings_the_robot_home_from_anywhere_in_its_range_within_th
     assert max(peaks(0.9 * approach)[0].max(), peaks(0.9 * approach)[1].max()) > 1.0
 
 
-def test_a_shorter_approach_brings_home_only_a_robot_within_its_reach_of_it(panda_runs):
+@pytest.fixture(scope="module")
+def panda_played(panda_runs):
+    """The rest run's first iteration as export plays it, at 200 Hz: ``play(speed, approach)``."""
+    excitation = build_excitation(result_problem(panda_runs["rest"]))
+    alpha = dict(read_alphas(panda_runs["rest"]))[1]
+    return excitation, lambda speed=1.0, approach=None: export_trajectory(
+        excitation, alpha, Played(panda_runs["rest"], 1, 200.0, 1, speed, approach)
+    )
+
+
+def test_a_shorter_approach_brings_home_only_a_robot_within_its_reach_of_it(panda_played):
     """Half a second: the quintic over each joint's reach peaks at its velocity or acceleration limit
     (sampled, as above), 1 % farther passes it; the export names those joints and the time needed."""
-    excitation = build_excitation(result_problem(panda_runs["rest"]))
+    excitation, play = panda_played
     limits, s = excitation.limits, np.linspace(0.0, 1.0, 20001)[:, None]
     reach = approach_reach(excitation, 0.5)
 
@@ -231,22 +243,23 @@ def test_a_shorter_approach_brings_home_only_a_robot_within_its_reach_of_it(pand
 
     np.testing.assert_allclose(peak(reach), 1.0, rtol=1e-6)
     assert np.all(peak(1.01 * reach) > 1.0)
-    played = played_result(panda_runs["rest"], approach=0.5)
+    played = play(approach=0.5)
     assert played.approach_needed == approach_duration(excitation) > 0.5
     assert [name for name, _ in played.reach] == excitation.robot.joint_names
-    assert not played_result(panda_runs["rest"]).reach  # the default reaches home from anywhere
+    assert not play().reach  # the default reaches home from anywhere
 
 
-def test_a_speed_the_limits_refuse_names_the_joint_and_the_largest_speed_that_passes(panda_runs):
+def test_a_speed_the_limits_refuse_names_the_joint_and_the_largest_speed_that_passes(panda_played):
+    _, play = panda_played
     with pytest.raises(ExciteError) as refused:
-        played_result(panda_runs["rest"], 1, rate=200.0, speed=3.0)
+        play(speed=3.0)
     message = refused.value.problem
     assert re.search(r"violates joint_limits: \w+ of panda_joint\d at [\d.]+ of its half-range", message), message
     fastest = float(re.search(r"the largest speed that passes: ([\d.]+);", message).group(1))
     assert 1.0 <= fastest < 3.0
-    assert played_result(panda_runs["rest"], 1, rate=200.0, speed=fastest).max_violation <= 0.0
+    assert play(speed=fastest).max_violation <= 0.0
     with pytest.raises(ExciteError):
-        played_result(panda_runs["rest"], 1, rate=200.0, speed=fastest + 0.02)
+        play(speed=fastest + 0.02)
 
 
 def _csv(path):
