@@ -115,6 +115,11 @@ class Constraint(ABC):
         self-collision's; default none): pairs ``init`` excludes, as they cost time and bind nothing."""
         return []
 
+    def shapes_in_reach(self) -> list[str]:
+        """The world shapes some moving capsule can come within the margin of (the world's; default
+        none): the others add no rows, which ``check`` says."""
+        return []
+
     def always_within(self, Q: np.ndarray) -> list[tuple[str, float]]:
         """Links within a world shape's margin at every posture Q (K, n) [rad], with that margin [m]
         (the world's; default none): links no motion moves off the shape, which ``init`` ignores."""

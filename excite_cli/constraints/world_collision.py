@@ -131,6 +131,10 @@ class WorldCollision(Constraint):
         """The rows, in words (for ``check``)."""
         return f"one per capsule and world shape ({len(self.pairs)})"
 
+    def shapes_in_reach(self) -> list[str]:
+        """The shapes of :attr:`pairs` (:meth:`Constraint.shapes_in_reach`)."""
+        return sorted({self.shapes[s].name for _, s in self.pairs})
+
     def always_within(self, Q: np.ndarray) -> list[tuple[str, float]]:
         """Links within a shape's margin at every posture Q (K, n), with that margin [m]."""
         if not self.pairs:

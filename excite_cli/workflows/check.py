@@ -10,7 +10,6 @@ import numpy as np
 
 from excite_cli.collision.world import world_shapes
 from excite_cli.config import Problem
-from excite_cli.constraints.world_collision import WorldCollision
 from excite_cli.design.excitation import Excitation
 from excite_cli.design.resolve import build_excitation
 from excite_cli.search.engine import default_workers
@@ -121,8 +120,7 @@ def plan_optimize(problem: Problem, timing: Timing | None = None, base=None) -> 
     workers = 1 if cfg.workers == 1 else min(cfg.workers or default_workers(), max(cfg.restarts, cfg.screened))
     self_collision = problem.constraints.self_collision
     excluded = [tuple(p) for p in self_collision.exclude_pairs] if self_collision else []
-    world = [c for c in excitation.constraints if isinstance(c, WorldCollision)]
-    reached = {world[0].shapes[s].name for _, s in world[0].pairs} if world else set()
+    reached = {name for c in excitation.constraints for name in c.shapes_in_reach()}
     shapes = world_shapes(problem.constraints.environment)
     return Plan(
         excitation=excitation,
