@@ -9,6 +9,7 @@ comment line, a bag's custom data), so that ``force`` replaces only what excite 
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import warnings
 from contextlib import contextmanager, suppress
@@ -22,6 +23,16 @@ from excite_cli.errors import CannotWrite, ExciteWarning
 #: command that wrote it).
 MARK_PREFIX = "written by excite"
 MARK = f"{MARK_PREFIX} {__version__}"
+#: A mark as excite writes it, whole: the prefix, a version and, in a text file or an NPZ, the command
+#: (``written by excite 0.1.0``, ``written by excite 0.1.0 export``): not ``NOT written by excite``, not
+#: ``written by excite_recorder 2.0``, not a sentence that quotes it.
+MARK_VERSION = r"\d+(?:\.\d+)+(?:[-+.]?[0-9A-Za-z]+)*"
+MARK_PATTERN = re.compile(rf"{MARK_PREFIX} {MARK_VERSION}(?: [a-z][a-z-]*)?")
+
+
+def is_mark(text: str) -> bool:
+    """Whether ``text`` is excite's mark and nothing else (:data:`MARK_PATTERN`)."""
+    return MARK_PATTERN.fullmatch(text.strip()) is not None
 
 
 def through_links(path: Path) -> Path:

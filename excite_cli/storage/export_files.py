@@ -116,12 +116,13 @@ def _write_csv(path: Path, export: Export, effort: bool) -> Path:
 def csv_notes(export: Export) -> list[str]:
     """What the CSV's ``#`` lines after its rows say: the export, its segments, what each group of
     torque columns is (for held joints the rule that split the ground force between the soles), the
-    held joints' peak against its URDF limit and their positions, the largest constraint violation."""
+    held joints' peak against its URDF limit and their positions, the largest constraint violation; the
+    mark last."""
     held = export.held
     at_rest = " with the base and the held joints at rest" if held else ""
     notes = [
         f"excite export: iteration {export.iteration}, {export.rate:g} Hz, {export.periods} period(s), "
-        f"speed {export.speed:g} ({MARK})",
+        f"speed {export.speed:g}",
         "segments: " + "; ".join(f"{n} {t0:.3f}-{t0 + d:.3f} s" for n, t0, d in export.segments),
         f"tau of the active joints ({len(export.joint_names)} columns after qdd): inverse dynamics (RNEA) of the "
         f"URDF's rigid model at the row's q, qd, qdd{at_rest}",
@@ -142,7 +143,7 @@ def csv_notes(export: Export) -> list[str]:
             "held joints (not moved): "
             + ", ".join(f"{name} at {value:.6g} rad" for name, value in zip(held.joint_names, held.positions)),
         ]
-    return notes
+    return notes + [f"{MARK} export"]
 
 
 #: What writes each format (:data:`~excite_cli.storage.formats.FORMATS`), by its name.
@@ -177,6 +178,7 @@ def ros2_goal(export: Export, effort: bool = False) -> str:
     names, (q, qd, qdd, tau) = controller_motion(export, effort)
     nanoseconds = time_from_start_ns(export.time + export.approach)
     lines = [
+        f"# {MARK} export",
         f"# excite export: iteration {export.iteration}, {export.rate:g} Hz, {export.periods} period(s)",
         "trajectory:",
         f"  joint_names: [{', '.join(names)}]",

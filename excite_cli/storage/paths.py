@@ -14,23 +14,27 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Iterator
 
-from excite_cli.atomic import MARK_PREFIX, new_folders, partial_path, remove_stale
+from excite_cli.atomic import MARK_PREFIX, MARK_VERSION, is_mark, new_folders, partial_path, remove_stale
 from excite_cli.errors import CannotWrite, ExciteError, ExciteWarning, OutputExists
 
 #: How much of a file's start is read for its mark [bytes].
 MARK_WINDOW = 4096
-#: A text file excite wrote: the mark (:data:`~excite_cli.atomic.MARK`) or, in the files of versions before
-#: it, the comment naming the command in its first lines (``# excite export: ...``, ``<!-- excite identify``).
-TEXT_MARK = re.compile(rf"{MARK_PREFIX}|^(# |<!-- )excite (export|identify|init)\b", re.MULTILINE)
+#: A text file excite wrote: a line that begins with the mark and its command, as a ``#`` or ``<!--``
+#: comment (``# written by excite 0.1.0 export``), or a JSON schema's ``"$comment"`` (its whole value).
+TEXT_MARK = re.compile(
+    rf"^[ \t]*(?:(?:# |<!-- ){MARK_PREFIX} {MARK_VERSION} [a-z][a-z-]*(?:[ :,]|-->|$)"
+    rf'|"\$comment": "{MARK_PREFIX} schema"$)',
+    re.MULTILINE,
+)
 
 
 def written_by_excite(path: Path) -> bool:
-    """Whether excite wrote the file at ``path``, by the mark it leaves (:data:`~excite_cli.atomic.MARK`):
-    an HDF5 file's ``written_by`` attribute (or the ``version_excite`` attribute of earlier versions), a
-    PNG's ``Software`` text chunk (or matplotlib's, which wrote excite's plots before the mark), an NPZ's
-    ``written_by`` array, or a text file's first or last 4 KiB (CSV, YAML, JSON, URDF, MJCF, HTML; a
-    simulated run's CSV ends with its mark, so that its header is its first row as a recording's). A
-    file that cannot be read is not excite's."""
+    """Whether excite wrote the file at ``path``, by the mark it leaves (:data:`~excite_cli.atomic.MARK`,
+    whole: :func:`~excite_cli.atomic.is_mark`): an HDF5 file's ``written_by`` attribute (or the
+    ``version_excite`` attribute of earlier versions), a PNG's ``Software`` text chunk, an NPZ's
+    ``written_by`` array, or a line of a text file's first or last 4 KiB (:data:`TEXT_MARK`: CSV, YAML,
+    JSON, URDF, MJCF, HTML; a recording-like CSV ends with its mark, so that its header is its first row).
+    A file that cannot be read is not excite's."""
     try:
         with open(path, "rb") as f:
             head = f.read(MARK_WINDOW)
@@ -40,15 +44,31 @@ def written_by_excite(path: Path) -> bool:
             import h5py  # only for an HDF5 file in the way
 
             with h5py.File(path, "r") as f:
-                return str(f.attrs.get("written_by", "")).startswith(MARK_PREFIX) or "version_excite" in f.attrs
+                return is_mark(str(f.attrs.get("written_by", ""))) or "version_excite" in f.attrs
         if head.startswith(b"\x89PNG"):
-            return re.search(rb"Software\x00(" + MARK_PREFIX.encode() + rb"|Matplotlib)", head) is not None
+            return is_mark(_png_software(head))
         if head.startswith(b"PK"):
-            with zipfile.ZipFile(path) as archive:
-                return "written_by.npy" in archive.namelist()
+            import numpy as np  # only for an NPZ in the way
+
+            with np.load(path, allow_pickle=False) as archive:
+                return "written_by" in archive.files and is_mark(str(archive["written_by"]))
         return any(TEXT_MARK.search(part.decode("utf-8", errors="replace")) for part in (head, tail))
     except (OSError, ValueError, zipfile.BadZipFile):
         return False
+
+
+def _png_software(head: bytes) -> str:
+    """The ``Software`` text of a PNG's ``tEXt`` chunks among its first bytes ``head``, or ""."""
+    at = 8  # after the signature: chunks of length (4 bytes), type (4), data, CRC (4)
+    while at + 8 <= len(head):
+        length, kind = int.from_bytes(head[at : at + 4], "big"), head[at + 4 : at + 8]
+        data = head[at + 8 : at + 8 + length]
+        if kind == b"tEXt" and data.startswith(b"Software\x00"):
+            return data[len(b"Software\x00") :].decode("latin-1")
+        if kind == b"IDAT":
+            break
+        at += 12 + length
+    return ""
 
 
 def check_target(path: Path, field: str, force: bool = False, exists_ok: bool = False) -> Path:

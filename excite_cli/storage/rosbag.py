@@ -26,7 +26,7 @@ import yaml
 from rosbags.rosbag2 import Writer, WriterError
 from rosbags.typesys import Stores, get_typestore
 
-from excite_cli.atomic import MARK, MARK_PREFIX, atomic_folder, atomic_folders
+from excite_cli.atomic import MARK, atomic_folder, atomic_folders, is_mark
 from excite_cli.errors import CannotWrite, ExciteError, OutputExists
 from excite_cli.storage.paths import check_target
 from excite_cli.storage.trajectory_controller import time_from_start_ns
@@ -82,7 +82,7 @@ def is_rosbag2_folder(folder: Path, excite: bool = False) -> bool:
     except (OSError, UnicodeDecodeError, yaml.YAMLError, KeyError, TypeError, AttributeError):
         return False
     only_the_bag = {entry.name for entry in folder.iterdir()} <= listed | {"metadata.yaml"}
-    return only_the_bag and (not excite or mark.startswith(MARK_PREFIX))
+    return only_the_bag and (not excite or is_mark(mark))
 
 
 def check_bag_target(folder: Path, field: str, force: bool) -> Path:
@@ -117,7 +117,7 @@ def check_bag_target(folder: Path, field: str, force: bool) -> Path:
             folder,
             "a new folder (or remove it yourself)",
         )
-    check_target(folder / "metadata.yaml", field, force=True)  # its folder (or the nearest one there is) writable
+    check_target(folder / "metadata.yaml", field, force=True, exists_ok=True)  # writable (the bag: checked above)
     return folder
 
 

@@ -11,7 +11,7 @@ from typing import Optional
 
 import yaml
 
-from excite_cli.atomic import atomic_path
+from excite_cli.atomic import MARK, atomic_path
 from excite_cli.config import RobotConfig
 from excite_cli.config_file import drafted_problem
 from excite_cli.drafting.data_columns import recognized_columns
@@ -139,7 +139,7 @@ def _existing(runs: list[str]) -> list[str]:
 
 def _text(draft: StartingConfig, urdf: str, kind: str) -> str:
     """The YAML with what was assumed as comments above it, one line per field."""
-    lines = [f"# excite init {urdf} ({kind} config), {date.today().isoformat()}: a starting config. What it assumed:"]
+    lines = [f"# {MARK} init: {urdf} ({kind} config), {date.today().isoformat()}: a starting config. What it assumed:"]
     lines += [f"#   {name}: {why}" for name, why in draft.assumptions.items()]
     lines += [f"#   excluded pair {a} – {b}: {why}" for a, b, why in draft.excluded]
     lines += [f"#   environment ignores {link}: {why}" for link, why in draft.ignored]

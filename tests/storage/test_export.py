@@ -8,6 +8,7 @@ import pytest
 import yaml
 from rosbags.typesys import Stores, get_typestore
 
+from excite_cli.atomic import MARK
 from excite_cli.config_file import load_problem, with_overrides
 from excite_cli.design.held_joints import HeldTorques, held_joints
 from excite_cli.design.resolve import build_excitation
@@ -15,7 +16,7 @@ from excite_cli.errors import ExciteError
 from excite_cli.search.sequence import describe
 from excite_cli.storage.export import Export, Played, export_trajectory
 from excite_cli.storage.export_files import columns, write_export
-from excite_cli.storage.formats import FORMATS
+from excite_cli.storage.formats import FORMATS, export_format
 from excite_cli.storage.results import write_result
 from excite_cli.storage.rosbag import MSGTYPE
 from excite_cli.workflows.export import played_result
@@ -109,6 +110,13 @@ def test_an_unknown_format_writes_nothing(export, tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
+def test_an_approach_is_refused_for_a_data_file_whose_time_starts_at_home():
+    for fmt in ("csv", "npz"):
+        with pytest.raises(ExciteError, match=f"approach: is for the ROS 2 formats .*a {fmt} file's time starts"):
+            export_format(fmt, approach=2.0)
+    assert export_format("rosbag2", approach=2.0).controller and export_format("csv").name == "csv"
+
+
 def test_a_trajectory_the_controller_would_refuse_is_not_written(export, tmp_path):
     """A motion that does not end at rest (which every export does) would be refused by the
     joint_trajectory_controller: excite says so and writes nothing, in both ROS 2 formats."""
@@ -156,7 +164,7 @@ def standing(export):
 def test_a_standing_robot_s_held_joints_are_columns_and_arrays_beside_the_active_joints(standing, tmp_path):
     path = write_export(tmp_path / "m.csv", standing, "csv")
     header = [line for line in path.read_text().splitlines() if line.startswith("#")]
-    assert header[-1].endswith("knee at 0.1 rad, hip at -0.2 rad")
+    assert header[-2].endswith("knee at 0.1 rad, hip at -0.2 rad") and header[-1] == f"# {MARK} export"
     table = np.genfromtxt(path, delimiter=",", names=True)
     assert list(table.dtype.names) == columns(JOINTS) + ["tau_knee_Nm", "tau_hip_Nm"]
     np.testing.assert_allclose(table["tau_hip_Nm"], standing.held.tau[:, 1], rtol=1e-9)

@@ -58,21 +58,33 @@ def test_a_second_run_on_one_output_stops_at_once(tmp_path):
 
 
 def test_every_kind_of_file_excite_writes_is_recognised_and_the_same_kind_from_elsewhere_is_not(tmp_path):
+    """Excite's whole mark, not a mention of it: the lab files a loose mark took for excite's (a note
+    saying NOT written by excite, a tool named excite_recorder, a lab note quoting the mark, a copied
+    export header line, a person's name in an NPZ's written_by, a lab's own matplotlib figure)."""
     with atomic_h5(tmp_path / "ours.h5") as f:
         f["x"] = 1.0
     with h5py.File(tmp_path / "theirs.h5", "w") as f:
         f["x"] = 1.0
+    with h5py.File(tmp_path / "theirs_recorder.h5", "w") as f:
+        f.attrs["written_by"] = "written by excite_recorder 2.0"
     save_figure(plt.figure(), tmp_path / "ours.png", 20)
     plt.figure().savefig(tmp_path / "theirs.png", metadata={"Software": "a lab's script"})
-    np.savez(tmp_path / "ours.npz", q=np.zeros(2), written_by=np.array(MARK))
+    plt.figure().savefig(tmp_path / "theirs_matplotlib.png")
+    np.savez(tmp_path / "ours.npz", q=np.zeros(2), written_by=np.array(f"{MARK} export"))
     np.savez(tmp_path / "theirs.npz", q=np.zeros(2))
-    (tmp_path / "ours.csv").write_text("# excite export: iteration 1, 1000 Hz\ntime_s\n0\n")  # before the mark
+    np.savez(tmp_path / "theirs_named.npz", q=np.zeros(2), written_by=np.array("Alice, panda-lab"))
+    (tmp_path / "ours.csv").write_text(f"time_s\n0\n# excite export: iteration 1, 1000 Hz\n# {MARK} export\n")
     (tmp_path / "ours.xml").write_text(f"<!-- {MARK} identify -->\n<mujoco/>")
     (tmp_path / "theirs.csv").write_text("time,q,tau\n0,0,0\n")
+    (tmp_path / "theirs_not.csv").write_text("# NOT written by excite: measured on panda-lab\ntime,q\n0,0\n")
+    (tmp_path / "theirs_recorder.csv").write_text("# written by excite_recorder 1.2\ntime,q\n0,0\n")
+    (tmp_path / "theirs_note.csv").write_text(f"time,q\n0,0\n# lab note: the plan was {MARK} export\n")
+    (tmp_path / "theirs_copied.csv").write_text("# excite export: iteration 1, 1000 Hz\ntime,q\n0,0\n")
+    (tmp_path / "theirs.yaml").write_text("# hand-tuned, NOT written by excite init\nrobot: {}\n")
     (tmp_path / "theirs.urdf").write_text('<robot name="arm"><!-- made with care, not by excite --></robot>')
     ours = sorted(p.name for p in tmp_path.iterdir() if written_by_excite(p))
     assert ours == ["ours.csv", "ours.h5", "ours.npz", "ours.png", "ours.xml"]
-    for theirs in ("theirs.h5", "theirs.png", "theirs.npz", "theirs.csv", "theirs.urdf"):
+    for theirs in sorted(p.name for p in tmp_path.iterdir() if p.name.startswith("theirs")):
         before = (tmp_path / theirs).read_bytes()
         with pytest.raises(ExciteError, match="excite did not write it"):
             check_target(tmp_path / theirs, "output", force=True)

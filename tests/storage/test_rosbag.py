@@ -186,6 +186,12 @@ def test_a_lab_s_recording_is_never_replaced_and_excite_s_own_bags_carry_its_mar
         metadata = yaml.safe_load((ours / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
         assert metadata["custom_data"][CUSTOM_DATA_KEY].startswith("written by excite")
         check_bag_target(ours, "output", True)
+    recorder = _recording(tmp_path / "recorder")  # a lab tool's mark that merely begins like excite's
+    metadata = yaml.safe_load((recorder / "metadata.yaml").read_text())
+    metadata["rosbag2_bagfile_information"]["custom_data"] = {CUSTOM_DATA_KEY: "written by excite_recorder 2.0"}
+    (recorder / "metadata.yaml").write_text(yaml.safe_dump(metadata))
+    with pytest.raises(ExciteError, match="a ROS 2 bag excite did not write"):
+        check_bag_target(recorder, "output", True)
     (tmp_path / "link").symlink_to(recording)
     with pytest.raises(ExciteError, match="symbolic link"):
         check_bag_target(tmp_path / "link", "output", True)

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from excite_cli.atomic import atomic_path
+from excite_cli.atomic import MARK, atomic_path
 from excite_cli.config import RobotConfig
 from excite_cli.dynamics.mjcf_compiled import is_mjcf
 from excite_cli.dynamics.robot import Robot, load_robot
@@ -131,7 +131,7 @@ def write_urdf(
     root.insert(
         0,
         ET.Comment(
-            f" excite identify, {stamp}: {note}. Links merged into a body (locked or fixed "
+            f" {MARK} identify, {stamp}: {note}. Links merged into a body (locked or fixed "
             f"joints) carry no <inertial>: their mass is in the body's. "
         ),
     )
