@@ -27,8 +27,8 @@ def read_joint_map(given: str) -> dict[str, str]:
     YAML file holding one mapping: {robot joint: controller joint}.
 
     Raises:
-        ExciteError: (``joint_names``) a pair without ``=``, a file that is not one mapping of names,
-            a name a controller cannot hold.
+        ExciteError: (``joint_names``) a pair without ``=``, a joint named twice, a file that is not one
+            mapping of names, a name a controller cannot hold.
     """
     path = Path(given)
     if "=" not in given and path.suffix.lower() in (".yaml", ".yml", ".json"):
@@ -43,6 +43,10 @@ def read_joint_map(given: str) -> dict[str, str]:
             if item.count("=") != 1:
                 raise ExciteError("joint_names", f"'{item}' is not robot=controller", item, "robot=controller pairs")
             key, _, name = (part.strip() for part in item.partition("="))
+            if key in pairs:  # as a YAML mapping refuses a repeated key
+                raise ExciteError(
+                    "joint_names", f"'{key}' is named twice ({key}={pairs[key]}, {item})", key, "each joint once"
+                )
             pairs[key] = name
     for name in pairs.values():
         if not NAME.match(name):

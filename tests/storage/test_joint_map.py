@@ -52,6 +52,11 @@ def test_a_map_naming_an_unknown_joint_or_one_name_twice_is_refused(standing, tm
         renamed(standing, {"knee": "hip"})
     with pytest.raises(ExciteError, match="'joint1' is not robot=controller"):
         read_joint_map("joint1")
+    with pytest.raises(ExciteError, match=r"'joint1' is named twice \(joint1=a, joint1=b\)"):
+        read_joint_map("joint1=a, joint2=c, joint1=b")
+    (tmp_path / "twice.yaml").write_text("joint1: a\njoint1: b\n")
+    with pytest.raises(ExciteError, match="joint1"):  # the YAML form refuses it too
+        read_joint_map(str(tmp_path / "twice.yaml"))
     with pytest.raises(ExciteError, match="'fr3 joint1' is not a joint name a controller can hold"):
         read_joint_map("joint1=fr3 joint1")
     (tmp_path / "list.yaml").write_text("[a, b]\n")
