@@ -42,16 +42,25 @@ FORMATS = {
 }
 
 
-def export_format(fmt: str, effort: bool = False) -> ExportFormat:
-    """The format ``fmt`` names, with ``effort`` (τ as a trajectory's effort) asked only of a format a
-    controller reads (a data file holds τ always).
+def export_format(fmt: str, effort: bool = False, approach: float | None = None) -> ExportFormat:
+    """The format ``fmt`` names, with ``effort`` (τ as a trajectory's effort) and ``approach`` (when its
+    first point comes) asked only of a format a controller reads (a data file holds τ always, and its
+    time starts at home).
 
     Raises:
-        ExciteError: another format, or effort for a data file.
+        ExciteError: another format, or effort or an approach for a data file.
     """
     if fmt not in FORMATS:
         raise ExciteError("format", f"must be one of {', '.join(FORMATS)} (got {fmt!r})")
     if effort and not FORMATS[fmt].controller:
         readers = " or ".join(name for name, f in FORMATS.items() if f.controller)
         raise ExciteError("effort", f"is for the ROS 2 formats; a {fmt} file holds τ always", expected=readers)
+    if approach is not None and not FORMATS[fmt].controller:
+        readers = " or ".join(name for name, f in FORMATS.items() if f.controller)
+        raise ExciteError(
+            "approach",
+            f"is for the ROS 2 formats (their first point's time); a {fmt} file's time starts at home, 0 s",
+            approach,
+            readers,
+        )
     return FORMATS[fmt]

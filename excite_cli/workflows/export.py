@@ -76,7 +76,7 @@ def run_export(
         ExciteError: see both and :func:`~excite_cli.storage.joint_map.renamed`, and a bad or existing
             (without ``force``) output path.
     """
-    form = export_format(fmt, effort)
+    form = export_format(fmt, effort, approach)
     check = check_bag_target if form.folder else check_target
     if output is not None:
         check(output, "output", force)
