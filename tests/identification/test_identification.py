@@ -390,7 +390,7 @@ def test_bad_data_gets_one_clear_message(tmp_path):
     assert "has no column 'q9'" in _bad_csv(
         tmp_path, _csv(3000), {"q": [f"q{k}" for k in range(1, 7)] + ["q9"], "tau": [f"t{k}" for k in range(1, 8)]}
     )
-    assert "fewer than the" in _bad_csv(tmp_path, _csv(3000), crop=[0.0, 0.05])
+    assert "bad.csv lasts 0.05 s, under the 2 s a run needs" in _bad_csv(tmp_path, _csv(3000), crop=[0.0, 0.05])
 
 
 def test_unknown_joint_in_declared_effects(tmp_path):

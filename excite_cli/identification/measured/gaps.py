@@ -78,11 +78,20 @@ def split_at_gaps(run: Run, quiet: bool = False) -> list[Run]:
     ``[run]`` itself when it has none.
 
     Raises:
-        ExciteError: (``data.runs``) every piece of the run is shorter than :data:`MIN_PIECE_S`: nothing
-            of it can be filtered without interpolating across its gaps, which are named.
+        ExciteError: (``data.runs``) the run, or every piece of it, is shorter than :data:`MIN_PIECE_S`:
+            nothing of it can be filtered (without interpolating across its gaps, which are named).
     """
     gaps = find_gaps(run.time)
     if not gaps:
+        span = float(run.time[-1] - run.time[0]) if run.time.size else 0.0
+        if span < MIN_PIECE_S:  # as a piece between gaps would be left out
+            raise ExciteError(
+                "data.runs",
+                f"{run.name} lasts {span:.3g} s, under the {MIN_PIECE_S:g} s a run needs to be filtered and "
+                "differentiated",
+                run.name,
+                "a longer recording (a period of the trajectory or more)",
+            )
         return [run]
     bounds = [0] + [g.index for g in gaps] + [run.time.size]
     pieces, short = [], []
