@@ -52,11 +52,10 @@ def export_format(fmt: str, effort: bool = False, approach: float | None = None)
     """
     if fmt not in FORMATS:
         raise ExciteError("format", f"must be one of {', '.join(FORMATS)} (got {fmt!r})")
+    readers = " or ".join(name for name, f in FORMATS.items() if f.controller)
     if effort and not FORMATS[fmt].controller:
-        readers = " or ".join(name for name, f in FORMATS.items() if f.controller)
         raise ExciteError("effort", f"is for the ROS 2 formats; a {fmt} file holds τ always", expected=readers)
     if approach is not None and not FORMATS[fmt].controller:
-        readers = " or ".join(name for name, f in FORMATS.items() if f.controller)
         raise ExciteError(
             "approach",
             f"is for the ROS 2 formats (their first point's time); a {fmt} file's time starts at home, 0 s",
