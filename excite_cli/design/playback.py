@@ -97,13 +97,7 @@ def approach_duration(excitation: Excitation) -> float:
     state to a point with positions, velocities and accelerations (its spline interpolation): the
     rest-to-rest bound max_j(15 Δ_j / (8 v_j), (10 Δ_j / (√3 a_j))^½) with Δ_j the farthest joint j
     can stand from home, rounded up to ``RESOLUTION``."""
-    robot, limits = excitation.robot, excitation.limits
-    lower, upper = robot.lower, robot.upper
-    delta = np.maximum(upper - robot.home, robot.home - lower)
-    within = np.maximum(limits.upper[0] - robot.home, robot.home - limits.lower[0])  # a joint without a range
-    delta = np.where(np.isfinite(delta), delta, within)
-    velocity = np.minimum(-limits.lower[1], limits.upper[1])
-    acceleration = np.minimum(-limits.lower[2], limits.upper[2])
+    delta, (velocity, acceleration) = _farthest(excitation), _rest_limits(excitation)
     bound = max(
         float(np.max(15.0 * delta / (8.0 * velocity))),
         float(np.max(np.sqrt(10.0 * delta / (np.sqrt(3.0) * acceleration)))),
@@ -115,10 +109,34 @@ def approach_reach(excitation: Excitation, duration: float) -> np.ndarray:
     """(n,) [rad] How far from home each joint can start and still be brought there at rest in
     ``duration`` [s] within the problem's velocity and acceleration limits, on the same quintic as
     :func:`approach_duration` (its bound solved for Δ: min(8 v T / 15, √3 a T² / 10))."""
-    limits = excitation.limits
-    velocity = np.minimum(-limits.lower[1], limits.upper[1])
-    acceleration = np.minimum(-limits.lower[2], limits.upper[2])
+    velocity, acceleration = _rest_limits(excitation)
     return np.minimum(8.0 * velocity * duration / 15.0, np.sqrt(3.0) * acceleration * duration**2 / 10.0)
+
+
+def approach_shortfall(excitation: Excitation, duration: float) -> tuple[tuple[str, float], ...]:
+    """(joint, reach [rad]) of the joints that ``duration`` [s] brings home only from within their
+    :func:`approach_reach`, nearer than the farthest they can stand (:func:`approach_duration`'s Δ);
+    empty from :func:`approach_duration` on."""
+    if duration >= approach_duration(excitation):
+        return ()
+    reach = approach_reach(excitation, duration)
+    names = excitation.robot.joint_names
+    return tuple((name, float(d)) for name, d, far in zip(names, reach, _farthest(excitation)) if d < far)
+
+
+def _farthest(excitation: Excitation) -> np.ndarray:
+    """(n,) [rad] The farthest each joint can stand from home: in the robot's file's range, or in the
+    problem's position limits for a joint without one."""
+    robot, limits = excitation.robot, excitation.limits
+    delta = np.maximum(robot.upper - robot.home, robot.home - robot.lower)
+    within = np.maximum(limits.upper[0] - robot.home, robot.home - limits.lower[0])  # a joint without a range
+    return np.where(np.isfinite(delta), delta, within)
+
+
+def _rest_limits(excitation: Excitation) -> tuple[np.ndarray, np.ndarray]:
+    """(n,) each: the problem's velocity [rad/s] and acceleration [rad/s²] limits, the smaller side."""
+    limits = excitation.limits
+    return np.minimum(-limits.lower[1], limits.upper[1]), np.minimum(-limits.lower[2], limits.upper[2])
 
 
 def plan_transition(

@@ -23,7 +23,7 @@ import numpy as np
 from excite_cli.constraints.constraint import Constraint
 from excite_cli.design.excitation import Excitation
 from excite_cli.design.held_joints import HeldJoints, HeldTorques
-from excite_cli.design.playback import Playback, approach_duration, approach_reach, check_motion, plan_playback
+from excite_cli.design.playback import Playback, approach_duration, approach_shortfall, check_motion, plan_playback
 from excite_cli.errors import ExciteError
 
 #: Highest export rate accepted [Hz] (memory grows with rate × duration).
@@ -61,7 +61,7 @@ class Export:
             their points' ``time_from_start`` there (:func:`~excite_cli.design.playback.approach_duration`).
         approach_needed: [s] that time from anywhere in the joint range (``approach`` unless one was given).
         reach: (joint, [rad]) of the joints a shorter given ``approach`` brings home only from within that
-            distance of it (:func:`~excite_cli.design.playback.approach_reach`), else empty.
+            distance of it (:func:`~excite_cli.design.playback.approach_shortfall`), else empty.
     """
 
     joint_names: list[str]
@@ -177,8 +177,6 @@ def export_trajectory(excitation: Excitation, alpha: np.ndarray, how: Played, he
     tau = np.array([robot.torques(*x) for x in zip(q, qd, qdd)])
     needed = approach_duration(excitation)
     approach = needed if approach is None else float(approach)
-    farthest = np.maximum(robot.upper - robot.home, robot.home - robot.lower)
-    reach = approach_reach(excitation, approach) if approach < needed else farthest
     starts = np.cumsum([0.0] + [s.duration for s in playback.segments])
     return Export(
         joint_names=list(robot.joint_names),
@@ -204,7 +202,7 @@ def export_trajectory(excitation: Excitation, alpha: np.ndarray, how: Played, he
         held=stance,
         approach=approach,
         approach_needed=needed,
-        reach=tuple((name, float(d)) for name, d, far in zip(robot.joint_names, reach, farthest) if d < far),
+        reach=approach_shortfall(excitation, approach),
     )
 
 
