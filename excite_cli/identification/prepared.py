@@ -71,7 +71,7 @@ def prepare_data(problem: IdentifyProblem, robot: Robot, base: BaseParameters, t
         runs += pieces
         payloads += [payload] * len(pieces)
         sources += [k] * len(pieces)
-    silent = silent_channels(runs)
+    silent = silent_channels(runs, robot.joint_names)
     cutoff, source = choose_cutoff(runs, problem.preprocessing)
     dropped = [(r.name, r.dropped) for r in runs if r.dropped]
     samples = [preprocess(runs.pop(0), problem.preprocessing, cutoff) for _ in range(len(runs))]

@@ -162,11 +162,27 @@ def in_sample_validation(runs: list[RunConfig], folder: Path | None) -> list[str
     return out
 
 
-def silent_channels(runs: list[Run]) -> np.ndarray:
+def silent_channels(runs: list[Run], joints: list[str]) -> np.ndarray:
     """(n,) the joints whose torque samples are exact zeros at least ``SILENT`` of the time over
-    ``runs``: a channel with no signal (a joint not recorded, a sensor off)."""
-    zeros = sum(np.count_nonzero(r.tau == 0.0, axis=0) for r in runs)
-    return zeros >= SILENT * sum(r.time.size for r in runs)
+    ``runs``: a channel with no signal (a joint not recorded, a sensor off).
+
+    Raises:
+        ExciteError: (``data.runs``) a channel silent in one recording that the others record: its
+            zeros would be fitted as the joint's torque (the channel is the file's, not the joint's).
+    """
+    zeros = [np.count_nonzero(r.tau == 0.0, axis=0) for r in runs]
+    silent = sum(zeros) >= SILENT * sum(r.time.size for r in runs)
+    for run, z in zip(runs, zeros):
+        alone = (z >= SILENT * run.time.size) & ~silent
+        if np.any(alone):
+            named = ", ".join(joints[j] for j in np.flatnonzero(alone))
+            raise ExciteError(
+                "data.runs",
+                f"{run.name}: the torque of {named} is exact zeros over "
+                f"{100 * z[alone].max() / run.time.size:.0f} % of the run while the other runs record it: a channel "
+                "this recording did not record; leave the run out or give its torque column",
+            )
+    return silent
 
 
 def check_joint_lists(data: DataConfig, n: int) -> None:

@@ -12,7 +12,7 @@ from excite_cli.errors import ExciteError
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.data_config import RunConfig
 from excite_cli.identification.measured.files import read_table
-from excite_cli.identification.measured.measurements import in_sample_validation, load_run
+from excite_cli.identification.measured.measurements import Run, in_sample_validation, load_run, silent_channels
 
 JOINTS = [f"panda_joint{k}" for k in range(1, 8)]
 T = 400
@@ -169,3 +169,23 @@ def test_a_validation_run_that_is_a_fit_run_over_the_same_times_is_warned_about(
     assert len(in_sample_validation(overlap, tmp_path)) == 1
     touching = runs(("a.csv", "fit", (0.1, 5.3)), ("a.csv", "validation", (5.3, 7.5)))
     assert in_sample_validation(touching, tmp_path) == []  # one shared instant is no shared motion
+
+
+def _run(name: str, tau: np.ndarray) -> Run:
+    return Run(name, "fit", TIME, Q, None, None, tau)
+
+
+def test_a_channel_silent_in_one_recording_the_others_record_is_refused_naming_both():
+    """Issue 102: one recording's joint-4 torque all zeros while the others record it was fitted as the
+    joint's torque (rms after 1-7 Nm): refused naming the file and the joint."""
+    dead = TAU.copy()
+    dead[:, 3] = 0.0
+    with pytest.raises(ExciteError) as refused:
+        silent_channels([_run("a.csv", TAU), _run("b.csv", dead), _run("c.csv", TAU)], JOINTS)
+    assert refused.value.field == "data.runs"
+    assert "b.csv" in str(refused.value) and "panda_joint4" in str(refused.value)
+    assert "panda_joint3" not in str(refused.value)
+    # silent in every recording: a channel not recorded at all, named as dead by the fit
+    silent = silent_channels([_run("a.csv", dead), _run("b.csv", dead)], JOINTS)
+    assert list(np.flatnonzero(silent)) == [3]
+    assert not np.any(silent_channels([_run("a.csv", TAU), _run("b.csv", TAU)], JOINTS))
