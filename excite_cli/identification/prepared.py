@@ -66,7 +66,7 @@ def prepare_data(problem: IdentifyProblem, robot: Robot, base: BaseParameters, t
         payload = payload_parameters(robot, r.payload, f"data.runs[{k}].payload") if r.payload else None
         run = load_run(r, problem.data, robot.joint_names, problem.folder)
         check_against_limits(run, robot.joint_names, robot.lower, robot.upper, robot.velocity_limit)
-        prints.append(motion_print(run.q))
+        prints.append(motion_print(run.time, run.q))
         pieces = split_at_gaps(run)  # a recording's gaps are never interpolated across
         runs += pieces
         payloads += [payload] * len(pieces)
