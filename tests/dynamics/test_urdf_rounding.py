@@ -3,6 +3,7 @@ rounding adds are dropped (and said), and an identification on it reports no par
 standard deviation is orders above the exact file's."""
 
 import math
+import re
 import warnings
 
 import numpy as np
@@ -11,6 +12,7 @@ import pytest
 from excite_cli.config import RobotConfig
 from excite_cli.dynamics.base_parameters import RANK_TOLERANCE, base_from_regressor, compute_base_parameters
 from excite_cli.dynamics.robot import load_robot
+from excite_cli.dynamics.robot_files import resolve_urdf
 from excite_cli.dynamics.urdf_rounding import angle_rounding
 from excite_cli.errors import ExciteWarning
 
@@ -86,3 +88,37 @@ def test_identification_on_the_rounded_file_has_the_exact_files_uncertainty(tmp_
     spurious = base_from_regressor(W, rounded_robot.parameter_names, tolerance=RANK_TOLERANCE)
     _, std_spurious = _standard_deviations(rounded_robot, spurious, tau, states)
     assert std_spurious.max() > 1e3 * std_exact.max()
+
+
+@pytest.mark.parametrize("written", ["0.26", "0.79", "0.52"])
+def test_two_decimals_near_15_45_or_30_degrees_are_taken_as_the_real_angle(tmp_path, written):
+    """Issue 102: a real 14.9° mount written 0.26 was read as a rounded 15° (and -0.79 as -π/4): 2 of
+    the arm's base parameters dropped with a warning blaming rounding. Such digits are written by
+    1.3-4 % of real angles: no evidence of a special one."""
+    robot = _arm(tmp_path, written)
+    assert robot.angle_rounding == 0.0
+    W = robot.regressor_stack(*robot.random_states(40, np.random.default_rng(0)))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ExciteWarning)
+        assert compute_base_parameters(robot).count == base_from_regressor(W, robot.parameter_names).count
+
+
+def test_the_panda_written_to_two_decimals_keeps_its_43_base_parameters(tmp_path):
+    """Its -π/4 hand written -0.79 and ±π/6 written ±0.52 are not evidence of rounding; its 1.57 and
+    3.14 are."""
+    config = RobotConfig(
+        urdf="panda_description/urdf/panda.urdf",
+        source="example-robot-data",
+        active_joints=[f"panda_joint{k}" for k in range(1, 8)],
+    )
+    exact = load_robot(config)
+    text = resolve_urdf(config, None)[0].read_text()
+    written = re.sub(
+        r'rpy="([^"]*)"', lambda m: 'rpy="' + " ".join(f"{float(x):.2f}" for x in m[1].split()) + '"', text
+    )
+    assert 'rpy="0.00 0.00 -0.79"' in written and 'rpy="1.57 0.00 0.00"' in written
+    path = tmp_path / "panda.urdf"
+    path.write_text(written)
+    rounded = load_robot(config.model_copy(update={"urdf": str(path), "source": "file"}))
+    assert rounded.angle_rounding == pytest.approx(math.pi / 2 - 1.57)
+    assert compute_base_parameters(rounded).count == compute_base_parameters(exact).count == 43
