@@ -94,6 +94,33 @@ def test_a_coupled_joint_is_checked_as_a_mimic(tmp_path):
     assert load_robot(held).joint_names == ["shoulder", "elbow"]
 
 
+def test_a_tendon_coupling_is_checked_as_a_mimic_and_a_closed_chain_keeps_its_joints_still(tmp_path):
+    """Issue 102: a fixed tendon's equality and a connect were ignored (the same chain as a URDF is
+    refused): now the tendon's joints are a coupling and the chain's joints may not be active."""
+    tendon = (
+        '<tendon><fixed name="pair"><joint joint="elbow" coef="1"/><joint joint="finger" coef="-1"/></fixed></tendon>'
+        '<equality><tendon tendon1="pair"/></equality>'
+    )
+    path = arm(tmp_path, equality=tendon)
+    assert mjcf_couplings(path) == {"finger": ("elbow", "tendon equality of 'pair'")}
+    with pytest.raises(ExciteError, match="robot.locked_joints: joint 'finger' mimics active joint 'elbow'"):
+        load_robot(RobotConfig(urdf=str(path), active_joints=["shoulder", "elbow"]))
+    held = RobotConfig(urdf=str(path), active_joints=["shoulder", "elbow"], locked_joints={"finger": 0.0})
+    assert load_robot(held).joint_names == ["shoulder", "elbow"]
+    chain = '<equality><connect body1="finger" body2="upper" anchor="0 0 0"/></equality>'
+    path = arm(tmp_path, equality=chain)
+    with pytest.raises(ExciteError) as refused:
+        load_robot(RobotConfig(urdf=str(path), active_joints=["shoulder", "elbow"]))
+    assert refused.value.describe().startswith(
+        "robot.active_joints: joint 'elbow' is in a closed kinematic chain (<equality><connect> of bodies "
+        "'finger' and 'upper', through 'elbow', 'finger')"
+    )
+    assert load_robot(RobotConfig(urdf=str(path), active_joints=["shoulder"])).joint_names == ["shoulder"]
+    welded = arm(tmp_path, equality='<equality><weld body1="fore"/></equality>')  # to the world: shoulder, elbow
+    with pytest.raises(ExciteError, match="joint 'shoulder' is in a closed kinematic chain"):
+        load_robot(RobotConfig(urdf=str(welded), active_joints=["shoulder"]))
+
+
 def test_bodies_in_frames_are_read_as_mujoco_reads_them(tmp_path):
     """MuJoCo writes a URDF's fixed links as <frame> elements (pinocchio's parser skipped them with
     what is in them: the Panda's fingers and hand vanished, mass and all): the same model as without."""
