@@ -10,6 +10,7 @@ paper does with HRP-4's legs and waist (Section IV-B).
 from __future__ import annotations
 
 import difflib
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -20,7 +21,7 @@ from excite_cli.config import RobotConfig
 from excite_cli.dynamics.robot_files import open_source, robot_source
 from excite_cli.dynamics.source import apply_joint_ranges
 from excite_cli.dynamics.urdf_meshes import package_folders
-from excite_cli.errors import ExciteError
+from excite_cli.errors import ExciteError, ExciteWarning
 
 #: Order of pinocchio's 10 dynamic parameters of one body (``Inertia.toDynamicParameters``).
 PARAMETER_SYMBOLS = ("m", "mx", "my", "mz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz")
@@ -198,10 +199,26 @@ def _check_joints(cfg: RobotConfig, full: pin.Model) -> list[str]:
             raise ExciteError("robot.locked_joints", f"'{name}' is also an active joint")
         j = full.getJointId(name)
         lo, hi = full.lowerPositionLimit[full.idx_qs[j]], full.upperPositionLimit[full.idx_qs[j]]
+        if full.joints[j].nv > 1:
+            raise ExciteError(
+                f"robot.locked_joints.{name}",
+                f"'{name}' has {full.joints[j].nv} degrees of freedom: one value cannot hold it",
+                value,
+                "a 1-DoF joint (other joints not active are held at their reference)",
+            )
         if full.joints[j].nq == 1 and not lo <= value <= hi:
             raise ExciteError(
                 f"robot.locked_joints.{name}", f"{value} rad is outside the joint limits [{lo:g}, {hi:g}]"
             )
+    held = [n for n in movable if full.joints[full.getJointId(n)].nv > 1 and n not in cfg.active_joints]
+    if held:
+        warnings.warn(
+            f"robot.active_joints: {', '.join(repr(n) for n in held)} "
+            f"{'is a joint' if len(held) == 1 else 'are joints'} of more than one degree of freedom (a ball "
+            "joint): held at the reference (no rotation), as excite moves 1-DoF joints only",
+            ExciteWarning,
+            stacklevel=3,
+        )
     return movable
 
 

@@ -121,6 +121,23 @@ def test_a_tendon_coupling_is_checked_as_a_mimic_and_a_closed_chain_keeps_its_jo
         load_robot(RobotConfig(urdf=str(welded), active_joints=["shoulder"]))
 
 
+def test_a_ball_joint_held_is_said_and_cannot_be_held_by_one_value(tmp_path):
+    """Issue 102: an MJCF ball joint was held at its reference without a word."""
+    path = tmp_path / "arm.xml"
+    path.write_text(ARM.format(compiler="", elbow='type="ball"', equality="").replace('axis="0 1 0" type', "type"))
+    with pytest.warns(
+        ExciteWarning, match="robot.active_joints: 'elbow' is a joint of more than one degree of freedom"
+    ):
+        assert load_robot(RobotConfig(urdf=str(path), active_joints=["shoulder", "finger"])).joint_names == [
+            "shoulder",
+            "finger",
+        ]
+    with pytest.raises(ExciteError, match="robot.locked_joints.elbow: 'elbow' has 3 degrees of freedom"):
+        load_robot(RobotConfig(urdf=str(path), active_joints=["shoulder"], locked_joints={"elbow": 0.1}))
+    with pytest.raises(ExciteError, match="robot.active_joints: 'elbow' is not a 1-DoF"):
+        load_robot(RobotConfig(urdf=str(path), active_joints=["elbow"]))
+
+
 def test_bodies_in_frames_are_read_as_mujoco_reads_them(tmp_path):
     """MuJoCo writes a URDF's fixed links as <frame> elements (pinocchio's parser skipped them with
     what is in them: the Panda's fingers and hand vanished, mass and all): the same model as without."""
