@@ -21,6 +21,7 @@ from typing import NamedTuple
 import numpy as np
 
 from excite_cli.constraints.constraint import Constraint
+from excite_cli.constraints.zmp import has_floating_base
 from excite_cli.design.excitation import Excitation
 from excite_cli.design.held_joints import HeldJoints, HeldTorques
 from excite_cli.design.playback import Playback, approach_duration, approach_shortfall, check_motion, plan_playback
@@ -198,11 +199,24 @@ def export_trajectory(excitation: Excitation, alpha: np.ndarray, how: Played, he
             for c, check in advisory
             if check.max_violation > 0.0
         )
-        + _slipping(stance),
+        + _slipping(stance)
+        + _unsupported(robot, stance),
         held=stance,
         approach=approach,
         approach_needed=needed,
         reach=approach_shortfall(excitation, approach),
+    )
+
+
+def _unsupported(robot, stance: HeldTorques | None) -> tuple[str, ...]:
+    """A line when a floating-base robot is exported without its held joints' feed-forward: its problem
+    names no soles to stand on (:func:`~excite_cli.design.held_joints.held_joints`)."""
+    if stance is not None or not has_floating_base(robot):
+        return ()
+    return (
+        "constraints.zmp.support_links: the robot has a floating base but its problem names no soles "
+        "(constraints.zmp or constraints.com support_links): the export gives the active joints' torques with the "
+        "base at rest, not the held joints' feed-forward that keeps it standing",
     )
 
 

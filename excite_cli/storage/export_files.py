@@ -116,8 +116,8 @@ def _write_csv(path: Path, export: Export, effort: bool) -> Path:
 def csv_notes(export: Export) -> list[str]:
     """What the CSV's ``#`` lines after its rows say: the export, its segments, what each group of
     torque columns is (for held joints the rule that split the ground force between the soles), the
-    held joints' peak against its URDF limit and their positions, the largest constraint violation; the
-    mark last."""
+    held joints' peak against its URDF limit and their positions, the largest constraint violation, the
+    export's warnings; the mark last."""
     held = export.held
     at_rest = " with the base and the held joints at rest" if held else ""
     notes = [
@@ -143,7 +143,7 @@ def csv_notes(export: Export) -> list[str]:
             "held joints (not moved): "
             + ", ".join(f"{name} at {value:.6g} rad" for name, value in zip(held.joint_names, held.positions)),
         ]
-    return notes + [f"{MARK} export"]
+    return notes + [f"warning: {w}" for w in export.warnings] + [f"{MARK} export"]
 
 
 #: What writes each format (:data:`~excite_cli.storage.formats.FORMATS`), by its name.

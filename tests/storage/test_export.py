@@ -152,6 +152,27 @@ def test_a_zmp_closer_to_the_edge_than_its_margin_is_a_warning_not_a_refusal(tmp
     assert played.predictions[0].startswith("constraints.zmp: ZMP ")
 
 
+def test_a_floating_base_without_soles_is_exported_with_a_word_on_what_its_torques_lack(tmp_path):
+    """Issue 102: a G1 result whose config names no soles was exported without the held joints'
+    feed-forward and without a word; the console and the CSV's notes now say so."""
+    data = yaml.safe_load((CONFIGS / "g1_arms.yaml").read_text())
+    del data["constraints"]["zmp"], data["constraints"]["com"]
+    (tmp_path / "g1.yaml").write_text(yaml.safe_dump(data))
+    problem = load_problem(tmp_path / "g1.yaml")
+    excitation = build_excitation(problem)
+    result = describe(
+        excitation, 1, excitation.random_start(np.random.default_rng(0)), np.zeros((0, excitation.columns))
+    )
+    target = tmp_path / "g1.h5"
+    write_result(target, excitation, [result], 0, {"method": "optimized"})
+    played = played_result(target, rate=50.0)
+    assert played.held is None
+    said = [w for w in played.warnings if w.startswith("constraints.zmp.support_links: the robot has a floating base")]
+    assert len(said) == 1 and "names no soles" in said[0]
+    notes = [line for line in write_export(tmp_path / "g1.csv", played, "csv").read_text().splitlines() if "#" in line]
+    assert f"# warning: {said[0]}" in notes and notes[-1] == f"# {MARK} export"
+
+
 @pytest.fixture
 def standing(export):
     """The fixture's motion with two held joints, held at 0.1 and −0.2 rad."""
