@@ -8,7 +8,7 @@ from rich.markup import escape
 
 from excite_cli import console, workflows
 from excite_cli.console.app import FORCE, JOINTS, MODEL, PRIOR, RUNS, SCHEDULER, WORKERS, app, command, err, say
-from excite_cli.console.progress import Bars
+from excite_cli.console.progress import Bars, Stages
 from excite_cli.criteria import NAMES as OBJECTIVES
 from excite_cli.storage.formats import FORMATS
 
@@ -157,8 +157,8 @@ def identify(
 ) -> None:
     """Identify base parameters (Eq. 4), trace the residual to missing effects, report the error before/after."""
     problem = _load(config, {"identification.fit": fit}, "identify")
-    with console.app.busy.status("preprocessing, fitting and selecting effects ..."):
-        run = workflows.run_identify(problem, output or Path(problem.output), urdf_out, force, mjcf_out)
+    with Stages(console.app.busy, "reading the runs ...") as stages:
+        run = workflows.run_identify(problem, output or Path(problem.output), urdf_out, force, mjcf_out, stages.say)
     say(console.identification.preprocessing_notes(run.report), console=err)
     say(
         console.identification.identification(run.report),

@@ -160,3 +160,48 @@ class Bars:
             self.bar.update(task[0], completed=kept, status=f"{kept} kept of {drawn} drawn")
 
         return hook
+
+
+class Stages:
+    """What a command without bars is doing (a context manager; :meth:`say` takes the line): a spinner
+    with the line on a terminal; in a log, the line when ``period`` has passed since the last one
+    printed, and a heartbeat thread that repeats the last line with the time elapsed while nothing new
+    comes, so that lines are at most 1.1 periods apart (as :class:`Bars`' iterations)."""
+
+    def __init__(
+        self, console: Console, first: str, clock: Callable[[], float] = time.monotonic, period: float = LOG_PERIOD
+    ):
+        self.console, self.clock, self.period = console, clock, period
+        self.start = clock()
+        self.seen = {"last": self.start, "line": first}
+        self._status = console.status(first) if console.is_terminal else None
+        self._stop = threading.Event()
+
+    def __enter__(self) -> "Stages":
+        if self._status is not None:
+            self._status.__enter__()
+        else:
+            threading.Thread(target=self._beat, name="progress-heartbeat-stages", daemon=True).start()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self._stop.set()
+        if self._status is not None:
+            self._status.__exit__(*exc)
+
+    def _print(self) -> None:
+        self.seen["last"] = self.clock()
+        self.console.print(f"{self.seen['line']}, {self.seen['last'] - self.start:.0f} s", highlight=False)
+
+    def _beat(self) -> None:
+        while not self._stop.wait(self.period / 10):
+            if self.clock() - self.seen["last"] >= self.period:
+                self._print()
+
+    def say(self, line: str) -> None:
+        """Show ``line`` (what is under way, without the time)."""
+        self.seen["line"] = line
+        if self._status is not None:
+            self._status.update(line)
+        elif self.clock() - self.seen["last"] >= self.period:
+            self._print()

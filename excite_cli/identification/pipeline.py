@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
@@ -74,13 +75,14 @@ def error_ladder(
 
 
 def run_identification(
-    problem: IdentifyProblem, consistent_beside: bool = False
+    problem: IdentifyProblem, consistent_beside: bool = False, say: Callable[[str], None] | None = None
 ) -> tuple[Report, Robot, BaseParameters, PriorRows]:
     """The whole loop on ``problem``'s data; memory follows the decimated data.
 
     Args:
         consistent_beside: fit the physically consistent model even when ``identification.fit`` is
             ``least_squares`` (the identified URDF needs it).
+        say: told what is under way (a line: the run read, the search's step, the model scored).
 
     Returns:
         The :class:`Report`, the robot, its base parameters and the rows of all samples, fit then
@@ -99,7 +101,7 @@ def run_identification(
     couplings = motor_couplings(problem.data.transmission, cfg.coupling_ratios, robot.n_joints)
     candidates = candidate_terms(cfg, robot.n_joints, couplings)
     terms = declared + [t for t in candidates + rotor_terms(robot.n_joints, []) if t not in declared]
-    data = prepare_data(problem, robot, base, list(dict.fromkeys(terms)))  # with the consistent fit's rotors
+    data = prepare_data(problem, robot, base, list(dict.fromkeys(terms)), say)  # with the consistent fit's rotors
     fit_data, val_data = data.fit, data.validation
     selection = select_effects(
         fit_data,
@@ -110,10 +112,11 @@ def run_identification(
         fitted_offsets=set(np.unique(val_data.run).tolist()) <= set(data.fitted),
         couplings=couplings,
         scored=~data.silent,
+        say=say,
     )
     labels = [r.label for r in problem.data.runs]
     offset_runs = [labels[k] for k in data.fitted]
-    selection, choice = choose_fit(selection, robot, base, offset_runs, cfg, consistent_beside)
+    selection, choice = choose_fit(selection, robot, base, offset_runs, cfg, consistent_beside, say)
     selection = replace(selection, fit=reported_fit(selection, fit_data, data.rate, data.trajectories))
     measured = val_data.tau.reshape(-1, val_data.n)
     before = predict(val_data, selection.rigid.x, [])

@@ -6,6 +6,7 @@ trajectory each run records (named, or recordings of one motion together:
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
@@ -50,11 +51,17 @@ class Prepared:
     repeats: list[str]
 
 
-def prepare_data(problem: IdentifyProblem, robot: Robot, base: BaseParameters, terms: list[Term]) -> Prepared:
+def prepare_data(
+    problem: IdentifyProblem,
+    robot: Robot,
+    base: BaseParameters,
+    terms: list[Term],
+    say: Callable[[str], None] | None = None,
+) -> Prepared:
     """Read every run, choose the cut-off, preprocess, build the fit and validation datasets with the
     columns of ``terms`` (known payloads taken out), check the fit data excite every base parameter,
     and add the two-stage load columns from a first rigid-body fit. Runs are released as they are
-    decimated.
+    decimated; ``say`` is told each run read.
 
     Raises:
         ExciteError: bad data (see :func:`load_run`, :func:`preprocess`, :func:`build_datasets`), or
@@ -63,6 +70,8 @@ def prepare_data(problem: IdentifyProblem, robot: Robot, base: BaseParameters, t
     cfg = problem.identification
     runs, payloads, sources, prints = [], [], [], []  # lists only: the runs are released as they are preprocessed
     for k, r in enumerate(problem.data.runs):
+        if say:
+            say(f"reading run {k + 1}/{len(problem.data.runs)} ({r.label})")
         payload = payload_parameters(robot, r.payload, f"data.runs[{k}].payload") if r.payload else None
         run = load_run(r, problem.data, robot.joint_names, problem.folder)
         check_against_limits(run, robot.joint_names, robot.lower, robot.upper, robot.velocity_limit)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Optional
+from typing import Callable, Optional
 
 from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.dynamics.robot import Robot
@@ -74,11 +74,13 @@ def run_identify(
     urdf_out: Optional[Path] = None,
     force: bool = False,
     mjcf_out: Optional[Path] = None,
+    say: Optional[Callable[[str], None]] = None,
 ) -> IdentifyRun:
-    """Identify (:func:`run_identification`), write the report (HDF5), the residual plots and, with
-    ``urdf_out`` or ``mjcf_out``, the identified URDF or MJCF (of the physically consistent fit, which
-    is then fitted whatever ``identification.fit`` says: a model file needs physical bodies); the MJCF
-    is written and checked by MuJoCo before the report, which records the check.
+    """Identify (:func:`run_identification`, ``say`` told what is under way), write the report (HDF5),
+    the residual plots and, with ``urdf_out`` or ``mjcf_out``, the identified URDF or MJCF (of the
+    physically consistent fit, which is then fitted whatever ``identification.fit`` says: a model file
+    needs physical bodies); the MJCF is written and checked by MuJoCo before the report, which records
+    the check.
 
     Raises:
         ExciteError: bad paths or data (see :func:`run_identification`); another run writing
@@ -92,9 +94,7 @@ def run_identify(
     if urdf_out is not None:  # before the fit, not after it
         check_urdf_source(resolve_urdf(problem.robot, problem.folder)[0])
     with output_lock(target, "output"):
-        report, robot, base, rows = run_identification(
-            problem, consistent_beside=urdf_out is not None or mjcf_out is not None
-        )
+        report, robot, base, rows = run_identification(problem, urdf_out is not None or mjcf_out is not None, say)
         run = IdentifyRun(report, robot, base, target, plots, urdf_out)
         if mjcf_out is not None:
             run.mjcf, run.mujoco = write_identified_mjcf(problem, report, robot, base, mjcf_out)

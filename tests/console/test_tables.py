@@ -19,7 +19,7 @@ from excite_cli.console import tables
 from excite_cli.console.bodies import consistent_bodies
 from excite_cli.console.errors import printed_warnings, spellings, word
 from excite_cli.console.identification import _unresolved, _why_not_least_squares, validation
-from excite_cli.console.progress import LOG_PERIOD, Bars
+from excite_cli.console.progress import LOG_PERIOD, Bars, Stages
 from excite_cli.errors import ExciteError, ExciteWarning, OutputExists
 from excite_cli.identification.choice.admission import Admission
 from excite_cli.identification.fitting.physical import ConsistentFit
@@ -141,6 +141,28 @@ def test_a_log_hears_from_an_iteration_whose_workers_report_nothing_for_a_while(
     assert len(beats) >= 4 and beats[0].startswith(f"iteration 1: working, 0/{runs} runs reported, 0 s")
     assert f"1/{runs} runs reported, lowest {problem.optimizer.objective} reported -3," in beats[-1]
     assert out.getvalue().count("working") == printed.count("working")  # silent once done
+
+
+def test_a_log_hears_what_a_command_without_bars_is_doing_and_its_heartbeat():
+    """identify's stages in a log: a line said after a period has passed is printed with the time;
+    lines said sooner are not; while nothing new is said the last line is repeated every period (here
+    0.1 s of real time), and nothing once the command is done."""
+    out, now = io.StringIO(), [0.0]
+    with Stages(Console(file=out, width=200, force_terminal=False), "reading", clock=lambda: now[0]) as stages:
+        for t, line in ((1.0, "step 1"), (LOG_PERIOD + 1, "step 2"), (LOG_PERIOD + 2, "step 3")):
+            now[0] = t
+            stages.say(line)
+    assert out.getvalue().splitlines() == [f"step 2, {LOG_PERIOD + 1:.0f} s"]
+    out = io.StringIO()
+    with Stages(Console(file=out, width=200, force_terminal=False), "reading", period=0.1) as stages:
+        time.sleep(0.35)
+        stages.say("effect search")
+        time.sleep(0.35)
+        printed = out.getvalue()
+    time.sleep(0.3)
+    lines = printed.splitlines()
+    assert len(lines) >= 4 and lines[0].startswith("reading, 0 s") and lines[-1].startswith("effect search, ")
+    assert out.getvalue() == printed  # silent once done
 
 
 def test_the_command_line_words_fields_as_its_options():

@@ -39,6 +39,7 @@ URDF are the winner's; the best consistent fit of the winning model stays beside
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import Callable
 
 import numpy as np
 
@@ -242,6 +243,7 @@ def choose_fit(
     offset_runs: list[str],
     cfg: IdentificationConfig,
     consistent_beside: bool = False,
+    say: Callable[[str], None] | None = None,
 ) -> tuple[Selection, FitChoice]:
     """Score every model of :func:`compared_models` under every fit of ``cfg.fit`` on the selection's
     folds, keep the pair with the lowest J and fit the winning model's best consistent λ on all fit
@@ -254,6 +256,7 @@ def choose_fit(
             pays is the selection's ``min_improvement``, the same the search used.
         consistent_beside: fit the consistent model (at the first λ) even when least squares is the
             only fit (the identified URDF needs one).
+        say: told each model scored.
 
     Returns:
         The selection with the winning model as its chosen one, and the choice.
@@ -271,7 +274,13 @@ def choose_fit(
             programs[_without_rotors(m.terms)] = ConsistentModel(m.terms, selection, robot, base, offset_runs)
     cv, folds, known = np.full((len(models), len(lams)), np.nan), None, {}
     if not single:
-        cv, folds = (np.array(x) for x in zip(*[_scores(selection, m, lams, programs, known) for m in models]))
+        scores = []
+        for k, m in enumerate(models):
+            if say:
+                folds_count = selection.cross_validation.folds
+                say(f"scoring fits: model {k + 1}/{len(models)} under {len(lams)} fits on {folds_count} folds")
+            scores.append(_scores(selection, m, lams, programs, known))
+        cv, folds = (np.array(x) for x in zip(*scores))
     paired = selection.admission is Admission.PAIRED and not single
     J, (win, chosen) = _objective(selection, models, lams, cv, folds, cfg.least_squares_margin, paired)
     consistent = [k for k, lam in enumerate(lams) if lam is not None]

@@ -22,6 +22,7 @@ the search cannot cycle, and it stops when no move is allowed.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Callable
 
 import numpy as np
 
@@ -122,8 +123,10 @@ class StepwiseSearch:
         declared: list[Term],
         cfg: IdentificationConfig,
         rule: Admission = Admission.PRICED,
+        say: Callable[[str], None] | None = None,
     ):
         self.cv, self.candidates, self.declared, self.cfg, self.rule = cv, candidates, declared, cfg, rule
+        self.say = say  # told each step: the search, the model's size and CV, the moves to score
         self.fixed = {t.family for t in declared}  # declared: never removed (their shape may move)
         self.penalty = np.log1p(cfg.min_improvement)
         self.cache: dict[frozenset, tuple[float, np.ndarray]] = {}
@@ -200,7 +203,13 @@ class StepwiseSearch:
         search = Search(name, list(terms), score[0], terms, score[0], self.objective(terms, score))
         search.initial_folds = score[1]
         while True:
-            tried = [(move, term, after, self.score(after)) for move, term, after in self.moves(terms)]
+            moves = self.moves(terms)
+            if self.say:
+                self.say(
+                    f"effect search '{name}': step {len(search.steps) + 1}, {len(terms)} terms, CV {score[0]:.2f} %, "
+                    f"scoring {len(moves)} moves on {self.cv.folds} folds"
+                )
+            tried = [(move, term, after, self.score(after)) for move, term, after in moves]
             if not tried:
                 search.stop = "no move left (every candidate is in the model)"
                 break

@@ -31,6 +31,7 @@ search scored and no effect is chosen for a coefficient the reported fit cannot 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
@@ -183,6 +184,7 @@ def select_effects(
     fitted_offsets: bool = False,
     couplings: list[tuple[float, ...]] = (),
     scored: np.ndarray | None = None,
+    say: Callable[[str], None] | None = None,
 ) -> Selection:
     """The stepwise search of the module docstring on the fit data.
 
@@ -197,6 +199,7 @@ def select_effects(
             fit the held-out runs' offsets).
         couplings: the motor coordinates of coupled candidates (:func:`motor_couplings`).
         scored: (n,) the joints the CV error is the mean over (a channel without signal is not).
+        say: told each step of each search (:class:`StepwiseSearch`).
     """
     n = fit_data.n
     candidates = [t for t in candidate_terms(cfg, n, couplings) if t not in declared and t in fit_data.blocks]
@@ -209,7 +212,7 @@ def select_effects(
     candidates = [t for t in candidates if t not in absorbed]
     keys = declared + candidates + [t for t in total.size if t not in declared + candidates]
     cv = CrossValidation(fit_data, keys, weights, cfg.folds, margin, recordings, fitted_offsets, scored)
-    search = StepwiseSearch(cv, candidates, declared, cfg, admission_of(cv.by_recording, cv.folds))
+    search = StepwiseSearch(cv, candidates, declared, cfg, admission_of(cv.by_recording, cv.folds), say)
     searches, seen = [], []
     for name, effects in STARTS.items():
         start = declared + [t for t in candidates if t.effect in effects and t.shape is None and t.coupling is None]

@@ -6,7 +6,7 @@ import pytest
 import scipy.optimize
 
 from excite_cli.identification.choice.admission import Admission
-from excite_cli.identification.choice.crossval import CrossValidation, fold_assignment
+from excite_cli.identification.choice.crossval import RECORDING_FOLDS, CrossValidation, fold_assignment
 from excite_cli.identification.choice.search import Search, StepwiseSearch
 from excite_cli.identification.choice.selection import STARTS, candidate_terms, kept_search, select_effects
 from excite_cli.identification.config import IdentificationConfig
@@ -63,6 +63,17 @@ def test_folds_are_time_blocks_of_every_run_with_margins():
     assert not np.any(margins[1] & (fold == 1))
 
 
+def test_many_recordings_are_dealt_into_ten_folds_of_consecutive_ones():
+    """Issue 102: 100 recordings were 100 folds, each model's score 100 solves (900 s without a word)."""
+    recording = np.repeat(np.arange(100), 5)
+    fold, margins = fold_assignment(np.tile(np.arange(5) * 0.01, 100), recording, 6, 0.05, recording)
+    assert len(margins) == RECORDING_FOLDS == np.unique(fold).size and not np.any(margins)
+    assert np.all(np.diff(fold) >= 0) and np.bincount(fold).tolist() == [50] * RECORDING_FOLDS
+    assert all(np.unique(fold[recording == r]).size == 1 for r in range(100))  # a recording is never split
+    few = np.repeat(np.arange(4), 5)
+    assert fold_assignment(np.tile(np.arange(5) * 0.01, 4), few, 6, 0.05, few)[0].tolist() == few.tolist()
+
+
 def test_fold_errors_equal_explicit_weighted_refits():
     cfg = IdentificationConfig(candidates=["coulomb", "offset"])
     terms = [Term("coulomb", 0), Term("offset", 1)]
@@ -101,7 +112,9 @@ def test_folds_fit_friction_as_bounded_least_squares_of_the_design():
         x = scipy.optimize.lsq_linear(A[train], data.tau[train], bounds=(lower, np.inf), tol=1e-12).x
         expected[k] = (((data.tau - A @ x)[np.repeat(fold == k, 2)].reshape(-1, 2)) ** 2).sum(axis=0)
     np.testing.assert_allclose(cv.fold_sse(terms), expected, rtol=1e-6)
-    selection = select_effects(data, cfg, [], margin=0.05)
+    said = []
+    selection = select_effects(data, cfg, [], margin=0.05, say=said.append)
+    assert said[0].startswith("effect search") and "step 1, 0 terms" in said[0] and "folds" in said[0]
     assert Term("viscous", 1) not in selection.terms  # held at 0 it explains nothing: never added
 
 
