@@ -91,14 +91,49 @@ def sole_points(robot: Robot, links: list[str], height: float, field: str) -> li
     return [p[p[:, 2] <= lowest + height] for p in points]
 
 
+#: [m] a sole whose contact points lie in a strip narrower than this stands on an edge (a flat foot
+#: touches the ground over several centimetres each way; the G1's heels alone over 3.5 mm).
+EDGE = 0.01
+
+
+def soles_on_an_edge(robot: Robot, links: list[str], height: float, field: str) -> list[tuple[str, int]]:
+    """(link, contact points) of the soles of ``links`` (:func:`sole_points`) that touch the ground on
+    two or more points in a strip narrower than :data:`EDGE` at the home posture: standing on an edge
+    (held joints that tilt the foot: a bent knee without the ankle that levels it). A point foot (one
+    point) is not one."""
+    out = []
+    for link, points in zip(links, sole_points(robot, links, height, field)):
+        xy = points[:, :2] - points[:, :2].mean(axis=0)
+        across = xy @ np.linalg.svd(xy, full_matrices=False)[2][-1]  # along the narrowest direction
+        if len(points) >= 2 and np.ptp(across) < EDGE:
+            out.append((link, len(points)))
+    return out
+
+
+def tilted_stance(edges: list[tuple[str, int]], what: str) -> ExciteError:
+    """The error of a support polygon that fails because soles stand on an edge (``edges``: see
+    :func:`soles_on_an_edge`): the held joints are at fault, not ``what`` (the field that failed)."""
+    named = ", ".join(f"'{link}' ({count} points in a strip under {100 * EDGE:g} cm)" for link, count in edges)
+    return ExciteError(
+        "robot.locked_joints",
+        f"at the home posture the soles of {named} touch the ground along an edge, so {what}: the held joints "
+        "tilt the feet; they must keep the soles flat (a bent knee needs the hip and ankle pitch that level the "
+        "foot, as excite init drafts a stance)",
+    )
+
+
 def support_polygon(robot: Robot, links: list[str], height: float, field: str) -> SupportPolygon:
     """The hull of the soles' contact points of ``links`` (:func:`sole_points`) on the ground plane.
 
     Raises:
-        ExciteError: (``field``) a link without collision geometry, or soles spanning no area.
+        ExciteError: (``field``) a link without collision geometry, or soles spanning no area
+            (``robot.locked_joints`` where soles stand on an edge: :func:`tilted_stance`).
     """
     sole = np.vstack(sole_points(robot, links, height, field))
     try:
         return SupportPolygon.from_points(sole[:, :2], sole[:, 2].min())
     except (QhullError, ValueError):  # degenerate input (too few, collinear or coincident points)
+        edges = soles_on_an_edge(robot, links, height, field)
+        if edges:
+            raise tilted_stance(edges, f"{field} span no area") from None
         raise ExciteError(field, "the soles of these links span no area") from None

@@ -28,7 +28,7 @@ from excite_cli.config import ZmpConfig
 from excite_cli.constraints.constraint import Constraint, FineCheck
 from excite_cli.constraints.lse import ACCEPT_MARGIN, smooth_max, smooth_max_value
 from excite_cli.constraints.self_collision import LENGTH_SCALE
-from excite_cli.constraints.support import SupportPolygon, support_polygon
+from excite_cli.constraints.support import SupportPolygon, soles_on_an_edge, support_polygon, tilted_stance
 from excite_cli.dynamics.robot import Robot
 from excite_cli.errors import ExciteError
 from excite_cli.memo import once
@@ -215,7 +215,18 @@ def zmp_from_config(cfg: ZmpConfig, robot: Robot, basis: FourierBasis) -> ZeroMo
     """The :class:`ZeroMomentPoint` of ``constraints.zmp`` (support polygon from the soles' contact points).
 
     Raises:
-        ExciteError: see :class:`ZeroMomentPoint` and :func:`~excite_cli.constraints.support.support_polygon`.
+        ExciteError: see :class:`ZeroMomentPoint` and :func:`~excite_cli.constraints.support.support_polygon`;
+            a margin that leaves no polygon because soles stand on an edge is the held joints' fault
+            (:func:`~excite_cli.constraints.support.tilted_stance`).
     """
-    polygon = support_polygon(robot, cfg.support_links, CONTACT_HEIGHT, "constraints.zmp.support_links")
-    return ZeroMomentPoint(robot, basis, polygon, cfg.margin)
+    field = "constraints.zmp.support_links"
+    polygon = support_polygon(robot, cfg.support_links, CONTACT_HEIGHT, field)
+    try:
+        return ZeroMomentPoint(robot, basis, polygon, cfg.margin)
+    except ExciteError as error:
+        edges = (
+            soles_on_an_edge(robot, cfg.support_links, CONTACT_HEIGHT, field) if error.field.endswith("margin") else []
+        )
+        if edges:
+            raise tilted_stance(edges, f"constraints.zmp.margin {cfg.margin:g} m leaves no support polygon") from None
+        raise

@@ -6,7 +6,8 @@ leaves no polygon)."""
 import numpy as np
 import pinocchio as pin
 import pytest
-from conftest import CONFIGS
+import yaml
+from conftest import CONFIGS, assert_refused
 
 from excite_cli.config_file import load_problem, with_overrides
 from excite_cli.constraints.support import SupportPolygon
@@ -111,3 +112,17 @@ def test_polygon_margins_are_distances_to_the_nearest_edge():
     np.testing.assert_allclose(square.centroid, [0.5, 0.5])
     inner = SupportPolygon.from_points(square.shrunk(0.1), 0.0)
     np.testing.assert_allclose(inner.margins(np.array([[0.5, 0.5], [0.9, 0.5]])), [0.4, 0.0], atol=1e-12)
+
+
+def test_locked_knees_that_tilt_the_soles_are_blamed_not_the_margin(tmp_path):
+    """Issue 102: the G1 with its knees held bent at 0.6 rad (hips and ankles at 0) stands on its heels'
+    edges; the refusal named constraints.zmp.margin. The held joints are at fault, and the flat stance
+    of the shipped config still builds."""
+    data = yaml.safe_load((CONFIGS / "g1_arms.yaml").read_text())
+    data["robot"]["locked_joints"] = {"left_knee_joint": 0.6, "right_knee_joint": 0.6}
+    data["output"] = str(tmp_path / "out.h5")
+    path = tmp_path / "knees.yaml"
+    path.write_text(yaml.safe_dump(data))
+    line = assert_refused(tmp_path, ["check", str(path)], "robot.locked_joints: at the home posture the soles of")
+    assert "'left_ankle_roll_link'" in line and "constraints.zmp.margin 0.02 m leaves no support polygon" in line
+    build_excitation(load_problem(CONFIGS / "g1_arms.yaml"))
