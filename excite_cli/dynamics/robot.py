@@ -9,8 +9,6 @@ paper does with HRP-4's legs and waist (Section IV-B).
 
 from __future__ import annotations
 
-import difflib
-import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -18,19 +16,14 @@ import numpy as np
 import pinocchio as pin
 
 from excite_cli.config import RobotConfig
+from excite_cli.dynamics.active_joints import check_joints, unknown_joint
 from excite_cli.dynamics.robot_files import open_source, robot_source
 from excite_cli.dynamics.source import apply_joint_ranges
 from excite_cli.dynamics.urdf_meshes import package_folders
-from excite_cli.errors import ExciteError, ExciteWarning
+from excite_cli.errors import ExciteError
 
 #: Order of pinocchio's 10 dynamic parameters of one body (``Inertia.toDynamicParameters``).
 PARAMETER_SYMBOLS = ("m", "mx", "my", "mz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz")
-
-
-def _unknown_joint(field_name: str, name: str, known: list[str]) -> ExciteError:
-    close = difflib.get_close_matches(name, known, n=1)
-    hint = f"; did you mean '{close[0]}'?" if close else ""
-    return ExciteError(field_name, f"'{name}' is not a joint of the robot{hint}")
 
 
 @dataclass
@@ -177,51 +170,6 @@ def _body_name(model: pin.Model, joint_id: int) -> str:
     return model.names[joint_id]
 
 
-def _check_joints(cfg: RobotConfig, full: pin.Model) -> list[str]:
-    """The movable joints of the full model, after checking the active and locked joints against them.
-
-    Raises:
-        ExciteError: an unknown joint, a joint that is not 1-DoF, a joint listed twice or both active
-            and locked, a locked value outside the joint's limits.
-    """
-    movable = [n for j, n in enumerate(full.names) if j > 0 and full.joints[j].shortname() != "JointModelFreeFlyer"]
-    for name in cfg.active_joints:
-        if name not in movable:
-            raise _unknown_joint("robot.active_joints", name, movable)
-        if full.joints[full.getJointId(name)].nq != 1:
-            raise ExciteError("robot.active_joints", f"'{name}' is not a 1-DoF revolute or prismatic joint")
-    if len(set(cfg.active_joints)) != len(cfg.active_joints):
-        raise ExciteError("robot.active_joints", "a joint is listed twice")
-    for name, value in cfg.locked_joints.items():
-        if name not in movable:
-            raise _unknown_joint("robot.locked_joints", name, movable)
-        if name in cfg.active_joints:
-            raise ExciteError("robot.locked_joints", f"'{name}' is also an active joint")
-        j = full.getJointId(name)
-        lo, hi = full.lowerPositionLimit[full.idx_qs[j]], full.upperPositionLimit[full.idx_qs[j]]
-        if full.joints[j].nv > 1:
-            raise ExciteError(
-                f"robot.locked_joints.{name}",
-                f"'{name}' has {full.joints[j].nv} degrees of freedom: one value cannot hold it",
-                value,
-                "a 1-DoF joint (other joints not active are held at their reference)",
-            )
-        if full.joints[j].nq == 1 and not lo <= value <= hi:
-            raise ExciteError(
-                f"robot.locked_joints.{name}", f"{value} rad is outside the joint limits [{lo:g}, {hi:g}]"
-            )
-    held = [n for n in movable if full.joints[full.getJointId(n)].nv > 1 and n not in cfg.active_joints]
-    if held:
-        warnings.warn(
-            f"robot.active_joints: {', '.join(repr(n) for n in held)} "
-            f"{'is a joint' if len(held) == 1 else 'are joints'} of more than one degree of freedom (a ball "
-            "joint): held at the reference (no rotation), as excite moves 1-DoF joints only",
-            ExciteWarning,
-            stacklevel=3,
-        )
-    return movable
-
-
 def load_robot(
     cfg: RobotConfig,
     folder: Path | None = None,
@@ -256,7 +204,7 @@ def load_robot(
     full = source.model(cfg.floating_base)
     apply_joint_ranges(full, cfg.joint_ranges, source.path.name)
 
-    movable = _check_joints(cfg, full)
+    movable = check_joints(cfg, full)
     q_full = pin.neutral(full)
     for name, value in cfg.locked_joints.items():
         q_full[full.idx_qs[full.getJointId(name)]] = value
@@ -283,7 +231,7 @@ def load_robot(
     lower, upper = model.lowerPositionLimit[q_idx].copy(), model.upperPositionLimit[q_idx].copy()
     unknown = [name for name in cfg.home_posture if name not in cfg.active_joints]
     if unknown:
-        raise _unknown_joint("robot.home_posture", unknown[0], list(cfg.active_joints))
+        raise unknown_joint("robot.home_posture", unknown[0], list(cfg.active_joints))
     home = np.array([cfg.home_posture.get(name, 0.0) for name in cfg.active_joints])
     return Robot(
         model=model,

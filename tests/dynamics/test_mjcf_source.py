@@ -10,7 +10,7 @@ from conftest import JOINTS, included_arm_mjcf, panda_mjcf
 from excite_cli.config import RobotConfig
 from excite_cli.dynamics.base_parameters import compute_base_parameters
 from excite_cli.dynamics.mjcf_compiled import is_mjcf
-from excite_cli.dynamics.mjcf_source import mjcf_couplings
+from excite_cli.dynamics.mjcf_equalities import mjcf_couplings
 from excite_cli.dynamics.robot import load_robot
 from excite_cli.dynamics.robot_files import open_source
 from excite_cli.errors import ExciteError, ExciteWarning

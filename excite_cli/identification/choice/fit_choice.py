@@ -38,7 +38,7 @@ URDF are the winner's; the best consistent fit of the winning model stays beside
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from typing import Callable
 
 import numpy as np
@@ -47,105 +47,12 @@ from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.dynamics.robot import Robot
 from excite_cli.identification.choice.admission import Admission, paired_choice
 from excite_cli.identification.choice.consistent_model import ConsistentModel
+from excite_cli.identification.choice.fit_records import LEAST_SQUARES, FitChoice, Model
 from excite_cli.identification.choice.search import effect_count, priced_objective
 from excite_cli.identification.choice.selection import Selection
 from excite_cli.identification.config import IdentificationConfig
 from excite_cli.identification.effects import Term
 from excite_cli.identification.fitting.least_squares import least_squares
-from excite_cli.identification.fitting.physical import ConsistentFit
-
-#: The name of the least-squares candidate.
-LEAST_SQUARES = "least squares"
-
-
-@dataclass(frozen=True)
-class Model:
-    """A model scored with the fits: the search it comes from, whether it is that search's start or
-    end, its terms, the number of effects it adds beyond the declared ones (p, a coupled one
-    counting as several: :func:`~excite_cli.identification.choice.selection.effect_count`) and how
-    many of those are a joint's armature, which a consistent fit holds anyway (its rotors:
-    :mod:`~excite_cli.identification.choice.consistent_model`) and which there add nothing to pay for."""
-
-    search: int
-    start: str
-    at_start: bool
-    terms: list[Term]
-    effects: float
-    rotors: int = 0
-
-    def counted(self, consistent: bool) -> float:
-        """p of J under a least-squares or a consistent fit (which does not count armature)."""
-        return self.effects - (self.rotors if consistent else 0)
-
-    @property
-    def label(self) -> str:
-        """e.g. ``end of 'Coulomb on every joint'``."""
-        return f"{'start' if self.at_start else 'end'} of '{self.start}'"
-
-
-@dataclass(frozen=True)
-class FitChoice:
-    """The models and fits compared and the pair chosen.
-
-    Attributes:
-        models: (m,) each model compared (the ends and starts of the searches, each set of terms once).
-        names: (f,) each candidate fit: ``least squares`` or ``consistent λ=<λ>``.
-        regularization: (f,) λ of each consistent candidate (NaN for least squares).
-        cv: (m, f) CV error [%] of each model under each fit on the selection's folds (NaN: the only
-            pair, not cross-validated).
-        objective: (m, f) J of each pair (module docstring).
-        model: index of the winning model in ``models``; chosen: index of its fit in ``names``.
-        consistent: the physically consistent fit of the winning model on all fit data at its best
-            consistent λ (the winner's, or the one beside least squares), or None when none was asked for.
-        margin: the fraction least squares had to cut the consistent fit's CV error by (0: none or
-            the paired test).
-        admission: the rule the pairs were compared by (the search's).
-    """
-
-    models: list[Model]
-    names: list[str]
-    regularization: np.ndarray
-    cv: np.ndarray
-    objective: np.ndarray
-    model: int
-    chosen: int
-    consistent: ConsistentFit | None
-    margin: float = 0.0
-    admission: Admission = Admission.PRICED
-
-    @property
-    def name(self) -> str:
-        """The winning fit's name."""
-        return self.names[self.chosen]
-
-    @property
-    def is_consistent(self) -> bool:
-        """Whether the winning fit is a physically consistent one."""
-        return self.name != LEAST_SQUARES
-
-    @property
-    def labels(self) -> list[str]:
-        """(m,) the models' labels, e.g. ``end of 'declared effects'``."""
-        return [m.label for m in self.models]
-
-    @property
-    def cv_error(self) -> np.ndarray:
-        """(f,) CV error [%] of the winning model under each fit."""
-        return self.cv[self.model]
-
-    def effects(self, model: int, fit: int) -> float:
-        """p of J: the effects ``models[model]`` adds, counted under the fit ``names[fit]`` (a consistent
-        fit does not count armature: module docstring)."""
-        return self.models[model].counted(self.names[fit] != LEAST_SQUARES)
-
-    @property
-    def lead(self) -> float:
-        """How much lower the winner's CV error is than the next best fit's of the same model [% points]
-        (NaN with a single fit)."""
-        others = np.delete(self.cv_error, self.chosen)
-        if others.size == 0 or np.all(np.isnan(others)):
-            return float("nan")
-        return float(np.nanmin(others) - self.cv_error[self.chosen])
 
 
 def candidates(cfg: IdentificationConfig) -> list[float | None]:
@@ -256,7 +163,7 @@ def choose_fit(
             pays is the selection's ``min_improvement``, the same the search used.
         consistent_beside: fit the consistent model (at the first λ) even when least squares is the
             only fit (the identified URDF needs one).
-        say: told each model scored.
+        say: told what is scored.
 
     Returns:
         The selection with the winning model as its chosen one, and the choice.
@@ -274,13 +181,11 @@ def choose_fit(
             programs[_without_rotors(m.terms)] = ConsistentModel(m.terms, selection, robot, base, offset_runs)
     cv, folds, known = np.full((len(models), len(lams)), np.nan), None, {}
     if not single:
-        scores = []
-        for k, m in enumerate(models):
-            if say:
-                folds_count = selection.cross_validation.folds
-                say(f"scoring fits: model {k + 1}/{len(models)} under {len(lams)} fits on {folds_count} folds")
-            scores.append(_scores(selection, m, lams, programs, known))
-        cv, folds = (np.array(x) for x in zip(*scores))
+        if say:
+            say(
+                f"scoring fits: {len(models)} models under {len(lams)} fits on {selection.cross_validation.folds} folds"
+            )
+        cv, folds = (np.array(x) for x in zip(*[_scores(selection, m, lams, programs, known) for m in models]))
     paired = selection.admission is Admission.PAIRED and not single
     J, (win, chosen) = _objective(selection, models, lams, cv, folds, cfg.least_squares_margin, paired)
     consistent = [k for k, lam in enumerate(lams) if lam is not None]

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from excite_cli.identification.choice.fit_choice import FitChoice
+from excite_cli.identification.choice.fit_records import FitChoice
 from excite_cli.identification.choice.selection import Selection
 from excite_cli.identification.effects import Term, coefficient_names
 from excite_cli.identification.fitting.dataset import Dataset

@@ -6,7 +6,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from excite_cli.identification.choice.fit_choice import LEAST_SQUARES, candidates, compared_models
+from excite_cli.identification.choice.fit_choice import candidates, compared_models
+from excite_cli.identification.choice.fit_records import LEAST_SQUARES
 from excite_cli.identification.config import IdentificationConfig
 
 
