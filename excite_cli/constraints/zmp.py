@@ -224,9 +224,8 @@ def zmp_from_config(cfg: ZmpConfig, robot: Robot, basis: FourierBasis) -> ZeroMo
     try:
         return ZeroMomentPoint(robot, basis, polygon, cfg.margin)
     except ExciteError as error:
-        edges = (
-            soles_on_an_edge(robot, cfg.support_links, CONTACT_HEIGHT, field) if error.field.endswith("margin") else []
-        )
+        margin_failed = error.field == "constraints.zmp.margin"
+        edges = soles_on_an_edge(robot, cfg.support_links, CONTACT_HEIGHT, field) if margin_failed else []
         if edges:
             raise tilted_stance(edges, f"constraints.zmp.margin {cfg.margin:g} m leaves no support polygon") from None
         raise
