@@ -36,6 +36,24 @@ def wide_console(stderr: bool = False) -> Console:
     return Console(stderr=stderr, width=None if stream.isatty() else LOG_WIDTH)
 
 
+def heartbeat(
+    seen: dict, say: Callable[[], None], clock: Callable[[], float], period: float, name: str
+) -> threading.Event:
+    """A daemon thread (``name``) that calls ``say`` when ``period`` [s] of ``clock`` has passed since
+    ``seen["last"]`` (a line printed), checking ten times a period, until the returned event is set."""
+    stop = threading.Event()
+
+    def beat() -> None:
+        while not stop.wait(period / 10):
+            now = clock()
+            if now - seen["last"] >= period:
+                seen["last"] = now
+                say()
+
+    threading.Thread(target=beat, name=name, daemon=True).start()
+    return stop
+
+
 class Bars:
     """One live display of bars on ``console`` (a context manager); it appears with the first bar, so
     an error found before any work is the only thing printed."""
@@ -135,19 +153,9 @@ class Bars:
         return progress, done
 
     def _heartbeat(self, seen: dict, say: Callable[[], None], k: int) -> threading.Event:
-        """A daemon thread that calls ``say`` when ``period`` has passed since ``seen["last"]`` (a line
-        printed), until the returned event is set (iteration ``k`` done) or the bars close."""
-        stop = threading.Event()
+        """:func:`heartbeat` of iteration ``k``, stopped when the bars close too."""
+        stop = heartbeat(seen, say, self.clock, self.period, f"progress-heartbeat-{k}")
         self._beats.append(stop)
-
-        def beat() -> None:
-            while not stop.wait(self.period / 10):
-                now = self.clock()
-                if now - seen["last"] >= self.period:
-                    seen["last"] = now
-                    say()
-
-        threading.Thread(target=beat, name=f"progress-heartbeat-{k}", daemon=True).start()
         return stop
 
     def draws(self, total: int | None) -> Callable[[int, int], None]:
@@ -175,28 +183,24 @@ class Stages:
         self.start = clock()
         self.seen = {"last": self.start, "line": first}
         self._status = console.status(first) if console.is_terminal else None
-        self._stop = threading.Event()
+        self._stop: threading.Event | None = None
 
     def __enter__(self) -> "Stages":
         if self._status is not None:
             self._status.__enter__()
         else:
-            threading.Thread(target=self._beat, name="progress-heartbeat-stages", daemon=True).start()
+            self._stop = heartbeat(self.seen, self._print, self.clock, self.period, "progress-heartbeat-stages")
         return self
 
     def __exit__(self, *exc) -> None:
-        self._stop.set()
+        if self._stop is not None:
+            self._stop.set()
         if self._status is not None:
             self._status.__exit__(*exc)
 
     def _print(self) -> None:
         self.seen["last"] = self.clock()
         self.console.print(f"{self.seen['line']}, {self.seen['last'] - self.start:.0f} s", highlight=False)
-
-    def _beat(self) -> None:
-        while not self._stop.wait(self.period / 10):
-            if self.clock() - self.seen["last"] >= self.period:
-                self._print()
 
     def say(self, line: str) -> None:
         """Show ``line`` (what is under way, without the time)."""
