@@ -68,6 +68,7 @@ NOISE = 0.02  # of each joint's RMS torque on the unseen motion (absolute), or o
 FLOOR = 0.002  # the relative noise's floor, of each joint's RMS torque on the unseen motion
 SEEDS = 5
 UNSEEN_SEED = 12345
+HEDGE_SEEDS = (1, 2, 3)  # random feasible motions whose RMS torques scale a hedged design's noise floor
 
 
 def samples(excitation, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -114,13 +115,32 @@ def in_the_loop(
     return float(np.mean(rms)), float(np.mean(worst)), float(np.mean(torque)), expected
 
 
-def run(config: Path, objective: str, scaling: str, seed: int, relative: bool) -> tuple:
+def design_noise(problem, design: str, relative: bool) -> None:
+    """Set ``problem.noise`` to what the design is told: ``measured`` the measurements' own noise (a lab
+    that declares its sensor), ``config`` what the config says (a lab that declares nothing), ``hedge:K``
+    σ_j(t) ∝ √((K R_j)² + τ_j(t)²), R_j the RMS torque of joint j on random feasible motions
+    (:data:`HEDGE_SEEDS`, not the unseen one)."""
+    if design == "config":
+        return
+    excitation = build_excitation(problem)
+    joints = problem.robot.active_joints
+    if design == "measured":
+        absolute, rho = noise_scale(excitation, relative)
+        problem.noise = NoiseConfig(absolute=dict(zip(joints, absolute.tolist())), relative=rho)
+        return
+    k = float(design.split(":")[1])
+    tau = np.vstack([samples(excitation, excitation.random_start(np.random.default_rng(s)))[1] for s in HEDGE_SEEDS])
+    rms = np.sqrt((tau**2).mean(axis=0))
+    problem.noise = NoiseConfig(absolute=dict(zip(joints, (k * np.maximum(rms, 1e-6 * rms.max())).tolist())), relative=1.0)
+
+
+def run(config: Path, objective: str, scaling: str, seed: int, truths: list[bool], design: str) -> list[tuple]:
     """The sequence of one criterion (or the random starts) with optimizer seed ``seed``, designed for
-    the noise of the measurements (absolute, or ``relative``), its figures and its wall time."""
+    ``design`` (:func:`design_noise`; ``measured``: for the one truth in ``truths``), its figures under
+    each truth (relative noise or not) and its wall time."""
     problem = load_problem(config)
     problem.optimizer.objective, problem.optimizer.scaling, problem.optimizer.seed = objective, scaling, seed
-    absolute, rho = noise_scale(build_excitation(problem), relative)
-    problem.noise = NoiseConfig(absolute=dict(zip(problem.robot.active_joints, absolute.tolist())), relative=rho)
+    design_noise(problem, design, truths[0])
     excitation = build_excitation(problem)
     begin = time.perf_counter()
     iterations = problem.sequence.iterations
@@ -135,7 +155,7 @@ def run(config: Path, objective: str, scaling: str, seed: int, relative: bool) -
     C = np.vstack([excitation.criterion(objective="log_cond", scaling="none").regressor(a) for a in alphas])
     unseen = excitation.random_start(np.random.default_rng(UNSEEN_SEED))
     figures = (condition_number(C), excitation.scaled_condition_number(C), excitation.excitation_level(C))
-    return (*figures, *in_the_loop(excitation, alphas, unseen, relative), wall)
+    return [(*figures, *in_the_loop(excitation, alphas, unseen, relative), wall) for relative in truths]
 
 
 def main() -> None:
@@ -143,26 +163,36 @@ def main() -> None:
     parser.add_argument("configs", type=Path, nargs="*", default=DEFAULT_CONFIGS)
     parser.add_argument("--criteria", nargs="+", default=[f"{o}:{s}" for o, s in CRITERIA] + ["random:none"])
     parser.add_argument("--seeds", type=int, nargs="+", default=[0])
-    parser.add_argument("--noise", choices=("absolute", "relative"), default="absolute")
+    parser.add_argument("--noise", choices=("absolute", "relative", "both"), default="absolute")
+    parser.add_argument("--design-noise", default="measured", help="measured | config | hedge:K")
     args = parser.parse_args()
-    relative = args.noise == "relative"
+    truths = {"absolute": [False], "relative": [True], "both": [False, True]}[args.noise]
+    if args.design_noise == "measured" and len(truths) > 1:
+        parser.error("--noise both needs a design that does not depend on the truth (--design-noise config or hedge:K)")
     header = f"{'criterion':<22} {'cond(C)':>8} {'cond(CL)':>9} {'e [Nm]':>8} {'param err RMS':>14} {'worst dir.':>11} {'unseen torque':>14} {'predicted':>10} {'wall [s]':>9}"
     for config in args.configs:
-        print(f"\n{config.name}, {args.noise} noise, optimizer seeds {args.seeds} (means)\n{header}")
         for criterion in args.criteria:
             objective, scaling = criterion.split(":")
-            rows = np.array([run(config, objective, scaling, seed, relative) for seed in args.seeds])
-            cond, scaled, level, rms, worst, torque, predicted, wall = rows.mean(axis=0)
-            label = objective if objective in ("random", "log_det") else f"{objective}, {scaling}"
-            print(
-                f"{label:<22} {cond:>8.1f} {scaled:>9.0f} {level:>8.4f} {rms:>14.2%} {worst:>11.1%} {torque:>14.3%} {predicted:>10.2%} {wall:>9.0f}",
-                flush=True,
-            )
-            if len(args.seeds) > 1:
-                print(
-                    f"{'  per seed':<22} param err {' '.join(f'{x:.2%}' for x in rows[:, 3])}; torque {' '.join(f'{x:.3%}' for x in rows[:, 5])}; "
-                    f"predicted {' '.join(f'{x:.2%}' for x in rows[:, 6])}"
-                )
+            runs = [run(config, objective, scaling, seed, truths, args.design_noise) for seed in args.seeds]
+            for k, relative in enumerate(truths):
+                truth = "relative" if relative else "absolute"
+                print(f"\n{config.name}, {truth} noise, designed for {args.design_noise}, optimizer seeds {args.seeds} (means)\n{header}")
+                report(objective, scaling, np.array([r[k] for r in runs]), len(args.seeds))
+
+
+def report(objective: str, scaling: str, rows: np.ndarray, seeds: int) -> None:
+    """One criterion's line (means over the seeds) and, with several seeds, each seed's errors."""
+    cond, scaled, level, rms, worst, torque, predicted, wall = rows.mean(axis=0)
+    label = objective if objective in ("random", "log_det") else f"{objective}, {scaling}"
+    print(
+        f"{label:<22} {cond:>8.1f} {scaled:>9.0f} {level:>8.4f} {rms:>14.2%} {worst:>11.1%} {torque:>14.3%} {predicted:>10.2%} {wall:>9.0f}",
+        flush=True,
+    )
+    if seeds > 1:
+        print(
+            f"{'  per seed':<22} param err {' '.join(f'{x:.2%}' for x in rows[:, 3])}; torque {' '.join(f'{x:.3%}' for x in rows[:, 5])}; "
+            f"predicted {' '.join(f'{100 * x:.4g}%' for x in rows[:, 6])}"
+        )
 
 
 if __name__ == "__main__":
