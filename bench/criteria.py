@@ -131,7 +131,9 @@ def design_noise(problem, design: str, relative: bool) -> None:
     k = float(design.split(":")[1])
     tau = np.vstack([samples(excitation, excitation.random_start(np.random.default_rng(s)))[1] for s in HEDGE_SEEDS])
     rms = np.sqrt((tau**2).mean(axis=0))
-    problem.noise = NoiseConfig(absolute=dict(zip(joints, (k * np.maximum(rms, 1e-6 * rms.max())).tolist())), relative=1.0)
+    problem.noise = NoiseConfig(
+        absolute=dict(zip(joints, (k * np.maximum(rms, 1e-6 * rms.max())).tolist())), relative=1.0
+    )
 
 
 def run(config: Path, objective: str, scaling: str, seed: int, truths: list[bool], design: str) -> list[tuple]:
@@ -176,7 +178,9 @@ def main() -> None:
             runs = [run(config, objective, scaling, seed, truths, args.design_noise) for seed in args.seeds]
             for k, relative in enumerate(truths):
                 truth = "relative" if relative else "absolute"
-                print(f"\n{config.name}, {truth} noise, designed for {args.design_noise}, optimizer seeds {args.seeds} (means)\n{header}")
+                print(
+                    f"\n{config.name}, {truth} noise, designed for {args.design_noise}, optimizer seeds {args.seeds} (means)\n{header}"
+                )
                 report(objective, scaling, np.array([r[k] for r in runs]), len(args.seeds))
 
 
