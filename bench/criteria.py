@@ -81,7 +81,8 @@ def samples(excitation, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def noise_scale(excitation, relative: bool) -> tuple[np.ndarray, float]:
-    """The absolute noise (n,) [Nm] and the part relative to the torque [1] of the measurements."""
+    """The absolute noise (n_rows,) [Nm, N] and the part relative to the torque [1] of the measurements
+    (a floating base's wrench rows first, then the joints')."""
     _, tau_unseen = samples(excitation, excitation.random_start(np.random.default_rng(UNSEEN_SEED)))
     rms = np.sqrt((tau_unseen**2).mean(axis=0))
     return (FLOOR * rms, NOISE) if relative else (NOISE * rms, 0.0)
@@ -126,11 +127,11 @@ def design_noise(problem, design: str, relative: bool) -> None:
     joints = problem.robot.active_joints
     if design == "measured":
         absolute, rho = noise_scale(excitation, relative)
-        problem.noise = NoiseConfig(absolute=dict(zip(joints, absolute.tolist())), relative=rho)
+        problem.noise = NoiseConfig(absolute=dict(zip(joints, absolute[-len(joints) :].tolist())), relative=rho)
         return
     k = float(design.split(":")[1])
     tau = np.vstack([samples(excitation, excitation.random_start(np.random.default_rng(s)))[1] for s in HEDGE_SEEDS])
-    rms = np.sqrt((tau**2).mean(axis=0))
+    rms = np.sqrt((tau**2).mean(axis=0))[-len(joints) :]  # the joints' rows (after a floating base's wrench)
     problem.noise = NoiseConfig(
         absolute=dict(zip(joints, (k * np.maximum(rms, 1e-6 * rms.max())).tolist())), relative=1.0
     )
