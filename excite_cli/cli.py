@@ -23,10 +23,7 @@ def _load(path: Path, overrides: Optional[dict] = None, kind: str = "optimize"):
 
 
 @app.callback()
-def main(
-    version: bool = console.app.VERSION,
-    quiet: bool = console.app.QUIET,
-) -> None:
+def main(version: bool = console.app.VERSION, quiet: bool = console.app.QUIET) -> None:
     """Persistently exciting trajectories for robot dynamic identification (Ayusawa et al. 2017)."""
 
 
@@ -57,6 +54,7 @@ def optimize(
         )
     say(
         console.tables.iterations(run.results, problem.optimizer, run.improved),
+        run.designed_for,
         f"wrote {run.target} and {', '.join(str(p) for p in run.plots)}",
     )
     if run.warning:
@@ -79,11 +77,14 @@ def init(
     posture: Optional[str] = console.app.POSTURE,
     soles: Optional[list[str]] = console.app.SOLES,
     budget: float = console.app.BUDGET,
+    torque_from: Optional[str] = console.app.TORQUE_FROM,
 ) -> None:
     """A starting config for your robot from its URDF or MJCF: joints, limits, capsules, floor, stance, home, sizes."""
     with console.app.busy.status("finding the stance, fitting capsules and searching postures ..."):
         stance = {"stand": stand, "srdf": srdf, "posture": posture, "soles": soles}
-        run = workflows.run_init(urdf, output, joints, kind, force, runs, collision, package_dir, stance, 60 * budget)
+        run = workflows.run_init(
+            urdf, output, joints, kind, force, runs, collision, package_dir, stance, 60 * budget, torque_from
+        )
     say(console.plans.initialized(run))
 
 

@@ -20,6 +20,7 @@ PRINTING = {"excite_cli.cli"} | {
         "rehearsal",
         "identification",
         "effect_search",
+        "noise_levels",
         "bodies",
         "model_files",
         "progress",

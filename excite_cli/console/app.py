@@ -86,6 +86,9 @@ POSTURE = typer.Option(
     "--posture",
     help="The named state to stand in (default: half_sitting, else standing*, else home; else searched).",
 )
+TORQUE_FROM = typer.Option(
+    None, "--torque-from", help="Where the torques come from: sensor, current or unknown (the noise: section)."
+)
 SOLES = typer.Option(None, "--soles", help="The links that touch the floor, comma-separated (default: found).")
 OBJECTIVE = typer.Option(None, "--objective", help=f"Criteria (repeatable; default all: {', '.join(NAMES)}).")
 FIT = typer.Option(

@@ -8,6 +8,7 @@ import numpy as np
 from rich.table import Table
 
 from excite_cli.console.effect_search import search
+from excite_cli.console.noise_levels import noise_table
 from excite_cli.console.tables import titled_table
 from excite_cli.identification.choice.admission import Admission
 from excite_cli.identification.reporting.report import Report
@@ -98,7 +99,7 @@ def identification(report: Report) -> list[Table | str]:
         f"{report.mean(report.relative_before):.1f} %, after {report.mean(report.relative_after):.1f} % "
         f"({choice.name})" + (f", {other_name} {report.mean(other):.1f} %" if extra else ""),
     )
-    return [errors, *fits(report), *_selection_tables(report)]
+    return [errors, *fits(report), *_selection_tables(report), *noise_table(report)]
 
 
 def fits(report: Report) -> list[Table]:

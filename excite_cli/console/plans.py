@@ -44,6 +44,7 @@ def plan(p: Plan) -> list[Table | str]:
             "posture: no rows (nothing to keep)"
             for name in p.unreached
         ),
+        f"noise: {e.noise.words if e.noise else 'none declared, every row weighs the same'}",
         f"optimizer: {cfg.optimizer.method} on {cfg.optimizer.objective}, {cfg.sequence.iterations} sequential "
         f"iteration(s) of at most {p.iterations} solver iterations each, on {p.workers} worker(s)",
         f"scaling: the criterion's largest gradient component {s.gradient:.3g} per half-range, scaled by "

@@ -17,7 +17,9 @@ no joint's sensor measures) weigh as a row of noise σ̄.
 
 With an identify report as prior data (``sequence.prior``), σ_j are the report's
 (:class:`~excite_cli.stored.design_model.MeasuredPrior`): the rows of its recording
-are weighed by them, and the new trajectory's by the same σ_j and the config's ρ.
+are weighed by them, and the new trajectory's by the noise the report fitted, a_j and ρ_j
+(:mod:`~excite_cli.identification.fitting.noise_level`), or by the same σ_j and the config's ρ
+where the report has no fit.
 """
 
 from __future__ import annotations
@@ -31,6 +33,13 @@ from excite_cli.constraints.joint_limits import per_joint
 from excite_cli.dynamics.robot import Robot
 from excite_cli.stored.design_model import MeasuredPrior
 
+#: Random feasible motions (the seeds of :meth:`~excite_cli.design.excitation.Excitation.random_start`)
+#: whose RMS torques are a joint's typical torque (:func:`typical_torques`).
+TYPICAL_SEEDS = (1, 2, 3)
+#: The smallest absolute noise a measured prior gives a joint's new rows, as a share of its σ_j: a fitted
+#: a of 0 (noise all relative) would weigh a row of zero torque without bound.
+MEASURED_FLOOR = 0.01
+
 
 @dataclass(frozen=True)
 class RowNoise:
@@ -42,12 +51,19 @@ class RowNoise:
         scale: σ̄ [Nm], the geometric mean of the joints' σ_j: a row of noise σ̄ weighs 1.
         reference: (p,) the standard parameters φ [kg, kg·m, kg·m²] the torques are computed with
             (the URDF's).
+        source: where the noise comes from, in words.
     """
 
     sigma: np.ndarray
     rho: np.ndarray
     scale: float
     reference: np.ndarray
+    source: str = "the config's noise section"
+
+    @property
+    def words(self) -> str:
+        """What the rows are weighed by, in words (``source``)."""
+        return f"the rows weighed by {self.source}"
 
     @property
     def varying(self) -> bool:
@@ -65,8 +81,10 @@ class RowNoise:
 
 
 def row_noise(cfg: NoiseConfig | None, robot: Robot, measured: MeasuredPrior | None) -> RowNoise | None:
-    """The rows' noise of the ``noise`` section (σ_j from ``measured``, an identify report's, when
-    there is one); None where every row weighs the same (no section and no measured prior).
+    """The rows' noise of the ``noise`` section, or of ``measured`` (an identify report's) when there
+    is one: its fitted a_j and ρ_j (:attr:`~excite_cli.stored.design_model.MeasuredPrior.level`; a
+    floor of :data:`MEASURED_FLOOR` σ_j keeps a row of zero torque finite) or, without them, its σ_j
+    and the config's ρ. None where every row weighs the same (no section and no measured prior).
 
     Raises:
         ExciteError: (``noise.absolute``, ``noise.relative``) an unknown joint, a σ that is not positive
@@ -76,15 +94,44 @@ def row_noise(cfg: NoiseConfig | None, robot: Robot, measured: MeasuredPrior | N
         return None
     n, rows = robot.n_joints, robot.n_rows
     if measured is not None:
-        by_joint = dict(zip(measured.joints, measured.floored))
-        sigma = np.array([by_joint[j] for j in robot.joint_names])
+        order = [measured.joints.index(j) for j in robot.joint_names]
+        sigma = measured.floored[order]
     else:
         sigma = per_joint("noise.absolute", cfg.absolute, np.full(n, np.nan), robot, noun="noise [Nm]")
     rho = np.zeros(n) if cfg is None else per_joint("noise.relative", cfg.relative, np.zeros(n), robot, True, "noise")
+    source = "the config's noise section"
+    if measured is not None and measured.level is not None:
+        level = measured.level[order]
+        fitted = np.isfinite(level).all(axis=1)  # a dead channel keeps its σ_j
+        sigma = np.where(fitted, np.maximum(np.nan_to_num(level[:, 0]), MEASURED_FLOOR * sigma), sigma)
+        rho = np.where(fitted, np.nan_to_num(level[:, 1]), 0.0)
+        source = "the noise the identify report measured (sequence.prior): " + ", ".join(
+            f"{j} {a:.3g} Nm + {100 * r:.3g} % of τ" for j, a, r in zip(robot.joint_names, sigma, rho)
+        )
+    elif measured is not None:
+        source = "the identify report's validation error per joint (sequence.prior)" + (
+            " and the config's noise.relative" if np.any(rho > 0) else ""
+        )
     scale = measured.noise if measured is not None else float(np.exp(np.log(sigma).mean()))
     return RowNoise(
         sigma=np.concatenate([np.full(rows - n, scale), sigma]),
         rho=np.concatenate([np.zeros(rows - n), rho]),
         scale=scale,
         reference=robot.urdf_parameters(),
+        source=source,
     )
+
+
+def typical_torques(excitation) -> np.ndarray:
+    """R_j (n,) [Nm]: each active joint's RMS torque (the URDF's rigid body, RNEA) over the random
+    feasible motions :data:`TYPICAL_SEEDS` of ``excitation`` (an
+    :class:`~excite_cli.design.excitation.Excitation`), at its cost samples; a joint whose torque stays
+    below 1e-6 of the largest is given that (a noise floor must be positive)."""
+    robot, n = excitation.robot, excitation.robot.n_joints
+    tau = [
+        robot.torques(*x)[-n:]  # the joints' rows (a floating base's 6 wrench rows come first)
+        for seed in TYPICAL_SEEDS
+        for x in zip(*excitation.cost_basis.evaluate(excitation.random_start(np.random.default_rng(seed))))
+    ]
+    rms = np.sqrt(np.mean(np.square(tau), axis=0))
+    return np.maximum(rms, 1e-6 * rms.max())

@@ -16,9 +16,11 @@ import pinocchio as pin
 
 from excite_cli.config_file import drafted_problem
 from excite_cli.design.excitation import Excitation
+from excite_cli.design.noise import typical_torques
 from excite_cli.design.resolve import build_excitation
 from excite_cli.drafting.home_posture import home_posture
 from excite_cli.drafting.joints import joint_choice
+from excite_cli.drafting.noise_source import draft_noise
 from excite_cli.drafting.stance import Stance
 from excite_cli.drafting.standing import (
     StandOptions,
@@ -219,6 +221,7 @@ def draft_config(
     target: Path,
     collision: bool = True,
     options: StandOptions = StandOptions(),
+    torque_from: str = "unknown",
 ) -> StartingConfig:
     """A starting config for the URDF or MJCF of ``robot`` (the section's ``urdf`` and ``source``), to be
     written to ``target``: a standing problem for a legged robot
@@ -233,6 +236,8 @@ def draft_config(
         collision: fit capsules to the collision meshes and draft a mounting plane or the floor; False:
             neither (no meshes are read, and no standing problem drafted).
         options: what the user said of the stance (:func:`~excite_cli.drafting.standing.stance_for`).
+        torque_from: where the lab's torques come from, one of
+            :data:`~excite_cli.drafting.noise_source.SOURCES`: the ``noise`` section drafted for it.
 
     Raises:
         ExciteError: an unknown joint; a mesh that cannot be read; see
@@ -277,4 +282,11 @@ def draft_config(
     draft.config["robot"]["home_posture"] = {n: round(float(q), 4) for n, q in zip(active, home)}
     draft.assumptions["robot.home_posture"] = f"searched: {why}" if found else f"FIX FIRST: {why}"
     draft.problem = "" if found else why
+    excitation = build_excitation(drafted_problem(draft.config, target), excitation.base, check_home=False)
+    noise, draft.assumptions["noise"] = draft_noise(torque_from, active, typical_torques(excitation))  # about home
+    draft.config = {
+        **{k: v for k, v in draft.config.items() if k != "output"},
+        "noise": noise,
+        "output": draft.config["output"],
+    }
     return draft

@@ -25,6 +25,7 @@ from excite_cli.identification.fitting.dataset import Dataset
 from excite_cli.identification.fitting.least_squares import Fit, least_squares, predict, torque_errors
 from excite_cli.identification.fitting.model_error import between_trajectories
 from excite_cli.identification.fitting.noise import middle
+from excite_cli.identification.fitting.noise_level import BLOCKS, NoiseLevel, fit_noise_level
 from excite_cli.identification.fitting.plausibility import implausible
 from excite_cli.identification.measured.measurements import in_sample_validation
 from excite_cli.identification.prepared import prepare_data
@@ -126,6 +127,8 @@ def run_identification(
         kept, x = consistent_model(choice.consistent, selection.terms, robot.joint_names)
         consistent = predict(val_data, x, kept)
     after = consistent if choice.is_consistent else plain
+    model = (x, kept) if choice.is_consistent else (selection.fit.x, selection.terms)
+    levels = noise_levels(fit_data, *model, data.gains[fit_data.run], ~data.silent | data.silent.all())
     rms_after, rms_torque, _ = torque_errors(measured, after)
     ladder = error_ladder(val_data, selection, robot.joint_names, ~data.silent | data.silent.all())
     for d in (fit_data, val_data):  # the candidates not chosen are no longer needed: released before the report
@@ -161,11 +164,28 @@ def run_identification(
         + implausible(fit_data, base.from_standard(robot.urdf_parameters()), robot, choice.consistent)
         + data.silence
         + data.repeats,
+        noise_levels=levels,
+        noise_gain=float(np.median(data.gains[fit_data.run])),
     )
     if choice.is_consistent:  # the reported model's step: the same effects, the consistent fit
         ladder.append((choice.name, float(choice.cv_error[choice.chosen]), report.mean(report.relative_after)))
     report.warnings += report.fit_disagreement()
     return report, robot, base, prior_rows([fit_data, val_data], selection.terms, robot.joint_names)
+
+
+def noise_levels(
+    fit_data: Dataset, x: np.ndarray, terms: list[Term], gain: np.ndarray, live: np.ndarray
+) -> list[NoiseLevel | None]:
+    """Each ``live`` (n,) joint's noise σ² = a² + (ρτ)² fitted to the residual of the model (coefficients
+    ``x`` of the base parameters and ``terms``) on the fit data, each instant's filter ``gain`` (N,): what
+    the model cannot explain where it was fitted, not its error away from it; None for the others; an
+    empty list when the data are too short
+    (:func:`~excite_cli.identification.fitting.noise_level.fit_noise_level`)."""
+    measured, predicted = fit_data.tau.reshape(-1, fit_data.n), predict(fit_data, x, terms)
+    if measured.shape[0] < 2 * BLOCKS:
+        return []
+    residual = measured - predicted
+    return [fit_noise_level(residual[:, j], predicted[:, j], gain) if live[j] else None for j in range(len(live))]
 
 
 def reported_fit(selection: Selection, fit_data: Dataset, rate: float, clusters: np.ndarray) -> Fit:

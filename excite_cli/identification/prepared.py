@@ -18,6 +18,7 @@ from excite_cli.identification.effects import Term
 from excite_cli.identification.fitting.channels import dead_channels
 from excite_cli.identification.fitting.dataset import Dataset, build_datasets, fit_position_range
 from excite_cli.identification.fitting.least_squares import joint_weights, least_squares
+from excite_cli.identification.fitting.noise_level import noise_gain
 from excite_cli.identification.fitting.normal import NormalEquations, excited_rank
 from excite_cli.identification.measured.gaps import split_at_gaps
 from excite_cli.identification.measured.measurements import check_against_limits, load_run, silent_channels
@@ -34,8 +35,9 @@ class Prepared:
     with ``identification.position_guard`` off or no position effect among the terms), the joints
     whose torque channel carries no signal (n,) and why, in words (one line per such joint), the
     trajectory of each configured run (R,) and, in words, the recordings taken as one trajectory
-    (:func:`~excite_cli.identification.measured.twins.trajectory_groups`). A run cut at its gaps is
-    preprocessed piece by piece and stays one run in the datasets."""
+    (:func:`~excite_cli.identification.measured.twins.trajectory_groups`), and the noise gain of each
+    configured run's low-pass (R,) (:func:`~excite_cli.identification.fitting.noise_level.noise_gain`).
+    A run cut at its gaps is preprocessed piece by piece and stays one run in the datasets."""
 
     fit: Dataset
     validation: Dataset
@@ -49,6 +51,7 @@ class Prepared:
     silence: list[str]
     trajectories: np.ndarray
     repeats: list[str]
+    gains: np.ndarray
 
 
 def prepare_data(
@@ -84,6 +87,8 @@ def prepare_data(
     cutoff, source = choose_cutoff(runs, problem.preprocessing)
     dropped = [(r.name, r.dropped) for r in runs if r.dropped]
     samples = [preprocess(runs.pop(0), problem.preprocessing, cutoff) for _ in range(len(runs))]
+    gains = np.ones(len(problem.data.runs))
+    gains[sources] = [noise_gain(s.filter.sos) for s in samples]  # a run's pieces share its rate
     rate = max(s.filter.rate / s.filter.step for s in samples)
     coulomb = [Term("coulomb", j) for j in range(robot.n_joints)]  # the load column's sign
     guarded = cfg.position_guard and any(t.kind.position for t in terms)  # the range costs a pass over q
@@ -129,4 +134,5 @@ def prepare_data(
             "together; name data.runs[].trajectory to say otherwise)"
             for k, m in repeats
         ],
+        gains,
     )

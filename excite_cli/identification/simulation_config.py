@@ -23,7 +23,9 @@ class SimulationConfig(Section):
     timestamp_jitter: float = Field(0.0, ge=0.0, lt=0.5)
     """Jitter of the time stamps [1], a fraction of the sample period."""
     torque_noise: float = Field(0.0, ge=0.0)
-    """Standard deviation of the torque noise [Nm]."""
+    """Standard deviation of the torque noise [Nm] (its part that does not grow with the torque)."""
+    torque_noise_relative: float = Field(0.0, ge=0.0, le=10.0)
+    """ρ [1]: torque noise growing with the torque, as a motor current's: σ(t) = √(torque_noise² + (ρ τ(t))²)."""
     position_noise: float = Field(0.0, ge=0.0)
     """Standard deviation of the position noise [rad]."""
     seed: int = Field(0, ge=0, le=MAX_SEED)

@@ -107,11 +107,15 @@ class MeasuredPrior:
         sigma: (n,) σ_j [Nm]: each joint's RMS torque error of the reported model on the validation
             data (``rms_after``), what the fit leaves unexplained, noise included.
         rate: the report's decimated sample rate [Hz]: regressor rows per second and joint.
+        level: (n, 2) each joint's fitted noise of its rows, a [Nm] and ρ [1] of σ² = a² + (ρτ)²
+            (:mod:`~excite_cli.identification.fitting.noise_level`), NaN for a dead channel; None: the
+            report has none (its σ_j alone weigh the new rows).
     """
 
     joints: list[str]
     sigma: np.ndarray
     rate: float
+    level: np.ndarray | None = None
 
     @property
     def floored(self) -> np.ndarray:
@@ -176,4 +180,6 @@ def measured_prior_of(report: StoredReport, path: Path) -> MeasuredPrior:
             rate,
             f"a positive rate up to {HIGHEST_RATE:g} Hz",
         )
-    return MeasuredPrior(joints, sigma, rate)
+    level = report.noise_level
+    usable = level is not None and level.shape == (len(joints), 2) and np.all(np.isfinite(level) | np.isnan(level))
+    return MeasuredPrior(joints, sigma, rate, level if usable and np.any(np.isfinite(level)) else None)

@@ -37,6 +37,9 @@ class StoredReport:
         rms_after: (n,) [Nm] each joint's RMS error of the reported model on the validation data
             (``/identification/rms_after``), or None (a report of an earlier excite).
         rate: its rows' sample rate [Hz] (``/regressor`` attribute ``sample_rate_Hz``), or None (the same).
+        noise_level: (n, 2) each joint's fitted noise (a [Nm], ρ [1]) of its rows, at the report's rate
+            (``/identification/noise_level`` times √ of its ``noise_gain``), NaN for a dead channel, or
+            None (a report of an earlier excite, or validation data too short to fit it).
         rotors: the last ``rotors`` of ``terms`` are the consistent fit's rotors with columns of their own
             (armature the effect search did not choose:
             :mod:`~excite_cli.identification.choice.consistent_model`), part of what it predicts.
@@ -55,6 +58,7 @@ class StoredReport:
     rms_after: np.ndarray | None = None
     rate: float | None = None
     rotors: int = 0
+    noise_level: np.ndarray | None = None
 
 
 def read_report(path: Path, field: str) -> StoredReport | None:
@@ -116,7 +120,20 @@ def report_in(f, path: Path, field: str) -> StoredReport | None:
         if "regressor" in f and "sample_rate_Hz" in f["regressor"].attrs
         else None,
         len(rotors),
+        _noise_level(g, len(joints)),
     )
+
+
+def _noise_level(g, n: int) -> np.ndarray | None:
+    """(n, 2) a [Nm], ρ [1] of the report's rows (at its rate: the fit times √noise_gain), or None."""
+    if "noise_level" not in g:
+        return None
+    table = g["noise_level"]
+    rows = table[()]
+    if rows.dtype.names is None or not {"absolute", "relative"} <= set(rows.dtype.names) or len(rows) != n:
+        return None
+    gain = float(table.attrs.get("noise_gain", 1.0))
+    return np.column_stack([rows["absolute"], rows["relative"]]).astype(float) * np.sqrt(gain)
 
 
 def _terms(rows: np.ndarray, coupling: np.ndarray | None) -> list[StoredTerm]:

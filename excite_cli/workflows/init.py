@@ -16,6 +16,7 @@ from excite_cli.config import RobotConfig
 from excite_cli.config_file import drafted_problem
 from excite_cli.drafting.data_columns import recognized_columns
 from excite_cli.drafting.joints import joint_choice
+from excite_cli.drafting.noise_source import SOURCES
 from excite_cli.drafting.standing import StandOptions
 from excite_cli.drafting.starting_config import StartingConfig, draft_config
 from excite_cli.dynamics.robot_files import installed_share, open_source, resolve_urdf
@@ -186,6 +187,7 @@ def run_init(
     package_dirs: Optional[list[str]] = None,
     stance: Optional[dict] = None,
     budget: float = BUDGET,
+    torque_from: Optional[str] = None,
 ):
     """Write a starting config of ``kind`` for ``urdf`` to ``target`` (default ``<file name>.yaml``). An
     ``optimize`` config passes the
@@ -204,6 +206,8 @@ def run_init(
             optimizer's sizes fit it (:func:`~excite_cli.search.run_time.sizes_within`).
         stance: what the user said of a legged robot's stance, the fields of
             :class:`~excite_cli.drafting.standing.StandOptions` (``soles`` also comma-separated).
+        torque_from: ``optimize``: where the lab's joint torques come from
+            (:data:`~excite_cli.drafting.noise_source.SOURCES`, default unknown): the drafted ``noise``.
 
     Raises:
         ExciteError: unknown kind or joint, a URDF not found or that no model can have
@@ -216,6 +220,12 @@ def run_init(
         raise ExciteError("budget", f"{budget / 60:g} min leaves no time to optimize", budget / 60, "minutes > 0")
     if runs and kind != "identify":
         raise ExciteError("runs", "are the measured runs of an identify config", runs[0], "kind identify")
+    if torque_from is not None and torque_from not in SOURCES:
+        raise ExciteError("torque_from", f"'{torque_from}' is not a torque source", torque_from, ", ".join(SOURCES))
+    if torque_from is not None and kind != "optimize":
+        raise ExciteError(
+            "torque_from", f"drafts the noise section of an optimize config; this is kind {kind}", kind, "optimize"
+        )
     target = check_target(Path(target or f"{Path(urdf).stem}.yaml"), "output", force)
     joints = [j.strip() for given in joints or [] for j in given.split(",") if j.strip()] or None
     robot = robot_source(urdf, target)
@@ -230,7 +240,9 @@ def run_init(
     plan = None
     if kind == "optimize":
         soles = [s.strip() for given in stance.soles or [] for s in given.split(",") if s.strip()] or None
-        draft = draft_config(robot, source, joints, target, collision, replace(stance, soles=soles))
+        draft = draft_config(
+            robot, source, joints, target, collision, replace(stance, soles=soles), torque_from or "unknown"
+        )
         text = _text(draft, urdf, kind)
         problem = drafted_problem(yaml.safe_load(text), target)
         plan = None if draft.problem else plan_optimize(problem)

@@ -55,6 +55,12 @@ class OptimizeRun:
     prior: np.ndarray | None = None
 
     @property
+    def designed_for(self) -> str:
+        """The noise the trajectories were designed for, in words."""
+        noise = self.excitation.noise
+        return f"designed for {'no declared noise (every row weighs the same)' if noise is None else noise.words}"
+
+    @property
     def improved(self) -> list[tuple[str, float, float]]:
         """With measured prior data (an identify report): the coefficients (base parameters, then
         effects) whose predicted standard deviation the new trajectories cut most, as (name, before,

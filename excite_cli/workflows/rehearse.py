@@ -25,9 +25,10 @@ from excite_cli.storage.joint_map import read_joint_map
 from excite_cli.storage.paths import check_folder, check_target
 from excite_cli.storage.results import read_alphas
 from excite_cli.workflows.export import played_result
+from excite_cli.workflows.simulate import torque_noise
 
 #: The fields of an effects file a rehearsal's recording takes.
-NOISE = ("torque_noise", "position_noise", "seed")
+NOISE = ("torque_noise", "torque_noise_relative", "position_noise", "seed")
 
 
 def run_rehearse(
@@ -147,13 +148,16 @@ def _check_noise(noise: SimulationConfig | None, record: Path | None) -> None:
 def _record(done: Rehearsal, targets: list[Path], noise: SimulationConfig | None) -> list[Path]:
     """Each played run written as a recording (:func:`run_rehearse`), with ``noise``'s added."""
     rng = np.random.default_rng(noise.seed if noise else 0)
-    sigma_q, sigma_tau = (noise.position_noise, noise.torque_noise) if noise else (0.0, 0.0)
+    sigma_q, sigma_tau, rho = (
+        (noise.position_noise, noise.torque_noise, noise.torque_noise_relative) if noise else (0,) * 3
+    )
     with atomic_paths(targets, "record") as temporary:
         for r, tmp in zip(done.iterations, temporary):
             names = r.export.joint_names
             header = ["time"] + [f"q_{j}" for j in names] + [f"tau_{j}" for j in names]
             q = r.played.q + rng.normal(0.0, sigma_q, r.played.q.shape)
-            table = np.column_stack([r.played.time, q, r.played.tau + rng.normal(0.0, sigma_tau, r.played.tau.shape)])
+            tau = r.played.tau + rng.normal(0.0, 1.0, r.played.tau.shape) * torque_noise(sigma_tau, rho, r.played.tau)
+            table = np.column_stack([r.played.time, q, tau])
             with open(tmp, "w") as f:
                 np.savetxt(f, table, delimiter=",", header=",".join(header), comments="", fmt="%.10g")
                 f.write(f"# {MARK} rehearse: iteration {r.iteration} of {done.result.name} played in MuJoCo\n")

@@ -141,7 +141,7 @@ def simulate_runs(
         if sim.motor_side:  # what the controller records: motor angles m = R q, motor torques τ_m = R⁻ᵀ τ
             R = sim.transmission.reduction()
             q, tau = q @ R.T, np.linalg.solve(R.T, tau.T).T
-        tau += rng.normal(0.0, sim.torque_noise, tau.shape)
+        tau += rng.normal(0.0, 1.0, tau.shape) * torque_noise(sim.torque_noise, sim.torque_noise_relative, tau)
         tables[k] = np.column_stack([time, q + rng.normal(0.0, sim.position_noise, q.shape), tau])
         if not np.all(np.isfinite(tables[k])):
             raise ExciteError("effects", "a value makes non-finite torques (NaN or inf in the effects file?)")
@@ -156,3 +156,9 @@ def simulate_runs(
                 np.savetxt(f, table, delimiter=",", header=",".join(header), comments="", fmt="%.10g")
                 f.write(f"# {MARK} simulate: a simulated run\n")
     return written
+
+
+def torque_noise(sigma: float, rho: float, tau: np.ndarray) -> float | np.ndarray:
+    """The torque noise's standard deviation [Nm] at torques ``tau`` (any shape) [Nm]: √(σ² + (ρ τ)²),
+    σ itself where ρ is 0."""
+    return np.sqrt(sigma**2 + (rho * tau) ** 2) if rho else sigma

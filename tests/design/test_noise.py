@@ -5,10 +5,12 @@ against finite differences, and the noise section's bad values named."""
 import re
 
 import numpy as np
+import pinocchio as pin
 import pytest
 from conftest import small
 
 from excite_cli.config import NoiseConfig
+from excite_cli.design.noise import TYPICAL_SEEDS, typical_torques
 from excite_cli.design.resolve import build_excitation
 from excite_cli.design.verify import finite_difference_gradient
 from excite_cli.errors import ExciteError
@@ -97,3 +99,16 @@ def test_a_noise_out_of_range_is_refused_where_it_is_read(noise, expected):
     """A number no sensor has (its weights' squares would overflow: numpy's warnings, then a traceback)."""
     with pytest.raises(ValueError, match=re.escape(expected)):
         NoiseConfig(**noise)
+
+
+def test_a_joints_typical_torque_is_its_rms_torque_over_random_feasible_motions(panda_problem):
+    excitation = build_excitation(small(panda_problem))
+    model = excitation.robot.model
+    data = model.createData()
+    torques = []
+    for seed in TYPICAL_SEEDS:
+        Q, QD, QDD = excitation.cost_basis.evaluate(excitation.random_start(np.random.default_rng(seed)))
+        torques += [pin.rnea(model, data, q, qd, qdd) for q, qd, qdd in zip(Q, QD, QDD)]  # the Panda: every joint
+    expected = np.sqrt(np.mean(np.square(torques), axis=0))[: excitation.robot.n_joints]
+    assert np.all(expected > 1e-3)  # every joint moves
+    np.testing.assert_allclose(typical_torques(excitation), expected, rtol=1e-12)

@@ -593,3 +593,16 @@ def test_data_as_labs_record_it_identify_without_conversion(tmp_path, optimized)
     for (effect, _, _), (value, std, _) in found.items():
         assert effect != "coulomb" or abs(value - 0.4) <= max(0.1 * 0.4, 3 * std)
     assert np.mean(report.relative_after) < 0.5 * np.mean(report.relative_before)
+
+
+@pytest.mark.end_to_end
+def test_noise_growing_with_the_torque_is_measured_per_joint(tmp_path, optimized):
+    """A motor current's noise, 2 % of the torque over a 0.005 N·m floor: identify fits ρ to the fit
+    residual within 20 % (median over the joints) and prefers noise growing with the torque."""
+    effects = {"coulomb": {"*": 0.6}, "viscous": {"*": 0.4}}
+    report, *_ = _simulate_and_identify(
+        tmp_path, optimized, effects, ["coulomb", "viscous"], torque_noise=0.005, torque_noise_relative=0.02
+    )
+    rho = np.array([level.relative for level in report.noise_levels])
+    assert abs(np.median(rho) / 0.02 - 1) < 0.2, rho
+    assert sum(level.preferred == "relative" for level in report.noise_levels) >= 6

@@ -10,6 +10,7 @@ from typer.testing import CliRunner
 
 from excite_cli.cli import app
 from excite_cli.config_file import load_problem
+from excite_cli.design.noise import MEASURED_FLOOR
 from excite_cli.design.resolve import build_excitation
 from excite_cli.errors import ExciteError
 from excite_cli.h5 import read_strings
@@ -119,25 +120,33 @@ def test_a_joints_rows_weigh_by_its_unexplained_torque():
 
 def test_optimize_with_the_report_as_prior_weighs_both_the_prior_and_its_own_rows(report_file, tmp_path):
     """`excite optimize CONFIG --prior REPORT.h5`: the report's rows enter weighted by σ̄/σ_j and the time
-    rule, and the new trajectory's rows by σ̄/σ_j too (the noise the next run will see)."""
+    rule, and the new trajectory's rows by the noise the report fitted, σ̄/√(a_j² + ρ_j² τ²) at the
+    report's rate (the noise the next run will see), and optimize says so."""
     out = tmp_path / "next.h5"
     run = CliRunner().invoke(
         app, ["optimize", str(CONFIGS / "smoke.yaml"), "--prior", str(report_file), "-o", str(out), "-k", "1"]
     )
     assert run.exit_code == 0, run.output
     assert "What the new trajectories determine better" in run.output
+    assert "designed for the rows weighed by the noise the identify report measured" in " ".join(run.output.split())
     measured = measured_prior_of(read_report(report_file, "sequence.prior"), report_file)
     assert measured is not None and measured.rate > 0
+    with h5py.File(report_file) as f:
+        table = f["identification/noise_level"]
+        gain = float(table.attrs["noise_gain"])
+        level = np.column_stack([table["absolute"], table["relative"]]) * np.sqrt(gain)
+    assert 0 < gain < 1  # the low-pass keeps a share of white noise
     problem = load_problem(CONFIGS / "smoke.yaml")
-    problem.sequence.prior = str(report_file)
     excitation = build_excitation(problem)
     with h5py.File(out) as f:
         alpha, own = f["iterations/1/alpha"][()], f["iterations/1/regressor"][()]
-    plain = build_excitation(load_problem(CONFIGS / "smoke.yaml")).criterion().regressor(alpha)
-    weights = np.tile(measured.weights(), own.shape[0] // measured.weights().size)
+    plain = excitation.criterion().regressor(alpha)
+    robot = excitation.robot
+    tau = np.array([robot.torques(*x) for x in zip(*excitation.cost_basis.evaluate(alpha))]).ravel()  # RNEA
+    sigma = np.tile(np.maximum(level[:, 0], MEASURED_FLOOR * measured.floored), tau.size // 7)
+    rho = np.tile(level[:, 1], tau.size // 7)
+    weights = measured.noise / np.sqrt(sigma**2 + (rho * tau) ** 2)
     np.testing.assert_allclose(own, plain * weights[:, None], rtol=1e-9, atol=1e-12)
-    np.testing.assert_allclose(excitation.noise.sigma, measured.floored)  # the report's σ_j weigh the new rows
-    assert not np.allclose(excitation.noise.weights(np.zeros(measured.floored.size))[0], 1.0)
 
 
 def test_the_reports_rows_hold_its_effects_as_the_fit_saw_them(simulated_identification):

@@ -14,6 +14,9 @@ from typer.testing import CliRunner
 
 from excite_cli.cli import app
 from excite_cli.config_file import load_problem
+from excite_cli.design.noise import typical_torques
+from excite_cli.design.resolve import build_excitation
+from excite_cli.drafting.noise_source import CURRENT_FLOOR, HEDGE_FLOOR, RELATIVE
 from excite_cli.dynamics.robot_files import example_robot_data_root
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.workflows.init import run_init
@@ -158,6 +161,14 @@ def test_recorded_bags_get_a_config_without_columns_that_identifies_the_friction
             "URDF or MJCF (a file, or a path inside example-robot-data's robots folder) not found",
         ),
         (["init", UR3, "--kind", "simulate"], "'simulate' is not a config kind"),
+        (
+            ["init", UR3, "--torque-from", "battery"],
+            "--torque-from: 'battery' is not a torque source; expected sensor, current, unknown",
+        ),
+        (
+            ["init", UR3, "--kind", "identify", "--torque-from", "current"],
+            "--torque-from: drafts the noise section of an optimize config; this is kind identify",
+        ),
         (["init", UR3, "-o", "taken.yaml"], "taken.yaml exists"),
         (
             ["init", "arm.urdf.xacro"],
@@ -182,6 +193,27 @@ def test_init_prints_its_assumptions_and_the_dry_run(tmp_path, monkeypatch):
     assert "wrote ur3_robot.yaml" in result.output and "robot.active_joints: the joints given" in result.output
     assert "robot.home_posture: searched" in result.output and "next: excite optimize ur3_robot.yaml" in result.output
     assert load_problem(tmp_path / "ur3_robot.yaml").robot.active_joints == ["shoulder_pan_joint", "elbow_joint"]
+
+
+def test_an_unknown_torque_source_drafts_the_hedged_noise_over_each_joints_typical_torque(ur3):
+    problem = load_problem(ur3.target)
+    typical = typical_torques(build_excitation(problem))
+    assert problem.noise.relative == RELATIVE
+    drafted = np.array([problem.noise.absolute[j] for j in problem.robot.active_joints])
+    np.testing.assert_allclose(drafted, HEDGE_FLOOR * typical, rtol=5e-3)  # written to 3 digits
+    assert "noise: torque source not said (sensor or current): the hedge" in ur3.target.read_text()
+
+
+def test_torque_from_current_drafts_noise_growing_with_the_torque_on_the_panda(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    result = runner.invoke(app, ["init", "panda_description/urdf/panda.urdf", "--torque-from", "current"])
+    assert result.exit_code == 0, result.output
+    problem = load_problem(tmp_path / "panda.yaml")
+    typical = typical_torques(build_excitation(problem))
+    drafted = np.array([problem.noise.absolute[j] for j in problem.robot.active_joints])
+    assert problem.noise.relative == RELATIVE
+    np.testing.assert_allclose(drafted, CURRENT_FLOOR * typical, rtol=5e-3)
+    assert "noise: torque from motor current: 2% of the torque" in result.output
 
 
 def test_a_urdf_file_without_collision_geometry_gets_no_collision_constraint(tmp_path):

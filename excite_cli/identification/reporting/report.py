@@ -12,6 +12,7 @@ from excite_cli.identification.choice.selection import Selection
 from excite_cli.identification.effects import Term, coefficient_names
 from excite_cli.identification.fitting.dataset import Dataset
 from excite_cli.identification.fitting.least_squares import torque_errors
+from excite_cli.identification.fitting.noise_level import NoiseLevel
 from excite_cli.identification.fitting.physical import ConsistentFit
 
 #: [% points] of mean relative validation error by which the fit not chosen must beat the chosen one
@@ -49,6 +50,11 @@ class Report:
             candidates, or ``position_guard`` off).
         warnings: what the user should know, in words (a URDF inertia kept as a reference only, a
             torque channel without signal).
+        noise_levels: (n,) each joint's noise fitted to the residual on the fit data, σ² = a² + (ρτ)²
+            (:mod:`~excite_cli.identification.fitting.noise_level`), None for a dead channel; an empty
+            list when the fit data are too short for it.
+        noise_gain: the median over the fit instants of the share of white noise's variance
+            their low-pass leaves (:func:`~excite_cli.identification.fitting.noise_level.noise_gain`).
         dead: (n,) the joints whose torque channel carries no signal
             (:mod:`~excite_cli.identification.fitting.channels`): their relative errors are of the
             model's predicted RMS torque instead of the measured one, and no mean includes them.
@@ -78,6 +84,8 @@ class Report:
     q_range: np.ndarray | None = None
     warnings: list[str] = field(default_factory=list)
     dead: np.ndarray | None = None
+    noise_levels: list[NoiseLevel | None] = field(default_factory=list)
+    noise_gain: float = 1.0
 
     @property
     def live(self) -> np.ndarray:

@@ -100,6 +100,7 @@ def write_identification(
         write_effects(g, report)
         write_search(g, report)
         _write_validation(g, report)
+        _write_noise_levels(g, report)
         if mjcf is not None:
             write_mujoco_group(f, mjcf, mujoco, report.joints)
 
@@ -176,6 +177,24 @@ def _write_validation(g: h5py.Group, report: Report) -> None:
         ("predicted_after", report.predicted_after),
     ):
         val.create_dataset(name, data=values, compression="gzip").attrs["unit"] = "Nm (filtered and decimated)"
+
+
+def _write_noise_levels(g: h5py.Group, report: Report) -> None:
+    """``/identification/noise_level``: each joint's σ² = a² + (ρτ)² fitted to the residual on the fit data
+    (NaN for a dead channel), at the recording's own rate; attribute ``noise_gain`` the median share g of
+    white noise's variance the low-pass leaves (a and ρ times √g: the noise of the report's rows)."""
+    if not report.noise_levels:
+        return
+    names = ("absolute", "absolute_std", "relative", "relative_std")
+    table = np.zeros(len(report.joints), dtype=[("joint", STR), *((n, "f8") for n in names), ("preferred", STR)])
+    for row, joint, level in zip(table, report.joints, report.noise_levels):
+        row["joint"] = joint
+        for n in names:
+            row[n] = np.nan if level is None else getattr(level, n)
+        row["preferred"] = "" if level is None else level.preferred
+    d = g.create_dataset("noise_level", data=table)
+    d.attrs["units"] = "absolute, absolute_std in Nm; relative, relative_std in 1 (of the torque)"
+    d.attrs["noise_gain"] = report.noise_gain
 
 
 def _write_consistent(g: h5py.Group, report: Report, robot: Robot) -> None:

@@ -1,0 +1,97 @@
+"""The torque noise's level against the torque, measured from a recording: per joint
+σ²(τ) = a² + (ρ τ)², an absolute part a [Nm] (a torque sensor's, a current reading's floor) and a
+part ρ [1] growing with the torque (a motor current's: torque-constant and gear errors scale with the
+load), fitted to the reported model's residual r on the fit data (its error away from them is model
+error, not noise) by maximum likelihood of
+r ~ N(0, a² + ρ² τ̂²) (τ̂ the model's predicted torque: the measured one carries the noise itself,
+which would correlate r² with τ²).
+
+The residual is low-passed and decimated as every column is (:mod:`~excite_cli.identification.measured.preprocessing`):
+white noise of variance σ² at the recording's rate leaves σ² g, g = (1/π)∫₀^π |H(e^{iω})|⁴ dω for the
+zero-phase filter's |H|² (:func:`noise_gain`). Each instant's residual is divided by √g of its run's
+filter, so a and ρ are the noise of the recording's own samples, as a data sheet gives it (model error
+is in it too: the design weighs rows by what the model leaves unexplained).
+
+Their standard deviations are from a delete-one-block jackknife over :data:`BLOCKS` contiguous
+blocks of the fit data (Künsch 1989: contiguous blocks keep the residual's correlation in
+time, which a per-sample Fisher information would ignore). The data prefer noise growing with the
+torque when ρ is at least :data:`CLEAR` of its standard deviations above zero, else absolute noise.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import optimize, signal
+
+#: Contiguous blocks of the jackknife.
+BLOCKS = 10
+#: Standard deviations above zero from which ρ counts as present.
+CLEAR = 3.0
+
+
+@dataclass(frozen=True)
+class NoiseLevel:
+    """One joint's fitted noise σ²(τ) = a² + (ρ τ)² at the recording's own rate.
+
+    Attributes:
+        absolute: a [Nm]; absolute_std: its jackknife standard deviation [Nm].
+        relative: ρ [1]; relative_std: its jackknife standard deviation [1].
+    """
+
+    absolute: float
+    absolute_std: float
+    relative: float
+    relative_std: float
+
+    @property
+    def preferred(self) -> str:
+        """``relative`` (ρ at least :data:`CLEAR` standard deviations above zero) or ``absolute``."""
+        return "relative" if self.relative >= CLEAR * self.relative_std and self.relative > 0 else "absolute"
+
+
+def noise_gain(sos: np.ndarray) -> float:
+    """g [1]: the variance a zero-phase (forward-backward) pass of the filter ``sos`` (scipy's second-
+    order sections) leaves of white noise, (1/π)∫₀^π |H(e^{iω})|⁴ dω (Parseval), on 8192 frequencies."""
+    _, h = signal.sosfreqz(sos, worN=8192)
+    return float(np.mean(np.abs(h) ** 4))
+
+
+def _likelihood_fit(r: np.ndarray, tau: np.ndarray) -> tuple[float, float]:
+    """(a², ρ²) maximizing the Gaussian likelihood of residuals r (N,) of variance a² + ρ²τ², on the
+    scale of r's RMS (a² and ρ² ≥ 0; the moment fit of r² on [1, τ²] starts it)."""
+    scale, level = float(np.sqrt(np.mean(r**2))) or 1.0, float(np.sqrt(np.mean(tau**2))) or 1.0
+    u, t2 = (r / scale) ** 2, (tau / level) ** 2
+
+    def negative_log_likelihood(v: np.ndarray) -> tuple[float, np.ndarray]:
+        var = np.maximum(v[0] + v[1] * t2, 1e-12)
+        d = 1.0 / var - u / var**2  # ∂/∂var of log var + u / var
+        return float(np.sum(np.log(var) + u / var)), np.array([d.sum(), (d * t2).sum()])
+
+    start = np.linalg.lstsq(np.column_stack([np.ones_like(t2), t2]), u, rcond=None)[0]
+    start = np.maximum(start, 1e-3 * max(start.max(), 1.0))
+    best = optimize.minimize(negative_log_likelihood, start, jac=True, method="L-BFGS-B", bounds=[(0, None)] * 2)
+    return float(best.x[0] * scale**2), float(best.x[1] * (scale / level) ** 2)
+
+
+def fit_noise_level(residual: np.ndarray, torque: np.ndarray, gain: np.ndarray) -> NoiseLevel:
+    """a, ρ and their standard deviations of one joint.
+
+    Args:
+        residual: (N,) [Nm] measured minus predicted torque on the fit data, in time order.
+        torque: (N,) [Nm] the model's predicted torque at the same instants.
+        gain: (N,) the noise gain g of each instant's filter (:func:`noise_gain`), > 0.
+
+    Raises:
+        ValueError: fewer than 2 × :data:`BLOCKS` instants (the caller reports no noise level then).
+    """
+    if residual.size < 2 * BLOCKS:
+        raise ValueError(f"{residual.size} instants; the jackknife needs at least {2 * BLOCKS}")
+    r = residual / np.sqrt(gain)
+    a2, rho2 = _likelihood_fit(r, torque)
+    edges = np.linspace(0, r.size, BLOCKS + 1).astype(int)
+    keep = [np.r_[0:lo, hi : r.size] for lo, hi in zip(edges[:-1], edges[1:])]
+    left_out = np.sqrt(np.array([_likelihood_fit(r[k], torque[k]) for k in keep]))
+    std = np.sqrt((BLOCKS - 1) / BLOCKS * ((left_out - left_out.mean(axis=0)) ** 2).sum(axis=0))
+    return NoiseLevel(float(np.sqrt(a2)), float(std[0]), float(np.sqrt(rho2)), float(std[1]))

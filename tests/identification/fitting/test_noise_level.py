@@ -1,0 +1,54 @@
+"""The noise level σ² = a² + (ρτ)² fitted to a residual: recovered from residuals drawn with known a
+and ρ, the right kind preferred, the jackknife's std against the spread over draws, and the filter's
+noise gain against white noise passed through it."""
+
+import numpy as np
+import pytest
+from scipy import signal
+
+from excite_cli.identification.fitting.noise_level import fit_noise_level, noise_gain
+
+RATE = 200.0
+TIME = np.arange(0.0, 40.0, 1.0 / RATE)
+TORQUE = 8.0 * np.sin(2 * np.pi * 0.2 * TIME) + 3.0 * np.sin(2 * np.pi * 0.55 * TIME + 1.0)  # [Nm]
+
+
+def _residual(seed: int, a: float, rho: float, sos=None) -> np.ndarray:
+    white = np.random.default_rng(seed).normal(size=TIME.size) * np.sqrt(a**2 + (rho * TORQUE) ** 2)
+    return white if sos is None else signal.sosfiltfilt(sos, white)
+
+
+@pytest.mark.parametrize("a, rho, kind", [(0.1, 0.0, "absolute"), (0.01, 0.02, "relative"), (0.0, 0.05, "relative")])
+def test_a_and_rho_are_recovered_and_the_right_kind_preferred_in_nine_of_ten_draws(a, rho, kind):
+    levels = [fit_noise_level(_residual(seed, a, rho), TORQUE, np.ones(TIME.size)) for seed in range(10)]
+    assert sum(level.preferred == kind for level in levels) >= 9
+    fitted = np.array([(level.absolute, level.relative) for level in levels])
+    if rho:
+        np.testing.assert_allclose(np.median(fitted[:, 1]), rho, rtol=0.05)
+    if a:
+        np.testing.assert_allclose(np.median(fitted[:, 0]), a, rtol=0.1)
+
+
+def test_the_jackknife_std_follows_the_spread_over_draws():
+    levels = [fit_noise_level(_residual(seed, 0.05, 0.02), TORQUE, np.ones(TIME.size)) for seed in range(40)]
+    rho, std = np.array([level.relative for level in levels]), np.array([level.relative_std for level in levels])
+    assert 0.6 < np.median(std) / rho.std() < 1.6
+
+
+def test_the_noise_gain_is_the_variance_white_noise_keeps_through_the_zero_phase_filter():
+    sos = signal.butter(4, 10.0, fs=RATE, output="sos")
+    white = np.random.default_rng(0).normal(size=400_000)
+    np.testing.assert_allclose(noise_gain(sos), signal.sosfiltfilt(sos, white).var(), rtol=0.02)
+
+
+def test_a_filtered_residual_divided_by_its_gain_gives_the_recordings_own_noise():
+    sos = signal.butter(4, 10.0, fs=RATE, output="sos")
+    gain = np.full(TIME.size, noise_gain(sos))
+    levels = [fit_noise_level(_residual(seed, 0.02, 0.02, sos), TORQUE, gain) for seed in range(10)]
+    np.testing.assert_allclose(np.median([level.relative for level in levels]), 0.02, rtol=0.1)
+    assert sum(level.preferred == "relative" for level in levels) >= 9
+
+
+def test_too_short_a_residual_is_refused():
+    with pytest.raises(ValueError, match="the jackknife needs at least 20"):
+        fit_noise_level(np.zeros(19), np.zeros(19), np.ones(19))
