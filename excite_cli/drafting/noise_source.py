@@ -10,8 +10,9 @@ figures page, "Which noise the design assumes").
 - ``current`` (the torque estimated from motor current): :data:`RELATIVE` of the torque (torque-constant
   and gear errors scale with the load) over a floor of :data:`CURRENT_FLOOR` of R_j (the current
   reading's own noise).
-- ``unknown``: the hedged model, :data:`RELATIVE` of the torque over a floor of :data:`HEDGE_FLOOR` of
-  R_j: the design that loses least under either kind (measured on four robots).
+- ``unknown``: no section: the design's default (every row weighs the same), and the comment says how
+  to declare the source. Which noise a design should assume when nothing is known is measured on the
+  figures page ("Which noise the design assumes"); it is not yet the default.
 
 Only the ratios between the rows' noises change a design; the σ [Nm] written are a guess to replace
 with the lab's figures, or with an identify report's (``sequence.prior``).
@@ -25,35 +26,33 @@ import numpy as np
 SOURCES = ("sensor", "current", "unknown")
 #: ρ [1]: the part of the noise that grows with the torque (current, unknown).
 RELATIVE = 0.02
-#: σ_j as a fraction of the joint's typical torque R_j: a sensor's, a current reading's floor, the hedge's floor.
-SENSOR_FLOOR, CURRENT_FLOOR, HEDGE_FLOOR = 0.02, 0.002, 0.02
+#: σ_j as a fraction of the joint's typical torque R_j: a sensor's, and a current reading's floor.
+SENSOR_FLOOR, CURRENT_FLOOR = 0.02, 0.002
 
 
-def draft_noise(source: str, joints: list[str], typical: np.ndarray) -> tuple[dict, str]:
-    """The drafted ``noise`` section and the sentence saying what it assumes.
+def draft_noise(source: str, joints: list[str], typical: np.ndarray) -> tuple[dict | None, str]:
+    """The drafted ``noise`` section (None: none) and the sentence saying what it assumes.
 
     Args:
         source: where the torque comes from, one of :data:`SOURCES`.
         joints: (n,) the active joints.
         typical: R_j (n,) [Nm], their typical torques (:func:`~excite_cli.design.noise.typical_torques`).
     """
-    floor = {"sensor": SENSOR_FLOOR, "current": CURRENT_FLOOR, "unknown": HEDGE_FLOOR}[source]
-    sigma = {j: float(f"{floor * r:.3g}") for j, r in zip(joints, typical)}
     typical_words = "each joint's RMS torque on random feasible motions"
+    if source == "unknown":
+        return None, (
+            "none: the torque source was not said, so every regressor row weighs the same (init's torque_from "
+            "sensor or current drafts the noise of either; an identify report as sequence.prior measures it)"
+        )
+    floor = SENSOR_FLOOR if source == "sensor" else CURRENT_FLOOR
+    sigma = {j: float(f"{floor * r:.3g}") for j, r in zip(joints, typical)}
     if source == "sensor":
         return {"absolute": sigma}, (
-            f"torque from joint torque sensors: absolute noise, {SENSOR_FLOOR:.0%} of "
-            f"{typical_words}; replace with your sensors' figures"
+            f"torque from joint torque sensors: absolute noise, {SENSOR_FLOOR:.0%} of {typical_words}; "
+            "replace with your sensors' figures"
         )
-    section = {"absolute": sigma, "relative": RELATIVE}
-    if source == "current":
-        return section, (
-            f"torque from motor current: {RELATIVE:.0%} of the torque over a floor of "
-            f"{CURRENT_FLOOR:.1%} of {typical_words}; replace with your figures, or design the next run from an "
-            "identify report (sequence.prior), which measures them"
-        )
-    return section, (
-        f"torque source not said (sensor or current): the hedge, {RELATIVE:.0%} of the torque "
-        f"over a floor of {HEDGE_FLOOR:.0%} of {typical_words}, the design that loses least under either "
-        "kind; an identify report (sequence.prior) measures the noise for the next run"
+    return {"absolute": sigma, "relative": RELATIVE}, (
+        f"torque from motor current: {RELATIVE:.0%} of the torque over a floor of {CURRENT_FLOOR:.1%} of "
+        f"{typical_words}; replace with your figures, or design the next run from an identify report "
+        "(sequence.prior), which measures them"
     )

@@ -282,11 +282,12 @@ def draft_config(
     draft.config["robot"]["home_posture"] = {n: round(float(q), 4) for n, q in zip(active, home)}
     draft.assumptions["robot.home_posture"] = f"searched: {why}" if found else f"FIX FIRST: {why}"
     draft.problem = "" if found else why
-    excitation = build_excitation(drafted_problem(draft.config, target), excitation.base, check_home=False)
-    noise, draft.assumptions["noise"] = draft_noise(torque_from, active, typical_torques(excitation))  # about home
-    draft.config = {
-        **{k: v for k, v in draft.config.items() if k != "output"},
-        "noise": noise,
-        "output": draft.config["output"],
-    }
+    typical = np.zeros(len(active))
+    if torque_from != "unknown":  # the typical torques about the home posture just found
+        excitation = build_excitation(drafted_problem(draft.config, target), excitation.base, check_home=False)
+        typical = typical_torques(excitation)
+    noise, draft.assumptions["noise"] = draft_noise(torque_from, active, typical)
+    if noise:
+        output = draft.config.pop("output")
+        draft.config.update(noise=noise, output=output)
     return draft

@@ -16,7 +16,7 @@ from excite_cli.cli import app
 from excite_cli.config_file import load_problem
 from excite_cli.design.noise import typical_torques
 from excite_cli.design.resolve import build_excitation
-from excite_cli.drafting.noise_source import CURRENT_FLOOR, HEDGE_FLOOR, RELATIVE
+from excite_cli.drafting.noise_source import CURRENT_FLOOR, RELATIVE
 from excite_cli.dynamics.robot_files import example_robot_data_root
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.workflows.init import run_init
@@ -195,13 +195,9 @@ def test_init_prints_its_assumptions_and_the_dry_run(tmp_path, monkeypatch):
     assert load_problem(tmp_path / "ur3_robot.yaml").robot.active_joints == ["shoulder_pan_joint", "elbow_joint"]
 
 
-def test_an_unknown_torque_source_drafts_the_hedged_noise_over_each_joints_typical_torque(ur3):
-    problem = load_problem(ur3.target)
-    typical = typical_torques(build_excitation(problem))
-    assert problem.noise.relative == RELATIVE
-    drafted = np.array([problem.noise.absolute[j] for j in problem.robot.active_joints])
-    np.testing.assert_allclose(drafted, HEDGE_FLOOR * typical, rtol=5e-3)  # written to 3 digits
-    assert "noise: torque source not said (sensor or current): the hedge" in ur3.target.read_text()
+def test_an_unknown_torque_source_drafts_no_noise_and_says_so(ur3):
+    assert load_problem(ur3.target).noise is None
+    assert "noise: none: the torque source was not said" in ur3.target.read_text()
 
 
 def test_torque_from_current_drafts_noise_growing_with_the_torque_on_the_panda(tmp_path, monkeypatch):
