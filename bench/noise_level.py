@@ -6,7 +6,8 @@ noises: *absolute* 0.05 N·m (a torque sensor's), *relative* 2 % of the torque o
 validation), least squares; the noise table of the report (:mod:`excite_cli.identification.fitting.noise_level`).
 
 Printed per truth and seed: the fitted ρ per joint, their median over the truth's ρ, and the joints
-whose preferred kind is the truth's; then per truth the seeds whose median ρ is within 20 % (relative)
+whose preferred kind is the truth's (a letter per joint: a absolute, r relative) and, under relative
+noise, how far each joint's relative part at its RMS torque rises above the floor; then per truth the seeds whose median ρ is within 20 % (relative)
 and the seeds where the truth's kind is preferred on at least 6 of the 7 joints.
 
     .venv/bin/python bench/noise_level.py [RESULT.h5] [--seeds 0 1 ...]
@@ -38,7 +39,8 @@ TRUTHS = {"absolute": (0.05, 0.0), "relative": (0.005, 0.02)}  # (torque_noise [
 
 
 def measured(result: Path, truth: str, seed: int, folder: Path) -> list:
-    """The noise levels identify fits to the two runs of ``result`` simulated under ``truth``."""
+    """The noise levels identify fits to the two runs of ``result`` simulated under ``truth``, and each
+    joint's RMS torque on the validation run [N·m]."""
     sigma, rho = TRUTHS[truth]
     effects = {"sample_rate": 500.0, "periods": 4, "position_noise": 0.0002, "torque_noise": sigma}
     effects |= {"torque_noise_relative": rho, "seed": seed, "effects": {"coulomb": {"*": 0.6}, "viscous": {"*": 0.4}}}
@@ -52,7 +54,7 @@ def measured(result: Path, truth: str, seed: int, folder: Path) -> list:
     }
     (folder / "identify.yaml").write_text(yaml.safe_dump(config))
     report = run_identification(load_problem(folder / "identify.yaml", IdentifyProblem))[0]
-    return report.noise_levels
+    return report.noise_levels, report.rms_torque
 
 
 def main() -> None:
@@ -64,7 +66,7 @@ def main() -> None:
         within, preferred = 0, 0
         for seed in args.seeds:
             with tempfile.TemporaryDirectory() as tmp:
-                levels = measured(args.result, truth, seed, Path(tmp))
+                levels, rms = measured(args.result, truth, seed, Path(tmp))
             fitted = np.array([level.relative for level in levels])
             right = sum(level.preferred == truth for level in levels)
             ratio = float(np.median(fitted) / rho) if rho else float("nan")
@@ -72,7 +74,9 @@ def main() -> None:
             preferred += right >= 6
             print(
                 f"{truth} seed {seed}: rho [%] {' '.join(f'{100 * x:.2f}' for x in fitted)}; median / truth "
-                f"{ratio:.3f}; the truth's kind preferred on {right} of {len(levels)} joints",
+                f"{ratio:.3f}; the truth's kind preferred on {right} of {len(levels)} joints "
+                f"({''.join(level.preferred[0] for level in levels)}); rho x RMS torque / floor "
+                f"{' '.join(f'{rho * r / TRUTHS[truth][0]:.2g}' for r in rms) if rho else '-'}",
                 flush=True,
             )
         print(

@@ -147,8 +147,8 @@ def measured_prior_of(report: StoredReport, path: Path) -> MeasuredPrior:
 
     Raises:
         ExciteError: (``sequence.prior``) a report of an earlier version without what weighs its rows, or
-            whose errors or sample rate no weighing can use (not finite, negative, all zero, not one per
-            joint; a rate that is not positive).
+            whose errors, noise levels or sample rate no weighing can use (not finite, negative, all zero,
+            not one per joint; a rate that is not positive).
     """
     sigma, rate, joints = report.rms_after, report.rate, report.joints
     if sigma is None or rate is None:
@@ -181,5 +181,10 @@ def measured_prior_of(report: StoredReport, path: Path) -> MeasuredPrior:
             f"a positive rate up to {HIGHEST_RATE:g} Hz",
         )
     level = report.noise_level
-    usable = level is not None and level.shape == (len(joints), 2) and np.all(np.isfinite(level) | np.isnan(level))
-    return MeasuredPrior(joints, sigma, rate, level if usable and np.any(np.isfinite(level)) else None)
+    if level is not None and not (np.all(np.isnan(level) | ((level >= 0) & (level <= [LARGEST_ERROR, 10.0])))):
+        raise ExciteError(
+            "sequence.prior",
+            f"{path}: /identification/noise_level must give each joint a in 0 to {LARGEST_ERROR:g} Nm and ρ in 0 "
+            "to 10 (NaN for a dead channel) (damaged?)",
+        )
+    return MeasuredPrior(joints, sigma, rate, level if level is not None and np.isfinite(level).any() else None)

@@ -39,7 +39,7 @@ class StoredReport:
         rate: its rows' sample rate [Hz] (``/regressor`` attribute ``sample_rate_Hz``), or None (the same).
         noise_level: (n, 2) each joint's fitted noise (a [Nm], ρ [1]) of its rows, at the report's rate
             (``/identification/noise_level`` times √ of its ``noise_gain``), NaN for a dead channel, or
-            None (a report of an earlier excite, or validation data too short to fit it).
+            None (a report of an earlier excite, or fit data too short to fit it).
         rotors: the last ``rotors`` of ``terms`` are the consistent fit's rotors with columns of their own
             (armature the effect search did not choose:
             :mod:`~excite_cli.identification.choice.consistent_model`), part of what it predicts.
@@ -120,19 +120,26 @@ def report_in(f, path: Path, field: str) -> StoredReport | None:
         if "regressor" in f and "sample_rate_Hz" in f["regressor"].attrs
         else None,
         len(rotors),
-        _noise_level(g, len(joints)),
+        _noise_level(g, len(joints), path, field),
     )
 
 
-def _noise_level(g, n: int) -> np.ndarray | None:
-    """(n, 2) a [Nm], ρ [1] of the report's rows (at its rate: the fit times √noise_gain), or None."""
+def _noise_level(g, n: int, path: Path, field: str) -> np.ndarray | None:
+    """(n, 2) a [Nm], ρ [1] of the report's rows (at its rate: the fit times √noise_gain), or None.
+
+    Raises:
+        ExciteError: a table without a row per joint or its fields, or a noise gain outside (0, 1].
+    """
     if "noise_level" not in g:
         return None
     table = g["noise_level"]
-    rows = table[()]
+    rows, gain = table[()], float(table.attrs.get("noise_gain", 1.0))
     if rows.dtype.names is None or not {"absolute", "relative"} <= set(rows.dtype.names) or len(rows) != n:
-        return None
-    gain = float(table.attrs.get("noise_gain", 1.0))
+        raise ExciteError(
+            field, f"{path}: /identification/noise_level needs a row per joint with absolute and relative"
+        )
+    if not 0.0 < gain <= 1.0:
+        raise ExciteError(field, f"{path}: /identification/noise_level noise_gain is {gain:g}", gain, "0 < gain ≤ 1")
     return np.column_stack([rows["absolute"], rows["relative"]]).astype(float) * np.sqrt(gain)
 
 

@@ -231,6 +231,13 @@ def _replace(f, name, value):
     f[name] = value
 
 
+def _noise(f, column, value):
+    table = f["identification/noise_level"]
+    rows = table[()]
+    rows[column][0] = value
+    table[...] = rows
+
+
 @pytest.mark.parametrize(
     "edit, message",
     [
@@ -242,6 +249,10 @@ def _replace(f, name, value):
         (lambda f: f["regressor"].attrs.__setitem__("sample_rate_Hz", 0.0), "sample_rate_Hz is 0"),
         (lambda f: f["identification/rms_after"].parent.pop("rms_after"), "report of an earlier excite"),
         (lambda f: f["regressor"].attrs.__delitem__("sample_rate_Hz"), "report of an earlier excite"),
+        (lambda f: _noise(f, "relative", -0.01), "noise_level must give each joint a in 0 to 1e.06 Nm"),
+        (lambda f: _noise(f, "absolute", np.inf), "noise_level must give each joint a in 0 to 1e.06 Nm"),
+        (lambda f: f["identification/noise_level"].attrs.__setitem__("noise_gain", 0.0), "noise_gain is 0"),
+        (lambda f: _replace(f, "identification/noise_level", np.ones(7)), "needs a row per joint"),
     ],
 )
 def test_a_damaged_report_as_prior_is_refused_in_one_line(report_file, tmp_path, edit, message):
