@@ -15,11 +15,10 @@ the weights move with α and their gradient ∂s/∂τ = −s ρ² τ / (σ² + 
 (:mod:`~excite_cli.design.criterion`). The rows of the base wrench (a floating base's, which
 no joint's sensor measures) weigh as a row of noise σ̄.
 
-With an identify report as prior data (``sequence.prior``), σ_j are the report's
-(:class:`~excite_cli.stored.design_model.MeasuredPrior`): the rows of its recording
-are weighed by them, and the new trajectory's by the noise the report fitted, a_j and ρ_j
-(:mod:`~excite_cli.identification.fitting.noise_level`), or by the same σ_j and the config's ρ
-where the report has no fit.
+With an identify report as prior data (``sequence.prior``), the new trajectory's rows are weighed by
+the noise the report fitted, a_j and ρ_j (:mod:`~excite_cli.identification.fitting.noise_level`), as
+the rows of its recording are (:class:`~excite_cli.stored.design_model.MeasuredPrior`), or by the
+report's σ_j and the config's ρ where the report has no fit.
 """
 
 from __future__ import annotations
@@ -36,9 +35,6 @@ from excite_cli.stored.design_model import MeasuredPrior
 #: Random feasible motions (the seeds of :meth:`~excite_cli.design.excitation.Excitation.random_start`)
 #: whose RMS torques are a joint's typical torque (:func:`typical_torques`).
 TYPICAL_SEEDS = (1, 2, 3)
-#: The smallest absolute noise a measured prior gives a joint's new rows, as a share of its σ_j: a fitted
-#: a of 0 (noise all relative) would weigh a row of zero torque without bound.
-MEASURED_FLOOR = 0.01
 
 
 @dataclass(frozen=True)
@@ -82,8 +78,8 @@ class RowNoise:
 
 def row_noise(cfg: NoiseConfig | None, robot: Robot, measured: MeasuredPrior | None) -> RowNoise | None:
     """The rows' noise of the ``noise`` section, or of ``measured`` (an identify report's) when there
-    is one: its fitted a_j and ρ_j (:attr:`~excite_cli.stored.design_model.MeasuredPrior.level`; a
-    floor of :data:`MEASURED_FLOOR` σ_j keeps a row of zero torque finite) or, without them, its σ_j
+    is one: its fitted a_j and ρ_j (:meth:`~excite_cli.stored.design_model.MeasuredPrior.noise_parts`; a
+    floor keeps a row of zero torque finite) or, without them, its σ_j
     and the config's ρ. None where every row weighs the same (no section and no measured prior).
 
     Raises:
@@ -101,10 +97,7 @@ def row_noise(cfg: NoiseConfig | None, robot: Robot, measured: MeasuredPrior | N
     rho = np.zeros(n) if cfg is None else per_joint("noise.relative", cfg.relative, np.zeros(n), robot, True, "noise")
     source = "the config's noise section"
     if measured is not None and measured.level is not None:
-        level = measured.level[order]
-        fitted = np.isfinite(level).all(axis=1)  # a dead channel keeps its σ_j
-        sigma = np.where(fitted, np.maximum(np.nan_to_num(level[:, 0]), MEASURED_FLOOR * sigma), sigma)
-        rho = np.where(fitted, np.nan_to_num(level[:, 1]), 0.0)
+        sigma, rho = (x[order] for x in measured.noise_parts())
         source = "the noise the identify report measured (sequence.prior): " + ", ".join(
             f"{j} {a:.3g} Nm + {100 * r:.3g} % of τ" for j, a, r in zip(robot.joint_names, sigma, rho)
         )

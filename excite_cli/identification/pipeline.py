@@ -170,7 +170,7 @@ def run_identification(
     if choice.is_consistent:  # the reported model's step: the same effects, the consistent fit
         ladder.append((choice.name, float(choice.cv_error[choice.chosen]), report.mean(report.relative_after)))
     report.warnings += report.fit_disagreement()
-    return report, robot, base, prior_rows([fit_data, val_data], selection.terms, robot.joint_names)
+    return report, robot, base, prior_rows([fit_data, val_data], selection.terms, robot.joint_names, model)
 
 
 def noise_levels(

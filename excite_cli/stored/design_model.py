@@ -94,13 +94,17 @@ def with_report_model(cfg: EffectsConfig, report: StoredReport, path: Path, join
 LARGEST_ERROR = 1e6
 #: The highest sample rate a report's rows may have [Hz].
 HIGHEST_RATE = 1e6
+#: The smallest absolute noise a measured noise level gives a joint's rows, as a share of its σ_j: a fitted
+#: a of 0 (noise all relative) would weigh a row of zero torque without bound.
+MEASURED_FLOOR = 0.01
 
 
 @dataclass(frozen=True)
 class MeasuredPrior:
-    """How an identify report's rows weigh as prior data C₀ (Eq. 41) of the next design, as
-    identification weighs them: each joint's rows divided by its noise, and one second of recording
-    worth one second of a trajectory on the cost grid.
+    """How an identify report's rows weigh as prior data C₀ (Eq. 41) of the next design, as weighted
+    least squares weighs them: each row divided by its noise (the measured level at the row's predicted
+    torque, or its joint's σ_j), and one second of recording worth one second of a trajectory on the
+    cost grid.
 
     Attributes:
         joints: (n,) the report's joints, in its rows' order.
@@ -109,7 +113,7 @@ class MeasuredPrior:
         rate: the report's decimated sample rate [Hz]: regressor rows per second and joint.
         level: (n, 2) each joint's fitted noise of its rows, a [Nm] and ρ [1] of σ² = a² + (ρτ)²
             (:mod:`~excite_cli.identification.fitting.noise_level`), NaN for a dead channel; None: the
-            report has none (its σ_j alone weigh the new rows).
+            report has none (its σ_j alone weigh the rows).
     """
 
     joints: list[str]
@@ -131,6 +135,30 @@ class MeasuredPrior:
         """(n,) σ̄ / σ_j (1 for equal noise on every joint): weighted least squares' weights (Gautier
         1997), relative so the criterion keeps its scale."""
         return self.noise / self.floored
+
+    def noise_parts(self) -> tuple[np.ndarray, np.ndarray]:
+        """(n,) a_j [Nm] and (n,) ρ_j [1] of each joint's rows' noise σ² = a² + (ρτ)²: the fitted
+        ``level``, a floored at :data:`MEASURED_FLOOR` σ_j; σ_j and ρ = 0 on a dead channel or without
+        a fitted level."""
+        if self.level is None:
+            return self.floored, np.zeros(len(self.joints))
+        fitted = np.isfinite(self.level).all(axis=1)  # a dead channel keeps its σ_j
+        a = np.maximum(np.nan_to_num(self.level[:, 0]), MEASURED_FLOOR * self.floored)
+        return np.where(fitted, a, self.floored), np.where(fitted, np.nan_to_num(self.level[:, 1]), 0.0)
+
+    def row_weights(self, predicted: np.ndarray) -> np.ndarray:
+        """σ̄ / √(a_j² + ρ_j² τ̂²) (M,) of the report's M rows (instants one after another, n joints
+        each) whose predicted torques are ``predicted`` (M,) [Nm] (the reported model's), a and ρ of
+        :meth:`noise_parts` (without a fitted level σ̄/σ_j, :meth:`weights`): weighted least squares'
+        weights of a noise growing with the torque (Gautier 1997 with a noise that depends on the sample).
+
+        Raises:
+            ValueError: M is not a whole number of instants of the n joints.
+        """
+        if predicted.size % len(self.joints):
+            raise ValueError(f"{predicted.size} rows are not instants of {len(self.joints)} joints")
+        a, rho = (np.tile(x, predicted.size // len(self.joints)) for x in self.noise_parts())
+        return self.noise / np.sqrt(a**2 + (rho * predicted) ** 2)
 
     def time_scale(self, cost_period: float) -> float:
         """√(1 / (cost_period · rate)): the information of a recording is a Riemann sum of ∫ YᵀWᵀWY dt

@@ -30,6 +30,8 @@ class PriorFile:
         effect_columns: (m, e') an identify report's ``/effect_regressor``, or None; effect_column_names:
             its (e',) names.
         report: the identify report the file is (:func:`~excite_cli.stored.report.read_report`), or None.
+        predicted: (m,) an identify report's ``/predicted_torque``, the reported model's torque of each
+            row [Nm], or None (not an identify report, or one of an earlier version).
     """
 
     path: Path
@@ -39,6 +41,7 @@ class PriorFile:
     effect_columns: np.ndarray | None
     effect_column_names: list[str]
     report: StoredReport | None
+    predicted: np.ndarray | None = None
 
 
 def read_prior_file(path: Path, field: str = "sequence.prior") -> PriorFile:
@@ -62,6 +65,7 @@ def read_prior_file(path: Path, field: str = "sequence.prior") -> PriorFile:
             np.asarray(f["effect_regressor"][()], dtype=float) if has_columns else None,
             [str(n) for n in f["effect_regressor"].attrs.get("names", [])] if has_columns else [],
             report_in(f, path, field),
+            np.asarray(f["predicted_torque"][()], dtype=float) if "predicted_torque" in f else None,
         )
 
 
@@ -78,13 +82,16 @@ def prior_rows(
     an identify report's ``/effect_regressor``: those it holds, taken by name).
 
     An identify report's rows (``measured``, see
-    :class:`~excite_cli.stored.design_model.MeasuredPrior`) are weighed as
-    identification weighs them: each joint's rows times σ̄/σ_j, and every row times
+    :class:`~excite_cli.stored.design_model.MeasuredPrior`) are weighed by their noise: each row times
+    σ̄/√(a_j² + ρ_j² τ̂²), the noise the report measured at the row's predicted torque τ̂
+    (:meth:`~excite_cli.stored.design_model.MeasuredPrior.row_weights`; σ̄/σ_j, the joint's validation
+    error, for a report without a noise table or predicted torques), and every row times
     √(1 / (cost_period · rate)) so that one second of recording carries the information of one second
     of a trajectory on the cost grid (``cost_period`` [s]).
 
     Raises:
-        ExciteError: no regressor in the file, or base parameters or effect columns that differ.
+        ExciteError: no regressor in the file, base parameters or effect columns that differ, a report's
+            damaged predicted torques.
     """
     path, names, effects = stored.path, stored.base_names, stored.effect_names
     if stored.rows is None:
@@ -112,13 +119,22 @@ def prior_rows(
     if not np.all(np.isfinite(prior)):
         raise ExciteError("sequence.prior", f"{path} contains NaN or infinite values")
     if measured is not None:
-        weights = measured.weights() * measured.time_scale(cost_period)
-        if len(prior) % weights.size:
+        n = len(measured.joints)
+        if len(prior) % n:
             raise ExciteError(
                 "sequence.prior",
-                f"{path} has {len(prior)} regressor rows, not a whole number of instants of its {weights.size} joints",
+                f"{path} has {len(prior)} regressor rows, not a whole number of instants of its {n} joints",
             )
-        prior = (prior.reshape(-1, weights.size, prior.shape[1]) * weights[None, :, None]).reshape(prior.shape)
+        predicted = stored.predicted
+        if predicted is not None and (predicted.shape != (len(prior),) or not np.all(np.isfinite(predicted))):
+            raise ExciteError(
+                "sequence.prior",
+                f"{path}: /predicted_torque must hold a finite torque for each of its {len(prior)} regressor rows "
+                "(damaged?)",
+            )
+        per_joint = np.tile(measured.weights(), len(prior) // n)  # a report without predicted torques
+        weights = per_joint if predicted is None else measured.row_weights(predicted)
+        prior = prior * (weights * measured.time_scale(cost_period))[:, None]
     if names is None:
         return prior
     order = np.concatenate(

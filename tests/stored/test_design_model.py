@@ -10,11 +10,11 @@ from typer.testing import CliRunner
 
 from excite_cli.cli import app
 from excite_cli.config_file import load_problem
-from excite_cli.design.noise import MEASURED_FLOOR
 from excite_cli.design.resolve import build_excitation
 from excite_cli.errors import ExciteError
 from excite_cli.h5 import read_strings
 from excite_cli.stored.design_model import (
+    MEASURED_FLOOR,
     MeasuredPrior,
     measured_prior_of,
     report_model,
@@ -118,6 +118,22 @@ def test_a_joints_rows_weigh_by_its_unexplained_torque():
     np.testing.assert_allclose(prior.weights(), 0.2 / np.array([0.1, 0.4, 0.2]))  # σ̄ = (0.1·0.4·0.2)^⅓ = 0.2
 
 
+def test_a_reports_rows_weighed_by_its_measured_noise_have_equal_noise():
+    """Residuals drawn with noise a² + (ρτ)² growing with the torque (a motor current's, 2 % over a
+    0.01 Nm floor) times the rows' weights: the same variance σ̄² at small and at large torques (within
+    5 % over 20000 draws per bin), as weighted least squares needs; σ_j alone leaves them 10× apart."""
+    rng = np.random.default_rng(0)
+    level = np.array([[0.01, 0.02], [0.01, 0.02]])
+    prior = MeasuredPrior(["a", "b"], np.array([0.05, 0.05]), 200.0, level)
+    tau = np.repeat([0.0, 5.0], 40000)  # two joints, instants one after another: 20000 draws per bin and joint
+    residual = rng.normal(0.0, 1.0, tau.size) * np.sqrt(0.01**2 + (0.02 * tau) ** 2)
+    small = np.var(residual[:40000] * prior.row_weights(tau)[:40000])
+    large = np.var(residual[40000:] * prior.row_weights(tau)[40000:])
+    assert abs(small / prior.noise**2 - 1) < 0.05 and abs(large / prior.noise**2 - 1) < 0.05
+    plain = np.tile(prior.weights(), tau.size // 2)
+    assert np.var(residual[40000:] * plain[40000:]) > 10 * np.var(residual[:40000] * plain[:40000])
+
+
 def test_optimize_with_the_report_as_prior_weighs_both_the_prior_and_its_own_rows(report_file, tmp_path):
     """`excite optimize CONFIG --prior REPORT.h5`: the report's rows enter weighted by σ̄/σ_j and the time
     rule, and the new trajectory's rows by the noise the report fitted, σ̄/√(a_j² + ρ_j² τ²) at the
@@ -163,6 +179,7 @@ def test_the_reports_rows_hold_its_effects_as_the_fit_saw_them(simulated_identif
     stacked = np.hstack([rows.regressor[1], rows.effects[1]])
     predicted = predict(report.validation, fit.x, report.selection.terms).ravel()
     np.testing.assert_allclose(stacked @ fit.x, predicted, atol=1e-9)
+    np.testing.assert_allclose(rows.predicted[1], report.predicted_after.ravel(), atol=1e-9)  # the reported model's
 
 
 def test_one_report_is_the_model_and_the_prior_data(report_file, tmp_path):
@@ -176,8 +193,9 @@ def test_one_report_is_the_model_and_the_prior_data(report_file, tmp_path):
     with h5py.File(report_file) as f:
         held = [str(name) for name in f["effect_regressor"].attrs["names"]]
         raw = f["effect_regressor"][()][:, [held.index(name) for name in excitation.effect_names]]
+        predicted = f["predicted_torque"][()]
     measured = excitation.measured
-    weights = np.tile(measured.weights(), raw.shape[0] // len(measured.joints)) * measured.time_scale(0.2)
+    weights = measured.row_weights(predicted) * measured.time_scale(0.2)
     np.testing.assert_allclose(prior[:, excitation.base.count :], raw * weights[:, None], rtol=1e-12)
     assert np.abs(prior[:, excitation.base.count :]).max(axis=0).min() > 0.0
     out = tmp_path / "next.h5"
@@ -262,6 +280,24 @@ def test_a_damaged_report_as_prior_is_refused_in_one_line(report_file, tmp_path,
     with pytest.raises(ExciteError, match=message) as error:
         damaged = _damaged(report_file, tmp_path, edit)
         measured_prior_of(read_report(damaged, "sequence.prior"), damaged)
+    assert error.value.field == "sequence.prior"
+
+
+@pytest.mark.parametrize("torque", [np.full(4, 1.0), np.array([np.nan])])
+def test_a_reports_damaged_predicted_torques_are_refused_in_one_line(report_file, tmp_path, torque):
+    """/predicted_torque with a row count other than /regressor's, or with NaN: refused naming it, not
+    a broadcasting error or rows weighed by NaN."""
+    problem = load_problem(CONFIGS / "smoke.yaml")
+    problem.sequence.prior = str(report_file)
+    excitation = build_excitation(problem)
+
+    def edit(f):
+        rows = f["predicted_torque"].shape[0]
+        _replace(f, "predicted_torque", torque if torque.size > 1 else np.r_[torque, np.ones(rows - 1)])
+
+    damaged = _damaged(report_file, tmp_path, edit)
+    with pytest.raises(ExciteError, match="predicted_torque must hold a finite torque") as error:
+        prior_rows(read_prior_file(damaged), excitation.base, (), excitation.measured, 0.2)
     assert error.value.field == "sequence.prior"
 
 

@@ -12,6 +12,7 @@ import numpy as np
 from excite_cli.dynamics.effect_columns import coefficient_name
 from excite_cli.identification.effects import Term
 from excite_cli.identification.fitting.dataset import Dataset
+from excite_cli.identification.fitting.least_squares import predict
 
 
 @dataclass
@@ -25,11 +26,14 @@ class PriorRows:
             (:func:`~excite_cli.dynamics.effect_columns.effect_columns`: ``Fc_panda_joint4``,
             ``Ia_motor_wrist_2+wrist_3``).
         effect_names: (e,) the names.
+        predicted: (M_k,) the reported model's torque [Nm] of each row per part, what the rows' noise
+            grows with (:meth:`~excite_cli.stored.design_model.MeasuredPrior.row_weights`).
     """
 
     regressor: list[np.ndarray]
     effects: list[np.ndarray]
     effect_names: list[str]
+    predicted: list[np.ndarray]
 
 
 def _design_names(term: Term, joints: list[str]) -> list[str] | None:
@@ -42,7 +46,7 @@ def _design_names(term: Term, joints: list[str]) -> list[str] | None:
     return None
 
 
-def prior_rows(parts: list[Dataset], terms: list[Term], joints: list[str]) -> PriorRows:
+def prior_rows(parts: list[Dataset], terms: list[Term], joints: list[str], model: tuple) -> PriorRows:
     """The rows of ``parts`` (the identification's fit and validation data) as prior data: their base
     regressor, and the columns of the chosen ``terms`` a design holds, taken from the parts' own
     low-passed and decimated effect blocks (the columns identification fitted, weighed as it weighed
@@ -50,6 +54,8 @@ def prior_rows(parts: list[Dataset], terms: list[Term], joints: list[str]) -> Pr
 
     Args:
         parts: datasets with the blocks of ``terms``; joints: the active joints (n), in the rows' order.
+        model: the reported model, its coefficients x (base parameters first) and terms: each row's
+            predicted torque.
 
     Returns:
         Per part, (M_k, b) base regressor rows and (M_k, e) effect columns: the prior data C₀ of the
@@ -71,4 +77,5 @@ def prior_rows(parts: list[Dataset], terms: list[Term], joints: list[str]) -> Pr
                 block = data.block(term)
             out.append(block)
     effects = [np.hstack(c) if c else np.zeros((d.tau.size, 0)) for c, d in zip(columns, parts)]
-    return PriorRows([d.regressor for d in parts], effects, names)
+    predicted = [predict(d, *model).ravel() for d in parts]  # what each row's noise grows with
+    return PriorRows([d.regressor for d in parts], effects, names, predicted)

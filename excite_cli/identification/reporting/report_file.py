@@ -63,6 +63,8 @@ def write_identification(
             "base regressor of all preprocessed (decimated) samples, fit then validation (C0)"
         )
         regressor.attrs["sample_rate_Hz"] = report.rate
+        torque = f.create_dataset("predicted_torque", data=np.concatenate(rows.predicted) if rows.predicted else [])
+        torque.attrs["description"] = "the reported model's torque of each /regressor row [Nm]: the noise grows with it"
         effects = write_parts(f, "effect_regressor", rows.effects, len(rows.effect_names))
         effects.attrs["description"] = "the chosen effects' columns a design holds, rows as /regressor's (C0)"
         effects.attrs.create("names", rows.effect_names, dtype=STR)

@@ -19,7 +19,7 @@ def test_a_coupled_motor_and_an_offset_are_named_and_placed_as_a_design_has_them
     data = Dataset(
         np.ones((6, 4)), np.zeros(6), np.arange(3.0), np.zeros(3, int), {motor: cols, offset: np.ones((3, 1))}
     )
-    rows = prior_rows([data], [offset, motor], ["a", "b"])
+    rows = prior_rows([data], [offset, motor], ["a", "b"], (np.zeros(4), []))
     design = effect_columns(
         EffectsConfig(joints={"a": ["offset"]}, motors=[MotorConfig(joints=["a", "b"], transmission=[1.0, -2.0])]),
         ["a", "b"],
