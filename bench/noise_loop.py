@@ -1,0 +1,175 @@
+"""The noise loop: after one recording, is the next design as good as one made knowing the noise?
+
+For each robot (a config), optimizer seed and true noise (bench/criteria.py's: *absolute* 2 % of each
+joint's RMS torque on an unseen motion, a torque sensor's; *relative* 2 % of the torque over a floor of
+0.2 % of that RMS, a motor current's):
+
+Every design is one trajectory of the config's problem under A-optimality in the URDF-scaled frame
+(``log_trace_inverse``, ``urdf``: the default, as bench/criteria.py's table), its restarts and screening.
+
+1. the first trajectory, designed as the config says (its ``noise`` section, or every row the same);
+2. its recording: sampled at 100 Hz over its duration, torques from RNEA with the URDF's inertias plus
+   one draw of the true noise (noise seed = optimizer seed);
+3. identified as identify does with nothing declared: weighted least squares of the base parameters
+   (each joint's rows by the inverse of its residual under least squares, Gautier 1997), then each
+   joint's noise σ² = a² + (ρτ)² fitted to the residual against the predicted torque
+   (:func:`~excite_cli.identification.fitting.noise_level.fit_noise_level`, no filter: gain 1) and its
+   RMS residual σ_j;
+4. the second trajectory, the recording as prior data (``sequence.prior``: each row scaled to the cost
+   grid's rate), designed three ways from the same random starts:
+   *measured*, as ``optimize --prior REPORT`` designs it: the recording's rows and the new ones weighed by
+   the fitted noise at their predicted torque (:class:`~excite_cli.stored.design_model.MeasuredPrior`);
+   *σ_j only*, a report without a noise table (every row of a joint weighs the same, σ̄/σ_j);
+   *told the truth*, every row, the recording's and the new, weighed by the true noise (the config's
+   ``noise: {absolute: s_j, relative: ρ}``).
+   A floating base's 6 wrench rows (the G1's) weigh σ̄ in all three, as a design weighs them (no joint's
+   sensor measures them and a config cannot declare their noise); their true noise enters the error.
+
+Printed per robot, truth and seed: the fitted ρ per joint (median over the joints), the kinds the data
+prefer, and each second design's expected parameter error: the RMS over the b identifiable directions of
+the error of weighted least squares on both recordings under the true noise, in the URDF-scaled frame
+(bench/criteria.py's "predicted"), with its ratio to the told-the-truth design's. The last line per robot:
+the largest ratio of *measured* (and of *σ_j only*) over its truths and seeds.
+
+    .venv/bin/python bench/noise_loop.py CONFIG [CONFIG ...] [--seeds 0 1 2] [--truths absolute relative]
+
+Asserts nothing.
+"""
+
+from __future__ import annotations
+
+import excite_cli  # noqa: F401  (before NumPy: the kernels of the command line, excite_cli/kernels.py)
+
+# isort: split
+
+import argparse
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+from criteria import noise_scale, samples
+
+from excite_cli.config import NoiseConfig
+from excite_cli.config_file import load_problem
+from excite_cli.design.resolve import build_excitation
+from excite_cli.identification.fitting.noise_level import fit_noise_level
+from excite_cli.search.engine import Engine, default_workers
+from excite_cli.search.sequence import run_sequence
+from excite_cli.stored.design_model import MeasuredPrior
+
+CRITERION = ("log_trace_inverse", "urdf")  # A-optimality in the URDF-scaled frame, as bench/criteria.py's table
+DESIGNS = ("measured", "sigma only", "told the truth")
+
+
+def designed(excitation, prior: np.ndarray, seed: int) -> np.ndarray:
+    """The Fourier coefficients of one trajectory designed for ``excitation`` with C₀ = ``prior``."""
+    workers = min(default_workers(), excitation.spec.optimizer.screened or excitation.spec.optimizer.restarts)
+    with Engine(excitation, workers) as engine:
+        return run_sequence(excitation, 1, seed, prior=prior, engine=engine)[0].alpha
+
+
+def recorded(excitation, alpha: np.ndarray, relative: bool, seed: int) -> tuple:
+    """The recording of α: base regressor Y (T·n_rows, b), true torques (T, n_rows), their true noise
+    σ (T, n_rows) and one draw of the measured torques (T, n_rows)."""
+    Y, tau = samples(excitation, alpha)
+    absolute, rho = noise_scale(excitation, relative)
+    sigma = np.sqrt(absolute**2 + (rho * tau) ** 2)
+    return Y, tau, sigma, tau + np.random.default_rng(seed).normal(0.0, 1.0, tau.shape) * sigma
+
+
+def identified(Y: np.ndarray, measured: np.ndarray, n: int) -> tuple[np.ndarray, list, np.ndarray]:
+    """Weighted least squares of the recording as identify's default (Gautier 1997: each joint's rows
+    by 1/σ_j, σ_j its residual under ordinary least squares), then the joints' (the last ``n`` rows of
+    each instant) RMS residual σ_j (n,) [Nm], fitted noise levels and predicted torques (T, n) [Nm]."""
+    rows = measured.shape[1]
+    plain = measured - (Y @ np.linalg.lstsq(Y, measured.ravel(), rcond=None)[0]).reshape(measured.shape)
+    weights = np.tile(1.0 / np.sqrt((plain**2).mean(axis=0)), len(measured))
+    beta = np.linalg.lstsq(Y * weights[:, None], measured.ravel() * weights, rcond=None)[0]
+    predicted = (Y @ beta).reshape(-1, rows)[:, -n:]
+    residual = measured[:, -n:] - predicted
+    gain = np.ones(len(residual))
+    levels = [fit_noise_level(residual[:, j], predicted[:, j], gain) for j in range(n)]
+    return np.sqrt((residual**2).mean(axis=0)), levels, predicted
+
+
+def second_designs(problem, excitation, record: tuple, fitted: tuple, relative: bool, seed: int):
+    """The second trajectory designed ``measured``, ``sigma only`` and ``told the truth`` (module docstring)."""
+    Y, tau, sigma, _ = record
+    rms, levels, predicted = fitted
+    n, rows = excitation.robot.n_joints, excitation.robot.n_rows
+    scale = np.sqrt(1.0 / (problem.trajectory.cost_period * 100.0))  # MeasuredPrior.time_scale at 100 Hz
+    out = {}
+    level = np.array([[x.absolute, x.relative] for x in levels])
+    for name, lab in (("measured", level), ("sigma only", None)):
+        measured = MeasuredPrior(list(excitation.robot.joint_names), rms, 100.0, lab)
+        weights = np.ones((len(tau), rows))  # a floating base's wrench rows weigh σ̄
+        weights[:, -n:] = measured.row_weights(predicted.ravel()).reshape(-1, n)  # as stored.prior weighs a report's
+        prior = Y * (weights.ravel() * scale)[:, None]
+        out[name] = designed(replace(excitation, spec=replace(excitation.spec, measured=measured)), prior, seed)
+    absolute, rho = noise_scale(excitation, relative)
+    joints = problem.robot.active_joints
+    told = problem.model_copy(deep=True)
+    told.noise = NoiseConfig(absolute=dict(zip(joints, absolute[-n:].tolist())), relative=rho)
+    truth = build_excitation(told)
+    weights = truth.noise.scale / sigma  # (T, n_rows)
+    weights[:, : rows - n] = 1.0  # a floating base's wrench rows weigh σ̄, as the design weighs them
+    out["told the truth"] = designed(truth, Y * (weights.ravel() * scale)[:, None], seed)
+    return out
+
+
+def expected_error(excitation, record: tuple, alpha: np.ndarray, relative: bool) -> float:
+    """RMS over the identifiable directions of the scaled parameter error of weighted least squares on
+    the recording and α's (sampled as the recording), under the true noise (bench/criteria.py's
+    "predicted")."""
+    Y1, _, sigma1, _ = record
+    Y2, tau2 = samples(excitation, alpha)
+    absolute, rho = noise_scale(excitation, relative)
+    sigma2 = np.sqrt(absolute**2 + (rho * tau2) ** 2)
+    weighted = np.vstack([Y1 / sigma1.ravel()[:, None], Y2 / sigma2.ravel()[:, None]])
+    inverse_frame = np.linalg.inv(excitation.scaled_frame)
+    covariance = inverse_frame @ np.linalg.inv(weighted.T @ weighted) @ inverse_frame.T
+    return float(np.sqrt(np.trace(covariance) / covariance.shape[0]))
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("configs", type=Path, nargs="+")
+    parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
+    parser.add_argument("--truths", nargs="+", default=["absolute", "relative"])
+    args = parser.parse_args()
+    for config in args.configs:
+        problem = load_problem(config)
+        problem.optimizer.objective, problem.optimizer.scaling = CRITERION
+        excitation = build_excitation(problem)
+        n = excitation.robot.n_joints
+        ratios = {name: [] for name in DESIGNS[:2]}
+        for seed in args.seeds:
+            problem.optimizer.seed = seed
+            first = designed(excitation, None, seed)
+            for relative in [t == "relative" for t in args.truths]:
+                truth = "relative" if relative else "absolute"
+                record = recorded(excitation, first, relative, seed)
+                fitted = identified(record[0], record[3], n)
+                levels = fitted[1]
+                second = second_designs(problem, excitation, record, fitted, relative, seed + 1000)
+                errors = {name: expected_error(excitation, record, a, relative) for name, a in second.items()}
+                for name in ratios:
+                    ratios[name].append(errors[name] / errors["told the truth"])
+                rho = np.array([x.relative for x in levels])
+                print(
+                    f"{config.stem} {truth} seed {seed}: rho [%] {' '.join(f'{100 * x:.2f}' for x in rho)} (median "
+                    f"{100 * np.median(rho):.2f}); preferred {''.join(x.preferred[0] for x in levels)}; expected error "
+                    + ", ".join(
+                        f"{name} {100 * e:.4g} % ({e / errors['told the truth']:.3f})" for name, e in errors.items()
+                    ),
+                    flush=True,
+                )
+        print(
+            f"loop {config.stem}: second design / told the truth, largest over truths and seeds: "
+            + ", ".join(f"{name} {max(r):.3f}" for name, r in ratios.items()),
+            flush=True,
+        )
+
+
+if __name__ == "__main__":
+    main()
