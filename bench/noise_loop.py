@@ -18,7 +18,8 @@ Every design is one trajectory of the config's problem under A-optimality in the
 4. the second trajectory, the recording as prior data (``sequence.prior``: each row scaled to the cost
    grid's rate), designed three ways from the same random starts:
    *measured*, as ``optimize --prior REPORT`` designs it: the recording's rows and the new ones weighed by
-   the fitted noise at their predicted torque (:class:`~excite_cli.stored.design_model.MeasuredPrior`);
+   the fitted noise at their predicted torque, a taken at its 95 % upper bound
+   (:class:`~excite_cli.stored.design_model.MeasuredPrior`);
    *σ_j only*, a report without a noise table (every row of a joint weighs the same, σ̄/σ_j);
    *told the truth*, every row, the recording's and the new, weighed by the true noise (the config's
    ``noise: {absolute: s_j, relative: ρ}``).
@@ -47,7 +48,7 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
-from criteria import noise_scale, samples
+from criteria import RATE, noise_scale, samples
 
 from excite_cli.config import NoiseConfig
 from excite_cli.config_file import load_problem
@@ -68,11 +69,12 @@ def designed(excitation, prior: np.ndarray, seed: int) -> np.ndarray:
         return run_sequence(excitation, 1, seed, prior=prior, engine=engine)[0].alpha
 
 
-def recorded(excitation, alpha: np.ndarray, relative: bool, seed: int) -> tuple:
-    """The recording of α: base regressor Y (T·n_rows, b), true torques (T, n_rows), their true noise
-    σ (T, n_rows) and one draw of the measured torques (T, n_rows)."""
+def recorded(excitation, alpha: np.ndarray, noise: tuple, seed: int) -> tuple:
+    """The recording of α under the true ``noise`` (absolute (n_rows,), ρ: bench/criteria.noise_scale):
+    base regressor Y (T·n_rows, b), true torques (T, n_rows), their true noise σ (T, n_rows) and one draw
+    of the measured torques (T, n_rows)."""
     Y, tau = samples(excitation, alpha)
-    absolute, rho = noise_scale(excitation, relative)
+    absolute, rho = noise
     sigma = np.sqrt(absolute**2 + (rho * tau) ** 2)
     return Y, tau, sigma, tau + np.random.default_rng(seed).normal(0.0, 1.0, tau.shape) * sigma
 
@@ -92,21 +94,21 @@ def identified(Y: np.ndarray, measured: np.ndarray, n: int) -> tuple[np.ndarray,
     return np.sqrt((residual**2).mean(axis=0)), levels, predicted
 
 
-def second_designs(problem, excitation, record: tuple, fitted: tuple, relative: bool, seed: int):
+def second_designs(problem, excitation, record: tuple, fitted: tuple, noise: tuple, seed: int):
     """The second trajectory designed ``measured``, ``sigma only`` and ``told the truth`` (module docstring)."""
     Y, tau, sigma, _ = record
     rms, levels, predicted = fitted
     n, rows = excitation.robot.n_joints, excitation.robot.n_rows
-    scale = np.sqrt(1.0 / (problem.trajectory.cost_period * 100.0))  # MeasuredPrior.time_scale at 100 Hz
     out = {}
-    level = np.array([[x.absolute, x.relative] for x in levels])
+    level = np.array([[x.absolute, x.relative, x.absolute_upper] for x in levels])
     for name, lab in (("measured", level), ("sigma only", None)):
-        measured = MeasuredPrior(list(excitation.robot.joint_names), rms, 100.0, lab)
+        measured = MeasuredPrior(list(excitation.robot.joint_names), rms, RATE, lab)
+        scale = measured.time_scale(problem.trajectory.cost_period)
         weights = np.ones((len(tau), rows))  # a floating base's wrench rows weigh σ̄
         weights[:, -n:] = measured.row_weights(predicted.ravel()).reshape(-1, n)  # as stored.prior weighs a report's
         prior = Y * (weights.ravel() * scale)[:, None]
         out[name] = designed(replace(excitation, spec=replace(excitation.spec, measured=measured)), prior, seed)
-    absolute, rho = noise_scale(excitation, relative)
+    absolute, rho = noise
     joints = problem.robot.active_joints
     told = problem.model_copy(deep=True)
     told.noise = NoiseConfig(absolute=dict(zip(joints, absolute[-n:].tolist())), relative=rho)
@@ -117,13 +119,13 @@ def second_designs(problem, excitation, record: tuple, fitted: tuple, relative: 
     return out
 
 
-def expected_error(excitation, record: tuple, alpha: np.ndarray, relative: bool) -> float:
+def expected_error(excitation, record: tuple, alpha: np.ndarray, noise: tuple) -> float:
     """RMS over the identifiable directions of the scaled parameter error of weighted least squares on
     the recording and α's (sampled as the recording), under the true noise (bench/criteria.py's
     "predicted")."""
     Y1, _, sigma1, _ = record
     Y2, tau2 = samples(excitation, alpha)
-    absolute, rho = noise_scale(excitation, relative)
+    absolute, rho = noise
     sigma2 = np.sqrt(absolute**2 + (rho * tau2) ** 2)
     weighted = np.vstack([Y1 / sigma1.ravel()[:, None], Y2 / sigma2.ravel()[:, None]])
     inverse_frame = np.linalg.inv(excitation.scaled_frame)
@@ -143,16 +145,16 @@ def main() -> None:
         excitation = build_excitation(problem)
         n = excitation.robot.n_joints
         ratios = {name: [] for name in DESIGNS[:2]}
+        noises = {truth: noise_scale(excitation, truth == "relative") for truth in args.truths}
         for seed in args.seeds:
             problem.optimizer.seed = seed
             first = designed(excitation, None, seed)
-            for relative in [t == "relative" for t in args.truths]:
-                truth = "relative" if relative else "absolute"
-                record = recorded(excitation, first, relative, seed)
+            for truth in args.truths:
+                record = recorded(excitation, first, noises[truth], seed)
                 fitted = identified(record[0], record[3], n)
                 levels = fitted[1]
-                second = second_designs(problem, excitation, record, fitted, relative, seed + 1000)
-                errors = {name: expected_error(excitation, record, a, relative) for name, a in second.items()}
+                second = second_designs(problem, excitation, record, fitted, noises[truth], seed + 1000)
+                errors = {name: expected_error(excitation, record, a, noises[truth]) for name, a in second.items()}
                 for name in ratios:
                     ratios[name].append(errors[name] / errors["told the truth"])
                 rho = np.array([x.relative for x in levels])

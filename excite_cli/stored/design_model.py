@@ -111,9 +111,9 @@ class MeasuredPrior:
         sigma: (n,) σ_j [Nm]: each joint's RMS torque error of the reported model on the validation
             data (``rms_after``), what the fit leaves unexplained, noise included.
         rate: the report's decimated sample rate [Hz]: regressor rows per second and joint.
-        level: (n, 2) each joint's fitted noise of its rows, a [Nm] and ρ [1] of σ² = a² + (ρτ)²
-            (:mod:`~excite_cli.identification.fitting.noise_level`), NaN for a dead channel; None: the
-            report has none (its σ_j alone weigh the rows).
+        level: (n, 3) each joint's fitted noise of its rows, a [Nm] and ρ [1] of σ² = a² + (ρτ)² and a's
+            95 % upper bound [Nm] (:mod:`~excite_cli.identification.fitting.noise_level`), NaN for a
+            dead channel; None: the report has none (its σ_j alone weigh the rows).
     """
 
     joints: list[str]
@@ -138,13 +138,16 @@ class MeasuredPrior:
 
     def noise_parts(self) -> tuple[np.ndarray, np.ndarray]:
         """(n,) a_j [Nm] and (n,) ρ_j [1] of each joint's rows' noise σ² = a² + (ρτ)²: the fitted
-        ``level``, a floored at :data:`MEASURED_FLOOR` σ_j; σ_j and ρ = 0 on a dead channel or without
-        a fitted level."""
+        ``level`` with a's upper bound for a (the largest absolute part the recording cannot rule out: a
+        fitted a is poorly determined, often 0, where the growing part dominates, and would trust the
+        joint's small-torque rows more than the data support; bench/noise_loop.py), floored at
+        :data:`MEASURED_FLOOR` σ_j; σ_j and ρ = 0 on a dead channel or without a fitted level."""
         if self.level is None:
             return self.floored, np.zeros(len(self.joints))
         fitted = np.isfinite(self.level).all(axis=1)  # a dead channel keeps its σ_j
-        a = np.maximum(np.nan_to_num(self.level[:, 0]), MEASURED_FLOOR * self.floored)
-        return np.where(fitted, a, self.floored), np.where(fitted, np.nan_to_num(self.level[:, 1]), 0.0)
+        level = np.nan_to_num(self.level)
+        a = np.maximum(level[:, 2], MEASURED_FLOOR * self.floored)
+        return np.where(fitted, a, self.floored), np.where(fitted, level[:, 1], 0.0)
 
     def row_weights(self, predicted: np.ndarray) -> np.ndarray:
         """σ̄ / √(a_j² + ρ_j² τ̂²) (M,) of the report's M rows (instants one after another, n joints
@@ -209,10 +212,11 @@ def measured_prior_of(report: StoredReport, path: Path) -> MeasuredPrior:
             f"a positive rate up to {HIGHEST_RATE:g} Hz",
         )
     level = report.noise_level
-    if level is not None and not (np.all(np.isnan(level) | ((level >= 0) & (level <= [LARGEST_ERROR, 10.0])))):
+    largest = [LARGEST_ERROR, 10.0, LARGEST_ERROR]  # a, ρ, a's upper bound
+    if level is not None and not (np.all(np.isnan(level) | ((level >= 0) & (level <= largest)))):
         raise ExciteError(
             "sequence.prior",
-            f"{path}: /identification/noise_level must give each joint a in 0 to {LARGEST_ERROR:g} Nm and ρ in 0 "
-            "to 10 (NaN for a dead channel) (damaged?)",
+            f"{path}: /identification/noise_level must give each joint a and its bound in 0 to {LARGEST_ERROR:g} "
+            "Nm and ρ in 0 to 10 (NaN for a dead channel) (damaged?)",
         )
     return MeasuredPrior(joints, sigma, rate, level if level is not None and np.isfinite(level).any() else None)

@@ -37,9 +37,10 @@ class StoredReport:
         rms_after: (n,) [Nm] each joint's RMS error of the reported model on the validation data
             (``/identification/rms_after``), or None (a report of an earlier excite).
         rate: its rows' sample rate [Hz] (``/regressor`` attribute ``sample_rate_Hz``), or None (the same).
-        noise_level: (n, 2) each joint's fitted noise (a [Nm], ρ [1]) of its rows, at the report's rate
-            (``/identification/noise_level`` times √ of its ``noise_gain``), NaN for a dead channel, or
-            None (a report of an earlier excite, or fit data too short to fit it).
+        noise_level: (n, 3) each joint's fitted noise (a [Nm], ρ [1], a's 95 % upper bound [Nm]) of its
+            rows, at the report's rate (``/identification/noise_level`` times √ of its ``noise_gain``; a
+            table without ``absolute_upper``: a), NaN for a dead channel, or None (a report of an earlier
+            excite, or fit data too short to fit it).
         rotors: the last ``rotors`` of ``terms`` are the consistent fit's rotors with columns of their own
             (armature the effect search did not choose:
             :mod:`~excite_cli.identification.choice.consistent_model`), part of what it predicts.
@@ -125,7 +126,8 @@ def report_in(f, path: Path, field: str) -> StoredReport | None:
 
 
 def _noise_level(g, n: int, path: Path, field: str) -> np.ndarray | None:
-    """(n, 2) a [Nm], ρ [1] of the report's rows (at its rate: the fit times √noise_gain), or None.
+    """(n, 3) a [Nm], ρ [1], a's upper bound [Nm] of the report's rows (at its rate: the fit times
+    √noise_gain; a for a table without ``absolute_upper``), or None.
 
     Raises:
         ExciteError: a table without a row per joint or its fields, or a noise gain outside (0, 1].
@@ -140,7 +142,8 @@ def _noise_level(g, n: int, path: Path, field: str) -> np.ndarray | None:
         )
     if not 0.0 < gain <= 1.0:
         raise ExciteError(field, f"{path}: /identification/noise_level noise_gain is {gain:g}", gain, "0 < gain ≤ 1")
-    return np.column_stack([rows["absolute"], rows["relative"]]).astype(float) * np.sqrt(gain)
+    upper = rows["absolute_upper"] if "absolute_upper" in rows.dtype.names else rows["absolute"]
+    return np.column_stack([rows["absolute"], rows["relative"], upper]).astype(float) * np.sqrt(gain)
 
 
 def _terms(rows: np.ndarray, coupling: np.ndarray | None) -> list[StoredTerm]:

@@ -18,7 +18,7 @@ def _text(tables) -> str:
 
 def test_each_joints_noise_and_the_kind_the_data_prefer_are_printed(simulated_identification):
     report = simulated_identification[1]
-    levels = [NoiseLevel(0.05, 0.004, 0.0, 0.0), NoiseLevel(0.01, 0.001, 0.02, 0.001)] + [None] * 5
+    levels = [NoiseLevel(0.05, 0.004, 0.0, 0.0, 0.06), NoiseLevel(0.01, 0.001, 0.02, 0.001, 0.012)] + [None] * 5
     text = _text(noise_table(replace(report, noise_levels=levels)))
     lines = {line.split("│")[1].strip(): line for line in text.splitlines() if line.count("│") > 2}
     assert "0.05 ± 0.004" in lines["panda_joint1"] and lines["panda_joint1"].rstrip("│ ").endswith("absolute")

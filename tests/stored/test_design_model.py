@@ -123,7 +123,7 @@ def test_a_reports_rows_weighed_by_its_measured_noise_have_equal_noise():
     0.01 Nm floor) times the rows' weights: the same variance σ̄² at small and at large torques (within
     5 % over 20000 draws per bin), as weighted least squares needs; σ_j alone leaves them 10× apart."""
     rng = np.random.default_rng(0)
-    level = np.array([[0.01, 0.02], [0.01, 0.02]])
+    level = np.array([[0.01, 0.02, 0.01], [0.01, 0.02, 0.01]])
     prior = MeasuredPrior(["a", "b"], np.array([0.05, 0.05]), 200.0, level)
     tau = np.repeat([0.0, 5.0], 40000)  # two joints, instants one after another: 20000 draws per bin and joint
     residual = rng.normal(0.0, 1.0, tau.size) * np.sqrt(0.01**2 + (0.02 * tau) ** 2)
@@ -137,7 +137,7 @@ def test_a_reports_rows_weighed_by_its_measured_noise_have_equal_noise():
 def test_optimize_with_the_report_as_prior_weighs_both_the_prior_and_its_own_rows(report_file, tmp_path):
     """`excite optimize CONFIG --prior REPORT.h5`: the report's rows enter weighted by σ̄/σ_j and the time
     rule, and the new trajectory's rows by the noise the report fitted, σ̄/√(a_j² + ρ_j² τ²) at the
-    report's rate (the noise the next run will see), and optimize says so."""
+    report's rate (the noise the next run will see; a_j the fitted a's upper bound), and optimize says so."""
     out = tmp_path / "next.h5"
     run = CliRunner().invoke(
         app, ["optimize", str(CONFIGS / "smoke.yaml"), "--prior", str(report_file), "-o", str(out), "-k", "1"]
@@ -150,7 +150,7 @@ def test_optimize_with_the_report_as_prior_weighs_both_the_prior_and_its_own_row
     with h5py.File(report_file) as f:
         table = f["identification/noise_level"]
         gain = float(table.attrs["noise_gain"])
-        level = np.column_stack([table["absolute"], table["relative"]]) * np.sqrt(gain)
+        level = np.column_stack([table["absolute"], table["relative"], table["absolute_upper"]]) * np.sqrt(gain)
     assert 0 < gain < 1  # the low-pass keeps a share of white noise
     problem = load_problem(CONFIGS / "smoke.yaml")
     excitation = build_excitation(problem)
@@ -159,7 +159,8 @@ def test_optimize_with_the_report_as_prior_weighs_both_the_prior_and_its_own_row
     plain = excitation.criterion().regressor(alpha)
     robot = excitation.robot
     tau = np.array([robot.torques(*x) for x in zip(*excitation.cost_basis.evaluate(alpha))]).ravel()  # RNEA
-    sigma = np.tile(np.maximum(level[:, 0], MEASURED_FLOOR * measured.floored), tau.size // 7)
+    floor = np.maximum(level[:, 2], MEASURED_FLOOR * measured.floored)
+    sigma = np.tile(floor, tau.size // 7)
     rho = np.tile(level[:, 1], tau.size // 7)
     weights = measured.noise / np.sqrt(sigma**2 + (rho * tau) ** 2)
     np.testing.assert_allclose(own, plain * weights[:, None], rtol=1e-9, atol=1e-12)
@@ -267,8 +268,8 @@ def _noise(f, column, value):
         (lambda f: f["regressor"].attrs.__setitem__("sample_rate_Hz", 0.0), "sample_rate_Hz is 0"),
         (lambda f: f["identification/rms_after"].parent.pop("rms_after"), "report of an earlier excite"),
         (lambda f: f["regressor"].attrs.__delitem__("sample_rate_Hz"), "report of an earlier excite"),
-        (lambda f: _noise(f, "relative", -0.01), "noise_level must give each joint a in 0 to 1e.06 Nm"),
-        (lambda f: _noise(f, "absolute", np.inf), "noise_level must give each joint a in 0 to 1e.06 Nm"),
+        (lambda f: _noise(f, "relative", -0.01), "noise_level must give each joint a and its bound in 0 to 1e.06 Nm"),
+        (lambda f: _noise(f, "absolute", np.inf), "noise_level must give each joint a and its bound in 0 to 1e.06 Nm"),
         (lambda f: f["identification/noise_level"].attrs.__setitem__("noise_gain", 0.0), "noise_gain is 0"),
         (lambda f: _replace(f, "identification/noise_level", np.ones(7)), "needs a row per joint"),
     ],

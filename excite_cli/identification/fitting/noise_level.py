@@ -16,6 +16,12 @@ Their standard deviations are from a delete-one-block jackknife over :data:`BLOC
 blocks of the fit data (Künsch 1989: contiguous blocks keep the residual's correlation in
 time, which a per-sample Fisher information would ignore). The data prefer noise growing with the
 torque when ρ is at least :data:`CLEAR` of its standard deviations above zero, else absolute noise.
+
+Where the growing part dominates, a is poorly determined and often fitted at 0, where the jackknife
+has no spread either. What the next design may trust is the largest a the data cannot rule out: a's
+one-sided 95 % upper bound from the profile likelihood (ρ re-fitted at each a; Wilks: −2 log of the
+likelihood ratio at most :data:`UPPER_BOUND`, Venzon & Moolgavkar 1988), the samples taken as
+independent.
 """
 
 from __future__ import annotations
@@ -29,6 +35,8 @@ from scipy import optimize, signal
 BLOCKS = 10
 #: Standard deviations above zero from which ρ counts as present.
 CLEAR = 3.0
+#: −2 log likelihood ratio of a's one-sided 95 % upper bound: the χ²₁ quantile at 0.90.
+UPPER_BOUND = 2.706
 
 
 @dataclass(frozen=True)
@@ -38,12 +46,14 @@ class NoiseLevel:
     Attributes:
         absolute: a [Nm]; absolute_std: its jackknife standard deviation [Nm].
         relative: ρ [1]; relative_std: its jackknife standard deviation [1].
+        absolute_upper: a's one-sided 95 % profile-likelihood upper bound [Nm] (≥ a).
     """
 
     absolute: float
     absolute_std: float
     relative: float
     relative_std: float
+    absolute_upper: float
 
     @property
     def preferred(self) -> str:
@@ -58,21 +68,51 @@ def noise_gain(sos: np.ndarray) -> float:
     return float(np.mean(np.abs(h) ** 4))
 
 
-def _likelihood_fit(r: np.ndarray, tau: np.ndarray) -> tuple[float, float]:
-    """(a², ρ²) maximizing the Gaussian likelihood of residuals r (N,) of variance a² + ρ²τ², on the
-    scale of r's RMS (a² and ρ² ≥ 0; the moment fit of r² on [1, τ²] starts it)."""
+def _scaled(r: np.ndarray, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray, float, float]:
+    """u = (r/s)², t² = (τ/l)² on the scales s, l of r's and τ's RMS, and s, l."""
     scale, level = float(np.sqrt(np.mean(r**2))) or 1.0, float(np.sqrt(np.mean(tau**2))) or 1.0
-    u, t2 = (r / scale) ** 2, (tau / level) ** 2
+    return (r / scale) ** 2, (tau / level) ** 2, scale, level
 
-    def negative_log_likelihood(v: np.ndarray) -> tuple[float, np.ndarray]:
-        var = np.maximum(v[0] + v[1] * t2, 1e-12)
-        d = 1.0 / var - u / var**2  # ∂/∂var of log var + u / var
-        return float(np.sum(np.log(var) + u / var)), np.array([d.sum(), (d * t2).sum()])
 
+def _deviance(v: np.ndarray, u: np.ndarray, t2: np.ndarray) -> tuple[float, np.ndarray]:
+    """−2 log likelihood (less a constant) of scaled residuals u of variance v₀ + v₁ t², and its gradient."""
+    var = np.maximum(v[0] + v[1] * t2, 1e-12)
+    d = 1.0 / var - u / var**2  # ∂/∂var of log var + u / var
+    return float(np.sum(np.log(var) + u / var)), np.array([d.sum(), (d * t2).sum()])
+
+
+def _scaled_fit(u: np.ndarray, t2: np.ndarray) -> tuple[np.ndarray, float]:
+    """The scaled (a², ρ²) ≥ 0 of largest likelihood (the moment fit of u on [1, t²] starts it) and its deviance."""
     start = np.linalg.lstsq(np.column_stack([np.ones_like(t2), t2]), u, rcond=None)[0]
     start = np.maximum(start, 1e-3 * max(start.max(), 1.0))
-    best = optimize.minimize(negative_log_likelihood, start, jac=True, method="L-BFGS-B", bounds=[(0, None)] * 2)
-    return float(best.x[0] * scale**2), float(best.x[1] * (scale / level) ** 2)
+    best = optimize.minimize(_deviance, start, (u, t2), jac=True, method="L-BFGS-B", bounds=[(0, None)] * 2)
+    return best.x, float(best.fun)
+
+
+def _likelihood_fit(r: np.ndarray, tau: np.ndarray) -> tuple[float, float]:
+    """(a², ρ²) maximizing the Gaussian likelihood of residuals r (N,) of variance a² + ρ²τ² (both ≥ 0)."""
+    u, t2, scale, level = _scaled(r, tau)
+    x, _ = _scaled_fit(u, t2)
+    return float(x[0] * scale**2), float(x[1] * (scale / level) ** 2)
+
+
+def _upper_bound(r: np.ndarray, tau: np.ndarray) -> float:
+    """a's one-sided 95 % profile-likelihood upper bound [Nm]: the a above the fitted one at which ρ
+    re-fitted leaves a deviance :data:`UPPER_BOUND` above the best."""
+    u, t2, scale, _ = _scaled(r, tau)
+    x, best = _scaled_fit(u, t2)
+    largest = 10.0 * u.mean() / max(t2.mean(), 1e-12)  # ρ² beyond which the variance exceeds 10 × r's
+
+    def excess(a2: float) -> float:
+        profile = optimize.minimize_scalar(
+            lambda rho2: _deviance(np.array([a2, rho2]), u, t2)[0], bounds=(0.0, largest), method="bounded"
+        )
+        return min(profile.fun, _deviance(np.array([a2, 0.0]), u, t2)[0]) - best - UPPER_BOUND
+
+    high = max(x[0], 1e-3)
+    while excess(high) < 0:
+        high *= 2.0
+    return float(np.sqrt(optimize.brentq(excess, x[0], high, xtol=1e-6)) * scale)
 
 
 def fit_noise_level(residual: np.ndarray, torque: np.ndarray, gain: np.ndarray) -> NoiseLevel:
@@ -94,4 +134,4 @@ def fit_noise_level(residual: np.ndarray, torque: np.ndarray, gain: np.ndarray) 
     keep = [np.r_[0:lo, hi : r.size] for lo, hi in zip(edges[:-1], edges[1:])]
     left_out = np.sqrt(np.array([_likelihood_fit(r[k], torque[k]) for k in keep]))
     std = np.sqrt((BLOCKS - 1) / BLOCKS * ((left_out - left_out.mean(axis=0)) ** 2).sum(axis=0))
-    return NoiseLevel(float(np.sqrt(a2)), float(std[0]), float(np.sqrt(rho2)), float(std[1]))
+    return NoiseLevel(float(np.sqrt(a2)), float(std[0]), float(np.sqrt(rho2)), float(std[1]), _upper_bound(r, torque))

@@ -183,11 +183,12 @@ def _write_validation(g: h5py.Group, report: Report) -> None:
 
 def _write_noise_levels(g: h5py.Group, report: Report) -> None:
     """``/identification/noise_level``: each joint's σ² = a² + (ρτ)² fitted to the residual on the fit data
-    (NaN for a dead channel), at the recording's own rate; attribute ``noise_gain`` the median share g of
-    white noise's variance the low-pass leaves (a and ρ times √g: the noise of the report's rows)."""
+    (NaN for a dead channel), at the recording's own rate, a's 95 % upper bound beside them; attribute
+    ``noise_gain`` the median share g of white noise's variance the low-pass leaves (a and ρ times √g:
+    the noise of the report's rows)."""
     if not report.noise_levels:
         return
-    names = ("absolute", "absolute_std", "relative", "relative_std")
+    names = ("absolute", "absolute_std", "relative", "relative_std", "absolute_upper")
     table = np.zeros(len(report.joints), dtype=[("joint", STR), *((n, "f8") for n in names), ("preferred", STR)])
     for row, joint, level in zip(table, report.joints, report.noise_levels):
         row["joint"] = joint
@@ -195,7 +196,7 @@ def _write_noise_levels(g: h5py.Group, report: Report) -> None:
             row[n] = np.nan if level is None else getattr(level, n)
         row["preferred"] = "" if level is None else level.preferred
     d = g.create_dataset("noise_level", data=table)
-    d.attrs["units"] = "absolute, absolute_std in Nm; relative, relative_std in 1 (of the torque)"
+    d.attrs["units"] = "absolute, absolute_std, absolute_upper in Nm; relative, relative_std in 1 (of the torque)"
     d.attrs["noise_gain"] = report.noise_gain
 
 
