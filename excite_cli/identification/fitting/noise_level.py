@@ -96,11 +96,10 @@ def _likelihood_fit(r: np.ndarray, tau: np.ndarray) -> tuple[float, float]:
     return float(x[0] * scale**2), float(x[1] * (scale / level) ** 2)
 
 
-def _upper_bound(r: np.ndarray, tau: np.ndarray) -> float:
-    """a's one-sided 95 % profile-likelihood upper bound [Nm]: the a above the fitted one at which ρ
-    re-fitted leaves a deviance :data:`UPPER_BOUND` above the best."""
-    u, t2, scale, _ = _scaled(r, tau)
-    x, best = _scaled_fit(u, t2)
+def _upper_bound(u: np.ndarray, t2: np.ndarray, x: np.ndarray, best: float) -> float:
+    """The scaled a²'s one-sided 95 % profile-likelihood upper bound: the a² above the fitted x₀ (x, of
+    deviance ``best``: :func:`_scaled_fit`) at which ρ re-fitted leaves a deviance :data:`UPPER_BOUND`
+    above the best."""
     largest = 10.0 * u.mean() / max(t2.mean(), 1e-12)  # ρ² beyond which the variance exceeds 10 × r's
 
     def excess(a2: float) -> float:
@@ -112,11 +111,11 @@ def _upper_bound(r: np.ndarray, tau: np.ndarray) -> float:
     high = max(x[0], 1e-3)
     while excess(high) < 0:
         high *= 2.0
-    return float(np.sqrt(optimize.brentq(excess, x[0], high, xtol=1e-6)) * scale)
+    return float(optimize.brentq(excess, x[0], high, xtol=1e-6))
 
 
 def fit_noise_level(residual: np.ndarray, torque: np.ndarray, gain: np.ndarray) -> NoiseLevel:
-    """a, ρ and their standard deviations of one joint.
+    """a, ρ and their standard deviations of one joint, and a's upper bound.
 
     Args:
         residual: (N,) [Nm] measured minus predicted torque on the fit data, in time order.
@@ -129,9 +128,12 @@ def fit_noise_level(residual: np.ndarray, torque: np.ndarray, gain: np.ndarray) 
     if residual.size < 2 * BLOCKS:
         raise ValueError(f"{residual.size} instants; the jackknife needs at least {2 * BLOCKS}")
     r = residual / np.sqrt(gain)
-    a2, rho2 = _likelihood_fit(r, torque)
+    u, t2, scale, level = _scaled(r, torque)
+    x, best = _scaled_fit(u, t2)
+    a2, rho2 = x[0] * scale**2, x[1] * (scale / level) ** 2
     edges = np.linspace(0, r.size, BLOCKS + 1).astype(int)
     keep = [np.r_[0:lo, hi : r.size] for lo, hi in zip(edges[:-1], edges[1:])]
     left_out = np.sqrt(np.array([_likelihood_fit(r[k], torque[k]) for k in keep]))
     std = np.sqrt((BLOCKS - 1) / BLOCKS * ((left_out - left_out.mean(axis=0)) ** 2).sum(axis=0))
-    return NoiseLevel(float(np.sqrt(a2)), float(std[0]), float(np.sqrt(rho2)), float(std[1]), _upper_bound(r, torque))
+    upper = float(np.sqrt(_upper_bound(u, t2, x, best)) * scale)
+    return NoiseLevel(float(np.sqrt(a2)), float(std[0]), float(np.sqrt(rho2)), float(std[1]), upper)
