@@ -22,6 +22,7 @@ def test_each_joints_noise_and_the_kind_the_data_prefer_are_printed(simulated_id
     text = _text(noise_table(replace(report, noise_levels=levels)))
     lines = {line.split("│")[1].strip(): line for line in text.splitlines() if line.count("│") > 2}
     assert "0.05 ± 0.004" in lines["panda_joint1"] and lines["panda_joint1"].rstrip("│ ").endswith("absolute")
+    assert "0.06" in lines["panda_joint1"].split("│")[3] and "0.012" in lines["panda_joint2"].split("│")[3]
     assert "2 ± 0.1" in lines["panda_joint2"] and "growing with the torque" in lines["panda_joint2"]
     assert "no signal" in lines["panda_joint3"]
     assert _text(noise_table(replace(report, noise_levels=[]))) == ""
