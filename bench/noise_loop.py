@@ -138,12 +138,11 @@ def expected_error(excitation, record: tuple, alpha: np.ndarray, noise: tuple) -
     return float(np.sqrt(np.trace(covariance) / covariance.shape[0]))
 
 
-def report(config: Path, excitation, record: tuple, truth: str, seed: int, starts: int, problem) -> dict:
-    """Identify the recording, design the second trajectory three ways from each of ``starts`` optimizer
-    starts (seeds seed + 1000, + 2000, ...), print a line per start; each design's mean expected error
-    over the starts."""
+def report(config: Path, excitation, record: tuple, noise: tuple, truth: str, seed: int, starts: int, problem) -> dict:
+    """Identify the recording (made under the true ``noise``), design the second trajectory three ways from
+    each of ``starts`` optimizer starts (seeds seed + 1000, + 2000, ...), print a line per start; each
+    design's mean expected error over the starts."""
     n = excitation.robot.n_joints
-    noise = record[4]
     fitted = identified(record[0], record[3], n)
     levels = fitted[1]
     rho = np.array([x.relative for x in levels])
@@ -153,8 +152,8 @@ def report(config: Path, excitation, record: tuple, truth: str, seed: int, start
     )
     errors = {name: [] for name in DESIGNS}
     for start in range(starts):
-        second = second_designs(problem, excitation, record[:4], fitted, noise, seed + 1000 * (start + 1))
-        e = {name: expected_error(excitation, record[:4], a, noise) for name, a in second.items()}
+        second = second_designs(problem, excitation, record, fitted, noise, seed + 1000 * (start + 1))
+        e = {name: expected_error(excitation, record, a, noise) for name, a in second.items()}
         for name in DESIGNS:
             errors[name].append(e[name])
         print(
@@ -182,8 +181,8 @@ def main() -> None:
             problem.optimizer.seed = seed
             first = designed(excitation, None, seed)
             for truth in args.truths:
-                record = (*recorded(excitation, first, noises[truth], seed), noises[truth])
-                mean = report(config, excitation, record, truth, seed, args.starts, problem)
+                record = recorded(excitation, first, noises[truth], seed)
+                mean = report(config, excitation, record, noises[truth], truth, seed, args.starts, problem)
                 for name in ratios:
                     ratios[name].append(mean[name] / mean["told the truth"])
                 if args.starts > 1:
