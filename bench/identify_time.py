@@ -1,15 +1,17 @@
 """Time of `excite identify` on many recordings: a simulated UR5 (6 joints; excite's simulator, random
-feasible trajectories of configs/ur5.yaml, each distinct, 10 s at 200 Hz, Coulomb 0.6 N·m and
-viscous 0.4 N·m·s/rad friction on every joint, 0.05 N·m torque and 0.2 mrad encoder noise), N
-recordings fitted with nothing declared (the default search) and one more for validation,
-identified in a child process: its wall time, its CPU time (user + system, every thread) and the
-report's mean validation error, so that a change of speed shows whether the figures moved.
+feasible trajectories of configs/ur5.yaml, each distinct, 10 s at 200 Hz per period, 0.2 mrad encoder
+noise; truth ``lab`` (default): Coulomb 0.6 N·m and viscous 0.4 N·m·s/rad friction on every joint,
+Stribeck friction on two joints, armature, offsets on two joints, torque noise 0.05 N·m + 1 % of the
+torque; ``friction``: the friction and 0.05 N·m of noise only), N recordings fitted with nothing
+declared (the default search) and one more for validation, identified in a child process: its wall
+time, its CPU time (user + system, every thread) and the report's mean validation error, so that a
+change of speed shows whether the figures moved.
 
 `--code DIR` runs another checkout's `excite` (its package on the path) on the same files, so the
 same recordings can be timed at an earlier commit (`git worktree add /tmp/old REV`).
 
-Run: `.venv/bin/python bench/identify_time.py [--recordings 16] [--seed 0] [--code DIR]`.
-Prints one line; asserts nothing.
+Run: `.venv/bin/python bench/identify_time.py [--recordings 16] [--seed 0] [--truth lab|friction]
+[--periods 1] [--code DIR]`. Prints one line; asserts nothing.
 """
 
 from __future__ import annotations
@@ -31,6 +33,7 @@ import h5py
 import numpy as np
 import yaml
 
+from excite_cli.config import RobotConfig
 from excite_cli.config_file import load_problem
 from excite_cli.design.resolve import build_excitation
 from excite_cli.identification.simulation_config import SimulationConfig
@@ -56,8 +59,8 @@ TRUTHS = {
 }
 
 
-def recordings(folder: Path, count: int, seed: int, truth: str, periods: int) -> tuple[list[Path], list[str]]:
-    """``count`` distinct random feasible trajectories of :data:`CONFIG`, simulated; and the joints."""
+def recordings(folder: Path, count: int, seed: int, truth: str, periods: int) -> tuple[list[Path], RobotConfig]:
+    """``count`` distinct random feasible trajectories of :data:`CONFIG`, simulated; and its robot."""
     problem = load_problem(CONFIG)
     excitation = build_excitation(problem)
     rng = np.random.default_rng(1000 + seed)
@@ -66,13 +69,13 @@ def recordings(folder: Path, count: int, seed: int, truth: str, periods: int) ->
     target = folder / "motions.h5"
     write_result(target, excitation, results, seed, {"method": "random_selection"})
     sim = SimulationConfig(sample_rate=200, periods=periods, position_noise=2e-4, seed=seed, **TRUTHS[truth])
-    return simulate_runs(target, sim, folder / "runs"), list(problem.robot.active_joints)
+    return simulate_runs(target, sim, folder / "runs"), problem.robot
 
 
-def identify(folder: Path, runs: list[Path], joints: list[str], code: Path) -> tuple[float, float, float]:
+def identify(folder: Path, runs: list[Path], robot: RobotConfig, code: Path) -> tuple[float, float, float]:
     """Wall and CPU time [s] of `excite identify` (``code``'s package) on ``runs`` (the last one
-    validation), and the report's mean relative validation error [%]."""
-    robot = load_problem(CONFIG).robot
+    validation) of ``robot``, and the report's mean relative validation error [%]."""
+    joints = list(robot.active_joints)
     config = {
         "robot": {"urdf": robot.urdf, "source": robot.source, "active_joints": joints},
         "data": {
@@ -112,8 +115,8 @@ def main() -> None:
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
-        runs, joints = recordings(folder, args.recordings + 1, args.seed, args.truth, args.periods)
-        wall, cpu, error = identify(folder, runs, joints, args.code.resolve())
+        runs, robot = recordings(folder, args.recordings + 1, args.seed, args.truth, args.periods)
+        wall, cpu, error = identify(folder, runs, robot, args.code.resolve())
     print(
         f"{args.recordings} recordings, seed {args.seed}, {args.code}: wall {wall:.1f} s, CPU {cpu:.1f} s, "
         f"validation error {error:.4f} %"
