@@ -191,7 +191,7 @@ def _selection_tables(report: Report) -> list[Table | str]:
     )
     order = {t: k + 1 for k, t in enumerate(sel.terms)}
     b, between = len(report.base_names), sel.fit.between
-    spread = ("std, trajectories",) if between is not None else ()
+    spread = (f"std, {sel.fit.spread_by}",) if between is not None else ()
     effects = titled_table(
         "Effects, in the order they were added (declared ones first)",
         ("#", "effect", "joint", "shape [rad/s]", "coefficient", "least squares", "std")
@@ -234,7 +234,7 @@ def _selection_tables(report: Report) -> list[Table | str]:
         if sel.absorbed
         else []
     )
-    stds = [STDS + (f" {TRAJECTORIES.format(count=sel.fit.trajectories)}" if spread else "")]
+    stds = [STDS + (f" {SPREADS[sel.fit.spread_by].format(count=sel.fit.groups)}" if spread else "")]
     return [ladder, *search(report), effects, *absorbed, *_guarded(report), params, *stds, *_unresolved(report)]
 
 
@@ -243,10 +243,13 @@ STDS = (
     "std: of the noise the fit residuals show, the model taken as right (an effect the model lacks makes "
     "recordings of one trajectory agree better, and distinct trajectories worse, than it says)"
 )
-TRAJECTORIES = (
-    "std, trajectories: the spread between the {count} distinct trajectories fitted, the model's error "
-    "included (recordings of one trajectory count once: data.runs[].trajectory)"
-)
+SPREADS = {
+    "trajectories": "std, trajectories: the spread between the {count} distinct trajectories fitted, the model's "
+    "error included (recordings of one trajectory count once: data.runs[].trajectory)",
+    "time blocks": "std, time blocks: the spread between the {count} time blocks of the folds (fewer than 3 "
+    "distinct trajectories), the model's error within this motion and any drift included; another motion "
+    "can differ by more",
+}
 
 
 def _std(value: float) -> str:

@@ -34,9 +34,10 @@ class Fit:
         sigma: (n,) per-joint residual standard deviation [Nm] of this fit.
         held: (p,) the unknowns held at their bound 0 (friction, armature: ``NONNEGATIVE``), which have
             no two-sided standard deviation; none when empty.
-        between: (p,) the standard deviations over the distinct trajectories fitted, model error
+        between: (p,) the standard deviations over the groups of the data fitted, model error
             included (:mod:`~excite_cli.identification.fitting.model_error`; NaN where undefined), or
-            None: fewer than 3 trajectories, or not computed; trajectories: how many there are.
+            None: not computed; spread_by: the groups, ``trajectories`` (3 or more distinct ones) or
+            ``time blocks`` (fewer); groups: how many there are.
     """
 
     x: np.ndarray
@@ -44,7 +45,8 @@ class Fit:
     sigma: np.ndarray
     held: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
     between: np.ndarray | None = None
-    trajectories: int = 0
+    spread_by: str = ""
+    groups: int = 0
 
 
 def least_squares(

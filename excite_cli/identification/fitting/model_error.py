@@ -19,7 +19,19 @@ Bell & McCaffrey 2002; Imbens & Kolesár, Rev. Econ. Stat. 2016): a median 0.90�
 parameters (3 seeds). Its
 standard deviations come from G − 1 degrees of freedom: with 3 or 4 trajectories each is known to
 within a factor of about 1.5 either way; the recordings of one trajectory (recorded twice) are one
-cluster, never two."""
+cluster, never two.
+
+Fewer than 3 trajectories (one recording, the folds its time blocks): the same form with the time
+blocks of the cross-validation as the groups, the k-th block of every run of one trajectory one group
+(a cluster covariance over a few large blocks of dependent data: Bester, Conley & Hansen, J.
+Econometrics 2011; its standard deviations from K − 1 degrees of freedom). It holds what the
+noise's sandwich (:mod:`~excite_cli.identification.fitting.noise`) cannot: a residual that grows
+and shrinks with the regressor's rows (model error is a function of the motion) and a slow drift.
+On halves of one simulated recording of a non-repeating motion (a spring, a friction shape or a
+drift the model lacks; ``bench/recording_halves.py``) this std of a half is 0.83–0.96 × the spread
+between the halves (median over the base parameters), the sandwich's 0.69–0.83 ×. Where every block
+holds the same motion (a periodic excitation recorded over whole periods) the model error is the
+same in every block, so the halves agree more closely than either says."""
 
 from __future__ import annotations
 
@@ -44,10 +56,16 @@ def trajectory_pieces(
     and its score s_g (G, m) (module docstring), of the model [Y_B, ``effects``] with coefficients x
     (m,) and joint weights (n,) (None: 1) on ``data``; ``cluster`` (R,) the trajectory of each run
     index of ``data.run``, the trajectories in ascending order."""
+    return _pieces(data, x, effects, weights, cluster[data.run])
+
+
+def _pieces(
+    data: Dataset, x: np.ndarray, effects: list[Term], weights: np.ndarray | None, of_instant: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`trajectory_pieces` with the group of each instant (N,) given, groups in ascending order."""
     n = data.n
     residual = data.tau.reshape(-1, n) - predict(data, x, effects)
     w = np.ones(n) if weights is None else np.asarray(weights, dtype=float)
-    of_instant = cluster[data.run]
     groups = np.unique(of_instant)
     grams, scores = np.zeros((groups.size, x.size, x.size)), np.zeros((groups.size, x.size))
     for k, g in enumerate(groups):
@@ -70,10 +88,33 @@ def between_trajectories(
     without one of them (a run's own offset)."""
     if np.unique(cluster[np.unique(data.run)]).size < FEWEST:
         return None
-    grams, scores = trajectory_pieces(data, x, effects, weights, cluster)
+    return _variance(*trajectory_pieces(data, x, effects, weights, cluster), x.size)
+
+
+def between_time_blocks(
+    data: Dataset,
+    x: np.ndarray,
+    effects: list[Term],
+    weights: np.ndarray | None,
+    block: np.ndarray,
+    cluster: np.ndarray,
+) -> np.ndarray:
+    """(m,) the variances of the estimates over the time blocks of fewer than ``FEWEST`` trajectories
+    (module docstring: CR2 by block; Bester, Conley & Hansen 2011) of the model [Y_B, ``effects``]
+    fitted with coefficients x (m,) and joint weights (n,) (None: 1) on ``data``; ``block`` (N,) the
+    time block of each instant within its run (the cross-validation's time-block folds), ``cluster``
+    (R,) the trajectory of each run index: the k-th blocks of one trajectory's runs are one group. NaN
+    for a coefficient that one group alone determines."""
+    of_instant = cluster[data.run] * (int(block.max()) + 1) + block
+    return _variance(*_pieces(data, x, effects, weights, of_instant), x.size)
+
+
+def _variance(grams: np.ndarray, scores: np.ndarray, m: int) -> np.ndarray:
+    """(m,) CR2 variances from each group's share of the normal matrix (G, m, m) and its score (G, m)
+    (:func:`trajectory_pieces`); NaN where one group alone determines a coefficient."""
     total = grams.sum(axis=0)
     inverse = np.linalg.pinv(total, rcond=1e-13, hermitian=True)
-    alone = np.zeros(x.size, dtype=bool)
+    alone = np.zeros(m, dtype=bool)
     adjusted = np.zeros_like(scores)
     for k in range(len(grams)):
         alone |= np.diag(total - grams[k]) <= 1e-12 * np.diag(total)

@@ -92,8 +92,9 @@ def write_identification(
         g.create_dataset("base_parameters", data=consistent.base if chosen else sel.fit.x[:b])
         g.create_dataset("base_parameters_unconstrained", data=sel.fit.x[:b])
         g.create_dataset("base_parameters_std", data=sel.fit.std[:b])
-        if sel.fit.between is not None:  # over 3 or more distinct trajectories, model error included
-            g.create_dataset("base_parameters_std_between_trajectories", data=sel.fit.between[:b])
+        if sel.fit.between is not None:  # over distinct trajectories or time blocks, model error included
+            name = f"base_parameters_std_between_{sel.fit.spread_by.replace(' ', '_')}"
+            g.create_dataset(name, data=sel.fit.between[:b]).attrs["groups"] = sel.fit.groups
         g.create_dataset("base_parameters_rigid_only", data=sel.rigid.x)
         g.create_dataset("physically_consistent", data=chosen)
         _write_fits(g, report)

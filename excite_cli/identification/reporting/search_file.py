@@ -34,6 +34,7 @@ def write_effects(g: h5py.Group, report: Report) -> None:
             ("value", "f8"),
             ("std", "f8"),
             ("std_between_trajectories", "f8"),
+            ("std_between_time_blocks", "f8"),
             ("unit", STR),
             ("declared", "?"),
             ("value_consistent", "f8"),
@@ -41,7 +42,9 @@ def write_effects(g: h5py.Group, report: Report) -> None:
     )
     effects["value_consistent"] = np.nan if report.consistent is None else report.consistent.effects
     between = sel.fit.between
-    effects["std_between_trajectories"] = np.nan if between is None else between[len(report.base_names) :]
+    for spread_by in ("trajectories", "time blocks"):
+        field = f"std_between_{spread_by.replace(' ', '_')}"
+        effects[field] = between[len(report.base_names) :] if sel.fit.spread_by == spread_by else np.nan
     order = {t: k + 1 for k, t in enumerate(sel.terms)}
     for row, (term, coefficient, value, std) in zip(effects, rows):
         row["order"], row["coefficient"], row["value"], row["std"] = order[term], coefficient, value, std

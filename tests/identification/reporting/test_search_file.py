@@ -1,5 +1,6 @@
 """The effects and the search of an identify report as its file holds them: a row per coefficient in
-the fit's order, the spread between trajectories NaN when the fit data hold one, a row per step."""
+the fit's order, the spread between trajectories NaN when the fit data hold one (the time blocks'
+instead), a row per step."""
 
 import h5py
 import numpy as np
@@ -17,5 +18,8 @@ def test_the_effects_and_steps_are_the_reports(simulated_identification, tmp_pat
         effects, steps = f["identification/effects"][()], f["identification/steps"][()]
     values = report.effect_values()
     np.testing.assert_array_equal(effects["value"], [v for _, _, v, _ in values])
+    fit, b = report.selection.fit, len(report.base_names)
     assert np.all(np.isnan(effects["std_between_trajectories"]))  # one fit run: one trajectory
-    assert report.selection.fit.between is None and len(steps) == len(report.selection.steps)
+    assert fit.spread_by == "time blocks" and fit.groups == 6  # identification.folds
+    np.testing.assert_array_equal(effects["std_between_time_blocks"], fit.between[b:])
+    assert len(steps) == len(report.selection.steps)
