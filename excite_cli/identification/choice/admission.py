@@ -20,6 +20,15 @@ the other (:func:`simplest`): the ends of the searches, and the models and fits 
 shares is admitted however small (a spring worth 5 %, a low-speed friction term worth 1.5 %); a gain
 one fold makes and another loses is not, however large its mean.
 
+A step tries every addition and shape change (50–150 moves), and one by one at 95 % some useless
+move passes in most steps; the search then takes the best of them. With :data:`FAMILY_FOLDS` or more
+folds the moves of a step are tested together (:func:`family_critical`): each move's t moderated by
+the family's median variance (Smyth, Stat. Appl. Genet. Mol. Biol. 2004), the critical t that of the
+family's largest t under the 2^K sign patterns of the folds (Westfall & Young, "Resampling-Based
+Multiple Testing" 1993, single-step maxT), so that a step admits a useless move in about 5 % of the
+cases whatever the number of moves and their correlation. Removals are one hypothesis each and keep
+the plain test.
+
 **Time blocks of one recording** share its motion: for a periodic excitation each block repeats the
 phases the other blocks saw (the real Panda run: folds of one periodic run rewarded position terms
 that cost on its unseen phases), so the folds cannot judge a new effect; nor can two or three
@@ -33,6 +42,7 @@ a term must cut the pooled cross-validated error by the fraction ``min_improveme
 from __future__ import annotations
 
 from enum import StrEnum
+from typing import NamedTuple
 
 import numpy as np
 import scipy.stats
@@ -48,6 +58,9 @@ FLOOR = 1e-3
 #: others lack, the test dropped the Coulomb friction of 3 of the 7 joints (tests/identification/
 #: test_transfer.py); three recordings keep the price.
 PAIRED_FOLDS = 4
+#: The fewest folds the moves of a step are tested together on (the family-wise error): the 2^K sign
+#: patterns of 4 folds are 16, whose smallest share 1/16 is above 5 %, so 4 folds test each move alone.
+FAMILY_FOLDS = 5
 
 
 class Admission(StrEnum):
@@ -82,9 +95,18 @@ def admission_of(by_recording: bool, folds: int) -> Admission:
     return Admission.PAIRED if by_recording and folds >= PAIRED_FOLDS else Admission.PRICED
 
 
-def paired_gain(before: np.ndarray, after: np.ndarray) -> tuple[float, float]:
-    """The mean over folds of d_k = log e_k(before) − log e_k(after) and its margin
-    t_{0.95, K−1} sd(d)/√K (module docstring).
+class Family(NamedTuple):
+    """The moves of one step tested together (:func:`family_critical`): the critical moderated t and
+    the family's variance s₀² of d [log units²] each move's own is pooled with."""
+
+    critical: float
+    variance: float
+
+
+def paired_gain(before: np.ndarray, after: np.ndarray, family: Family | None = None) -> tuple[float, float]:
+    """The mean over folds of d_k = log e_k(before) − log e_k(after) and its margin c · s/√K (module
+    docstring): c = t_{0.95, K−1} and s = sd(d), or in a ``family`` its critical t and the moderated
+    s = √((s₀² + sd(d)²)/2) (:func:`family_critical`).
 
     Args:
         before, after: (K,) fold errors [%] of two models (K ≥ 2), positive.
@@ -94,13 +116,44 @@ def paired_gain(before: np.ndarray, after: np.ndarray) -> tuple[float, float]:
     """
     d = np.log(np.maximum(before, 1e-12)) - np.log(np.maximum(after, 1e-12))
     k = d.size
-    margin = scipy.stats.t.ppf(LEVEL, k - 1) * d.std(ddof=1) / np.sqrt(k)
+    if family is None:
+        margin = scipy.stats.t.ppf(LEVEL, k - 1) * d.std(ddof=1) / np.sqrt(k)
+    else:
+        margin = family.critical * np.sqrt((family.variance + d.var(ddof=1)) / 2.0 / k)
     return float(d.mean()), float(margin)
 
 
-def passes(before: np.ndarray, after: np.ndarray) -> bool:
-    """Whether the move from fold errors ``before`` to ``after`` (K,) passes the paired test (module docstring)."""
-    mean, margin = paired_gain(before, after)
+def family_critical(before: np.ndarray, after: np.ndarray) -> Family | None:
+    """The moves tried at one step tested together (module docstring: the family-wise error), or None
+    below :data:`FAMILY_FOLDS` folds (each move's own t-test then).
+
+    Each move's t is moderated: its variance of d pooled half and half with the family's median
+    variance s₀² (Smyth 2004: few folds give each move's variance few degrees of freedom, and a move
+    whose folds happen to agree would otherwise win by its small spread). The critical t is that of
+    the largest t of the family under the 2^K sign patterns of the folds (one flip of fold k for every
+    move, which keeps the moves' correlation; Westfall & Young 1993, single-step maxT): a move passes
+    when at most 5 % of the patterns give some move a t as large.
+
+    Args:
+        before: (K,) fold errors [%] of the model the moves start from; after: (M, K) each move's.
+    """
+    k = before.size
+    if k < FAMILY_FOLDS or after.shape[0] == 0:
+        return None
+    d = np.log(np.maximum(before, 1e-12))[None, :] - np.log(np.maximum(after, 1e-12))  # (M, K)
+    signs = 1.0 - 2.0 * ((np.arange(2**k)[:, None] >> np.arange(k)) & 1)  # (2^K, K), the first all +1
+    means = signs @ d.T / k  # (2^K, M)
+    variance = np.maximum((d**2).sum(axis=1) - k * means**2, 0.0) / (k - 1)
+    pooled = np.median(variance, axis=1)  # (2^K,) s₀² of each pattern
+    t = means / np.maximum(np.sqrt((pooled[:, None] + variance) / 2.0 / k), 1e-15)
+    largest = np.sort(t.max(axis=1))[::-1]
+    return Family(float(largest[int(np.floor((1.0 - LEVEL) * largest.size))]), float(pooled[0]))
+
+
+def passes(before: np.ndarray, after: np.ndarray, family: Family | None = None) -> bool:
+    """Whether the move from fold errors ``before`` to ``after`` (K,) passes the paired test (module
+    docstring), tested in its step's ``family`` if given (:func:`family_critical`)."""
+    mean, margin = paired_gain(before, after, family)
     return mean > max(margin, FLOOR)
 
 

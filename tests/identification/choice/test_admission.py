@@ -1,14 +1,17 @@
-"""The paired test over folds against scipy's paired t-test, and the fit choice it makes."""
+"""The paired test over folds against scipy's paired t-test, the family-wise error of the moves of one
+step tested together on draws with no gain, and the fit choice it makes."""
 
 import numpy as np
 import pytest
 import scipy.stats
 
 from excite_cli.identification.choice.admission import (
+    FAMILY_FOLDS,
     PAIRED_FOLDS,
     Admission,
     admission_of,
     as_percent,
+    family_critical,
     paired_choice,
     paired_gain,
     passes,
@@ -64,3 +67,37 @@ def test_a_larger_model_is_kept_only_when_it_passes_the_test_against_the_smaller
         assert simplest(J, folds, np.array([[0], [3]]), [0]) == (kept, 0)
     folds = np.stack([consistent, small])[:, None, :]  # the larger model listed first: sizes order them
     assert simplest(np.log(folds).mean(axis=2), folds, np.array([[3], [0]]), [0]) == (0, 0)
+
+
+def _step(rng, folds: int, moves: int, gain: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """Fold errors of a model and of ``moves`` moves from it: no move helps (each fold's change is
+    symmetric about 0, the moves' changes correlated through a share of each fold's), the first one
+    by ``gain`` [log units] on every fold."""
+    before = rng.uniform(2.0, 5.0, folds)
+    common = rng.normal(0.0, 0.02, folds)
+    change = 0.8 * common + 0.6 * rng.normal(0.0, 0.02, (moves, folds))
+    change[0] += gain
+    return before, before * np.exp(-change)
+
+
+@pytest.mark.parametrize("folds", [FAMILY_FOLDS, 8, 10])
+def test_the_moves_of_a_step_tested_together_admit_none_of_many_useless_ones_in_95_percent(folds):
+    """400 steps of 60 moves none of which helps: some move passes at the family's critical t in at
+    most 5 % of them (binomial: ≤ 8 % allowing for the draws), where each move's own t-test passes some
+    move in most steps; a move that gains 3 % on every fold still passes."""
+    rng = np.random.default_rng(folds)
+    family = alone = 0
+    for _ in range(400):
+        before, after = _step(rng, folds, 60)
+        c = family_critical(before, after)
+        family += any(passes(before, a, c) for a in after)
+        alone += any(passes(before, a) for a in after)
+    assert family <= 0.08 * 400 and alone >= 0.3 * 400, (family, alone)
+    before, after = _step(rng, folds, 60, gain=0.1)
+    assert passes(before, after[0], family_critical(before, after))
+
+
+def test_below_five_folds_each_move_is_tested_alone():
+    """16 sign patterns of 4 folds cannot put a share under 5 %: no family critical t."""
+    before, after = _step(np.random.default_rng(0), PAIRED_FOLDS, 10)
+    assert family_critical(before, after) is None
