@@ -22,12 +22,16 @@ one fold makes and another loses is not, however large its mean.
 
 A step tries every addition and shape change (50–150 moves), and one by one at 95 % some useless
 move passes in most steps; the search then takes the best of them. With :data:`FAMILY_FOLDS` or more
-folds the moves of a step are tested together (:func:`family_critical`): each move's t moderated by
-the family's median variance (Smyth, Stat. Appl. Genet. Mol. Biol. 2004), the critical t that of the
-family's largest t under the 2^K sign patterns of the folds (Westfall & Young, "Resampling-Based
-Multiple Testing" 1993, single-step maxT), so that a step admits a useless move in about 5 % of the
-cases whatever the number of moves and their correlation. Removals are one hypothesis each and keep
-the plain test.
+folds a step therefore takes an addition or shape change only when one of them passes tested
+together with the others (:func:`family_critical`): each move's t moderated by the family's median
+variance (Smyth, Stat. Appl. Genet. Mol. Biol. 2004), the critical t that of the family's largest t
+under the 2^K sign patterns of the folds (Westfall & Young, "Resampling-Based Multiple Testing"
+1993, single-step maxT), so that a step where no move helps admits one in about 5 % of the cases
+whatever the number of moves and their correlation. The move taken is still the lowest J of those
+that pass their own test: a real effect whose gain differs between recordings (a Stribeck term that
+matters on the trajectories slow on its joint) has a large mean and a large spread, and tested in
+the family it lost to a small steady stand-in (held friction). Removals are one hypothesis each and
+keep the plain test.
 
 **Time blocks of one recording** share its motion: for a periodic excitation each block repeats the
 phases the other blocks saw (the real Panda run: folds of one periodic run rewarded position terms

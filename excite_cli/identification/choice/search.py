@@ -5,11 +5,11 @@ A move adds a candidate whose prerequisites are in the model, removes an added t
 on, or moves a Stribeck or held term along its velocity grid or a coupled term along its ratio grid.
 
 - **Paired test** (folds that are four or more distinct trajectories): an addition or a shape change
-  must pass the paired test over the folds (and gain at least its 0.1 % floor), from five folds on
-  tested together with the step's other additions and shape changes (the family-wise error:
-  :func:`~excite_cli.identification.choice.admission.family_critical`); an added term whose
-  keeping no longer passes it is removed (a start's friction terms the data do not need, a term a
-  later one took over); of the moves allowed to a model not visited before, the one with the lowest
+  must pass the paired test over the folds (and gain at least its 0.1 % floor), and from five folds
+  on a step takes one only when one of them passes tested together with the others (the
+  family-wise error: :func:`~excite_cli.identification.choice.admission.family_critical`); an added
+  term whose keeping no longer passes it is removed (a start's friction terms the data do not need,
+  a term a later one took over); of the moves allowed to a model not visited before, the one with the lowest
   mean log fold error J(M) = mean_k log e_k(M) is taken.
 - **Price** (time blocks of one recording): J(M) = log CV(M) + p(M) · log(1 + min_improvement),
   p(M) the effects the search added, a coupled one counting as log(1 + coupling_improvement) /
@@ -28,14 +28,7 @@ from typing import Callable
 
 import numpy as np
 
-from excite_cli.identification.choice.admission import (
-    Admission,
-    Family,
-    as_percent,
-    family_critical,
-    paired_gain,
-    passes,
-)
+from excite_cli.identification.choice.admission import Admission, as_percent, family_critical, paired_gain, passes
 from excite_cli.identification.choice.crossval import CrossValidation
 from excite_cli.identification.config import IdentificationConfig
 from excite_cli.identification.effects import Term
@@ -160,25 +153,25 @@ class StepwiseSearch:
         shape_price = self.penalty if move == "shape" and self.rule is Admission.PRICED else 0.0
         return self.objective(terms, score) + shape_price
 
-    def allowed(
-        self, move: str, before: tuple[float, np.ndarray], after: tuple[float, np.ndarray], family: Family | None
-    ) -> bool:
+    def allowed(self, move: str, before: tuple[float, np.ndarray], after: tuple[float, np.ndarray]) -> bool:
         """Whether a move from the model scored ``before`` to one scored ``after`` is allowed:
-        under the paired test, an addition or shape change that passes it (tested in its step's
-        ``family``, :func:`~excite_cli.identification.choice.admission.family_critical`), or the
-        removal of a term whose keeping no longer passes it; under the price every move (the best
-        one's cost is then compared with J; module docstring)."""
+        under the paired test, an addition or shape change that passes it, or the removal of a term
+        whose keeping no longer passes it; under the price every move (the best one's cost is then
+        compared with J; module docstring)."""
         if self.rule is Admission.PRICED:
             return True  # the price is in the cost; the best move is then compared with J
-        return not passes(after[1], before[1]) if move == "remove" else passes(before[1], after[1], family)
+        return not passes(after[1], before[1]) if move == "remove" else passes(before[1], after[1])
 
-    def family(self, before: tuple[float, np.ndarray], tried: list) -> Family | None:
-        """The additions and shape changes ``tried`` from the model scored ``before`` tested together
-        (None under the price or with too few folds)."""
+    def gate(self, before: tuple[float, np.ndarray], tried: list) -> bool:
+        """Whether the additions and shape changes ``tried`` from the model scored ``before`` may be
+        taken at all: from :data:`~excite_cli.identification.choice.admission.FAMILY_FOLDS` folds on,
+        only when one of them passes tested together with the others
+        (:func:`~excite_cli.identification.choice.admission.family_critical`); always under the price."""
         if self.rule is Admission.PRICED:
-            return None
+            return True
         folds = [m[3][1] for m in tried if m[0] != "remove"]
-        return family_critical(before[1], np.array(folds) if folds else np.zeros((0, before[1].size)))
+        family = family_critical(before[1], np.array(folds) if folds else np.zeros((0, before[1].size)))
+        return family is None or any(passes(before[1], f, family) for f in folds)
 
     def moves(self, terms: list[Term]) -> list[tuple[str, Term, list[Term]]]:
         """(move, term, model after) of every allowed move from ``terms``."""
@@ -234,18 +227,19 @@ class StepwiseSearch:
             if not tried:
                 search.stop = "no move left (every candidate is in the model)"
                 break
-            family = self.family(score, tried)
-            allowed = [m for m in tried if self.allowed(m[0], score, m[3], family) and frozenset(m[2]) not in visited]
+            gate = self.gate(score, tried)
+            allowed = [
+                m
+                for m in tried
+                if (gate or m[0] == "remove") and self.allowed(m[0], score, m[3]) and frozenset(m[2]) not in visited
+            ]
             best = min(allowed, key=lambda m: self.cost(m[0], m[2], m[3]), default=None)
             priced_out = self.rule is Admission.PRICED and best is not None
             if best is None or (priced_out and self.cost(best[0], best[2], best[3]) >= search.objective - 1e-12):
                 search.stop = self._stop(terms)
                 break
             move, term, after, value = best
-            paired = self.rule is Admission.PAIRED
-            gain, margin = (
-                paired_gain(score[1], value[1], None if move == "remove" else family) if paired else (np.nan,) * 2
-            )
+            gain, margin = paired_gain(score[1], value[1]) if self.rule is Admission.PAIRED else (np.nan, np.nan)
             tried_cv = [(m, t, v[0]) for m, t, _, v in tried]
             search.steps.append(
                 Step(move, term, after, value[0], score[0], tried_cv, as_percent(gain), as_percent(margin))

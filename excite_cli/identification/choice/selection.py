@@ -167,12 +167,17 @@ def _distinct_ends(searches: list[Search]) -> list[int]:
 
 def kept_by_test(searches: list[Search]) -> int:
     """Under the paired test: the index of the search whose end the paired test keeps, the ends in
-    order of their number of terms, a larger one kept only when it passes the test against the kept
-    one (:func:`~excite_cli.identification.choice.admission.simplest`); of ends at one model, the first."""
+    order of their size, a larger one kept only when it passes the test against the kept one
+    (:func:`~excite_cli.identification.choice.admission.simplest`); of ends at one model, the first.
+    A model's size is its terms and the shape velocities the search chose for them from their grid
+    (Stribeck's v_s, held friction's v_h): each is fitted by the same folds, so Coulomb friction with
+    a negative Stribeck term at v_s 0.5 rad/s, which follows viscous friction over the velocities a
+    slow joint reaches, is not kept over Coulomb and viscous friction unless it beats them."""
     index = _distinct_ends(searches)
     J = np.array([[searches[k].objective] for k in index])
     folds = np.array([[searches[k].folds] for k in index])
-    return index[simplest(J, folds, np.array([[len(searches[k].terms)] for k in index]), [0])[0]]
+    sizes = [len(searches[k].terms) + sum(t.shape is not None for t in searches[k].terms) for k in index]
+    return index[simplest(J, folds, np.array(sizes)[:, None], [0])[0]]
 
 
 def select_effects(

@@ -8,7 +8,13 @@ import scipy.optimize
 from excite_cli.identification.choice.admission import Admission
 from excite_cli.identification.choice.crossval import RECORDING_FOLDS, CrossValidation, fold_assignment
 from excite_cli.identification.choice.search import Search, StepwiseSearch
-from excite_cli.identification.choice.selection import STARTS, candidate_terms, kept_search, select_effects
+from excite_cli.identification.choice.selection import (
+    STARTS,
+    candidate_terms,
+    kept_by_test,
+    kept_search,
+    select_effects,
+)
 from excite_cli.identification.config import IdentificationConfig
 from excite_cli.identification.effects import Term, effect_columns
 from excite_cli.identification.fitting.dataset import Dataset, run_offset_columns
@@ -214,6 +220,20 @@ def test_of_searches_ending_at_one_model_the_first_is_kept_whatever_the_rounding
     assert kept_search(searches[:1] + searches[2:3]) == 0
     with pytest.raises(ValueError):
         kept_search([])
+
+
+def test_under_the_paired_test_a_shaped_term_counts_its_shape_velocity():
+    """Two ends of one number of terms that the folds cannot tell apart: Coulomb and a Stribeck term at
+    a chosen v_s against Coulomb and viscous friction. The Stribeck end comes first and has the lower J;
+    its shape velocity makes it the larger model, which is kept only when it passes the paired test."""
+    c, v, s = Term("coulomb", 0), Term("viscous", 0), Term("stribeck", 0, shape=0.5)
+    folds = np.array([2.0, 2.5, 3.0, 2.2, 2.8, 2.4])
+    tied = folds * np.array([0.99, 1.005, 0.995, 1.0, 0.992, 1.004])  # 0.1 % lower on average, no fold agreement
+    ends = [([c, s], tied), ([c, v], folds)]
+    searches = [Search(f"s{k}", [], 0.0, t, 0.0, float(np.log(f).mean()), folds=f) for k, (t, f) in enumerate(ends)]
+    assert searches[0].objective < searches[1].objective and kept_by_test(searches) == 1
+    searches[0].folds = folds * 0.95  # 5 % lower on every fold: it beats the smaller model
+    assert kept_by_test(searches) == 0
 
 
 def test_coulomb_data_every_search_ends_at_coulomb_and_the_report_shows_the_first_search_s_steps():
