@@ -85,7 +85,7 @@ def half(t, Y, tau, qd, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nd
     normal = NormalEquations(data, terms)
     fit = least_squares(normal, terms, middle=middle(data, least_squares(normal, terms).x, terms, None, RATE))
     block, _ = fold_assignment(data.time, data.run, FOLDS, 0.0)
-    return fit.x, fit.std, np.sqrt(between_time_blocks(data, fit.x, terms, None, block, np.zeros(1, dtype=int)))
+    return fit.x, fit.std, np.sqrt(between_time_blocks(data, fit.x, terms, None, block, np.zeros(1, dtype=int))[0])
 
 
 def simulated(sets: int, periodic: bool) -> None:

@@ -3,11 +3,12 @@ the best moves it did not take, and the outcome of every start."""
 
 from __future__ import annotations
 
+import numpy as np
 from rich.table import Table
 
 from excite_cli.console.tables import titled_table
 from excite_cli.identification.choice.admission import Admission
-from excite_cli.identification.choice.search import MOVE_SIGNS
+from excite_cli.identification.choice.search import MOVE_SIGNS, Step
 from excite_cli.identification.reporting.report import Report
 
 
@@ -27,19 +28,25 @@ def search(report: Report, runners_up: int = 2) -> list[Table | str]:
                 str(k),
                 step.label(report.joints),
                 f"{step.gain:.1f}",
-                *([f"{step.fold_gain:.1f} > {step.fold_margin:.1f}"] if paired else []),
+                *([_folds(step)] if paired else []),
                 str(len(step.tried)),
                 "; ".join(f"{MOVE_SIGNS[m]} {t.label(report.joints)} {step.gain_of(v):.1f}" for v, m, t in others),
             )
         )
     steps = titled_table(
         f"Selection steps from the start '{kept.start}' (gain: cut of the cross-validated error [%]"
-        + ("; folds: the mean gain over the folds and the margin of the paired test it passed)" if paired else ")"),
+        + (
+            "; folds: the mean gain over the folds and the margin of the paired test it passed, from 5 folds on "
+            "and in brackets the margin of the moves tested together, some move's gain above its own)"
+            if paired
+            else ")"
+        ),
         ("step", "move", "gain [%]", *(["folds [%]"] if paired else []), "tried", f"next best {runners_up} [gain %]"),
         rows,
         "kept at its start: scored with the fits, the start wins (see the models compared)"
         if sel.at_start
-        else f"stopped: {kept.stop}",
+        else f"stopped: {kept.stop}"
+        + (f"\nrefused at the last step: {kept.refused.label(report.joints)}" if kept.refused else ""),
     )
     starts = "; ".join(
         f"{s.start}: {s.cv_error:.2f} % with {len(s.terms)} effects" + (" (kept)" if k == sel.chosen else "")
@@ -50,3 +57,9 @@ def search(report: Report, runners_up: int = 2) -> list[Table | str]:
         f"searches (cross-validated error at their end): {starts}",
         f"effects admitted by: {sel.admission} ({sel.folds} folds by {sel.folds_by})",
     ]
+
+
+def _folds(step: Step) -> str:
+    """A step's mean gain over the folds > its margin, and its margin in the family-wise test if any."""
+    family = "" if np.isnan(step.family_margin) else f" ({step.family_margin:.1f})"
+    return f"{step.fold_gain:.1f} > {step.fold_margin:.1f}{family}"

@@ -202,8 +202,7 @@ def reported_fit(selection: Selection, fit_data: Dataset, rate: float, clusters:
     count = np.unique(clusters[np.unique(fit_data.run)]).size
     if variance is None:
         block, _ = fold_assignment(fit_data.time, fit_data.run, folds, 0.0)
-        variance, spread_by = between_time_blocks(fit_data, x, terms, weights, block, clusters), "time blocks"
-        count = np.unique(clusters[fit_data.run] * folds + block).size
+        (variance, count), spread_by = between_time_blocks(fit_data, x, terms, weights, block, clusters), "time blocks"
     held = fit.held if fit.held.size else False
     return replace(fit, between=np.where(held, np.nan, np.sqrt(variance)), groups=int(count), spread_by=spread_by)
 

@@ -51,6 +51,9 @@ from typing import NamedTuple
 import numpy as np
 import scipy.stats
 
+from excite_cli.identification.config import IdentificationConfig
+from excite_cli.identification.effects import Term
+
 #: One-sided level of the paired test over folds.
 LEVEL = 0.95
 #: The smallest mean gain over folds [log units] a move must make to be admitted: 0.1 % of the error.
@@ -195,3 +198,26 @@ def paired_choice(J: np.ndarray, folds: np.ndarray, preferred: list[bool], sizes
         return simplest(J, folds, sizes, first or others)
     kept, challenger = simplest(J, folds, sizes, first), simplest(J, folds, sizes, others)
     return challenger if passes(folds[kept], folds[challenger]) else kept
+
+
+def effect_count(terms: list[Term], declared: int, weights: tuple[float, float]) -> float:
+    """p: the effects ``terms`` add beyond their first ``declared``, a coupled one counting as
+    ``weights[0]`` effects (its price is log(1 + ``coupling_improvement``): it ties two joints and,
+    unlike a joint's own effect, could stand in for effects of both) and a position-dependent one as
+    ``weights[1]`` (log(1 + ``position_improvement``): a function of q can follow a residual of the
+    positions the fit data visit, whatever its cause)."""
+    coupled, position = weights
+    return sum(coupled if t.coupling is not None else position if t.kind.position else 1.0 for t in terms[declared:])
+
+
+def effect_weights(cfg: IdentificationConfig) -> tuple[float, float]:
+    """How many effects a coupled and a position-dependent one count as: log(1 + coupling_improvement)
+    and log(1 + position_improvement) over log(1 + min_improvement)."""
+    unit = max(np.log1p(cfg.min_improvement), 1e-12)
+    return float(np.log1p(cfg.coupling_improvement) / unit), float(np.log1p(cfg.position_improvement) / unit)
+
+
+def priced_objective(cv_error, effects, min_improvement: float):
+    """J = log CV + p · log(1 + min_improvement) (module docstring: the price) of CV errors [%] with p
+    added effects; scalars or arrays that broadcast."""
+    return np.log(np.maximum(cv_error, 1e-12)) + np.asarray(effects) * np.log1p(min_improvement)

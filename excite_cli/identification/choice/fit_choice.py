@@ -45,10 +45,9 @@ import numpy as np
 
 from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.dynamics.robot import Robot
-from excite_cli.identification.choice.admission import Admission, paired_choice
+from excite_cli.identification.choice.admission import Admission, effect_count, paired_choice, priced_objective
 from excite_cli.identification.choice.consistent_model import ConsistentModel
 from excite_cli.identification.choice.fit_records import LEAST_SQUARES, FitChoice, Model
-from excite_cli.identification.choice.search import effect_count, priced_objective
 from excite_cli.identification.choice.selection import Selection
 from excite_cli.identification.config import IdentificationConfig
 from excite_cli.identification.effects import Term

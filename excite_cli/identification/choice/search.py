@@ -24,11 +24,21 @@ the search cannot cycle, and it stops when no move is allowed.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Callable
+from typing import Callable, NamedTuple
 
 import numpy as np
 
-from excite_cli.identification.choice.admission import Admission, as_percent, family_critical, paired_gain, passes
+from excite_cli.identification.choice.admission import (
+    Admission,
+    Family,
+    as_percent,
+    effect_count,
+    effect_weights,
+    family_critical,
+    paired_gain,
+    passes,
+    priced_objective,
+)
 from excite_cli.identification.choice.crossval import CrossValidation
 from excite_cli.identification.config import IdentificationConfig
 from excite_cli.identification.effects import Term
@@ -49,6 +59,10 @@ class Step:
         tried: every move considered at this step: (move, term, CV after [%]).
         fold_gain, fold_margin: under the paired test, the move's mean gain over the folds and the
             margin it passed, as cuts of the error [%] (NaN under the price).
+        family_margin: from :data:`~excite_cli.identification.choice.admission.FAMILY_FOLDS` folds on,
+            the move's margin tested together with the step's other moves (the family-wise error), as a
+            cut of the error [%]: the step was open because some move's gain exceeded its own (NaN
+            below those folds and under the price).
     """
 
     move: str
@@ -59,6 +73,7 @@ class Step:
     tried: list[tuple[str, Term, float]]
     fold_gain: float = float("nan")
     fold_margin: float = float("nan")
+    family_margin: float = float("nan")
 
     def gain_of(self, cv_error: float) -> float:
         """The cut [%] of the CV error before this step that a move to ``cv_error`` [%] makes."""
@@ -74,11 +89,32 @@ class Step:
         return f"{MOVE_SIGNS[self.move]} {self.term.label(joints)}"
 
 
+class Refused(NamedTuple):
+    """The best addition or shape change of the last step that passed its own paired test but not the
+    family's (:meth:`StepwiseSearch.gate`): its gain over the folds, its own margin and its margin
+    tested together with the step's ``tried`` moves, as cuts of the error [%]."""
+
+    move: str
+    term: Term
+    gain: float
+    margin: float
+    family_margin: float
+    tried: int
+
+    def label(self, joints: list[str]) -> str:
+        """The refusal in words, e.g. ``+ armature j4 gains 0.41 % over the folds, ...``."""
+        return (
+            f"{MOVE_SIGNS[self.move]} {self.term.label(joints)} gains {self.gain:.2f} % over the folds, above its own "
+            f"margin {self.margin:.2f} % but not the {self.family_margin:.2f} % of the {self.tried} moves tested "
+            "together (family-wise, 95 %)"
+        )
+
+
 @dataclass
 class Search:
     """The search from one start: its name, start model and its CV error [%], end model and its CV
     error [%] and objective J, the steps and why it stopped; the start's and the end's (K,) fold
-    errors [%]."""
+    errors [%]; the move the family test refused at the last step (:class:`Refused`), if any."""
 
     start: str
     initial: list[Term]
@@ -90,29 +126,7 @@ class Search:
     stop: str = ""
     initial_folds: np.ndarray | None = None
     folds: np.ndarray | None = None
-
-
-def effect_count(terms: list[Term], declared: int, weights: tuple[float, float]) -> float:
-    """p: the effects ``terms`` add beyond their first ``declared``, a coupled one counting as
-    ``weights[0]`` effects (its price is log(1 + ``coupling_improvement``): it ties two joints and,
-    unlike a joint's own effect, could stand in for effects of both) and a position-dependent one as
-    ``weights[1]`` (log(1 + ``position_improvement``): a function of q can follow a residual of the
-    positions the fit data visit, whatever its cause)."""
-    coupled, position = weights
-    return sum(coupled if t.coupling is not None else position if t.kind.position else 1.0 for t in terms[declared:])
-
-
-def effect_weights(cfg: IdentificationConfig) -> tuple[float, float]:
-    """How many effects a coupled and a position-dependent one count as: log(1 + coupling_improvement)
-    and log(1 + position_improvement) over log(1 + min_improvement)."""
-    unit = max(np.log1p(cfg.min_improvement), 1e-12)
-    return float(np.log1p(cfg.coupling_improvement) / unit), float(np.log1p(cfg.position_improvement) / unit)
-
-
-def priced_objective(cv_error, effects, min_improvement: float):
-    """J = log CV + p · log(1 + min_improvement) (module docstring: the price) of CV errors [%] with p
-    added effects; scalars or arrays that broadcast."""
-    return np.log(np.maximum(cv_error, 1e-12)) + np.asarray(effects) * np.log1p(min_improvement)
+    refused: Refused | None = None
 
 
 class StepwiseSearch:
@@ -162,16 +176,18 @@ class StepwiseSearch:
             return True  # the price is in the cost; the best move is then compared with J
         return not passes(after[1], before[1]) if move == "remove" else passes(before[1], after[1])
 
-    def gate(self, before: tuple[float, np.ndarray], tried: list) -> bool:
+    def gate(self, before: tuple[float, np.ndarray], tried: list) -> tuple[bool, Family | None]:
         """Whether the additions and shape changes ``tried`` from the model scored ``before`` may be
         taken at all: from :data:`~excite_cli.identification.choice.admission.FAMILY_FOLDS` folds on,
         only when one of them passes tested together with the others
-        (:func:`~excite_cli.identification.choice.admission.family_critical`); always under the price."""
+        (:func:`~excite_cli.identification.choice.admission.family_critical`); always under the price.
+        Also returns the family test (None when there is none). Every move scored is in the family,
+        those leading to a model visited before included: the test counts what was tried."""
         if self.rule is Admission.PRICED:
-            return True
+            return True, None
         folds = [m[3][1] for m in tried if m[0] != "remove"]
         family = family_critical(before[1], np.array(folds) if folds else np.zeros((0, before[1].size)))
-        return family is None or any(passes(before[1], f, family) for f in folds)
+        return family is None or any(passes(before[1], f, family) for f in folds), family
 
     def moves(self, terms: list[Term]) -> list[tuple[str, Term, list[Term]]]:
         """(move, term, model after) of every allowed move from ``terms``."""
@@ -210,6 +226,19 @@ class StepwiseSearch:
             f"min_improvement ({100 * self.cfg.min_improvement:g} %)"
         )
 
+    def _refused(self, before: tuple[float, np.ndarray], tried: list, visited: set, family: Family) -> Refused | None:
+        """The addition or shape change of lowest J that passed its own test at a step the family test
+        kept closed (None when none did)."""
+        alone = [
+            m for m in tried if m[0] != "remove" and frozenset(m[2]) not in visited and self.allowed(m[0], before, m[3])
+        ]
+        if not alone:
+            return None
+        move, term, _, value = min(alone, key=lambda m: self.cost(m[0], m[2], m[3]))
+        gain, margin = paired_gain(before[1], value[1])
+        together = paired_gain(before[1], value[1], family)[1]
+        return Refused(move, term, as_percent(gain), as_percent(margin), as_percent(together), len(tried))
+
     def run(self, name: str, start: list[Term]) -> Search:
         """The search named ``name`` from the model ``start`` until no move is allowed (module docstring)."""
         terms = list(start)
@@ -227,7 +256,7 @@ class StepwiseSearch:
             if not tried:
                 search.stop = "no move left (every candidate is in the model)"
                 break
-            gate = self.gate(score, tried)
+            gate, family = self.gate(score, tried)
             allowed = [
                 m
                 for m in tried
@@ -237,12 +266,24 @@ class StepwiseSearch:
             priced_out = self.rule is Admission.PRICED and best is not None
             if best is None or (priced_out and self.cost(best[0], best[2], best[3]) >= search.objective - 1e-12):
                 search.stop = self._stop(terms)
+                search.refused = None if gate else self._refused(score, tried, visited, family)
                 break
             move, term, after, value = best
             gain, margin = paired_gain(score[1], value[1]) if self.rule is Admission.PAIRED else (np.nan, np.nan)
+            together = paired_gain(score[1], value[1], family)[1] if family is not None else np.nan
             tried_cv = [(m, t, v[0]) for m, t, _, v in tried]
             search.steps.append(
-                Step(move, term, after, value[0], score[0], tried_cv, as_percent(gain), as_percent(margin))
+                Step(
+                    move,
+                    term,
+                    after,
+                    value[0],
+                    score[0],
+                    tried_cv,
+                    as_percent(gain),
+                    as_percent(margin),
+                    as_percent(together),
+                )
             )
             terms, score = after, value
             visited.add(frozenset(terms))

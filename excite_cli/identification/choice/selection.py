@@ -36,9 +36,9 @@ from typing import Callable
 import numpy as np
 
 from excite_cli.effects import EFFECTS
-from excite_cli.identification.choice.admission import Admission, admission_of, simplest
+from excite_cli.identification.choice.admission import Admission, admission_of, effect_weights, simplest
 from excite_cli.identification.choice.crossval import CrossValidation
-from excite_cli.identification.choice.search import Search, Step, StepwiseSearch, effect_weights
+from excite_cli.identification.choice.search import Search, Step, StepwiseSearch
 from excite_cli.identification.config import IdentificationConfig
 from excite_cli.identification.data_config import TransmissionConfig
 from excite_cli.identification.effects import Term, rotor_terms

@@ -98,15 +98,15 @@ def between_time_blocks(
     weights: np.ndarray | None,
     block: np.ndarray,
     cluster: np.ndarray,
-) -> np.ndarray:
+) -> tuple[np.ndarray, int]:
     """(m,) the variances of the estimates over the time blocks of fewer than ``FEWEST`` trajectories
     (module docstring: CR2 by block; Bester, Conley & Hansen 2011) of the model [Y_B, ``effects``]
     fitted with coefficients x (m,) and joint weights (n,) (None: 1) on ``data``; ``block`` (N,) the
     time block of each instant within its run (the cross-validation's time-block folds), ``cluster``
     (R,) the trajectory of each run index: the k-th blocks of one trajectory's runs are one group. NaN
-    for a coefficient that one group alone determines."""
+    for a coefficient that one group alone determines. Also returns the number of groups."""
     of_instant = cluster[data.run] * (int(block.max()) + 1) + block
-    return _variance(*_pieces(data, x, effects, weights, of_instant), x.size)
+    return _variance(*_pieces(data, x, effects, weights, of_instant), x.size), int(np.unique(of_instant).size)
 
 
 def _variance(grams: np.ndarray, scores: np.ndarray, m: int) -> np.ndarray:

@@ -92,6 +92,9 @@ def write_search(g: h5py.Group, report: Report) -> None:
     if sel.admission is Admission.PAIRED:  # each step's mean gain over the folds and the margin it passed
         written.attrs["fold_gain_percent"] = [step.fold_gain for step in sel.steps]
         written.attrs["fold_margin_percent"] = [step.fold_margin for step in sel.steps]
+        written.attrs["family_margin_percent"] = [step.family_margin for step in sel.steps]
+        refused = sel.searches[sel.chosen].refused
+        written.attrs["refused_at_stop"] = refused.label(report.joints) if refused else ""
     g.create_dataset("candidates", data=np.array(tried, dtype=move)).attrs["units"] = (
         units + "; every move tried at each step"
     )

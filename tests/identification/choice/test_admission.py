@@ -17,6 +17,9 @@ from excite_cli.identification.choice.admission import (
     passes,
     simplest,
 )
+from excite_cli.identification.choice.search import StepwiseSearch
+from excite_cli.identification.config import IdentificationConfig
+from excite_cli.identification.effects import Term
 
 
 @pytest.mark.parametrize("seed", range(20))
@@ -101,3 +104,42 @@ def test_below_five_folds_each_move_is_tested_alone():
     """16 sign patterns of 4 folds cannot put a share under 5 %: no family critical t."""
     before, after = _step(np.random.default_rng(0), PAIRED_FOLDS, 10)
     assert family_critical(before, after) is None
+
+
+class _Folds:
+    """A stand-in for the cross-validation (its ``score``): a model's fold errors are the start's
+    times exp(−Σ its terms' true gains) and a change of its own drawn as in :func:`_step` (seeded by
+    the model's joints), so that only ``gains`` help."""
+
+    def __init__(self, folds: int, gains: dict[int, float], seed: int):
+        self.folds, self.gains, self.seed = folds, gains, seed
+        self.common = np.random.default_rng(seed).normal(0.0, 0.02, folds)
+        self.before = np.random.default_rng(seed + 1).uniform(2.0, 5.0, folds)
+
+    def score(self, terms):
+        joints = sorted(t.joint for t in terms)
+        own = np.random.default_rng([self.seed, *joints]).normal(0.0, 0.02, self.folds) if joints else 0.0
+        change = sum(self.gains.get(j, 0.0) for j in joints) + (0.8 * self.common + 0.6 * own) * bool(joints)
+        errors = self.before * np.exp(-change)
+        return float(errors.mean()), None, errors
+
+
+def _search(folds: int, gains: dict[int, float], seed: int):
+    candidates = [Term("coulomb", j) for j in range(60)]
+    cfg = IdentificationConfig(candidates=["coulomb"])
+    return StepwiseSearch(_Folds(folds, gains, seed), candidates, [], cfg, Admission.PAIRED).run("none", [])
+
+
+def test_a_step_records_its_family_margin_and_a_stop_names_the_move_the_family_refused():
+    """From 5 folds on a step taken records the margin its move had tested with the others (larger
+    than its own: 60 moves); where the family kept the last step closed while some move passed its
+    own test, the search names that move with a gain between its own margin and the family's."""
+    search = _search(8, {7: 0.1}, 0)
+    first = search.steps[0]
+    assert first.term == Term("coulomb", 7) and first.fold_gain > first.family_margin > first.fold_margin
+    refused = [s.refused for s in (_search(8, {}, seed) for seed in range(10)) if s.refused is not None]
+    assert refused, "no step where a useless move passed its own test in 10 draws"
+    for r in refused:
+        assert r.margin < r.gain <= r.family_margin and r.tried == 60 and r.move == "add"
+        assert "tested together" in r.label([f"j{k}" for k in range(60)])
+    assert np.isnan(_search(PAIRED_FOLDS, {7: 0.1}, 0).steps[0].family_margin)
