@@ -171,15 +171,16 @@ def as_percent(log_gain: float) -> float:
 
 def simplest(J: np.ndarray, folds: np.ndarray, sizes: np.ndarray, columns: list[int]) -> tuple[int, int]:
     """The (model, fit) of the fits ``columns`` kept by the paired test: each model's lowest-J pair among
-    them, the models in order of their pair's size (ties by index), a larger one replacing the kept one
-    only when it passes the test against it (module docstring).
+    them, the models in order of their pair's size (of one size, the lowest J first: the folds' own
+    preference where the test cannot choose; then by index), a larger one replacing the kept one only
+    when it passes the test against it (module docstring).
 
     Args:
         J: (m, f) each pair's objective; folds: (m, f, K) each pair's fold errors [%]; sizes: (m, f)
             the terms each pair adds (a consistent fit does not count the armature it holds anyway).
     """
     best = [(k, min(columns, key=lambda f: np.nan_to_num(J[k, f], nan=np.inf))) for k in range(J.shape[0])]
-    order = sorted(range(len(best)), key=lambda k: (sizes[best[k]], k))
+    order = sorted(range(len(best)), key=lambda k: (sizes[best[k]], np.nan_to_num(J[best[k]], nan=np.inf), k))
     kept = best[order[0]]
     for k in order[1:]:
         if passes(folds[kept], folds[best[k]]):

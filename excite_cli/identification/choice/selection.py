@@ -168,7 +168,10 @@ def _distinct_ends(searches: list[Search]) -> list[int]:
 def kept_by_test(searches: list[Search]) -> int:
     """Under the paired test: the index of the search whose end the paired test keeps, the ends in
     order of their size, a larger one kept only when it passes the test against the kept one
-    (:func:`~excite_cli.identification.choice.admission.simplest`); of ends at one model, the first.
+    (:func:`~excite_cli.identification.choice.admission.simplest`; of ends of one size the lowest J
+    first: on a spring joint whose friction the torque noise hides, one search ended at a load-dependent
+    Coulomb term and another at the joint's Coulomb friction, as many terms, and the first search's
+    end was kept by its index); of ends at one model, the first.
     A model's size is its terms and the shape velocities the search chose for them from their grid
     (Stribeck's v_s, held friction's v_h): each is fitted by the same folds, so Coulomb friction with
     a negative Stribeck term at v_s 0.5 rad/s, which follows viscous friction over the velocities a

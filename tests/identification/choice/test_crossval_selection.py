@@ -287,3 +287,14 @@ def test_an_effect_of_one_recording_fails_the_paired_test_however_large_its_mean
     data = Dataset(data.regressor, tau, data.time, data.run, data.blocks)
     selection = select_effects(data, cfg, [], margin=0.05, recordings=np.arange(4))
     assert selection.admission is Admission.PAIRED and set(selection.terms) == {Term("coulomb", 0)}
+
+
+def test_of_two_ends_of_one_size_the_test_cannot_tell_apart_the_lower_j_is_kept_whatever_the_order():
+    """A load-dependent Coulomb term standing in for a joint's Coulomb friction: as many terms, folds
+    0.1 % apart on average without agreeing; the end the folds prefer is kept, listed first or last."""
+    c0, c1, load = Term("coulomb", 0), Term("coulomb", 1), Term("load_coulomb", 1)
+    folds = np.array([2.0, 2.5, 3.0, 2.2, 2.8, 2.4])
+    worse = folds * np.array([1.01, 0.995, 1.005, 1.0, 1.008, 0.996])
+    for ends in ([([c0, load], worse), ([c0, c1], folds)], [([c0, c1], folds), ([c0, load], worse)]):
+        searches = [Search(f"s{k}", [], 0.0, t, 0.0, float(np.log(f).mean()), folds=f) for k, (t, f) in enumerate(ends)]
+        assert searches[kept_by_test(searches)].terms == [c0, c1]
