@@ -186,6 +186,17 @@ def mujoco_analogue(folder: Path, name: str, robot: dict, result: Path, physics:
     )
     fit = report.consistent
     masses = fit.standard.reshape(-1, 10)[:, 0] / physics.standard(model_robot).reshape(-1, 10)[:, 0] - 1.0
+    print(
+        f"    consistent masses against MuJoCo's: {', '.join(f'{100 * m:+.1f}' for m in masses)} % "
+        f"(the last with the payload); {effect_errors(report, truth, joints)}",
+        flush=True,
+    )
+
+
+def effect_errors(report, truth: list[tuple[Term, float]], joints: list[str]) -> str:
+    """Of each kind of effect in ``truth`` ((term, MuJoCo's value)), the largest relative error of the
+    consistent fit's value, and the terms not found, in words."""
+    fit = report.consistent
     found_values = {(t, coefficient): value for t, coefficient, value, _ in report.effect_values(consistent=True)}
     rotors = dict(zip(fit.rotor_joints, fit.rotors))
     worst, missing = {}, []
@@ -195,12 +206,10 @@ def mujoco_analogue(folder: Path, name: str, robot: dict, result: Path, physics:
             missing.append(term.label(joints))
             continue
         worst[term.effect] = max(worst.get(term.effect, 0.0), abs(got / value - 1.0))
-    print(
-        f"    consistent masses against MuJoCo's: {', '.join(f'{100 * m:+.1f}' for m in masses)} % "
-        f"(the last with the payload); largest effect errors: "
+    return (
+        "largest effect errors: "
         + ", ".join(f"{effect} {100 * e:.1f} %" for effect, e in worst.items())
-        + (f"; not found: {', '.join(missing)}" if missing else ""),
-        flush=True,
+        + (f"; not found: {', '.join(missing)}" if missing else "")
     )
 
 
@@ -326,6 +335,7 @@ def admitted_by_folds(folder: Path) -> None:
     runs = mujoco_twins(folder, "spring_twins", PANDA_ROBOT, spring)
     problem, report = identify(folder, "spring_twins", PANDA_ROBOT, runs, COLUMNS)
     line(f"MuJoCo spring {SPRING:g} Nm/rad j4, 4 traj. x2", problem, report, PANDA, None)
+    print(f"    {effect_errors(report, spring.truth(len(PANDA)) + [(Term('spring', 3), SPRING)], PANDA)}", flush=True)
     runs = mujoco_twins(folder, "periodic", PANDA_ROBOT, MUJOCO_PANDA, trajectories=1, periods=3)
     problem, report = identify(folder, "periodic", PANDA_ROBOT, runs, COLUMNS)
     line("MuJoCo no spring, one periodic run", problem, report, PANDA, None)
