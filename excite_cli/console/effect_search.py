@@ -8,7 +8,7 @@ from rich.table import Table
 
 from excite_cli.console.tables import titled_table
 from excite_cli.identification.choice.admission import Admission
-from excite_cli.identification.choice.search import MOVE_SIGNS, Step
+from excite_cli.identification.choice.search_record import MOVE_SIGNS, Step
 from excite_cli.identification.reporting.report import Report
 
 

@@ -169,6 +169,12 @@ def as_percent(log_gain: float) -> float:
     return float(100.0 * -np.expm1(-log_gain))
 
 
+def model_size(terms: list[Term]) -> int:
+    """A model's size under the paired test: its terms and the shape velocities chosen for them from
+    their grid (Stribeck's v_s, held friction's v_h), each fitted by the same folds."""
+    return len(terms) + sum(t.shape is not None for t in terms)
+
+
 def simplest(J: np.ndarray, folds: np.ndarray, sizes: np.ndarray, columns: list[int]) -> tuple[int, int]:
     """The (model, fit) of the fits ``columns`` kept by the paired test: each model's lowest-J pair among
     them, the models in order of their pair's size (of one size, the lowest J first: the folds' own

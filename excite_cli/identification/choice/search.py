@@ -9,8 +9,10 @@ on, or moves a Stribeck or held term along its velocity grid or a coupled term a
   on a step takes one only when one of them passes tested together with the others (the
   family-wise error: :func:`~excite_cli.identification.choice.admission.family_critical`); an added
   term whose keeping no longer passes it is removed (a start's friction terms the data do not need,
-  a term a later one took over); of the moves allowed to a model not visited before, the one with the lowest
-  mean log fold error J(M) = mean_k log e_k(M) is taken.
+  a term a later one took over); of the moves allowed to a model not visited before, the one to the
+  smallest model (its terms and shape velocities) with the lowest mean log fold error
+  J(M) = mean_k log e_k(M) is taken, unless a larger one passes the test against it, tested
+  together with every larger move (:meth:`StepwiseSearch._taken`).
 - **Price** (time blocks of one recording): J(M) = log CV(M) + p(M) · log(1 + min_improvement),
   p(M) the effects the search added, a coupled one counting as log(1 + coupling_improvement) /
   log(1 + min_improvement) effects and a position-dependent one as log(1 + position_improvement) /
@@ -23,8 +25,7 @@ the search cannot cycle, and it stops when no move is allowed.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from typing import Callable, NamedTuple
+from typing import Callable
 
 import numpy as np
 
@@ -35,98 +36,15 @@ from excite_cli.identification.choice.admission import (
     effect_count,
     effect_weights,
     family_critical,
+    model_size,
     paired_gain,
     passes,
     priced_objective,
 )
 from excite_cli.identification.choice.crossval import CrossValidation
+from excite_cli.identification.choice.search_record import Refused, Search, Step
 from excite_cli.identification.config import IdentificationConfig
 from excite_cli.identification.effects import Term
-
-#: How a move is written: added, removed, shape changed.
-MOVE_SIGNS = {"add": "+", "remove": "−", "shape": "~"}
-
-
-@dataclass(frozen=True)
-class Step:
-    """One move of the search.
-
-    Attributes:
-        move: ``add``, ``remove`` or ``shape`` (a Stribeck or held term's velocity changed).
-        term: the term added, removed, or the new shape's term.
-        terms: the model after the move.
-        cv_error: CV(M) [%] after the move; before: CV(M) [%] before it.
-        tried: every move considered at this step: (move, term, CV after [%]).
-        fold_gain, fold_margin: under the paired test, the move's mean gain over the folds and the
-            margin it passed, as cuts of the error [%] (NaN under the price).
-        family_margin: from :data:`~excite_cli.identification.choice.admission.FAMILY_FOLDS` folds on,
-            the move's margin tested together with the step's other moves (the family-wise error), as a
-            cut of the error [%]: the step was open because some move's gain exceeded its own (NaN
-            below those folds and under the price).
-    """
-
-    move: str
-    term: Term
-    terms: list[Term]
-    cv_error: float
-    before: float
-    tried: list[tuple[str, Term, float]]
-    fold_gain: float = float("nan")
-    fold_margin: float = float("nan")
-    family_margin: float = float("nan")
-
-    def gain_of(self, cv_error: float) -> float:
-        """The cut [%] of the CV error before this step that a move to ``cv_error`` [%] makes."""
-        return 100.0 * (1.0 - cv_error / self.before)
-
-    @property
-    def gain(self) -> float:
-        """The cut [%] of the CV error this step made."""
-        return self.gain_of(self.cv_error)
-
-    def label(self, joints: list[str]) -> str:
-        """e.g. ``+ held panda_joint7 (v_h 0.1 rad/s)``."""
-        return f"{MOVE_SIGNS[self.move]} {self.term.label(joints)}"
-
-
-class Refused(NamedTuple):
-    """The best addition or shape change of the last step that passed its own paired test but not the
-    family's (:meth:`StepwiseSearch.gate`): its gain over the folds, its own margin and its margin
-    tested together with the step's ``tried`` moves, as cuts of the error [%]."""
-
-    move: str
-    term: Term
-    gain: float
-    margin: float
-    family_margin: float
-    tried: int
-
-    def label(self, joints: list[str]) -> str:
-        """The refusal in words, e.g. ``+ armature j4 gains 0.41 % over the folds, ...``."""
-        return (
-            f"{MOVE_SIGNS[self.move]} {self.term.label(joints)} gains {self.gain:.2f} % over the folds, above its own "
-            f"margin {self.margin:.2f} % but not the {self.family_margin:.2f} % of the {self.tried} moves tested "
-            "together (family-wise, 95 %)"
-        )
-
-
-@dataclass
-class Search:
-    """The search from one start: its name, start model and its CV error [%], end model and its CV
-    error [%] and objective J, the steps and why it stopped; the start's and the end's (K,) fold
-    errors [%]; the move the family test refused at the last step (:class:`Refused`), if any."""
-
-    start: str
-    initial: list[Term]
-    initial_error: float
-    terms: list[Term]
-    cv_error: float
-    objective: float
-    steps: list[Step] = field(default_factory=list)
-    stop: str = ""
-    initial_folds: np.ndarray | None = None
-    folds: np.ndarray | None = None
-    refused: Refused | None = None
 
 
 class StepwiseSearch:
@@ -239,6 +157,25 @@ class StepwiseSearch:
         together = paired_gain(before[1], value[1], family)[1]
         return Refused(move, term, as_percent(gain), as_percent(margin), as_percent(together), len(tried))
 
+    def _taken(self, allowed: list) -> tuple | None:
+        """The move a step takes of the ``allowed`` ones (module docstring): under the price the lowest
+        cost; under the paired test the smallest model after the move
+        (:func:`~excite_cli.identification.choice.admission.model_size`; of one size the lowest J)
+        unless a larger one passes the test against it, tested together with every larger move (from
+        :data:`~excite_cli.identification.choice.admission.FAMILY_FOLDS` folds on: the best of a grid
+        of shape velocities is a selection too); then the same from the larger one taken."""
+        if self.rule is Admission.PRICED or not allowed:
+            return min(allowed, key=lambda m: self.cost(m[0], m[2], m[3]), default=None)
+        order = sorted(allowed, key=lambda m: (model_size(m[2]), self.cost(m[0], m[2], m[3])))
+        kept = order[0]
+        while True:
+            larger = [m for m in order if model_size(m[2]) > model_size(kept[2])]
+            family = family_critical(kept[3][1], np.array([m[3][1] for m in larger])) if larger else None
+            passing = [m for m in larger if passes(kept[3][1], m[3][1], family)]
+            if not passing:
+                return kept
+            kept = passing[0]  # the smallest of them, of one size the lowest J (the order)
+
     def run(self, name: str, start: list[Term]) -> Search:
         """The search named ``name`` from the model ``start`` until no move is allowed (module docstring)."""
         terms = list(start)
@@ -262,7 +199,7 @@ class StepwiseSearch:
                 for m in tried
                 if (gate or m[0] == "remove") and self.allowed(m[0], score, m[3]) and frozenset(m[2]) not in visited
             ]
-            best = min(allowed, key=lambda m: self.cost(m[0], m[2], m[3]), default=None)
+            best = self._taken(allowed)
             priced_out = self.rule is Admission.PRICED and best is not None
             if best is None or (priced_out and self.cost(best[0], best[2], best[3]) >= search.objective - 1e-12):
                 search.stop = self._stop(terms)

@@ -36,9 +36,10 @@ from typing import Callable
 import numpy as np
 
 from excite_cli.effects import EFFECTS
-from excite_cli.identification.choice.admission import Admission, admission_of, effect_weights, simplest
+from excite_cli.identification.choice.admission import Admission, admission_of, effect_weights, model_size, simplest
 from excite_cli.identification.choice.crossval import CrossValidation
-from excite_cli.identification.choice.search import Search, Step, StepwiseSearch
+from excite_cli.identification.choice.search import StepwiseSearch
+from excite_cli.identification.choice.search_record import Search, Step
 from excite_cli.identification.config import IdentificationConfig
 from excite_cli.identification.data_config import TransmissionConfig
 from excite_cli.identification.effects import Term, rotor_terms
@@ -179,7 +180,7 @@ def kept_by_test(searches: list[Search]) -> int:
     index = _distinct_ends(searches)
     J = np.array([[searches[k].objective] for k in index])
     folds = np.array([[searches[k].folds] for k in index])
-    sizes = [len(searches[k].terms) + sum(t.shape is not None for t in searches[k].terms) for k in index]
+    sizes = [model_size(searches[k].terms) for k in index]
     return index[simplest(J, folds, np.array(sizes)[:, None], [0])[0]]
 
 

@@ -7,7 +7,8 @@ import scipy.optimize
 
 from excite_cli.identification.choice.admission import Admission
 from excite_cli.identification.choice.crossval import RECORDING_FOLDS, CrossValidation, fold_assignment
-from excite_cli.identification.choice.search import Search, StepwiseSearch
+from excite_cli.identification.choice.search import StepwiseSearch
+from excite_cli.identification.choice.search_record import Search
 from excite_cli.identification.choice.selection import (
     STARTS,
     candidate_terms,
