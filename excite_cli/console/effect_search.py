@@ -7,7 +7,7 @@ import numpy as np
 from rich.table import Table
 
 from excite_cli.console.tables import titled_table
-from excite_cli.identification.choice.admission import Admission
+from excite_cli.identification.choice.admission import FAMILY_FOLDS, Admission
 from excite_cli.identification.choice.search_record import MOVE_SIGNS, Step
 from excite_cli.identification.reporting.report import Report
 
@@ -52,10 +52,17 @@ def search(report: Report, runners_up: int = 2) -> list[Table | str]:
         f"{s.start}: {s.cv_error:.2f} % with {len(s.terms)} effects" + (" (kept)" if k == sel.chosen else "")
         for k, s in enumerate(sel.searches)
     )
+    alone = sel.admission is Admission.PAIRED and sel.folds < FAMILY_FOLDS
     return [
         steps,
         f"searches (cross-validated error at their end): {starts}",
-        f"effects admitted by: {sel.admission} ({sel.folds} folds by {sel.folds_by})",
+        f"effects admitted by: {sel.admission} ({sel.folds} folds by {sel.folds_by})"
+        + (
+            f"; with {sel.folds} folds each move is tested alone, and terms the data do not hold enter more often "
+            f"than from {FAMILY_FOLDS} distinct recordings on, which test the moves of a step together"
+            if alone
+            else ""
+        ),
     ]
 
 
