@@ -27,11 +27,16 @@ together with the others (:func:`family_critical`): each move's t moderated by t
 variance (Smyth, Stat. Appl. Genet. Mol. Biol. 2004), the critical t that of the family's largest t
 under the 2^K sign patterns of the folds (Westfall & Young, "Resampling-Based Multiple Testing"
 1993, single-step maxT), so that a step where no move helps admits one in about 5 % of the cases
-whatever the number of moves and their correlation. The move taken is still the lowest J of those
-that pass their own test: a real effect whose gain differs between recordings (a Stribeck term that
-matters on the trajectories slow on its joint) has a large mean and a large spread, and tested in
-the family it lost to a small steady stand-in (held friction). Removals are one hypothesis each and
-keep the plain test.
+whatever the number of moves and their correlation. The move taken is of those that pass their own
+test: a real effect whose gain differs between recordings (a Stribeck term that matters on the
+trajectories slow on its joint) has a large mean and a large spread, and tested in the family it
+lost to a small steady stand-in (held friction). Of them the one to the smallest model
+(:func:`model_size`), of one size the lowest J, unless a larger one passes the test against it,
+tested together with every larger move (the best of a grid of shape velocities is a selection too;
+:meth:`~excite_cli.identification.choice.search.StepwiseSearch._taken`). Removals are one
+hypothesis each and keep the plain test. With 4 folds the family's level could be no lower than
+1/16: tried, it refused the true Stribeck term of a simulated Panda in 3 of 10 runs on 4 recordings,
+so 4 folds test each move alone.
 
 **Time blocks of one recording** share its motion: for a periodic excitation each block repeats the
 phases the other blocks saw (the real Panda run: folds of one periodic run rewarded position terms

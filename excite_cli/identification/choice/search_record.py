@@ -58,8 +58,9 @@ class Step:
 
 class Refused(NamedTuple):
     """The best addition or shape change of the last step that passed its own paired test but not the
-    family's (:meth:`~excite_cli.identification.choice.search.StepwiseSearch.gate`): its gain over the folds, its own margin and its margin
-    tested together with the step's ``tried`` moves, as cuts of the error [%]."""
+    family's (:meth:`~excite_cli.identification.choice.search.StepwiseSearch.gate`): its gain over the
+    folds, its own margin and its margin tested together with the step's ``tried`` moves, as cuts of
+    the error [%]."""
 
     move: str
     term: Term
