@@ -152,7 +152,7 @@ def _validation_error(path: Path | None, error: ValidationError) -> ExciteError:
     return ExciteError(field, f"{message}{suffix}", value, source=path)
 
 
-def load_problem(path: str | Path, kind: type[BaseModel] = Problem, field: str = "config"):
+def load_problem(path: str | Path, kind: type[BaseModel] = Problem, field: str = "config") -> BaseModel:
     """Read and validate a YAML file as a :class:`Problem` (or another config ``kind``).
 
     Args:

@@ -65,7 +65,7 @@ class TrajectoryConfig(Section):
     cost_period: float = Field(0.2, gt=0.0)
     """Time between cost samples [s]; the duration is cost_samples × cost_period."""
     constraint_period: float = Field(0.02, gt=0.0)
-    """Time step of the constraint grid over [0, duration] [s]."""
+    """Time step [s] of the constraint grid over the duration."""
     boundary: Literal["rest", "periodic"] = "rest"
     """`rest`: q̇ = q̈ = 0 at both ends; `periodic`: Eq. 50 as it is."""
     ends_at_home: bool = False

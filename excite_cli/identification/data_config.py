@@ -96,7 +96,7 @@ class RunConfig(Section):
     file: Union[str, list[str]]
     """A data file (CSV, NPZ, MAT, HDF5, ROS bag), or a list of files recorded apart, joined on time."""
     crop: Optional[tuple[float, float]] = None
-    """[t0, t1] [s]: the part of the run used."""
+    """The part of the run used: its start t0 and end t1 [s]."""
     role: Literal["fit", "validation", "blocks"] = "blocks"
     """`fit`, `validation` (never fitted nor seen by the selection) or `blocks` (alternate time blocks)."""
     payload: Optional[PayloadConfig] = None

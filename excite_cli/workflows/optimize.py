@@ -134,7 +134,8 @@ def run_optimize(
         force: replace an existing ``target``.
         resume: continue the iterations already in ``target`` (made with the same config, up to
             ``RESUMABLE_CHANGES``); the end result is that of an uninterrupted run.
-        progress, on_iteration: see :func:`run_sequence`.
+        progress: see :func:`run_sequence`.
+        on_iteration: see :func:`run_sequence`.
         engine: where restarts run (default: :func:`engine_for`).
 
     Raises:
