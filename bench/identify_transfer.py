@@ -201,7 +201,9 @@ def effect_errors(report, truth: list[tuple[Term, float]], joints: list[str]) ->
     rotors = dict(zip(fit.rotor_joints, fit.rotors))
     worst, missing = {}, []
     for term, value in truth:
-        got = found_values.get((term, term.kind.coefficients[0]), rotors.get(joints[term.joint]))
+        got = found_values.get((term, term.kind.coefficients[0]))
+        if got is None and term.effect == "armature":  # the consistent fit holds every rotor
+            got = rotors.get(joints[term.joint])
         if got is None:
             missing.append(term.label(joints))
             continue
