@@ -155,7 +155,8 @@ class StepwiseSearch:
         move, term, _, value = min(alone, key=lambda m: self.cost(m[0], m[2], m[3]))
         gain, margin = paired_gain(before[1], value[1])
         together = paired_gain(before[1], value[1], family)[1]
-        return Refused(move, term, as_percent(gain), as_percent(margin), as_percent(together), len(tried))
+        family_size = sum(m[0] != "remove" for m in tried)
+        return Refused(move, term, as_percent(gain), as_percent(margin), as_percent(together), family_size)
 
     def _taken(self, allowed: list) -> tuple | None:
         """The move a step takes of the ``allowed`` ones (module docstring): under the price the lowest
@@ -207,7 +208,8 @@ class StepwiseSearch:
                 break
             move, term, after, value = best
             gain, margin = paired_gain(score[1], value[1]) if self.rule is Admission.PAIRED else (np.nan, np.nan)
-            together = paired_gain(score[1], value[1], family)[1] if family is not None else np.nan
+            tested = family is not None and move != "remove"  # removals keep the plain test
+            together = paired_gain(score[1], value[1], family)[1] if tested else np.nan
             tried_cv = [(m, t, v[0]) for m, t, _, v in tried]
             search.steps.append(
                 Step(

@@ -29,7 +29,7 @@ class Step:
         family_margin: from :data:`~excite_cli.identification.choice.admission.FAMILY_FOLDS` folds on,
             the move's margin tested together with the step's other moves (the family-wise error), as a
             cut of the error [%]: the step was open because some move's gain exceeded its own (NaN
-            below those folds and under the price).
+            below those folds, for a removal, which keeps the plain test, and under the price).
     """
 
     move: str
@@ -59,8 +59,8 @@ class Step:
 class Refused(NamedTuple):
     """The best addition or shape change of the last step that passed its own paired test but not the
     family's (:meth:`~excite_cli.identification.choice.search.StepwiseSearch.gate`): its gain over the
-    folds, its own margin and its margin tested together with the step's ``tried`` moves, as cuts of
-    the error [%]."""
+    folds, its own margin and its margin tested together with the step's ``tried`` additions and
+    shape changes, as cuts of the error [%]."""
 
     move: str
     term: Term
