@@ -36,7 +36,8 @@ def search(report: Report, runners_up: int = 2) -> list[Table | str]:
     steps = titled_table(
         f"Selection steps from the start '{kept.start}' (gain: cut of the cross-validated error [%]"
         + (
-            "; folds: the mean gain over the folds and the margin of the paired test it passed, from 5 folds on "
+            "; folds: the mean gain over the folds and the margin of the paired test it passed, "
+            f"from {FAMILY_FOLDS} folds on "
             "and in brackets the margin of the moves tested together, some move's gain above its own)"
             if paired
             else ")"

@@ -30,6 +30,7 @@ from typing import Callable
 import numpy as np
 
 from excite_cli.identification.choice.admission import (
+    FAMILY_FOLDS,
     Admission,
     Family,
     as_percent,
@@ -136,8 +137,8 @@ class StepwiseSearch:
         if self.rule is Admission.PAIRED:
             return (
                 "no addition or shape change improves the folds by more than their own spread (paired test "
-                "over distinct recordings, 95 %, the step's moves together from 5 folds on) and every added term "
-                "passes it"
+                f"over distinct recordings, 95 %, the step's moves together from {FAMILY_FOLDS} folds on) and every "
+                "added term passes it"
             )
         return (
             f"no addition, removal or shape change lowers the cross-validated error by "
