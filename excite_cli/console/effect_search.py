@@ -23,13 +23,14 @@ def search(report: Report, runners_up: int = 2) -> list[Table | str]:
         others = sorted(((v, m, t) for m, t, v in step.tried if (m, t) != (step.move, step.term)), key=lambda o: o[0])[
             :runners_up
         ]
+        unclear = not np.isnan(step.clear_of_zero)
         rows.append(
             (
                 str(k),
-                step.label(report.joints),
+                step.label(report.joints) + (f" (estimate {step.clear_of_zero:.1f} std from 0)" if unclear else ""),
                 f"{step.gain:.1f}",
-                *([_folds(step)] if paired else []),
-                str(len(step.tried)),
+                *(["—" if unclear else _folds(step)] if paired else []),
+                "—" if unclear else str(len(step.tried)),
                 "; ".join(f"{MOVE_SIGNS[m]} {t.label(report.joints)} {step.gain_of(v):.1f}" for v, m, t in others),
             )
         )

@@ -16,15 +16,14 @@ from excite_cli.dynamics.robot_files import resolve_urdf
 from excite_cli.effects import EFFECTS
 from excite_cli.errors import ExciteError
 from excite_cli.identification.choice.consistent_model import consistent_model
-from excite_cli.identification.choice.crossval import fold_assignment, fold_groups
+from excite_cli.identification.choice.crossval import fold_groups
+from excite_cli.identification.choice.estimates import reported_fit
 from excite_cli.identification.choice.fit_choice import choose_fit
 from excite_cli.identification.choice.selection import Selection, candidate_terms, motor_couplings, select_effects
 from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.effects import Term, rotor_terms
 from excite_cli.identification.fitting.dataset import Dataset
-from excite_cli.identification.fitting.least_squares import Fit, least_squares, predict, torque_errors
-from excite_cli.identification.fitting.model_error import between_time_blocks, between_trajectories
-from excite_cli.identification.fitting.noise import middle
+from excite_cli.identification.fitting.least_squares import least_squares, predict, torque_errors
 from excite_cli.identification.fitting.noise_level import BLOCKS, NoiseLevel, fit_noise_level
 from excite_cli.identification.fitting.plausibility import implausible
 from excite_cli.identification.measured.measurements import in_sample_validation
@@ -114,11 +113,15 @@ def run_identification(
         couplings=couplings,
         scored=~data.silent,
         say=say,
+        uncertainty=(data.rate, data.trajectories),
     )
     labels = [r.label for r in problem.data.runs]
     offset_runs = [labels[k] for k in data.fitted]
     selection, choice = choose_fit(selection, robot, base, offset_runs, cfg, consistent_beside, say)
-    selection = replace(selection, fit=reported_fit(selection, fit_data, data.rate, data.trajectories, cfg.folds))
+    reported = reported_fit(
+        selection.normal, selection.terms, selection.weights, fit_data, data.rate, data.trajectories, cfg.folds
+    )
+    selection = replace(selection, fit=reported)
     measured = val_data.tau.reshape(-1, val_data.n)
     before = predict(val_data, selection.rigid.x, [])
     plain = predict(val_data, selection.fit.x, selection.terms)
@@ -186,25 +189,6 @@ def noise_levels(
         return []
     residual = measured - predicted
     return [fit_noise_level(residual[:, j], predicted[:, j], gain) if live[j] else None for j in range(len(live))]
-
-
-def reported_fit(selection: Selection, fit_data: Dataset, rate: float, clusters: np.ndarray, folds: int) -> Fit:
-    """The chosen model's least-squares fit as reported: its standard deviations from the noise the
-    residuals show (the sandwich of :mod:`~excite_cli.identification.fitting.noise`, ``rate`` [Hz]),
-    and beside them the spread between the distinct trajectories of the fit data (``clusters``: (R,)
-    the trajectory of each configured run) when there are 3 or more, else between the ``folds`` time
-    blocks of each trajectory's runs (:mod:`~excite_cli.identification.fitting.model_error`); a
-    coefficient held at its bound has neither."""
-    sandwich = middle(fit_data, selection.fit.x, selection.terms, selection.weights, rate)
-    fit = least_squares(selection.normal, selection.terms, selection.weights, middle=sandwich)
-    x, terms, weights = fit.x, selection.terms, selection.weights
-    variance, spread_by = between_trajectories(fit_data, x, terms, weights, clusters), "trajectories"
-    count = np.unique(clusters[np.unique(fit_data.run)]).size
-    if variance is None:
-        block, _ = fold_assignment(fit_data.time, fit_data.run, folds, 0.0)
-        (variance, count), spread_by = between_time_blocks(fit_data, x, terms, weights, block, clusters), "time blocks"
-    held = fit.held if fit.held.size else False
-    return replace(fit, between=np.where(held, np.nan, np.sqrt(variance)), groups=int(count), spread_by=spread_by)
 
 
 def write_identified_urdf(

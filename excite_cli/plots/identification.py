@@ -113,7 +113,7 @@ def plot_ladder(path: Path, report: Report) -> Path:
             label="min_improvement",
         )
     else:  # each move taken passed the paired test over the folds: its margin
-        margins = [step.fold_margin for step in sel.steps]
+        margins = [step.fold_margin for step in sel.steps]  # NaN for a removal of an estimate not clear of zero
         bottom.plot(np.arange(1, len(margins) + 1), margins, "_", color="k", markersize=12, label="paired-test margin")
     bottom.set_xlabel("step of the search (★ the move taken, dots every move tried)")
     bottom.set_ylabel("gain [%]")

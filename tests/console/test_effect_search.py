@@ -5,6 +5,7 @@ from types import SimpleNamespace
 
 from excite_cli.console.effect_search import search
 from excite_cli.identification.choice.admission import FAMILY_FOLDS, Admission
+from excite_cli.identification.choice.search_record import Step
 
 
 def test_a_row_per_step_and_the_kept_start_named(simulated_identification):
@@ -24,3 +25,20 @@ def test_four_recordings_are_said_to_test_each_move_alone(simulated_identificati
         selection = replace(report.selection, admission=Admission.PAIRED, cross_validation=folds_of)
         rule = search(replace(report, selection=selection))[-1]
         assert ("each move is tested alone" in rule) is said, rule
+
+
+def test_a_removal_of_an_estimate_not_clear_of_zero_says_so_in_its_row(simulated_identification):
+    """The search's last removals (an estimate under 3 standard deviations from zero) print the
+    estimate's distance instead of a paired test, and their row tried no other move."""
+    _, report, *_ = simulated_identification
+    sel = report.selection
+    kept = sel.searches[sel.chosen]
+    term = kept.terms[-1]
+    removal = Step("remove", term, kept.terms[:-1], kept.cv_error, kept.cv_error, [], clear_of_zero=1.73)
+    searches = list(sel.searches)
+    searches[sel.chosen] = replace(kept, steps=[*kept.steps, removal])
+    paired = replace(sel, searches=searches, admission=Admission.PAIRED, at_start=False)
+    table = search(replace(report, selection=paired))[0]
+    last = [column._cells[-1] for column in table.columns]
+    assert last[1] == f"− {term.label(report.joints)} (estimate 1.7 std from 0)"
+    assert last[3] == "—" and last[4] == "—"

@@ -20,7 +20,10 @@ on, or moves a Stribeck or held term along its velocity grid or a coupled term a
   free); the move that lowers J most is taken.
 
 Under the price every move lowers J; under the paired test no model is visited twice. Either way
-the search cannot cycle, and it stops when no move is allowed.
+the search cannot cycle, and it stops when no move is allowed. Given the reported fit's estimates
+(from five distinct recordings on: :mod:`~excite_cli.identification.choice.selection`), it then
+removes the added terms whose estimate is not clear of zero, the least clear first, each a step
+(:mod:`~excite_cli.identification.choice.estimates`).
 """
 
 from __future__ import annotations
@@ -43,6 +46,7 @@ from excite_cli.identification.choice.admission import (
     priced_objective,
 )
 from excite_cli.identification.choice.crossval import CrossValidation
+from excite_cli.identification.choice.estimates import CLEAR
 from excite_cli.identification.choice.search_record import Refused, Search, Step
 from excite_cli.identification.config import IdentificationConfig
 from excite_cli.identification.effects import Term
@@ -59,8 +63,10 @@ class StepwiseSearch:
         cfg: IdentificationConfig,
         rule: Admission = Admission.PRICED,
         say: Callable[[str], None] | None = None,
+        clear: Callable[[list[Term], list[Term]], dict[Term, float]] | None = None,
     ):
         self.cv, self.candidates, self.declared, self.cfg, self.rule = cv, candidates, declared, cfg, rule
+        self.clear = clear  # (model, its removable terms) -> each one's |value| / std in the reported fit
         self.say = say  # told each step: the search, the model's size and CV, the moves to score
         self.fixed = {t.family for t in declared}  # declared: never removed (their shape may move)
         self.penalty = np.log1p(cfg.min_improvement)
@@ -228,5 +234,31 @@ class StepwiseSearch:
             terms, score = after, value
             visited.add(frozenset(terms))
             search.objective = self.objective(terms, score)
+        terms, score = self._clear_of_zero(search, terms, score)
         search.terms, search.cv_error, search.folds = terms, score[0], score[1]
         return search
+
+    def _removable(self, terms: list[Term]) -> list[Term]:
+        """The terms of ``terms`` a removal may take: added, and no other term requires them."""
+        return [m[1] for m in self.moves(terms) if m[0] == "remove"]
+
+    def _clear_of_zero(self, search: Search, terms: list[Term], score: tuple) -> tuple[list[Term], tuple]:
+        """The end ``terms`` (scored ``score``) without the added terms whose estimate is not clear of
+        zero (:data:`~excite_cli.identification.choice.estimates.CLEAR`), the least clear removed first
+        and the rest judged again without it, each removal a step of ``search``."""
+        removed = 0
+        while self.clear is not None and (removable := self._removable(terms)):
+            term, ratio = min(self.clear(terms, removable).items(), key=lambda item: item[1])
+            if ratio >= CLEAR:
+                break
+            after = [t for t in terms if t != term]
+            value = self.score(after)
+            search.steps.append(Step("remove", term, after, value[0], score[0], [], clear_of_zero=ratio))
+            terms, score, removed = after, value, removed + 1
+            search.objective = self.objective(terms, score)
+        if removed:
+            search.stop += (
+                f"; then {removed} added term{'s' * (removed > 1)} removed whose estimate the report could not tell "
+                f"from zero (under {CLEAR:g} standard deviations)"
+            )
+        return terms, score

@@ -30,6 +30,9 @@ class Step:
             the move's margin tested together with the step's other moves (the family-wise error), as a
             cut of the error [%]: the step was open because some move's gain exceeded its own (NaN
             below those folds, for a removal, which keeps the plain test, and under the price).
+        clear_of_zero: a removal because the term's estimate was not clear of zero in the reported fit
+            (:mod:`~excite_cli.identification.choice.estimates`): its clearest coefficient's |value| in
+            standard deviations (NaN for every other step).
     """
 
     move: str
@@ -41,6 +44,7 @@ class Step:
     fold_gain: float = float("nan")
     fold_margin: float = float("nan")
     family_margin: float = float("nan")
+    clear_of_zero: float = float("nan")
 
     def gain_of(self, cv_error: float) -> float:
         """The cut [%] of the CV error before this step that a move to ``cv_error`` [%] makes."""

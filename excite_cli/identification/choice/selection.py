@@ -19,7 +19,9 @@ its path: a joint whose Coulomb friction is missing bends the shared base parame
 later can make another joint's error worse first. So the search runs from three starts (the declared
 effects alone, plus Coulomb friction on every joint, plus Coulomb and viscous friction on every
 joint) and keeps the end with the lowest J (under the paired test: the fewest terms, unless a larger
-end passes the test against it; of searches ending at the same model, the first).
+end passes the test against it; of searches ending at the same model, the first). From five
+distinct recordings on, each end keeps an added term only when its estimate is clear of zero in the
+reported fit (:mod:`~excite_cli.identification.choice.estimates`).
 Candidates whose columns lie in the span of the rigid-body model (e.g. the armature of a joint whose
 rotor inertia regroups with a link's) are not separately identifiable and are skipped. Every fit,
 in the folds and the final one, uses the same per-joint weights (WLS: 1/σ_j of the rigid-body fit,
@@ -36,8 +38,16 @@ from typing import Callable
 import numpy as np
 
 from excite_cli.effects import EFFECTS
-from excite_cli.identification.choice.admission import Admission, admission_of, effect_weights, model_size, simplest
+from excite_cli.identification.choice.admission import (
+    FAMILY_FOLDS,
+    Admission,
+    admission_of,
+    effect_weights,
+    model_size,
+    simplest,
+)
 from excite_cli.identification.choice.crossval import CrossValidation
+from excite_cli.identification.choice.estimates import Clearance
 from excite_cli.identification.choice.search import StepwiseSearch
 from excite_cli.identification.choice.search_record import Search, Step
 from excite_cli.identification.config import IdentificationConfig
@@ -194,6 +204,7 @@ def select_effects(
     couplings: list[tuple[float, ...]] = (),
     scored: np.ndarray | None = None,
     say: Callable[[str], None] | None = None,
+    uncertainty: tuple[float, np.ndarray] | None = None,
 ) -> Selection:
     """The stepwise search of the module docstring on the fit data.
 
@@ -209,6 +220,10 @@ def select_effects(
         couplings: the motor coordinates of coupled candidates (:func:`motor_couplings`).
         scored: (n,) the joints the CV error is the mean over (a channel without signal is not).
         say: told each step of each search (:class:`StepwiseSearch`).
+        uncertainty: the rate [Hz] of the fit data and the trajectory of each run (R,): where the folds
+            are :data:`~excite_cli.identification.choice.admission.FAMILY_FOLDS` or more distinct
+            recordings, each search's end keeps an added term only when its estimate is clear of zero
+            in the reported fit (:mod:`~excite_cli.identification.choice.estimates`); None: not judged.
     """
     n = fit_data.n
     candidates = [t for t in candidate_terms(cfg, n, couplings) if t not in declared and t in fit_data.blocks]
@@ -221,7 +236,10 @@ def select_effects(
     candidates = [t for t in candidates if t not in absorbed]
     keys = declared + candidates + [t for t in total.size if t not in declared + candidates]
     cv = CrossValidation(fit_data, keys, weights, cfg.folds, margin, recordings, fitted_offsets, scored)
-    search = StepwiseSearch(cv, candidates, declared, cfg, admission_of(cv.by_recording, cv.folds), say)
+    rule = admission_of(cv.by_recording, cv.folds)
+    judged = uncertainty is not None and rule is Admission.PAIRED and cv.folds >= FAMILY_FOLDS
+    clear = Clearance(total, weights, fit_data, *uncertainty, cfg.folds) if judged else None
+    search = StepwiseSearch(cv, candidates, declared, cfg, rule, say, clear)
     searches, seen = [], []
     for name, effects in STARTS.items():
         start = declared + [t for t in candidates if t.effect in effects and t.shape is None and t.coupling is None]

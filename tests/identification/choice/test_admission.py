@@ -19,6 +19,7 @@ from excite_cli.identification.choice.admission import (
     passes,
     simplest,
 )
+from excite_cli.identification.choice.estimates import CLEAR
 from excite_cli.identification.choice.search import StepwiseSearch
 from excite_cli.identification.config import IdentificationConfig
 from excite_cli.identification.effects import Term
@@ -162,3 +163,38 @@ def test_a_step_takes_a_shaped_term_over_a_plain_one_only_where_it_passes_the_te
     assert taken.count(viscous) >= 9, taken
     better = _search(8, {viscous: 0.05, stribeck: 0.1}, 0, candidates, declared)
     assert better.steps[0].term == stribeck
+
+
+class _Clear:
+    """A stand-in of the reported fit's ratios: each term's from ``ratios`` (10 for any other), and the
+    terms it was asked about."""
+
+    def __init__(self, ratios: dict):
+        self.ratios, self.asked = ratios, []
+
+    def __call__(self, terms, asked):
+        self.asked.append(list(asked))
+        return {t: self.ratios.get(t, 10.0) for t in asked}
+
+
+def test_the_search_removes_the_admitted_terms_its_estimates_cannot_tell_from_zero_least_clear_first():
+    """Eight folds where two terms help: both admitted; stated 1.5 and 2.5 std from zero they are
+    removed (1.5 first), each a step of the search with its ratio; at 3.5 the term stays; the
+    declared term is never asked about."""
+    declared, a, b = [Term("viscous", 99)], Term("coulomb", 3), Term("coulomb", 7)
+    candidates = [Term("coulomb", j) for j in range(20)]
+    cfg = IdentificationConfig(candidates=["coulomb", "viscous"])
+    gains = {a: 0.1, b: 0.1}
+    plain = StepwiseSearch(_Folds(8, gains, 0), candidates, declared, cfg, Admission.PAIRED).run("s", declared)
+    assert {a, b} <= set(plain.terms)
+    clear = _Clear({a: 2.5, b: 1.5})
+    search = StepwiseSearch(_Folds(8, gains, 0), candidates, declared, cfg, Admission.PAIRED, clear=clear).run(
+        "s", declared
+    )
+    removals = [s for s in search.steps if not np.isnan(s.clear_of_zero)]
+    assert [(s.move, s.term, s.clear_of_zero) for s in removals] == [("remove", b, 1.5), ("remove", a, 2.5)]
+    assert a not in search.terms and b not in search.terms and search.terms == removals[-1].terms
+    assert "2 added terms removed" in search.stop and f"under {CLEAR:g} standard deviations" in search.stop
+    assert all(declared[0] not in asked for asked in clear.asked)
+    kept = StepwiseSearch(_Folds(8, gains, 0), candidates, declared, cfg, Admission.PAIRED, clear=_Clear({a: 3.5}))
+    assert a in kept.run("s", declared).terms

@@ -16,6 +16,7 @@ def test_the_effects_and_steps_are_the_reports(simulated_identification, tmp_pat
         write_search(g, report)
     with h5py.File(tmp_path / "r.h5") as f:
         effects, steps = f["identification/effects"][()], f["identification/steps"][()]
+        clear = f["identification/steps"].attrs["clear_of_zero_std"]
     values = report.effect_values()
     np.testing.assert_array_equal(effects["value"], [v for _, _, v, _ in values])
     fit, b = report.selection.fit, len(report.base_names)
@@ -23,3 +24,4 @@ def test_the_effects_and_steps_are_the_reports(simulated_identification, tmp_pat
     assert fit.spread_by == "time blocks" and fit.groups == 6  # identification.folds
     np.testing.assert_array_equal(effects["std_between_time_blocks"], fit.between[b:])
     assert len(steps) == len(report.selection.steps)
+    np.testing.assert_array_equal(clear, [s.clear_of_zero for s in report.selection.steps])  # NaN: no such removal
