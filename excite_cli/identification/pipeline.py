@@ -17,7 +17,6 @@ from excite_cli.effects import EFFECTS
 from excite_cli.errors import ExciteError
 from excite_cli.identification.choice.consistent_model import consistent_model
 from excite_cli.identification.choice.crossval import fold_groups
-from excite_cli.identification.choice.estimates import reported_fit
 from excite_cli.identification.choice.fit_choice import choose_fit
 from excite_cli.identification.choice.selection import Selection, candidate_terms, motor_couplings, select_effects
 from excite_cli.identification.config import IdentifyProblem
@@ -115,13 +114,9 @@ def run_identification(
         say=say,
         uncertainty=(data.rate, data.trajectories),
     )
-    labels = [r.label for r in problem.data.runs]
-    offset_runs = [labels[k] for k in data.fitted]
+    offset_runs = [problem.data.runs[k].label for k in data.fitted]
     selection, choice = choose_fit(selection, robot, base, offset_runs, cfg, consistent_beside, say)
-    reported = reported_fit(
-        selection.normal, selection.terms, selection.weights, fit_data, data.rate, data.trajectories, cfg.folds
-    )
-    selection = replace(selection, fit=reported)
+    selection = replace(selection, fit=selection.estimates.reported(selection.terms))
     measured = val_data.tau.reshape(-1, val_data.n)
     before = predict(val_data, selection.rigid.x, [])
     plain = predict(val_data, selection.fit.x, selection.terms)
@@ -157,7 +152,7 @@ def run_identification(
         validation_samples=val_data.time.size,
         rate=data.rate,
         dropped=data.dropped,
-        run_names=labels,
+        run_names=[r.label for r in problem.data.runs],
         offset_runs=offset_runs,
         ladder=ladder,
         dead=data.silent,

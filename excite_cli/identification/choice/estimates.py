@@ -5,7 +5,8 @@ The reported standard deviations are two (:func:`reported_fit`): the noise's, fr
 the residuals' spectra (:mod:`~excite_cli.identification.fitting.noise`), and the spread between the
 distinct trajectories of the fit data, model error included (between time blocks with fewer than
 three; :mod:`~excite_cli.identification.fitting.model_error`). An added term is kept only when one
-of its coefficients is at least :data:`CLEAR` times the larger of the two from zero: the search's
+of its coefficients is at least :data:`CLEAR` times the larger of the two from zero (with ``spread``
+off, as on four recordings, whose spread has three degrees of freedom, the noise's alone): the search's
 tests judge a move by the folds' errors, and a term that passes them by chance, or stands in for
 another term of its joint, leaves an estimate within its own uncertainty of zero (on simulated UR10s
 and Pandas, ``bench/admission.py``: the load-dependent Coulomb, Stribeck, held, asymmetric friction
@@ -60,22 +61,25 @@ def reported_fit(
     return replace(fit, between=np.where(held, np.nan, np.sqrt(variance)), groups=int(count), spread_by=spread_by)
 
 
-def clearance(fit: Fit, terms: list[Term], sizes: dict[Term, int]) -> dict[Term, float]:
+def clearance(fit: Fit, terms: list[Term], sizes: dict[Term, int], spread: bool = True) -> dict[Term, float]:
     """Each of ``terms``' clearest coefficient's |value| over the larger of its two reported standard
-    deviations (module docstring), in the fit (:func:`reported_fit`) of the model [Y_B, ``terms``]
-    whose terms have ``sizes`` coefficients each (the base parameters first)."""
-    spread = fit.std if fit.between is None else np.fmax(fit.std, fit.between)
-    ratio = np.where(np.isfinite(spread) & (spread > 0), np.abs(fit.x) / np.where(spread > 0, spread, 1.0), 0.0)
+    deviations (module docstring; without ``spread`` the noise's alone), in the fit
+    (:func:`reported_fit`) of the model [Y_B, ``terms``] whose terms have ``sizes`` coefficients each
+    (the base parameters first)."""
+    std = fit.std if fit.between is None or not spread else np.fmax(fit.std, fit.between)
+    ratio = np.where(np.isfinite(std) & (std > 0), np.abs(fit.x) / np.where(std > 0, std, 1.0), 0.0)
     ends = fit.x.size - sum(sizes[t] for t in terms) + np.cumsum([0] + [sizes[t] for t in terms])
     return {t: float(ratio[lo:hi].max(initial=0.0)) for t, lo, hi in zip(terms, ends[:-1], ends[1:])}
 
 
-class Clearance:
-    """How clear of zero the terms of any model are in its reported fit, on one selection's data.
+class Estimates:
+    """The reported fit of any model on one selection's data, and how clear of zero its terms are.
 
     Args:
         normal: the fit data's normal equations (every candidate); weights: (n,) the joints' (None: 1).
         fit_data, rate, clusters, folds: as :func:`reported_fit`.
+        spread: judge by the larger of the noise's deviation and the spread between the recordings
+            (five or more), or by the noise's alone (:func:`clearance`).
     """
 
     def __init__(
@@ -86,12 +90,16 @@ class Clearance:
         rate: float,
         clusters: np.ndarray,
         folds: int,
+        spread: bool = True,
     ):
         self.normal, self.weights, self.data = normal, weights, fit_data
-        self.rate, self.clusters, self.folds = rate, clusters, folds
+        self.rate, self.clusters, self.folds, self.spread = rate, clusters, folds, spread
 
-    def __call__(self, terms: list[Term], asked: list[Term]) -> dict[Term, float]:
+    def reported(self, terms: list[Term]) -> Fit:
+        """:func:`reported_fit` of the model [Y_B, ``terms``]."""
+        return reported_fit(self.normal, terms, self.weights, self.data, self.rate, self.clusters, self.folds)
+
+    def clearance(self, terms: list[Term], asked: list[Term]) -> dict[Term, float]:
         """:func:`clearance` of the ``asked`` terms in the model [Y_B, ``terms``]."""
-        fit = reported_fit(self.normal, terms, self.weights, self.data, self.rate, self.clusters, self.folds)
-        ratios = clearance(fit, terms, self.normal.size)
+        ratios = clearance(self.reported(terms), terms, self.normal.size, self.spread)
         return {t: ratios[t] for t in asked}

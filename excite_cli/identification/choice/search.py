@@ -21,7 +21,7 @@ on, or moves a Stribeck or held term along its velocity grid or a coupled term a
 
 Under the price every move lowers J; under the paired test no model is visited twice. Either way
 the search cannot cycle, and it stops when no move is allowed. Given the reported fit's estimates
-(from five distinct recordings on: :mod:`~excite_cli.identification.choice.selection`), it then
+(on distinct recordings: :mod:`~excite_cli.identification.choice.selection`), it then
 removes the added terms whose estimate is not clear of zero, the least clear first, each a step
 (:mod:`~excite_cli.identification.choice.estimates`).
 """

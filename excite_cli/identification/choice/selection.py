@@ -19,9 +19,9 @@ its path: a joint whose Coulomb friction is missing bends the shared base parame
 later can make another joint's error worse first. So the search runs from three starts (the declared
 effects alone, plus Coulomb friction on every joint, plus Coulomb and viscous friction on every
 joint) and keeps the end with the lowest J (under the paired test: the fewest terms, unless a larger
-end passes the test against it; of searches ending at the same model, the first). From five
-distinct recordings on, each end keeps an added term only when its estimate is clear of zero in the
-reported fit (:mod:`~excite_cli.identification.choice.estimates`).
+end passes the test against it; of searches ending at the same model, the first). On distinct
+recordings each end keeps an added term only when its estimate is clear of zero in the reported fit
+(:mod:`~excite_cli.identification.choice.estimates`).
 Candidates whose columns lie in the span of the rigid-body model (e.g. the armature of a joint whose
 rotor inertia regroups with a link's) are not separately identifiable and are skipped. Every fit,
 in the folds and the final one, uses the same per-joint weights (WLS: 1/σ_j of the rigid-body fit,
@@ -47,7 +47,7 @@ from excite_cli.identification.choice.admission import (
     simplest,
 )
 from excite_cli.identification.choice.crossval import CrossValidation
-from excite_cli.identification.choice.estimates import Clearance
+from excite_cli.identification.choice.estimates import Estimates
 from excite_cli.identification.choice.search import StepwiseSearch
 from excite_cli.identification.choice.search_record import Search, Step
 from excite_cli.identification.config import IdentificationConfig
@@ -89,6 +89,9 @@ class Selection:
             or the price (:mod:`~excite_cli.identification.choice.admission`).
         normal: the fit data's normal equations (every candidate and every joint's armature: the rotors of
             :mod:`~excite_cli.identification.choice.consistent_model`), for refitting other models.
+        estimates: the reported fit of any model on these data and its terms' distance from zero
+            (:class:`~excite_cli.identification.choice.estimates.Estimates`); None without the fit
+            data's rate and trajectories.
     """
 
     terms: list[Term]
@@ -108,6 +111,7 @@ class Selection:
     effect_weights: tuple[float, float] = (1.0, 1.0)
     at_start: bool = False
     admission: Admission = Admission.PRICED
+    estimates: Estimates | None = None
 
     @property
     def folds(self) -> int:
@@ -221,9 +225,10 @@ def select_effects(
         scored: (n,) the joints the CV error is the mean over (a channel without signal is not).
         say: told each step of each search (:class:`StepwiseSearch`).
         uncertainty: the rate [Hz] of the fit data and the trajectory of each run (R,): where the folds
-            are :data:`~excite_cli.identification.choice.admission.FAMILY_FOLDS` or more distinct
-            recordings, each search's end keeps an added term only when its estimate is clear of zero
-            in the reported fit (:mod:`~excite_cli.identification.choice.estimates`); None: not judged.
+            are distinct recordings (the paired test), each search's end keeps an added term only when
+            its estimate is clear of zero in the reported fit, judged by the spread between the
+            recordings too from :data:`~excite_cli.identification.choice.admission.FAMILY_FOLDS` folds
+            on (:mod:`~excite_cli.identification.choice.estimates`); None: not judged.
     """
     n = fit_data.n
     candidates = [t for t in candidate_terms(cfg, n, couplings) if t not in declared and t in fit_data.blocks]
@@ -237,8 +242,9 @@ def select_effects(
     keys = declared + candidates + [t for t in total.size if t not in declared + candidates]
     cv = CrossValidation(fit_data, keys, weights, cfg.folds, margin, recordings, fitted_offsets, scored)
     rule = admission_of(cv.by_recording, cv.folds)
-    judged = uncertainty is not None and rule is Admission.PAIRED and cv.folds >= FAMILY_FOLDS
-    clear = Clearance(total, weights, fit_data, *uncertainty, cfg.folds) if judged else None
+    spread = cv.folds >= FAMILY_FOLDS  # the spread of fewer recordings is itself too uncertain to judge by
+    estimates = None if uncertainty is None else Estimates(total, weights, fit_data, *uncertainty, cfg.folds, spread)
+    clear = estimates.clearance if estimates is not None and rule is Admission.PAIRED else None
     search = StepwiseSearch(cv, candidates, declared, cfg, rule, say, clear)
     searches, seen = [], []
     for name, effects in STARTS.items():
@@ -266,4 +272,5 @@ def select_effects(
         normal=total,
         effect_weights=effect_weights(cfg),
         admission=search.rule,
+        estimates=estimates,
     )

@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 import scipy.optimize
 
-import excite_cli.identification.choice.selection as selection_module
 from excite_cli.identification.choice.admission import Admission
 from excite_cli.identification.choice.crossval import RECORDING_FOLDS, CrossValidation, fold_assignment
+from excite_cli.identification.choice.estimates import Estimates
 from excite_cli.identification.choice.search import StepwiseSearch
 from excite_cli.identification.choice.search_record import Search
 from excite_cli.identification.choice.selection import (
@@ -305,19 +305,25 @@ def test_of_two_ends_of_one_size_the_test_cannot_tell_apart_the_lower_j_is_kept_
 def test_a_small_true_effect_of_six_recordings_is_clear_of_zero_and_kept(monkeypatch):
     """Viscous friction on joint 1 worth about 1 % of the error, in each of six recordings: the
     paired test admits it and the rule keeps it, its estimate within 3 of its standard deviations of
-    the truth. The rule judges from five distinct recordings on only: not four, not time blocks."""
+    the truth. The rule judges distinct recordings only: from five on by the larger of the two
+    deviations, on four by the noise's alone; time blocks not at all."""
     judged = []
-    real = selection_module.Clearance
-    monkeypatch.setattr(selection_module, "Clearance", lambda *a: judged.append(a) or real(*a))
+    real = Estimates.clearance
+    monkeypatch.setattr(Estimates, "clearance", lambda self, *a: judged.append(self.spread) or real(self, *a))
     cfg = IdentificationConfig(candidates=["coulomb", "viscous", "offset"])
     truth = {Term("coulomb", 0): 0.5, Term("viscous", 1): 0.006}
     data = dataset(truth, cfg, runs=6)
     selection = select_effects(data, cfg, [], margin=0.05, recordings=np.arange(6), uncertainty=(RATE, np.arange(6)))
-    assert set(selection.terms) == set(truth) and len(judged) == 1
+    assert set(selection.terms) == set(truth) and judged and all(judged)
     assert all(np.isnan(s.clear_of_zero) for s in selection.steps)
     k = B + selection.terms.index(Term("viscous", 1))
     assert abs(selection.fit.x[k] - 0.006) < 3 * selection.fit.std[k]
+    judged.clear()
     four = dataset(truth, cfg, runs=4)
-    select_effects(four, cfg, [], margin=0.05, recordings=np.arange(4), uncertainty=(RATE, np.arange(4)))
+    assert set(
+        select_effects(four, cfg, [], margin=0.05, recordings=np.arange(4), uncertainty=(RATE, np.arange(4))).terms
+    ) == set(truth)
+    assert judged and not any(judged)
+    judged.clear()
     select_effects(four, cfg, [], margin=0.05, uncertainty=(RATE, np.arange(4)))
-    assert len(judged) == 1
+    assert judged == []
