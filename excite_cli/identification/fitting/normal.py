@@ -27,6 +27,9 @@ from excite_cli.identification.fitting.dataset import Dataset
 #: A candidate block keeps less than this fraction of its squared norm outside the model's span:
 #: not separately identifiable (above the ~1e-10 rounding floor of squared normal equations).
 ABSORBED = 1e-8
+#: A Cholesky pivot below this fraction of the largest (unit-diagonal normal equations) is rounding:
+#: the system is solved by the pseudo-inverse with this cut (its healthy fits sit above 1e-11).
+PIVOT = 1e-13
 #: Instants stacked at a time when the normal equations are summed.
 CHUNK = 20_000
 
@@ -139,12 +142,20 @@ def solve(G: np.ndarray, c: np.ndarray, nonnegative: np.ndarray | None = None) -
 def _solver(G: np.ndarray):
     """y ↦ G⁻¹ y (y (m,) or (m, k)) for G scaled to unit diagonal: 0 for the unknowns whose column the
     data never see (a held-out run's offset in a fold: a zero row and column), Cholesky for the rest,
-    or the pseudo-inverse where that is singular too (each the minimum-norm solution)."""
+    or the pseudo-inverse where that is singular too (each the minimum-norm solution).
+
+    Singular means Cholesky fails or finishes with a pivot below 1e-13 × the largest: a dependent
+    column's pivot is rounding, and whether Cholesky accepts it depends on the order of the sums (the
+    number of BLAS threads), so it would give huge coefficients on one machine and the minimum-norm
+    ones on another (Higham, Accuracy and Stability of Numerical Algorithms, 2nd ed., 2002, ch. 10)."""
     seen = np.diag(G) > 0.0
     try:
         factor = scipy.linalg.cho_factor(G[np.ix_(seen, seen)])
+        pivots = np.diag(factor[0]) ** 2
+        if pivots.size and pivots.min() <= PIVOT * pivots.max():
+            raise np.linalg.LinAlgError("a pivot is rounding")
     except np.linalg.LinAlgError:
-        inverse = np.linalg.pinv(G, rcond=1e-13, hermitian=True)
+        inverse = np.linalg.pinv(G, rcond=PIVOT, hermitian=True)
         return lambda y: inverse @ y
 
     def apply(y: np.ndarray) -> np.ndarray:
@@ -156,34 +167,50 @@ def _solver(G: np.ndarray):
 
 
 def _bounded(G: np.ndarray, c: np.ndarray, bounded: np.ndarray) -> np.ndarray:
-    """argmin ½xᵀGx − cᵀx with x_i ≥ 0 where ``bounded``: the free unknowns F eliminated for given
-    bounded ones B (x_F = G_FF⁻¹(c_F − G_FB x_B)), the rest is ½x_BᵀSx_B − rᵀx_B, S the Schur
-    complement G_BB − G_BF G_FF⁻¹ G_FB, r = c_B − G_BF G_FF⁻¹ c_F: a non-negative least squares
-    ‖Ax_B − b‖² with AᵀA = S, Aᵀb = r (Lawson & Hanson, Solving Least Squares Problems, 1974, ch. 23;
-    scipy's ``nnls``)."""
+    """argmin ½xᵀGx − cᵀx (G (m, m) scaled to unit diagonal) with x_i ≥ 0 where ``bounded``: the free
+    unknowns F eliminated for given bounded ones B (x_F = G_FF⁻¹(c_F − G_FB x_B)), the rest is
+    ½x_BᵀSx_B − rᵀx_B, S the Schur complement G_BB − G_BF G_FF⁻¹ G_FB, r = c_B − G_BF G_FF⁻¹ c_F: a
+    non-negative least squares (:func:`_nonnegative_least_squares`; Lawson & Hanson, Solving Least
+    Squares Problems, 1974, ch. 23; scipy's ``nnls``)."""
     free = ~bounded
     solve_free = _solver(G[np.ix_(free, free)])
     K = solve_free(G[np.ix_(free, bounded)])  # G_FF⁻¹ G_FB
     S = G[np.ix_(bounded, bounded)] - G[np.ix_(bounded, free)] @ K
-    r = c[bounded] - K.T @ c[free]
-    try:
-        L = np.linalg.cholesky(0.5 * (S + S.T))  # S = L Lᵀ: A = Lᵀ, b = L⁻¹ r
-        A, b = L.T, scipy.linalg.solve_triangular(L, r, lower=True)
-    except np.linalg.LinAlgError:  # a bounded column the free ones span: S singular
-        A, b = square_root(0.5 * (S + S.T), r)
     x = np.zeros(c.size)
-    x[bounded] = scipy.optimize.nnls(A, b)[0]
+    x[bounded] = _nonnegative_least_squares(0.5 * (S + S.T), c[bounded] - K.T @ c[free])
     x[free] = solve_free(c[free] - G[np.ix_(free, bounded)] @ x[bounded])
     return x
 
 
-def square_root(G: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _nonnegative_least_squares(S: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """argmin ½xᵀSx − rᵀx with x ≥ 0 (S (k, k) a Schur complement of a unit-diagonal G, r (k,)), as
+    the non-negative least squares ‖Ax − b‖² with AᵀA = S, Aᵀb = r. S_ii is the share of column i
+    outside the span of the columns eliminated: below PIVOT it is rounding (or the data never see
+    the column) and x_i is held at 0, where dividing by that rounding would give any value."""
+    x = np.zeros(r.size)
+    live = np.diag(S) > PIVOT
+    if not live.any():
+        return x
+    S, r = S[np.ix_(live, live)], r[live]
+    try:
+        L = np.linalg.cholesky(S)  # S = L Lᵀ: A = Lᵀ, b = L⁻¹ r
+        if np.diag(L).min() ** 2 <= PIVOT:
+            raise np.linalg.LinAlgError("a pivot is rounding")
+        A, b = L.T, scipy.linalg.solve_triangular(L, r, lower=True)
+    except np.linalg.LinAlgError:  # S singular: its directions below PIVOT dropped
+        A, b = square_root(S, r, floor=PIVOT)
+    if A.shape[0]:
+        x[live] = scipy.optimize.nnls(A, b)[0]
+    return x
+
+
+def square_root(G: np.ndarray, c: np.ndarray, floor: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """A (k, m), b (k,) with AᵀA = G and Aᵀb = c for normal equations G (m, m) (symmetric positive
     semidefinite), c (m,): ‖Ax − b‖² = xᵀGx − 2cᵀx + const, a least-squares form of them, from the
-    eigenpairs of G with eigenvalues above 1e-13 × the largest (k of them; the rest, directions G does
-    not see, dropped)."""
+    eigenpairs of G with eigenvalues above 1e-13 × the largest and above ``floor`` (k of them; the
+    rest, directions G does not see, dropped)."""
     eigenvalues, vectors = np.linalg.eigh(G)
-    kept = eigenvalues > 1e-13 * max(eigenvalues[-1], 1e-300)
+    kept = eigenvalues > max(1e-13 * max(eigenvalues[-1], 1e-300), floor)
     roots = np.sqrt(eigenvalues[kept])
     return roots[:, None] * vectors[:, kept].T, (vectors[:, kept].T @ c) / roots
 

@@ -2,6 +2,8 @@
 armature kept non-negative, against the optimality conditions of the bounded problem."""
 
 import numpy as np
+import scipy.linalg
+import scipy.optimize
 
 from excite_cli.identification.effects import Term
 from excite_cli.identification.fitting.dataset import Dataset
@@ -70,3 +72,49 @@ def test_a_negative_viscous_friction_is_fitted_at_zero_and_an_offset_keeps_its_s
     np.testing.assert_array_equal(fit.held, [False, False, True, False])  # held at 0: no two-sided std
     free = least_squares(NormalEquations(data, terms[1:]), terms[1:])  # nothing at a bound
     assert not free.held.any()
+
+
+def test_a_dependent_column_gets_the_minimum_norm_solution_whether_or_not_cholesky_accepts_it():
+    """A column the others span exactly: by rounding, Cholesky accepts half of these systems (its last
+    pivot is ~1e-16); the solution must be the minimum-norm least squares of the unit-diagonal columns
+    (numpy's SVD lstsq) on every one, not the huge coefficients of a rounding pivot."""
+    accepted = 0
+    for seed in range(20):
+        rng = np.random.default_rng(seed)
+        X = rng.standard_normal((50, 3)) * [1.0, 3.0, 0.2]
+        X = np.column_stack([X, 0.7 * X[:, 0] + 1.3 * X[:, 1]])
+        y = X @ [1.0, -2.0, 0.5, 0.0] + 0.1 * rng.standard_normal(50)
+        G = X.T @ X
+        d = np.sqrt(np.diag(G))
+        try:
+            scipy.linalg.cho_factor(G / np.outer(d, d))
+            accepted += 1
+        except np.linalg.LinAlgError:
+            pass
+        expected = np.linalg.lstsq(X / d, y, rcond=None)[0] / d
+        np.testing.assert_allclose(solve(G, X.T @ y), expected, rtol=1e-6, atol=1e-9)
+    assert accepted >= 5  # the case the rule exists for is among them
+
+
+def test_dependent_columns_kept_non_negative_do_not_follow_the_rounding():
+    """Columns kept ≥ 0 (friction, armature): one the free columns span exactly, one independent, one
+    the data never see (a zero column), the unconstrained solution negative on the first two. The
+    bounded solve eliminates the free columns; the Schur complement of the first and the last is
+    rounding. The solution must not move when G moves by 1e-15 of its scale (as the order of a sum
+    moves it with the number of BLAS threads), must stay near the data's coefficients, and must fit as
+    well as scipy's bounded least squares of the columns that add to the fit."""
+    for seed in range(20):
+        rng = np.random.default_rng(seed)
+        X = rng.standard_normal((50, 3)) * [1.0, 3.0, 0.2]
+        X = np.column_stack([X, 0.7 * X[:, 0] + 1.3 * X[:, 1], rng.standard_normal(50), np.zeros(50)])
+        y = X[:, :3] @ [-1.0, -2.0, 0.5] - 0.3 * X[:, 4] + 0.1 * rng.standard_normal(50)
+        G, c = X.T @ X, X.T @ y
+        rounding = rng.standard_normal(G.shape)
+        rounding = (rounding + rounding.T) * 1e-15 * np.sqrt(np.outer(np.diag(G), np.diag(G)))
+        kept = np.array([False, False, False, True, True, True])
+        x = solve(G, c, kept)
+        np.testing.assert_allclose(solve(G + rounding, c, kept), x, atol=1e-9)
+        assert np.all(x[kept] >= 0.0) and np.abs(x).max() < 10.0
+        own = [0, 1, 2, 4]  # the columns that add to the fit: scipy's bounded least squares on them
+        best = scipy.optimize.lsq_linear(X[:, own], y, bounds=([-np.inf] * 3 + [0.0], np.inf), tol=1e-12).x
+        np.testing.assert_allclose(np.sum((X @ x - y) ** 2), np.sum((X[:, own] @ best - y) ** 2), rtol=1e-7)
