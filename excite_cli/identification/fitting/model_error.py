@@ -40,7 +40,7 @@ import numpy as np
 from excite_cli.identification.effects import Term
 from excite_cli.identification.fitting.dataset import Dataset
 from excite_cli.identification.fitting.least_squares import predict
-from excite_cli.identification.fitting.normal import covariance_diagonal
+from excite_cli.identification.fitting.normal import ROUNDING, covariance_diagonal
 
 #: The fewest distinct trajectories the spread is estimated from (2 give scores s₁ = −s₂: one degree
 #: of freedom).
@@ -113,7 +113,7 @@ def _variance(grams: np.ndarray, scores: np.ndarray, m: int) -> np.ndarray:
     """(m,) CR2 variances from each group's share of the normal matrix (G, m, m) and its score (G, m)
     (:func:`trajectory_pieces`); NaN where one group alone determines a coefficient."""
     total = grams.sum(axis=0)
-    inverse = np.linalg.pinv(total, rcond=1e-13, hermitian=True)
+    inverse = np.linalg.pinv(total, rcond=ROUNDING, hermitian=True)
     alone = np.zeros(m, dtype=bool)
     adjusted = np.zeros_like(scores)
     for k in range(len(grams)):

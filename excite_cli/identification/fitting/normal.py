@@ -27,9 +27,9 @@ from excite_cli.identification.fitting.dataset import Dataset
 #: A candidate block keeps less than this fraction of its squared norm outside the model's span:
 #: not separately identifiable (above the ~1e-10 rounding floor of squared normal equations).
 ABSORBED = 1e-8
-#: A Cholesky pivot below this fraction of the largest (unit-diagonal normal equations) is rounding:
-#: the system is solved by the pseudo-inverse with this cut (its healthy fits sit above 1e-11).
-PIVOT = 1e-13
+#: An eigenvalue or Cholesky pivot of unit-diagonal normal equations below this fraction of the
+#: largest is rounding: every pseudo-inverse here cuts there (healthy fits' pivots sit above 1e-11).
+ROUNDING = 1e-13
 #: Instants stacked at a time when the normal equations are summed.
 CHUNK = 20_000
 
@@ -152,10 +152,10 @@ def _solver(G: np.ndarray):
     try:
         factor = scipy.linalg.cho_factor(G[np.ix_(seen, seen)])
         pivots = np.diag(factor[0]) ** 2
-        if pivots.size and pivots.min() <= PIVOT * pivots.max():
+        if pivots.size and pivots.min() <= ROUNDING * pivots.max():
             raise np.linalg.LinAlgError("a pivot is rounding")
     except np.linalg.LinAlgError:
-        inverse = np.linalg.pinv(G, rcond=PIVOT, hermitian=True)
+        inverse = np.linalg.pinv(G, rcond=ROUNDING, hermitian=True)
         return lambda y: inverse @ y
 
     def apply(y: np.ndarray) -> np.ndarray:
@@ -185,20 +185,20 @@ def _bounded(G: np.ndarray, c: np.ndarray, bounded: np.ndarray) -> np.ndarray:
 def _nonnegative_least_squares(S: np.ndarray, r: np.ndarray) -> np.ndarray:
     """argmin ½xᵀSx − rᵀx with x ≥ 0 (S (k, k) a Schur complement of a unit-diagonal G, r (k,)), as
     the non-negative least squares ‖Ax − b‖² with AᵀA = S, Aᵀb = r. S_ii is the share of column i
-    outside the span of the columns eliminated: below PIVOT it is rounding (or the data never see
+    outside the span of the columns eliminated: below :data:`ROUNDING` it is rounding (or the data never see
     the column) and x_i is held at 0, where dividing by that rounding would give any value."""
     x = np.zeros(r.size)
-    live = np.diag(S) > PIVOT
+    live = np.diag(S) > ROUNDING
     if not live.any():
         return x
     S, r = S[np.ix_(live, live)], r[live]
     try:
         L = np.linalg.cholesky(S)  # S = L Lᵀ: A = Lᵀ, b = L⁻¹ r
-        if np.diag(L).min() ** 2 <= PIVOT:
+        if np.diag(L).min() ** 2 <= ROUNDING:
             raise np.linalg.LinAlgError("a pivot is rounding")
         A, b = L.T, scipy.linalg.solve_triangular(L, r, lower=True)
-    except np.linalg.LinAlgError:  # S singular: its directions below PIVOT dropped
-        A, b = square_root(S, r, floor=PIVOT)
+    except np.linalg.LinAlgError:  # S singular: its directions below ROUNDING dropped
+        A, b = square_root(S, r, floor=ROUNDING)
     if A.shape[0]:
         x[live] = scipy.optimize.nnls(A, b)[0]
     return x
@@ -210,7 +210,7 @@ def square_root(G: np.ndarray, c: np.ndarray, floor: float = 0.0) -> tuple[np.nd
     eigenpairs of G with eigenvalues above 1e-13 × the largest and above ``floor`` (k of them; the
     rest, directions G does not see, dropped)."""
     eigenvalues, vectors = np.linalg.eigh(G)
-    kept = eigenvalues > max(1e-13 * max(eigenvalues[-1], 1e-300), floor)
+    kept = eigenvalues > max(ROUNDING * max(eigenvalues[-1], 1e-300), floor)
     roots = np.sqrt(eigenvalues[kept])
     return roots[:, None] * vectors[:, kept].T, (vectors[:, kept].T @ c) / roots
 
@@ -233,7 +233,7 @@ def outside_fraction(G: np.ndarray, model: int) -> float:
     of the first ones: the Schur complement's trace over the block's, with unit-diagonal scaling."""
     scaled, _ = _unit_diagonal(G)
     S, C, SC = scaled[:model, :model], scaled[model:, model:], scaled[:model, model:]
-    inside = SC.T @ np.linalg.lstsq(S, SC, rcond=1e-13)[0]
+    inside = SC.T @ np.linalg.lstsq(S, SC, rcond=ROUNDING)[0]
     return float(np.trace(C - inside) / max(np.trace(C), 1e-300))
 
 
@@ -241,7 +241,7 @@ def covariance_diagonal(G: np.ndarray, middle: np.ndarray | None = None) -> np.n
     """diag(G⁻¹), or of the sandwich G⁻¹ M G⁻¹ with ``middle`` M (the same size as G), with
     unit-diagonal scaling."""
     scaled, d = _unit_diagonal(G)
-    inverse = np.linalg.pinv(scaled, rcond=1e-13, hermitian=True)
+    inverse = np.linalg.pinv(scaled, rcond=ROUNDING, hermitian=True)
     if middle is None:
         return np.diag(inverse) / d**2
     return np.einsum("ij,jk,ki->i", inverse, middle / np.outer(d, d), inverse) / d**2
