@@ -12,9 +12,10 @@ Every design is one trajectory of the config's problem under A-optimality in the
    one draw of the true noise (noise seed = optimizer seed);
 3. identified as identify does with nothing declared: weighted least squares of the base parameters
    (each joint's rows by the inverse of its residual under least squares, Gautier 1997), then each
-   joint's noise σ² = a² + (ρτ)² fitted to the residual against the predicted torque
-   (:func:`~excite_cli.identification.fitting.noise_level.fit_noise_level`, no filter: gain 1) and its
-   RMS residual σ_j;
+   joint's noise σ² = a² + (ρτ)² fitted to the residual against the predicted torque, measured again
+   after one reweighted fit where some joint's noise grows with the torque
+   (:func:`~excite_cli.identification.fitting.noise_level.measured_noise`, no filter: gain 1; the
+   wrench rows keep their weight) and its RMS residual σ_j;
 4. the second trajectory, the recording as prior data (``sequence.prior``: each row scaled to the cost
    grid's rate), designed three ways from the same random starts:
    *measured*, as ``optimize --prior REPORT`` designs it: the recording's rows and the new ones weighed by
@@ -58,7 +59,7 @@ from criteria import RATE, noise_scale, samples
 from excite_cli.config import NoiseConfig
 from excite_cli.config_file import load_problem
 from excite_cli.design.resolve import build_excitation
-from excite_cli.identification.fitting.noise_level import fit_noise_level
+from excite_cli.identification.fitting.noise_level import measured_noise
 from excite_cli.search.engine import Engine, default_workers
 from excite_cli.search.sequence import run_sequence
 from excite_cli.stored.design_model import MeasuredPrior
@@ -91,12 +92,19 @@ def identified(Y: np.ndarray, measured: np.ndarray, n: int) -> tuple[np.ndarray,
     rows = measured.shape[1]
     plain = measured - (Y @ np.linalg.lstsq(Y, measured.ravel(), rcond=None)[0]).reshape(measured.shape)
     weights = np.tile(1.0 / np.sqrt((plain**2).mean(axis=0)), len(measured))
-    beta = np.linalg.lstsq(Y * weights[:, None], measured.ravel() * weights, rcond=None)[0]
-    predicted = (Y @ beta).reshape(-1, rows)[:, -n:]
-    residual = measured[:, -n:] - predicted
-    gain = np.ones(len(residual))
-    levels = [fit_noise_level(residual[:, j], predicted[:, j], gain) for j in range(n)]
-    return np.sqrt((residual**2).mean(axis=0)), levels, predicted
+
+    def fit(w: np.ndarray) -> np.ndarray:
+        beta = np.linalg.lstsq(Y * w[:, None], measured.ravel() * w, rcond=None)[0]
+        return (Y @ beta).reshape(-1, rows)[:, -n:]
+
+    def refit(joints: np.ndarray) -> np.ndarray:  # the joints' rows by the noise measured, the wrench's as before
+        w = weights.reshape(-1, rows).copy()
+        w[:, -n:] = joints
+        return fit(w.ravel())
+
+    predicted = fit(weights)
+    levels = measured_noise(measured[:, -n:], predicted, np.ones(len(predicted)), np.ones(n, dtype=bool), refit)
+    return np.sqrt(((measured[:, -n:] - predicted) ** 2).mean(axis=0)), levels, predicted
 
 
 def second_designs(problem, excitation, record: tuple, fitted: tuple, noise: tuple, seed: int):

@@ -23,7 +23,8 @@ from excite_cli.identification.config import IdentifyProblem
 from excite_cli.identification.effects import Term, rotor_terms
 from excite_cli.identification.fitting.dataset import Dataset
 from excite_cli.identification.fitting.least_squares import least_squares, predict, torque_errors
-from excite_cli.identification.fitting.noise_level import BLOCKS, NoiseLevel, fit_noise_level
+from excite_cli.identification.fitting.noise_level import BLOCKS, NoiseLevel, measured_noise
+from excite_cli.identification.fitting.normal import weighted_fit
 from excite_cli.identification.fitting.plausibility import implausible
 from excite_cli.identification.measured.measurements import in_sample_validation
 from excite_cli.identification.prepared import prepare_data
@@ -176,14 +177,18 @@ def noise_levels(
 ) -> list[NoiseLevel | None]:
     """Each ``live`` (n,) joint's noise σ² = a² + (ρτ)² fitted to the residual of the model (coefficients
     ``x`` of the base parameters and ``terms``) on the fit data, each instant's filter ``gain`` (N,): what
-    the model cannot explain where it was fitted, not its error away from it; None for the others; an
-    empty list when the data are too short
-    (:func:`~excite_cli.identification.fitting.noise_level.fit_noise_level`)."""
+    the model cannot explain where it was fitted, not its error away from it; where some joint's noise
+    grows with the torque, on the residual of the model's terms refitted with each sample weighed by
+    that noise; None for the others; an empty list when the data are too short
+    (:func:`~excite_cli.identification.fitting.noise_level.measured_noise`)."""
     measured, predicted = fit_data.tau.reshape(-1, fit_data.n), predict(fit_data, x, terms)
     if measured.shape[0] < 2 * BLOCKS:
         return []
-    residual = measured - predicted
-    return [fit_noise_level(residual[:, j], predicted[:, j], gain) if live[j] else None for j in range(len(live))]
+
+    def refit(weights: np.ndarray) -> np.ndarray:
+        return predict(fit_data, weighted_fit(fit_data, terms, weights), terms)
+
+    return measured_noise(measured, predicted, gain, live, refit)
 
 
 def write_identified_urdf(

@@ -41,9 +41,13 @@ class NormalEquations:
         data: the samples (base regressor, torques, effect blocks).
         keys: the terms (effect blocks) that models may contain.
         rows: (m,) the instants to use (default all), e.g. one fold of a cross-validation.
+        scale: (N, n) a factor for each instant's row of each joint, regressor and torque alike (the
+            weights of a feasible generalized least squares, :func:`weighted_fit`), or None: 1.
     """
 
-    def __init__(self, data: Dataset, keys: list[Term], rows: np.ndarray | None = None):
+    def __init__(
+        self, data: Dataset, keys: list[Term], rows: np.ndarray | None = None, scale: np.ndarray | None = None
+    ):
         n, b = data.n, data.regressor.shape[1]
         rows = np.arange(data.time.size) if rows is None else np.asarray(rows)
         self.n, self.b, self.rows = n, b, rows.size * n
@@ -60,6 +64,8 @@ class NormalEquations:
                 part = rows[lo : lo + CHUNK]
                 L = np.hstack([data.regressor[part * n + j]] + [key.rows(n)[j] * data.blocks[key][part] for key in own])
                 tau = data.tau[part * n + j]
+                if scale is not None:
+                    L, tau = L * scale[part, j, None], tau * scale[part, j]
                 G += L.T @ L
                 c += L.T @ tau
                 s += float(tau @ tau)
@@ -245,3 +251,12 @@ def covariance_diagonal(G: np.ndarray, middle: np.ndarray | None = None) -> np.n
     if middle is None:
         return np.diag(inverse) / d**2
     return np.einsum("ij,jk,ki->i", inverse, middle / np.outer(d, d), inverse) / d**2
+
+
+def weighted_fit(data: Dataset, effects: list[Term], scale: np.ndarray) -> np.ndarray:
+    """x (b + Σk,) of the model [Y_B, ``effects``] fitted by least squares to ``data`` with each
+    instant's row of each joint weighed by ``scale`` (N, n) (generalized least squares with a diagonal
+    noise covariance, the weights 1/σ of each sample; friction and armature kept ≥ 0 as in every fit)."""
+    normal = NormalEquations(data, effects, scale=scale)
+    G, c, _ = normal.system(None, effects)
+    return solve(G, c, normal.nonnegative(effects))

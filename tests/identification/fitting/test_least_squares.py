@@ -8,7 +8,7 @@ import scipy.optimize
 from excite_cli.identification.effects import Term
 from excite_cli.identification.fitting.dataset import Dataset
 from excite_cli.identification.fitting.least_squares import least_squares, torque_errors
-from excite_cli.identification.fitting.normal import NormalEquations, solve
+from excite_cli.identification.fitting.normal import NormalEquations, solve, weighted_fit
 
 
 def test_weighted_least_squares_and_standard_deviations_match_the_closed_form():
@@ -27,6 +27,25 @@ def test_weighted_least_squares_and_standard_deviations_match_the_closed_form():
     s2 = np.sum((y - A @ x) ** 2) / (N * n - b)
     np.testing.assert_allclose(fit.x, x, rtol=1e-10)
     np.testing.assert_allclose(fit.std, np.sqrt(s2 * np.diag(np.linalg.inv(A.T @ A))), rtol=1e-8)
+
+
+def test_a_fit_weighed_sample_by_sample_is_the_closed_form_of_generalized_least_squares():
+    """Each instant's row of each joint scaled by its own weight (an effect block on one joint, a
+    coupled one on two): the closed form of the scaled rows."""
+    rng = np.random.default_rng(3)
+    N, n, b = 300, 2, 3
+    Y = rng.standard_normal((N * n, b))
+    blocks = {Term("offset", 0): np.ones((N, 1)), Term("offset", 0, coupling=(1.0, -1.0)): rng.standard_normal((N, 1))}
+    terms = list(blocks)
+    tau = rng.standard_normal(N * n)
+    scale = rng.uniform(0.1, 10.0, (N, n))
+    x = weighted_fit(Dataset(Y, tau, np.arange(N) * 0.01, np.zeros(N, dtype=int), blocks), terms, scale)
+    offset = np.zeros(N * n)
+    offset[0::n] = 1.0
+    motor = np.zeros(N * n)
+    motor[0::n], motor[1::n] = blocks[terms[1]][:, 0], -blocks[terms[1]][:, 0]
+    A = np.column_stack([Y, offset, motor]) * scale.ravel()[:, None]
+    np.testing.assert_allclose(x, np.linalg.lstsq(A, tau * scale.ravel(), rcond=None)[0], rtol=1e-9, atol=1e-12)
 
 
 def test_torque_errors_are_rms_per_joint_relative_to_the_torque():
