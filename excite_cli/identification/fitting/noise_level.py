@@ -25,8 +25,8 @@ independent.
 
 Where some joint's noise grows with the torque, the model's fit weighed each joint's rows alike, so the
 noise of its large-torque rows enters the estimates and, through them, the residual of its small-torque
-rows, where it reads as an absolute floor several times the true one. The noise is then measured once
-more (:func:`measured_noise`): on the residual of the model refitted with each sample weighed by the
+rows, where it reads as an absolute floor several times the true one. The noise is then measured
+again (:func:`measured_noise`): on the residual of the model refitted with each sample weighed by the
 inverse of the noise just measured at its predicted torque, twice (:data:`REWEIGHTINGS`: feasible
 generalized least squares iterated, Carroll, Wu & Ruppert 1988, "The effect of estimating weights in
 weighted least squares", JASA 83), a taken at its upper bound so that no sample's weight is
