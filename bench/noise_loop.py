@@ -13,7 +13,7 @@ Every design is one trajectory of the config's problem under A-optimality in the
 3. identified as identify does with nothing declared: weighted least squares of the base parameters
    (each joint's rows by the inverse of its residual under least squares, Gautier 1997), then each
    joint's noise σ² = a² + (ρτ)² fitted to the residual against the predicted torque, measured again
-   after one reweighted fit where some joint's noise grows with the torque
+   after the reweighted fits where some joint's noise grows with the torque
    (:func:`~excite_cli.identification.fitting.noise_level.measured_noise`, no filter: gain 1; the
    wrench rows keep their weight) and its RMS residual σ_j;
 4. the second trajectory, the recording as prior data (``sequence.prior``: each row scaled to the cost

@@ -150,7 +150,7 @@ def _solver(G: np.ndarray):
     data never see (a held-out run's offset in a fold: a zero row and column), Cholesky for the rest,
     or the pseudo-inverse where that is singular too (each the minimum-norm solution).
 
-    Singular means Cholesky fails or finishes with a pivot below 1e-13 × the largest: a dependent
+    Singular means Cholesky fails or finishes with a pivot below :data:`ROUNDING` × the largest: a dependent
     column's pivot is rounding, and whether Cholesky accepts it depends on the order of the sums (the
     number of BLAS threads), so it would give huge coefficients on one machine and the minimum-norm
     ones on another (Higham, Accuracy and Stability of Numerical Algorithms, 2nd ed., 2002, ch. 10)."""
@@ -213,7 +213,7 @@ def _nonnegative_least_squares(S: np.ndarray, r: np.ndarray) -> np.ndarray:
 def square_root(G: np.ndarray, c: np.ndarray, floor: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """A (k, m), b (k,) with AᵀA = G and Aᵀb = c for normal equations G (m, m) (symmetric positive
     semidefinite), c (m,): ‖Ax − b‖² = xᵀGx − 2cᵀx + const, a least-squares form of them, from the
-    eigenpairs of G with eigenvalues above 1e-13 × the largest and above ``floor`` (k of them; the
+    eigenpairs of G with eigenvalues above :data:`ROUNDING` × the largest and above ``floor`` (k of them; the
     rest, directions G does not see, dropped)."""
     eigenvalues, vectors = np.linalg.eigh(G)
     kept = eigenvalues > max(ROUNDING * max(eigenvalues[-1], 1e-300), floor)
