@@ -84,8 +84,8 @@ def iterations(
             "stop",
         ),
         rows,
-        "cond(C): on the base columns (the paper's), the effect columns beside them with effects; cond(CL) and ē: "
-        "condition number and excitation "
+        "cond(C): on the base columns (the paper's), the effect columns beside them with effects, every row as it is "
+        "where the design weighs the rows by their noise; cond(CL) and ē: condition number and excitation "
         "(geometric mean of the singular values) of the URDF-scaled regressor, which do not depend on the "
         "choice of base columns; in/out: quintic transitions from and to the home posture at "
         "rest (checked on the fine grid); corr.: largest correlation of the motion with an earlier iteration's "

@@ -91,11 +91,14 @@ class Excitation:
         prior: np.ndarray | PriorInformation | None = None,
         objective: str | None = None,
         scaling: str | None = None,
+        weighed: bool = True,
     ) -> Criterion:
         """The criterion of ``objective`` (default ``optimizer.objective``) with C₀ = ``prior`` (m₁, b+e)
         (Eq. 41), the rows or their information (a restart is sent the b+e-square blocks, not the
         rows), of C (``scaling`` ``none``) or of C L (``urdf``; default ``optimizer.scaling``, else
-        the criterion's own, :attr:`~excite_cli.criteria.record.CriterionRecord.scaling`)."""
+        the criterion's own, :attr:`~excite_cli.criteria.record.CriterionRecord.scaling`); its rows
+        weighed by their noise (:attr:`noise`), or with ``weighed`` False every row as it is (the
+        paper's C, which Table I reports)."""
         objective = objective or self.spec.optimizer.objective
         scaling = scaling or self.spec.optimizer.scaling_of(objective)
         return Criterion(
@@ -106,7 +109,7 @@ class Excitation:
             objective=criterion_record(objective),
             frame=self.scaled_frame if scaling == "urdf" else None,
             effects=self.effects,
-            noise=self.noise,
+            noise=self.noise if weighed else None,
         )
 
     def excitation_level(self, C: np.ndarray) -> float:

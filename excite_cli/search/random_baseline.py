@@ -85,7 +85,7 @@ class DrawTask:
                 alphas.append(alpha)
             if progress:
                 progress(len(alphas), drawn)
-        criterion = excitation.criterion()
+        criterion = excitation.criterion(weighed=False)  # greedy selection by the paper's cond(C)
         shape = (excitation.robot.n_joints, excitation.trajectory.n_coefficients)
         regressors = [criterion.regressor(a) for a in alphas]
         rows = excitation.cost_basis.time.size * excitation.robot.n_rows

@@ -31,8 +31,14 @@ class IterationResult:
         index: iteration number k, 1-based.
         alpha: (n, 2N+1) Fourier coefficients.
         time: (T_grid,) constraint grid [s]; q, qd, qdd: (T_grid, n) [rad, rad/s, rad/s²] on it.
-        regressor: C⁽ᵏ⁾, (T·n_rows, b) base regressor at the cost samples.
-        cond_own: cond(C⁽ᵏ⁾); cond_stacked: cond([C₀; C⁽ᵏ⁾]) (Table I), on the base (and effect) columns.
+        regressor: C⁽ᵏ⁾, (T·n_rows, b+e) base regressor (and effect columns) at the cost samples,
+            every row as it is: the paper's C, which the figures below are of.
+        weighed: (T·n_rows, b+e) the same rows as the design weighs them, each by its noise
+            (:attr:`~excite_cli.design.excitation.Excitation.noise`), or None: every row weighs the
+            same (then the design's rows are ``regressor``).
+        cond_own: cond(C⁽ᵏ⁾); cond_stacked: cond([C₀; C⁽¹⁾; …; C⁽ᵏ⁾]) (Table I), on the base (and effect)
+            columns, C₀ the prior rows as the design weighs them (measured data's rows are weighed
+            by their noise in weighted least squares) and every iteration's rows as they are.
         scaled_cond_own, scaled_cond_stacked: cond(C L) of the same, the condition number that does
             not depend on the choice of base columns (:mod:`excite_cli.design.information`).
         excitation_own, excitation_stacked: ē of the same [N·m], the excitation figure that does
@@ -72,6 +78,13 @@ class IterationResult:
     restarts: tuple[RestartResult, ...] = ()
     correlations: tuple[float, ...] = ()
     kept: int = -1
+    weighed: Optional[np.ndarray] = None
+
+    @property
+    def design_rows(self) -> np.ndarray:
+        """(T·n_rows, b+e) the rows as the design takes them: ``weighed``, or ``regressor`` where every
+        row weighs the same; what the next iteration stacks as C₀ (Eq. 41)."""
+        return self.regressor if self.weighed is None else self.weighed
 
     @property
     def max_correlation(self) -> float:
@@ -99,10 +112,11 @@ class IterationResult:
 def stacked_regressors(
     excitation: Excitation, prior: Optional[np.ndarray], results: Sequence[IterationResult]
 ) -> np.ndarray:
-    """C₀ of the next iteration (Eq. 41): the prior rows (m, b), or none, then every earlier
-    iteration's regressor, in order: (m + Σ T·n_rows, b)."""
+    """C₀ of the next iteration (Eq. 41), as the design weighs it: the prior rows (m, b+e), or none,
+    then every earlier iteration's rows (:attr:`IterationResult.design_rows`), in order:
+    (m + Σ T·n_rows, b+e)."""
     first = np.zeros((0, excitation.columns)) if prior is None else prior
-    return np.vstack([first, *[r.regressor for r in results]])
+    return np.vstack([first, *[r.design_rows for r in results]])
 
 
 def describe(
@@ -115,11 +129,14 @@ def describe(
     earlier: Sequence[IterationResult] = (),
     kept: int = -1,
 ) -> IterationResult:
-    """The :class:`IterationResult` of trajectory α (n, 2N+1) stacked under ``prior`` (m, b): its
-    regressor, condition numbers, samples on the constraint grid, every constraint's fine check, its
-    correlation with each of the ``earlier`` iterations, and the index of the restart ``kept``."""
-    own = excitation.criterion().regressor(alpha)
-    stacked = np.vstack([prior, own])
+    """The :class:`IterationResult` of trajectory α (n, 2N+1), iteration ``index`` after the ``earlier``
+    ones, stacked under the ``prior`` rows (m, b+e; as the design weighs them) and theirs: its
+    regressor (and the rows as the design weighs them), condition numbers, samples on the constraint
+    grid, every constraint's fine check, its correlation with each earlier iteration, and the index
+    of the restart ``kept``."""
+    own = excitation.criterion(weighed=False).regressor(alpha)
+    weighed = None if excitation.noise is None else excitation.criterion().regressor(alpha)
+    stacked = np.vstack([prior, *[r.regressor for r in earlier], own])
     checks = [c.check(alpha, excitation.fine_basis) for c in excitation.constraints]
     details = {key: value for c in checks for key, value in c.details.items()}
     details.update(transition_checks(excitation, alpha))
@@ -148,6 +165,7 @@ def describe(
         restarts=tuple(restarts),
         correlations=tuple(correlation(q, r.q) for r in earlier),
         kept=kept,
+        weighed=weighed,
     )
 
 
@@ -267,7 +285,8 @@ def run_sequence(
         runs, best = polish_kept(context, runs, polished)
         if len(more := from_earlier_optimum(context, runs, best, [r.alpha for r in results])) > len(runs):
             runs, best = polish_kept(context, more, polished)  # not the one polished above again
-        result = describe(excitation, k, best.alpha, stacked, time.perf_counter() - start, runs, results, best.index)
+        first = np.zeros((0, excitation.columns)) if prior is None else prior
+        result = describe(excitation, k, best.alpha, first, time.perf_counter() - start, runs, results, best.index)
         results.append(result)
         if on_iteration:
             on_iteration(result)

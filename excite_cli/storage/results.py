@@ -19,7 +19,7 @@ from excite_cli.errors import ExciteError
 from excite_cli.h5 import atomic_h5, open_h5, read_strings, write_strings
 from excite_cli.search.kkt import Optimality
 from excite_cli.search.optimizer import RestartResult
-from excite_cli.search.sequence import IterationResult, describe, stacked_regressors
+from excite_cli.search.sequence import IterationResult, describe
 
 UNITS = {
     "alpha": "rad",
@@ -204,10 +204,10 @@ def read_iterations(
                 if "restarts" in g
                 else []
             )
-            stacked = stacked_regressors(excitation, prior, results)
+            first = np.zeros((0, excitation.columns)) if prior is None else prior
             kept = int(g["restarts"].attrs["kept"]) if "restarts" in g else -1
             results.append(
-                describe(excitation, int(key), alpha, stacked, float(g.attrs["wall_time_s"]), restarts, results, kept)
+                describe(excitation, int(key), alpha, first, float(g.attrs["wall_time_s"]), restarts, results, kept)
             )
     return results
 

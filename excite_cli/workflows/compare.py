@@ -17,7 +17,7 @@ from excite_cli.h5 import open_h5, read_strings
 from excite_cli.plots.comparison import plot_comparison
 from excite_cli.search.optimizer import ProgressHook
 from excite_cli.search.random_baseline import draw_pool, greedy_selection, pool_convergence
-from excite_cli.search.sequence import describe, stacked_regressors
+from excite_cli.search.sequence import describe
 from excite_cli.storage.paths import check_target, output_lock
 from excite_cli.storage.results import check_base, read_table, results_table, write_result
 from excite_cli.workflows.optimize import engine_for, run_optimize
@@ -102,9 +102,7 @@ def run_compare_random(
     selection_s = time.perf_counter() - begin
     results = []
     for k, index in enumerate(chosen, start=1):
-        results.append(
-            describe(excitation, k, drawn.alphas[index], stacked_regressors(excitation, None, results), earlier=results)
-        )
+        results.append(describe(excitation, k, drawn.alphas[index], np.zeros((0, excitation.columns)), earlier=results))
     write_result(
         target,
         excitation,

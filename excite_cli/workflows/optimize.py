@@ -73,7 +73,7 @@ class OptimizeRun:
         # C holds s·W·Y per recorded row (s the time rule), and the new runs recorded at the same rate
         # carry (their cost-grid rows)/s² of information: std = s·σ̄·√diag((CᵀC)⁻¹)
         noise = measured.noise * measured.time_scale(self.excitation.spec.trajectory.cost_period)
-        stacked = np.vstack([self.prior, *[r.regressor for r in self.results]])
+        stacked = np.vstack([self.prior, *[r.design_rows for r in self.results]])
         before, after = predicted_std(self.prior, noise), predicted_std(stacked, noise)
         names = [*self.excitation.base.names, *self.excitation.effect_names]
         gain = np.where(np.isinf(before), np.inf, before / after)

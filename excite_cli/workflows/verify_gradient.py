@@ -61,7 +61,7 @@ def run_verify(
     points = [("random", None, excitation.limits.random_start(m, np.random.default_rng(seed), fill=0.7))]
     if result is not None:
         finished = read_iterations(result, excitation, field="result")
-        stacked = np.vstack([np.zeros((0, excitation.columns)), *[r.regressor for r in finished[:-1]]])
+        stacked = np.vstack([np.zeros((0, excitation.columns)), *[r.design_rows for r in finished[:-1]]])
         points.append((f"optimum {finished[-1].index}", stacked, finished[-1].alpha))
     gradients = []
     for label, prior, alpha in points:

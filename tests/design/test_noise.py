@@ -14,6 +14,8 @@ from excite_cli.design.noise import TYPICAL_SEEDS, typical_torques
 from excite_cli.design.resolve import build_excitation
 from excite_cli.design.verify import finite_difference_gradient
 from excite_cli.errors import ExciteError
+from excite_cli.search.sequence import describe, stacked_regressors
+from excite_cli.storage.results import read_iterations, write_result
 
 
 def _alpha(excitation, seed):
@@ -112,3 +114,28 @@ def test_a_joints_typical_torque_is_its_rms_torque_over_random_feasible_motions(
     expected = np.sqrt(np.mean(np.square(torques), axis=0))[: excitation.robot.n_joints]
     assert np.all(expected > 1e-3)  # every joint moves
     np.testing.assert_allclose(typical_torques(excitation), expected, rtol=1e-12)
+
+
+def test_table_i_reports_the_rows_as_they_are_and_the_design_stacks_them_weighed(panda_problem, tmp_path):
+    """cond(C) is the paper's (every row as it is) also where the design weighs the rows; the next
+    iteration's C₀ is the weighed rows, and a resumed result reads the same figures back."""
+    problem = small(panda_problem)
+    joints = problem.robot.active_joints
+    problem.noise = NoiseConfig(absolute={joints[0]: 0.2, **{j: 0.05 for j in joints[1:]}}, relative=0.02)
+    excitation = build_excitation(problem)
+    alphas = [_alpha(excitation, seed) for seed in (3, 4)]
+    none = np.zeros((0, excitation.columns))
+    first = describe(excitation, 1, alphas[0], none)
+    second = describe(excitation, 2, alphas[1], none, earlier=[first])
+    problem.noise = None
+    plain = [build_excitation(problem).criterion().regressor(a) for a in alphas]
+    assert first.cond_own == pytest.approx(np.linalg.cond(plain[0]), rel=1e-9)
+    assert second.cond_own == pytest.approx(np.linalg.cond(plain[1]), rel=1e-9)
+    assert second.cond_stacked == pytest.approx(np.linalg.cond(np.vstack(plain)), rel=1e-9)
+    weighed = excitation.criterion().regressor(alphas[0])
+    assert np.linalg.cond(weighed) > 1.5 * np.linalg.cond(plain[0])  # the weights change what cond reads
+    np.testing.assert_array_equal(stacked_regressors(excitation, None, [first]), weighed)
+    write_result(tmp_path / "r.h5", excitation, [first, second], 0)
+    again = read_iterations(tmp_path / "r.h5", excitation)
+    assert [r.cond_stacked for r in again] == [first.cond_stacked, second.cond_stacked]
+    np.testing.assert_array_equal(again[0].design_rows, weighed)

@@ -155,8 +155,11 @@ def test_optimize_with_the_report_as_prior_weighs_both_the_prior_and_its_own_row
     problem = load_problem(CONFIGS / "smoke.yaml")
     excitation = build_excitation(problem)
     with h5py.File(out) as f:
-        alpha, own = f["iterations/1/alpha"][()], f["iterations/1/regressor"][()]
+        alpha, stored = f["iterations/1/alpha"][()], f["iterations/1/regressor"][()]
     plain = excitation.criterion().regressor(alpha)
+    np.testing.assert_array_equal(stored, plain)  # the file holds the rows as they are (Table I's)
+    problem.sequence.prior = str(report_file)
+    own = build_excitation(problem).criterion().regressor(alpha)  # as the design weighs them
     robot = excitation.robot
     tau = np.array([robot.torques(*x) for x in zip(*excitation.cost_basis.evaluate(alpha))]).ravel()  # RNEA
     floor = np.maximum(level[:, 2], MEASURED_FLOOR * measured.floored)
