@@ -114,7 +114,9 @@ def _upper_bound(u: np.ndarray, t2: np.ndarray, x: np.ndarray, best: float) -> f
     """The scaled a²'s one-sided 95 % profile-likelihood upper bound: the a² above the fitted x₀ (x, of
     deviance ``best``: :func:`_scaled_fit`) at which ρ re-fitted leaves a deviance :data:`UPPER_BOUND`
     above the best."""
-    largest = 10.0 * u.mean() / max(t2.mean(), 1e-12)  # ρ² beyond which the variance exceeds 10 × r's
+    # ρ² beyond which the variance exceeds 10 × r's, or twice the fitted one where that is larger (noise
+    # growing steeply at small torques with a few large ones the model follows: the fit lies beyond)
+    largest = max(10.0 * u.mean() / max(t2.mean(), 1e-12), 2.0 * x[1])
 
     def excess(a2: float) -> float:
         profile = optimize.minimize_scalar(

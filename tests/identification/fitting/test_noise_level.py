@@ -107,3 +107,26 @@ def test_absolute_noise_is_measured_once():
     measured = predicted + np.random.default_rng(0).normal(size=predicted.shape) * 0.1
     levels = measured_noise(measured, predicted, np.ones(TIME.size), np.array([True, False]), None)
     assert levels[1] is None and levels[0].preferred == "absolute"
+
+
+def _deviance(r: np.ndarray, tau: np.ndarray, a2: float, rho2: float) -> float:
+    variance = a2 + rho2 * tau**2
+    return float(np.sum(np.log(variance) + r**2 / variance))
+
+
+def test_the_bound_of_a_is_found_where_the_fitted_rho_lies_beyond_the_torques_typical_share():
+    """Noise growing as √|τ| at small torques (dry friction's shape) and 1 % of the samples at large
+    torques the model follows (a joint pressed against a contact): the fit's ρ² exceeds 10 × r's mean
+    over τ's, where the profile of a once ended (a traceback). a's upper bound is the profile
+    likelihood's: ρ re-fitted at it, the deviance is 2.706 (χ²₁ at 90 %, one-sided 95 %) above the best."""
+    for seed in range(5):
+        rng = np.random.default_rng(seed)
+        small, large = 0.07 * rng.normal(size=2700), rng.choice([-1.0, 1.0], 30) * rng.uniform(5.0, 9.0, 30)
+        tau = np.r_[small, large]
+        r = np.r_[np.sqrt(5e-4 + 0.05 * np.abs(small)), 0.1 * np.abs(large)] * rng.normal(size=tau.size)
+        level = fit_noise_level(r, tau, np.ones(tau.size))
+        assert level.absolute_upper > level.absolute > 0.0
+        grid = np.geomspace(1e-6, 1e3, 4001)  # ρ² re-fitted on a wide grid, independent of the fit's search
+        best = min(_deviance(r, tau, level.absolute**2, x) for x in grid)
+        at_bound = min(_deviance(r, tau, level.absolute_upper**2, x) for x in grid)
+        assert at_bound - best == pytest.approx(2.706, abs=0.05)
