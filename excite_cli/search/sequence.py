@@ -123,20 +123,21 @@ def describe(
     excitation: Excitation,
     index: int,
     alpha: np.ndarray,
-    prior: np.ndarray,
+    prior: Optional[np.ndarray] = None,
     wall_time_s: float = 0.0,
     restarts: Sequence[RestartResult] = (),
     earlier: Sequence[IterationResult] = (),
     kept: int = -1,
 ) -> IterationResult:
     """The :class:`IterationResult` of trajectory α (n, 2N+1), iteration ``index`` after the ``earlier``
-    ones, stacked under the ``prior`` rows (m, b+e; as the design weighs them) and theirs: its
+    ones, stacked under the ``prior`` rows (m, b+e; as the design weighs them; None: none) and theirs: its
     regressor (and the rows as the design weighs them), condition numbers, samples on the constraint
     grid, every constraint's fine check, its correlation with each earlier iteration, and the index
     of the restart ``kept``."""
     own = excitation.criterion(weighed=False).regressor(alpha)
     weighed = None if excitation.noise is None else excitation.criterion().regressor(alpha)
-    stacked = np.vstack([prior, *[r.regressor for r in earlier], own])
+    first = np.zeros((0, excitation.columns)) if prior is None else prior
+    stacked = np.vstack([first, *[r.regressor for r in earlier], own])
     checks = [c.check(alpha, excitation.fine_basis) for c in excitation.constraints]
     details = {key: value for c in checks for key, value in c.details.items()}
     details.update(transition_checks(excitation, alpha))
@@ -285,8 +286,7 @@ def run_sequence(
         runs, best = polish_kept(context, runs, polished)
         if len(more := from_earlier_optimum(context, runs, best, [r.alpha for r in results])) > len(runs):
             runs, best = polish_kept(context, more, polished)  # not the one polished above again
-        first = np.zeros((0, excitation.columns)) if prior is None else prior
-        result = describe(excitation, k, best.alpha, first, time.perf_counter() - start, runs, results, best.index)
+        result = describe(excitation, k, best.alpha, prior, time.perf_counter() - start, runs, results, best.index)
         results.append(result)
         if on_iteration:
             on_iteration(result)

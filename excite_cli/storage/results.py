@@ -204,10 +204,9 @@ def read_iterations(
                 if "restarts" in g
                 else []
             )
-            first = np.zeros((0, excitation.columns)) if prior is None else prior
             kept = int(g["restarts"].attrs["kept"]) if "restarts" in g else -1
             results.append(
-                describe(excitation, int(key), alpha, first, float(g.attrs["wall_time_s"]), restarts, results, kept)
+                describe(excitation, int(key), alpha, prior, float(g.attrs["wall_time_s"]), restarts, results, kept)
             )
     return results
 

@@ -102,7 +102,7 @@ def run_compare_random(
     selection_s = time.perf_counter() - begin
     results = []
     for k, index in enumerate(chosen, start=1):
-        results.append(describe(excitation, k, drawn.alphas[index], np.zeros((0, excitation.columns)), earlier=results))
+        results.append(describe(excitation, k, drawn.alphas[index], earlier=results))
     write_result(
         target,
         excitation,

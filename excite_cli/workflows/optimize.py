@@ -20,7 +20,7 @@ from excite_cli.h5 import open_h5
 from excite_cli.plots.optimize import figure_paths, plot_result
 from excite_cli.search.engine import Engine, default_workers
 from excite_cli.search.optimizer import ProgressHook
-from excite_cli.search.sequence import IterationResult, run_sequence
+from excite_cli.search.sequence import IterationResult, run_sequence, stacked_regressors
 from excite_cli.storage.paths import check_target, output_lock
 from excite_cli.storage.results import read_iterations, write_result
 from excite_cli.stored.inputs import read_inputs
@@ -73,7 +73,7 @@ class OptimizeRun:
         # C holds s·W·Y per recorded row (s the time rule), and the new runs recorded at the same rate
         # carry (their cost-grid rows)/s² of information: std = s·σ̄·√diag((CᵀC)⁻¹)
         noise = measured.noise * measured.time_scale(self.excitation.spec.trajectory.cost_period)
-        stacked = np.vstack([self.prior, *[r.design_rows for r in self.results]])
+        stacked = stacked_regressors(self.excitation, self.prior, self.results)
         before, after = predicted_std(self.prior, noise), predicted_std(stacked, noise)
         names = [*self.excitation.base.names, *self.excitation.effect_names]
         gain = np.where(np.isinf(before), np.inf, before / after)

@@ -13,6 +13,7 @@ from excite_cli.criteria import NAMES as OBJECTIVES
 from excite_cli.design.resolve import build_excitation
 from excite_cli.design.verify import GradientCheck, check_gradient, constraint_jacobian_error
 from excite_cli.errors import ExciteError
+from excite_cli.search.sequence import stacked_regressors
 from excite_cli.storage.results import read_iterations
 
 
@@ -61,7 +62,7 @@ def run_verify(
     points = [("random", None, excitation.limits.random_start(m, np.random.default_rng(seed), fill=0.7))]
     if result is not None:
         finished = read_iterations(result, excitation, field="result")
-        stacked = np.vstack([np.zeros((0, excitation.columns)), *[r.design_rows for r in finished[:-1]]])
+        stacked = stacked_regressors(excitation, None, finished[:-1])
         points.append((f"optimum {finished[-1].index}", stacked, finished[-1].alpha))
     gradients = []
     for label, prior, alpha in points:
