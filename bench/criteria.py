@@ -48,6 +48,7 @@ import numpy as np
 from excite_cli.config import NoiseConfig
 from excite_cli.config_file import load_problem
 from excite_cli.design.criterion import condition_number
+from excite_cli.design.noise import typical_torques
 from excite_cli.design.resolve import build_excitation
 from excite_cli.search.engine import Engine, default_workers
 from excite_cli.search.restarts import RestartTask
@@ -68,7 +69,6 @@ NOISE = 0.02  # of each joint's RMS torque on the unseen motion (absolute), or o
 FLOOR = 0.002  # the relative noise's floor, of each joint's RMS torque on the unseen motion
 SEEDS = 5
 UNSEEN_SEED = 12345
-HEDGE_SEEDS = (1, 2, 3)  # random feasible motions whose RMS torques scale a hedged design's noise floor
 
 
 def samples(excitation, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -118,10 +118,18 @@ def in_the_loop(
 
 def design_noise(problem, design: str, relative: bool) -> None:
     """Set ``problem.noise`` to what the design is told: ``measured`` the measurements' own noise (a lab
-    that declares its sensor), ``config`` what the config says (a lab that declares nothing), ``hedge:K``
-    σ_j(t) ∝ √((K R_j)² + τ_j(t)²), R_j the RMS torque of joint j on random feasible motions
-    (:data:`HEDGE_SEEDS`, not the unseen one)."""
+    that declares its sensor), ``config`` what the config says, ``default`` nothing (the config's
+    ``noise`` removed: what excite designs for when a lab declares nothing, the hedge), ``equal`` every
+    row the same (``noise: {absolute: 0.1}``, the default before the hedge), ``hedge:K``
+    σ_j(t) ∝ √((K R_j)² + τ_j(t)²), R_j the typical torque of joint j as the default takes it
+    (:func:`~excite_cli.design.noise.typical_torques`: random feasible motions, not the unseen one)."""
     if design == "config":
+        return
+    if design == "default":
+        problem.noise = None
+        return
+    if design == "equal":
+        problem.noise = NoiseConfig(absolute=0.1)  # every row the same (the shipped configs' declaration)
         return
     excitation = build_excitation(problem)
     joints = problem.robot.active_joints
@@ -130,11 +138,8 @@ def design_noise(problem, design: str, relative: bool) -> None:
         problem.noise = NoiseConfig(absolute=dict(zip(joints, absolute[-len(joints) :].tolist())), relative=rho)
         return
     k = float(design.split(":")[1])
-    tau = np.vstack([samples(excitation, excitation.random_start(np.random.default_rng(s)))[1] for s in HEDGE_SEEDS])
-    rms = np.sqrt((tau**2).mean(axis=0))[-len(joints) :]  # the joints' rows (after a floating base's wrench)
-    problem.noise = NoiseConfig(
-        absolute=dict(zip(joints, (k * np.maximum(rms, 1e-6 * rms.max())).tolist())), relative=1.0
-    )
+    typical = typical_torques(excitation)  # R_j as the default's hedge takes them: hedge:0.5 is the default
+    problem.noise = NoiseConfig(absolute=dict(zip(joints, (k * typical).tolist())), relative=1.0)
 
 
 def run(config: Path, objective: str, scaling: str, seed: int, truths: list[bool], design: str) -> list[tuple]:
@@ -155,7 +160,9 @@ def run(config: Path, objective: str, scaling: str, seed: int, truths: list[bool
         with Engine(excitation, workers) as engine:
             alphas = [r.alpha for r in run_sequence(excitation, iterations, seed, engine=engine)]
     wall = time.perf_counter() - begin
-    C = np.vstack([excitation.criterion(objective="log_cond", scaling="none").regressor(a) for a in alphas])
+    C = np.vstack(
+        [excitation.criterion(objective="log_cond", scaling="none", weighed=False).regressor(a) for a in alphas]
+    )
     unseen = excitation.random_start(np.random.default_rng(UNSEEN_SEED))
     figures = (condition_number(C), excitation.scaled_condition_number(C), excitation.excitation_level(C))
     return [(*figures, *in_the_loop(excitation, alphas, unseen, relative), wall) for relative in truths]
@@ -167,7 +174,7 @@ def main() -> None:
     parser.add_argument("--criteria", nargs="+", default=[f"{o}:{s}" for o, s in CRITERIA] + ["random:none"])
     parser.add_argument("--seeds", type=int, nargs="+", default=[0])
     parser.add_argument("--noise", choices=("absolute", "relative", "both"), default="absolute")
-    parser.add_argument("--design-noise", default="measured", help="measured | config | hedge:K")
+    parser.add_argument("--design-noise", default="measured", help="measured | config | default | equal | hedge:K")
     args = parser.parse_args()
     truths = {"absolute": [False], "relative": [True], "both": [False, True]}[args.noise]
     if args.design_noise == "measured" and len(truths) > 1:

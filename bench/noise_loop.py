@@ -7,7 +7,8 @@ joint's RMS torque on an unseen motion, a torque sensor's; *relative* 2 % of the
 Every design is one trajectory of the config's problem under A-optimality in the URDF-scaled frame
 (``log_trace_inverse``, ``urdf``: the default, as bench/criteria.py's table), its restarts and screening.
 
-1. the first trajectory, designed as the config says (its ``noise`` section, or every row the same);
+1. the first trajectory, designed as the config says (its ``noise`` section; where it has none, the
+   hedge, :func:`~excite_cli.design.noise.hedged_noise`);
 2. its recording: sampled at 100 Hz over its duration, torques from RNEA with the URDF's inertias plus
    one draw of the true noise (noise seed = optimizer seed);
 3. identified as identify does with nothing declared: weighted least squares of the base parameters
@@ -124,7 +125,9 @@ def second_designs(problem, excitation, record: tuple, fitted: tuple, noise: tup
         weights = np.ones((len(tau), rows))  # a floating base's wrench rows weigh σ̄
         weights[:, -n:] = measured.row_weights(predicted.ravel()).reshape(-1, n)  # as stored.prior weighs a report's
         prior = Y * (weights.ravel() * scale)[:, None]
-        out[name] = designed(replace(excitation, spec=replace(excitation.spec, measured=measured)), prior, seed)
+        spec = replace(excitation.spec, measured=measured)  # as resolve makes it: a measured prior, no hedge
+        spec = replace(spec, noise=None, hedged=False) if spec.hedged else spec
+        out[name] = designed(replace(excitation, spec=spec), prior, seed)
     absolute, rho = noise
     joints = problem.robot.active_joints
     told = problem.model_copy(deep=True)

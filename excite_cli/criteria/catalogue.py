@@ -40,6 +40,7 @@ CRITERIA = {
             source="Eq. 5",
             extremes=(1.0, -1.0),
             exponentiate_extremes=True,
+            hedged=False,
         ),
         CriterionRecord(
             "log_cond",
@@ -49,6 +50,7 @@ CRITERIA = {
             exponentiate=True,
             source="Eqs. 5, 17",
             extremes=(1.0, -1.0),
+            hedged=False,
         ),
         CriterionRecord(
             "log_det",

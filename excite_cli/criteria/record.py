@@ -40,6 +40,10 @@ class CriterionRecord:
         exponentiate_extremes: f = exp(w_max log σ_max + w_min log σ_min) (cond itself).
         scaling: the regressor it is taken of unless ``optimizer.scaling`` says: ``none`` (C, the
             paper's) or ``urdf`` (C L, the frame in which it measures what it is meant to).
+        hedged: where a config declares no noise, the design weighs the rows by the hedge
+            (:func:`~excite_cli.design.noise.hedged_noise`): a criterion of the estimate's covariance
+            (A-, D-, E-optimality) needs a noise model; the paper's condition number (off) is of the
+            rows as they are.
     """
 
     name: str
@@ -51,6 +55,7 @@ class CriterionRecord:
     extremes: tuple[float, ...] = ()
     exponentiate_extremes: bool = False
     scaling: str = "none"
+    hedged: bool = True
 
     def terms(self, eigenvalues: Any) -> tuple[float, Any, Any]:
         """The value, the indices r (R,) of the eigenpairs the gradient needs and their coefficients

@@ -6,14 +6,18 @@ built from it: the design's one reader of the whole config.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 from scipy.linalg import block_diag
 
 from excite_cli.config import Problem, effective_yaml
 from excite_cli.constraints.joint_limits import joint_limit_bounds
+from excite_cli.criteria.catalogue import criterion_record
 from excite_cli.design.excitation import Excitation, build_design
 from excite_cli.design.information import parameter_magnitudes, scaled_frame
 from excite_cli.design.model_columns import design_effects, measured_prior
+from excite_cli.design.noise import hedged_noise, typical_torques
 from excite_cli.design.spec import ConfigText, DesignSpec, needs_collision
 from excite_cli.dynamics.base_parameters import BaseParameters, compute_base_parameters
 from excite_cli.dynamics.robot import Robot, load_robot
@@ -24,7 +28,8 @@ def resolve(
     problem: Problem, base: BaseParameters | None = None, stored: StoredInputs | None = None
 ) -> tuple[DesignSpec, Robot]:
     """The design of ``problem`` as values, and the robot it was resolved on (its pinocchio and coal
-    objects, which :func:`~excite_cli.design.excitation.build_design` reuses in this process).
+    objects, which :func:`~excite_cli.design.excitation.build_design` reuses in this process); with
+    nothing declared of the noise, the hedge for it (:func:`_hedged`).
 
     Args:
         problem: the validated config.
@@ -47,7 +52,25 @@ def resolve(
         frame = block_diag(frame, np.diag(effects.magnitudes(robot.model.effortLimit[robot.v_idx], upper[1], upper[2])))
     text = ConfigText(effective_yaml(p), p.source_text, str(p.source_path or ""))
     sections = (p.robot, p.trajectory, p.limits, p.constraints, p.optimizer, p.sequence, p.noise, p.folder, text)
-    return DesignSpec(*sections, base, effects, frame, measured_prior(stored.prior, robot)), robot
+    spec = DesignSpec(*sections, base, effects, frame, measured_prior(stored.prior, robot))
+    return _hedged(spec, robot), robot
+
+
+def _hedged(spec: DesignSpec, robot: Robot) -> DesignSpec:
+    """``spec`` with the hedge for undeclared noise (:func:`~excite_cli.design.noise.hedged_noise` on the
+    joints' typical torques, :func:`~excite_cli.design.noise.typical_torques`) where it declares no
+    ``noise``, has no measured prior and optimizes a criterion of the estimate's covariance
+    (``CriterionRecord.hedged``: not the paper's condition number, which is of the rows as they are),
+    and the robot has torques (a file without inertias has none for the noise to grow with); else
+    ``spec``."""
+    if spec.noise is not None or spec.measured is not None:
+        return spec
+    if not criterion_record(spec.optimizer.objective).hedged:
+        return spec
+    typical = typical_torques(build_design(spec, robot, check_home=False))
+    if not typical.max() > 0.0:
+        return spec
+    return replace(spec, noise=hedged_noise(robot.joint_names, typical), hedged=True)
 
 
 def build_excitation(

@@ -55,7 +55,8 @@ class DesignSpec:
 
     Attributes:
         robot, trajectory, limits, constraints, optimizer, sequence, noise: the config's sections
-            (``noise`` None: every regressor row weighs the same).
+            (``noise`` None: none declared; :func:`~excite_cli.design.resolve.build_excitation` puts the hedge
+            there, ``hedged``).
         folder: the config file's folder, which relative paths in it are resolved from (None: the
             working directory).
         config: the config's text, as the result file stores it.
@@ -66,6 +67,8 @@ class DesignSpec:
             effect column scaled by its typical magnitude (:meth:`EffectColumns.magnitudes`).
         measured: how the rows of ``sequence.prior`` weigh when it is an identify report
             (:class:`~excite_cli.stored.design_model.MeasuredPrior`), or None.
+        hedged: ``noise`` is the hedge for noise nobody declared
+            (:func:`~excite_cli.design.noise.hedged_noise`: no ``noise`` section, no measured prior).
     """
 
     robot: RobotConfig
@@ -81,6 +84,7 @@ class DesignSpec:
     effects: EffectColumns | None
     scaled_frame: np.ndarray
     measured: MeasuredPrior | None
+    hedged: bool = False
 
     def __post_init__(self) -> None:
         frame = np.array(self.scaled_frame, dtype=float)

@@ -10,9 +10,9 @@ figures page, "Which noise the design assumes").
 - ``current`` (the torque estimated from motor current): :data:`RELATIVE` of the torque (torque-constant
   and gear errors scale with the load) over a floor of :data:`CURRENT_FLOOR` of R_j (the current
   reading's own noise).
-- ``unknown``: no section: the design's default (every row weighs the same), and the comment says how
-  to declare the source. Which noise a design should assume when nothing is known is measured on the
-  figures page ("Which noise the design assumes"); it is not yet the default.
+- ``unknown``: no section: the design's default, the hedge for undeclared noise
+  (:func:`~excite_cli.design.noise.hedged_noise`, chosen on the figures page, "Which noise the design
+  assumes when the lab declares none"), and the comment says how to declare the source.
 
 Only the ratios between the rows' noises change a design; the σ [Nm] written are a guess to replace
 with the lab's figures, or with an identify report's (``sequence.prior``).
@@ -41,8 +41,10 @@ def draft_noise(source: str, joints: list[str], typical: np.ndarray) -> tuple[di
     typical_words = "each joint's RMS torque on random feasible motions"
     if source == "unknown":
         return None, (
-            "none: the torque source was not said, so every regressor row weighs the same (init's torque_from "
-            "sensor or current drafts the noise of either; an identify report as sequence.prior measures it)"
+            "none: the torque source was not said, so the design hedges between a sensor's noise and a motor "
+            "current's (noise growing with the torque over a floor of half each joint's typical torque; init's "
+            "torque_from sensor or current drafts the noise of either; an identify report as sequence.prior "
+            "measures it)"
         )
     floor = SENSOR_FLOOR if source == "sensor" else CURRENT_FLOOR
     sigma = {j: float(f"{floor * r:.3g}") for j, r in zip(joints, typical)}

@@ -210,7 +210,7 @@ def test_gradient_with_row_weights_matches_finite_differences(ur5_problem):
     sigma = np.linspace(0.5, 2.0, excitation.robot.n_rows)
     noise = RowNoise(sigma, np.zeros_like(sigma), 1.0, excitation.robot.urdf_parameters())
     weights = 1.0 / sigma
-    plain = excitation.criterion()
+    plain = excitation.criterion(weighed=False)
     prior = (
         plain.regressor(_feasible_alpha(excitation, seed=4))
         * np.tile(weights, problem.trajectory.cost_samples)[:, None]

@@ -10,7 +10,7 @@ import pytest
 from conftest import small
 
 from excite_cli.config import NoiseConfig
-from excite_cli.design.noise import TYPICAL_SEEDS, typical_torques
+from excite_cli.design.noise import HEDGE_FLOOR, TYPICAL_SEEDS, typical_torques
 from excite_cli.design.resolve import build_excitation
 from excite_cli.design.verify import finite_difference_gradient
 from excite_cli.errors import ExciteError
@@ -29,8 +29,7 @@ def test_each_row_weighs_by_its_noise_at_the_torque_of_the_motion(panda_problem)
     excitation = build_excitation(problem)
     alpha = _alpha(excitation, 3)
     weighted = excitation.criterion().regressor(alpha)
-    problem.noise = None
-    plain = build_excitation(problem).criterion().regressor(alpha)
+    plain = excitation.criterion(weighed=False).regressor(alpha)
     robot, (Q, QD, QDD) = excitation.robot, excitation.cost_basis.evaluate(alpha)
     tau = np.array([robot.torques(q, qd, qdd) for q, qd, qdd in zip(Q, QD, QDD)])  # pinocchio's RNEA
     sigma = np.array([0.2] + [0.05] * (len(joints) - 1))
@@ -43,11 +42,13 @@ def test_each_row_weighs_by_its_noise_at_the_torque_of_the_motion(panda_problem)
 def test_equal_absolute_noise_is_the_unweighted_design(panda_problem):
     problem = small(panda_problem)
     alpha = _alpha(build_excitation(problem), 1)
-    plain = build_excitation(problem).criterion()
-    problem.noise = NoiseConfig(absolute=0.3, relative=0.0)
+    plain = build_excitation(problem).criterion(weighed=False)
+    problem.noise = NoiseConfig(absolute=0.1, relative=0.0)  # the shipped configs' declaration
     noisy = build_excitation(problem).criterion()
-    np.testing.assert_allclose(noisy.regressor(alpha), plain.regressor(alpha), rtol=1e-12)
-    assert noisy.value(alpha) == pytest.approx(plain.value(alpha), rel=1e-12)
+    # to the bit (a weight 1 ± 1 ulp would move an optimizer's path over hundreds of iterations)
+    np.testing.assert_array_equal(noisy.regressor(alpha), plain.regressor(alpha))
+    assert noisy.value(alpha) == plain.value(alpha)
+    np.testing.assert_array_equal(noisy.value_and_gradient(alpha)[1], plain.value_and_gradient(alpha)[1])
 
 
 @pytest.mark.parametrize(
@@ -127,8 +128,7 @@ def test_table_i_reports_the_rows_as_they_are_and_the_design_stacks_them_weighed
     none = np.zeros((0, excitation.columns))
     first = describe(excitation, 1, alphas[0], none)
     second = describe(excitation, 2, alphas[1], none, earlier=[first])
-    problem.noise = None
-    plain = [build_excitation(problem).criterion().regressor(a) for a in alphas]
+    plain = [excitation.criterion(weighed=False).regressor(a) for a in alphas]
     assert first.cond_own == pytest.approx(np.linalg.cond(plain[0]), rel=1e-9)
     assert second.cond_own == pytest.approx(np.linalg.cond(plain[1]), rel=1e-9)
     assert second.cond_stacked == pytest.approx(np.linalg.cond(np.vstack(plain)), rel=1e-9)
@@ -139,3 +139,33 @@ def test_table_i_reports_the_rows_as_they_are_and_the_design_stacks_them_weighed
     again = read_iterations(tmp_path / "r.h5", excitation)
     assert [r.cond_stacked for r in again] == [first.cond_stacked, second.cond_stacked]
     np.testing.assert_array_equal(again[0].design_rows, weighed)
+
+
+def test_nothing_declared_weighs_each_row_by_the_hedge_over_half_the_joints_typical_torque(panda_problem):
+    """No ``noise``: each row weighs as noise √((K R_j)² + τ_j(t)²), K = 0.5, R_j the joint's RMS torque
+    (pinocchio's RNEA) over the random feasible motions of TYPICAL_SEEDS at the cost samples."""
+    problem = small(panda_problem)
+    problem.noise = None  # nothing declared
+    excitation = build_excitation(problem)
+    assert excitation.spec.hedged and "0.5 × each joint's typical torque" in excitation.noise.words
+    robot, basis = excitation.robot, excitation.cost_basis
+    tau = [
+        pin.rnea(robot.model, robot.model.createData(), q, qd, qdd)
+        for seed in TYPICAL_SEEDS
+        for q, qd, qdd in zip(*basis.evaluate(excitation.random_start(np.random.default_rng(seed))))
+    ]
+    floor = HEDGE_FLOOR * np.sqrt(np.mean(np.square(tau), axis=0))
+    alpha = _alpha(excitation, 2)
+    Q, QD, QDD = basis.evaluate(alpha)
+    now = np.array([pin.rnea(robot.model, robot.model.createData(), *x) for x in zip(Q, QD, QDD)])
+    weights = np.exp(np.log(floor).mean()) / np.sqrt(floor**2 + now**2)
+    plain = excitation.criterion(weighed=False).regressor(alpha)
+    np.testing.assert_allclose(excitation.criterion().regressor(alpha), plain * weights.reshape(-1, 1), rtol=1e-9)
+    problem.noise = NoiseConfig(absolute=0.1)  # the opt-out: every row the same, the paper's criterion
+    equal = build_excitation(problem)
+    assert not equal.spec.hedged
+    np.testing.assert_allclose(equal.criterion().regressor(alpha), plain, rtol=1e-12)
+    problem.noise, problem.optimizer.objective = None, "log_cond"  # the paper's cond: the rows as they are
+    paper = build_excitation(problem)
+    assert not paper.spec.hedged
+    np.testing.assert_allclose(paper.criterion().regressor(alpha), plain, rtol=1e-12)

@@ -14,6 +14,7 @@ from scipy.optimize import nnls
 from typer.testing import CliRunner
 
 from excite_cli.cli import app
+from excite_cli.config import NoiseConfig
 from excite_cli.config_file import load_problem
 from excite_cli.constraints import accepted
 from excite_cli.design.resolve import build_excitation
@@ -122,6 +123,7 @@ def _small_problem(tmp_path, objective, iterations=2):
     data["trajectory"].update(harmonics=3, cost_samples=20, cost_period=0.4, constraint_period=0.05)
     data["optimizer"] = {"objective": objective, "max_iterations": 300, "restarts": 2, "seed": 1, "workers": 1}
     data["sequence"] = {"iterations": iterations}
+    data["noise"] = {"absolute": 0.1}  # every row the same: the rows the solvers' settings were tuned on
     return write_config(tmp_path, data)
 
 
@@ -168,7 +170,7 @@ def test_a_restart_reported_converged_meets_its_tolerance(tmp_path):
                     converged += 1
                     assert _fd_kkt(excitation, prior, r["alpha"][()]) <= 1.01 * tolerance
                     assert r.attrs["kkt_residual"] <= tolerance
-            prior = np.vstack([prior, group["regressor"][()]])
+            prior = np.vstack([prior, excitation.criterion().regressor(group["alpha"][()])])  # as the design
     assert converged >= 1  # the smooth D-optimal criterion converges on this small problem
 
 
@@ -246,6 +248,7 @@ def test_every_method_ends_feasible_and_below_its_start(ur5_problem, method):
         pytest.importorskip("cyipopt", reason="IPOPT not installed (Makefile target ipopt)")
     ur5_problem.optimizer.method = method
     ur5_problem.optimizer.objective = "log_det"  # the methods, on the criterion they were tuned on
+    ur5_problem.noise = NoiseConfig(absolute=0.1)  # and its rows, every one the same
     ur5_problem.optimizer.max_iterations = 40
     excitation = build_excitation(ur5_problem)
     from excite_cli.search.restarts import RestartTask

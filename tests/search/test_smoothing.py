@@ -27,6 +27,7 @@ def _small_ur5(tmp_path, objective: str):
     data = copy.deepcopy(UR5)
     data["trajectory"].update(harmonics=3, cost_samples=20, cost_period=0.4, constraint_period=0.05)
     data["optimizer"] = {"objective": objective, "seed": 1, "workers": 1}
+    data["noise"] = {"absolute": 0.1}  # every row the same: the paper's cond and σ_min
     return build_excitation(load_problem(write_config(tmp_path, data)))
 
 

@@ -7,6 +7,7 @@ from dataclasses import replace
 import numpy as np
 from conftest import small
 
+from excite_cli.config import NoiseConfig
 from excite_cli.constraints import accepted
 from excite_cli.design.resolve import build_excitation
 from excite_cli.search import optimizer, solver_runs, solvers
@@ -19,6 +20,7 @@ def _first_run_cut(panda_problem, monkeypatch, cut=5, warm_up=1000, **ending):
     the budget): the excitation, the start, each run's (start z, iteration budget, tolerance, scale,
     run) and the restart's result."""
     problem = small(panda_problem)
+    problem.noise = NoiseConfig(absolute=0.1)  # every row the same: the paper's criterion
     excitation = build_excitation(problem)
     start = excitation.random_start(np.random.default_rng(5))
     calls = []

@@ -108,7 +108,7 @@ def test_a_second_of_recording_weighs_as_a_second_on_the_cost_grid():
     Y = excitation.robot.regressor_stack(*fine.evaluate(alpha))[:, excitation.base.independent]
     prior = MeasuredPrior(excitation.robot.joint_names, np.ones(excitation.robot.n_joints), 7.0 / period)
     scaled = Y * prior.time_scale(period)
-    own = excitation.criterion().regressor(alpha)
+    own = excitation.criterion(weighed=False).regressor(alpha)
     gram_fine, gram_cost = scaled.T @ scaled, own.T @ own
     assert np.linalg.norm(gram_fine - gram_cost) <= 0.05 * np.linalg.norm(gram_cost)
 
@@ -156,7 +156,7 @@ def test_optimize_with_the_report_as_prior_weighs_both_the_prior_and_its_own_row
     excitation = build_excitation(problem)
     with h5py.File(out) as f:
         alpha, stored = f["iterations/1/alpha"][()], f["iterations/1/regressor"][()]
-    plain = excitation.criterion().regressor(alpha)
+    plain = excitation.criterion(weighed=False).regressor(alpha)
     np.testing.assert_array_equal(stored, plain)  # the file holds the rows as they are (Table I's)
     problem.sequence.prior = str(report_file)
     own = build_excitation(problem).criterion().regressor(alpha)  # as the design weighs them
