@@ -44,3 +44,29 @@ def test_a_sole_on_its_edge_or_a_tipping_root_is_a_fall_even_where_the_root_keep
         return Played(two, none, none, none, none, {}, (), sole_tilt=two + sole, root_tilt=two + root, drop=two)
 
     assert not run(4.9, 19.0).fell and run(5.1, 0.0).fell and run(0.0, 20.5).fell
+
+
+PAN = """<robot name="pan"><link name="base"><collision><origin xyz="0 0 0.05"/>
+    <geometry><box size="0.2 0.2 0.1"/></geometry></collision></link>
+  <link name="arm"><inertial><origin xyz="0 0 0.05"/><mass value="2"/>
+    <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.05"/></inertial>
+    <collision><origin xyz="0 0 0.04"/><geometry><cylinder radius="0.08" length="0.1"/></geometry></collision></link>
+  <joint name="pan" type="revolute"><origin xyz="0 0 0.1"/><parent link="base"/><child link="arm"/>
+    <axis xyz="0 0 1"/><limit lower="-2" upper="2" effort="20" velocity="3"/></joint>
+</robot>"""
+
+
+def test_a_link_resting_on_its_fixed_base_turns_freely_as_on_its_bearing(tmp_path):
+    """The arm's collision cylinder sits 1 cm into the base's box at home (as a UR3's shoulder on its base):
+    MuJoCo fuses a fixed base into the world, whose pairs are not left out, so the pan rubbed the base; the
+    rehearsal keeps the base a body and leaves the pair out, and the pan plays τ = I_zz q̈."""
+    (tmp_path / "pan.urdf").write_text(PAN)
+    robot = {"urdf": "pan.urdf", "active_joints": ["pan"]}
+    problem = load_problem(write_config(tmp_path, {"robot": robot, "limits": {"acceleration": 5.0}}))
+    robot = rehearsal_robot(problem.robot, problem.constraints, tmp_path / "pan.urdf", [], RehearsalConfig())
+    assert any("overlapping at home: arm-base" in note or "base-arm" in note for note in robot.notes)
+    t = np.arange(0.0, 4.0, 1e-3)
+    q, qdd = 0.6 * (1 - np.cos(1.5 * t)), 1.35 * np.cos(1.5 * t)
+    played = play(robot, Commands(q[:, None], (0.9 * np.sin(1.5 * t))[:, None], (0.05 * qdd)[:, None], None, 1000.0))
+    assert np.abs(played.q[:, 0] - q).max() < 1e-3  # rad (rubbing the base: 1.18 rad)
+    assert not played.contacts
