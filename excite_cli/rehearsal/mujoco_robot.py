@@ -80,6 +80,7 @@ def rehearsal_robot(
     soles: dict[str, tuple[np.ndarray, np.ndarray]] | None = None,
     welded: bool = False,
     joint_names: dict[str, str] | None = None,
+    fusestatic: bool = True,
 ) -> RehearsalRobot:
     """MuJoCo's robot of a problem (module docstring), from ``urdf`` (a URDF or the lab's MJCF).
 
@@ -95,6 +96,9 @@ def rehearsal_robot(
         joint_names: {the problem's joint: the file's name for it} where they differ (a lab's MJCF).
         welded: a standing robot's held joints welded at their values (rigid, as excite's model holds
             them) instead of held by their PD.
+        fusestatic: MuJoCo's ``compiler.fusestatic`` where the file sets it (a URDF): off where a link
+            rests on a fixed base at home, that pair then left out (kept on, the UR3's shoulder rubbed
+            its base: its pan tracked within 22° RMS instead of 0.01°).
 
     Returns:
         The :class:`RehearsalRobot`.
@@ -103,32 +107,8 @@ def rehearsal_robot(
         ExciteError: MuJoCo is missing, cannot read the file or refuses the model; a joint of the problem
             the file does not have; no contact geometry on the soles.
     """
-    args = (robot, constraints, urdf, package_dirs, controller, soles, welded, joint_names)
-    built, on_base = _rehearsal_robot(*args, fusestatic=True)
-    if not on_base:
-        return built
-    # a link lies on the fixed base's geometry at home, which MuJoCo fused into the world (a URDF's
-    # default, compiler.fusestatic): built again with the base a body of its own, so that the pair is left
-    # out of contact as every pair overlapping at home is (left in, the UR3's shoulder rubbed its base and
-    # its pan tracked within 22° RMS where it tracks within 0.01°)
-    return _rehearsal_robot(*args, fusestatic=False)[0]
-
-
-def _rehearsal_robot(
-    robot: RobotConfig,
-    constraints: ConstraintsConfig,
-    urdf: Path,
-    package_dirs: list[str],
-    controller: RehearsalConfig,
-    soles: dict[str, tuple[np.ndarray, np.ndarray]] | None,
-    welded: bool,
-    joint_names: dict[str, str] | None,
-    fusestatic: bool,
-) -> tuple[RehearsalRobot, bool]:
-    """:func:`rehearsal_robot` with MuJoCo's ``compiler.fusestatic`` as given, and whether a fixed-base
-    robot's moving link touches the world's geometry at home."""
     mujoco, spec = urdf_spec(urdf)
-    spec.compiler.fusestatic = fusestatic
+    spec.compiler.fusestatic = spec.compiler.fusestatic and fusestatic  # an MJCF's default is off
     notes: list[str] = []
     if is_mjcf(urdf):
         package_dirs = [*package_dirs, str(urdf.parent / spec.meshdir)]
@@ -175,7 +155,6 @@ def _rehearsal_robot(
     if standing and not any(j.type == mujoco.mjtJoint.mjJNT_FREE for j in spec.joints):
         spec.worldbody.first_body().add_freejoint()
     model = _compile(spec, urdf)
-    on_base = False
     if standing:
         spec.worldbody.add_geom(
             name="floor",
@@ -187,7 +166,10 @@ def _rehearsal_robot(
     else:
         excluded = constraints.self_collision.exclude_pairs if constraints.self_collision else []
         model, on_base = _excluded(mujoco, spec, model, locked | dict(robot.home_posture), excluded, urdf, notes)
-    return RehearsalRobot(model, list(robot.active_joints), held, gains, standing, links, notes), on_base
+        if on_base and spec.compiler.fusestatic:  # a link on the base MuJoCo fused into the world: again
+            args = (robot, constraints, urdf, package_dirs, controller, soles, welded, joint_names)
+            return rehearsal_robot(*args, fusestatic=False)  # with the base a body, so that pair is left out
+    return RehearsalRobot(model, list(robot.active_joints), held, gains, standing, links, notes)
 
 
 def _excluded(mujoco, spec, model, posture: dict[str, float], pairs: list, urdf: Path, notes: list[str]):
