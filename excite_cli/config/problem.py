@@ -241,7 +241,7 @@ class Problem(ConfigFile):
     sequence: SequenceConfig = SequenceConfig()
     """Sequential generation (Sec. IV-B)."""
     noise: Optional[NoiseConfig] = None
-    """The torque noise the rows are weighed by; none: the hedge (cond: none); {absolute: 0.1}: every row the same."""
+    """The torque noise the rows are weighed by; none: the hedge (for cond, every row the same; README)."""
     random_baseline: RandomBaselineConfig = RandomBaselineConfig()
     """compare-random's candidates."""
     rehearsal: RehearsalConfig = RehearsalConfig()

@@ -103,8 +103,9 @@ def row_noise(
     """The rows' noise of the ``noise`` section, or of ``measured`` (an identify report's) when there
     is one: its fitted a_j and ρ_j (:meth:`~excite_cli.stored.design_model.MeasuredPrior.noise_parts`; a
     floor keeps a row of zero torque finite) or, without them, its σ_j
-    and the config's ρ. None where there is no section and no measured prior (a design then has the
-    hedge of :func:`hedged_noise` as its section, :func:`~excite_cli.design.resolve.build_excitation`).
+    and the config's ρ. None where there is no section and no measured prior (the paper's cond, or a
+    robot without inertias: :func:`~excite_cli.design.resolve.resolve` gives every other design the
+    hedge of :func:`hedged_noise` as its section).
     ``source`` says where a section's noise comes from (the config's, or the hedge of
     :func:`hedged_noise`).
 

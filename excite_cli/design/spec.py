@@ -55,8 +55,8 @@ class DesignSpec:
 
     Attributes:
         robot, trajectory, limits, constraints, optimizer, sequence, noise: the config's sections
-            (``noise`` None: none declared; :func:`~excite_cli.design.resolve.build_excitation` puts the hedge
-            there, ``hedged``).
+            (``noise`` None: none declared and no hedge; :func:`~excite_cli.design.resolve.resolve` puts
+            the hedge there where the criterion takes it, ``hedged``).
         folder: the config file's folder, which relative paths in it are resolved from (None: the
             working directory).
         config: the config's text, as the result file stores it.

@@ -131,11 +131,14 @@ class Engine:
             # on an error or interruption the running tasks are not waited for: their processes are
             # stopped (the executor has no public call for it before Python 3.14)
             processes = list((self._pool._processes or {}).values()) if kind is not None else []
+            manager = self._pool._executor_manager_thread if kind is not None else None
             self._pool.shutdown(wait=kind is None, cancel_futures=True)
             for process in processes:
                 process.terminate()
             for process in processes:
                 process.join(WORKER_STOP)
+            if manager is not None:  # its teardown closes the wake-up pipe Python's exit handler writes to:
+                manager.join(WORKER_STOP)  # met mid-close, that printed a traceback after the error line
         if self._client is not None:
             self._client.close()
         if self._limits is not None:
