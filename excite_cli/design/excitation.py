@@ -24,7 +24,7 @@ from excite_cli.constraints.zmp import zmp_from_config
 from excite_cli.criteria import criterion_record
 from excite_cli.design.criterion import Criterion, condition_number
 from excite_cli.design.information import PriorInformation, excitation_level, parameter_magnitudes
-from excite_cli.design.noise import HEDGE_WORDS, RowNoise, row_noise
+from excite_cli.design.noise import RowNoise, row_noise
 from excite_cli.design.spec import DesignSpec, needs_collision
 from excite_cli.dynamics.base_parameters import BaseParameters
 from excite_cli.dynamics.effect_columns import EffectColumns
@@ -132,8 +132,7 @@ class Excitation:
     def noise(self) -> RowNoise | None:
         """The regressor rows' noise (``noise``, σ_j from a measured prior's report), or None: unweighted;
         resolved once per design (every criterion it builds takes the same)."""
-        source = HEDGE_WORDS if self.spec.hedged else "the config's noise section"
-        return row_noise(self.spec.noise, self.robot, self.measured, source)
+        return row_noise(self.spec.noise, self.robot, self.measured, self.spec.hedged)
 
     @property
     def effect_names(self) -> tuple[str, ...]:

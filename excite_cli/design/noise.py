@@ -98,7 +98,7 @@ def hedged_noise(joints: list[str], typical: np.ndarray) -> NoiseConfig:
 
 
 def row_noise(
-    cfg: NoiseConfig | None, robot: Robot, measured: MeasuredPrior | None, source: str = "the config's noise section"
+    cfg: NoiseConfig | None, robot: Robot, measured: MeasuredPrior | None, hedged: bool = False
 ) -> RowNoise | None:
     """The rows' noise of the ``noise`` section, or of ``measured`` (an identify report's) when there
     is one: its fitted a_j and ρ_j (:meth:`~excite_cli.stored.design_model.MeasuredPrior.noise_parts`; a
@@ -106,8 +106,7 @@ def row_noise(
     and the config's ρ. None where there is no section and no measured prior (the paper's cond, or a
     robot without inertias: :func:`~excite_cli.design.resolve.resolve` gives every other design the
     hedge of :func:`hedged_noise` as its section).
-    ``source`` says where a section's noise comes from (the config's, or the hedge of
-    :func:`hedged_noise`).
+    ``hedged``: the section is the hedge of :func:`hedged_noise`, not the config's (the words say so).
 
     Raises:
         ExciteError: (``noise.absolute``, ``noise.relative``) an unknown joint, a σ that is not positive
@@ -122,6 +121,7 @@ def row_noise(
     else:
         sigma = per_joint("noise.absolute", cfg.absolute, np.full(n, np.nan), robot, noun="noise [Nm]")
     rho = np.zeros(n) if cfg is None else per_joint("noise.relative", cfg.relative, np.zeros(n), robot, True, "noise")
+    source = HEDGE_WORDS if hedged else "the config's noise section"
     if measured is not None and measured.level is not None:
         sigma, rho = (x[order] for x in measured.noise_parts())
         source = "the noise the identify report measured (sequence.prior): " + ", ".join(
