@@ -28,7 +28,7 @@ Printed per criterion: cond(C) on the base columns and cond(C L) (the condition 
 not depend on the base columns) after the last iteration, ē, the mean errors over the noise seeds
 and the optimization's wall time.
 
-Run: `.venv/bin/python bench/criteria.py [CONFIG ...] [--criteria OBJECTIVE:SCALING ...] [--seeds S ...] [--noise absolute|relative]`
+Run: `.venv/bin/python bench/criteria.py [CONFIG ...] [--criteria OBJECTIVE:SCALING ...] [--seeds S ...] [--noise absolute|relative|both] [--design-noise D]`
 (default the G1 arms and the Panda with joint limits, every criterion and random, seed 0; figures are
 means over the seeds). Asserts nothing.
 """
@@ -44,6 +44,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from maximin import maximin_sequence  # bench/ on the path, as a script has it
 
 from excite_cli.config import NoiseConfig
 from excite_cli.config_file import load_problem
@@ -122,8 +123,11 @@ def design_noise(problem, design: str, relative: bool) -> None:
     ``noise`` removed: what excite designs for when a lab declares nothing, the hedge), ``equal`` every
     row the same (``noise: {absolute: 0.1}``, the default before the hedge), ``hedge:K``
     σ_j(t) ∝ √((K R_j)² + τ_j(t)²), R_j the typical torque of joint j as the default takes it
-    (:func:`~excite_cli.design.noise.typical_torques`: random feasible motions, not the unseen one)."""
-    if design == "config":
+    (:func:`~excite_cli.design.noise.typical_torques`: random feasible motions, not the unseen one);
+    ``maximin`` (``maximin:sequence``) or ``maximin:iteration``, the maximin-efficiency design over an
+    absolute and a relative model, normalized by each model's own sequence or by each model's optimum
+    at each iteration (bench/maximin.py; it sets its models itself)."""
+    if design == "config" or design.startswith("maximin"):  # maximin: the models are bench/maximin.py's
         return
     if design == "default":
         problem.noise = None
@@ -152,7 +156,10 @@ def run(config: Path, objective: str, scaling: str, seed: int, truths: list[bool
     excitation = build_excitation(problem)
     begin = time.perf_counter()
     iterations = problem.sequence.iterations
-    if objective == "random":
+    if design.startswith("maximin"):
+        workers = min(default_workers(), problem.optimizer.screened or problem.optimizer.restarts)
+        alphas = maximin_sequence(problem, seed, workers, (design.split(":") + ["sequence"])[1])
+    elif objective == "random":
         prior = np.zeros((0, excitation.base.count))
         alphas = [excitation.random_start(RestartTask(k, 1, seed, prior).rng()) for k in range(1, iterations + 1)]
     else:
@@ -174,7 +181,11 @@ def main() -> None:
     parser.add_argument("--criteria", nargs="+", default=[f"{o}:{s}" for o, s in CRITERIA] + ["random:none"])
     parser.add_argument("--seeds", type=int, nargs="+", default=[0])
     parser.add_argument("--noise", choices=("absolute", "relative", "both"), default="absolute")
-    parser.add_argument("--design-noise", default="measured", help="measured | config | default | equal | hedge:K")
+    parser.add_argument(
+        "--design-noise",
+        default="measured",
+        help="measured | config | default | equal | hedge:K | maximin[:iteration|:sequence]",
+    )
     args = parser.parse_args()
     truths = {"absolute": [False], "relative": [True], "both": [False, True]}[args.noise]
     if args.design_noise == "measured" and len(truths) > 1:
@@ -197,7 +208,7 @@ def report(objective: str, scaling: str, rows: np.ndarray, seeds: int) -> None:
     cond, scaled, level, rms, worst, torque, predicted, wall = rows.mean(axis=0)
     label = objective if objective in ("random", "log_det") else f"{objective}, {scaling}"
     print(
-        f"{label:<22} {cond:>8.1f} {scaled:>9.0f} {level:>8.4f} {rms:>14.2%} {worst:>11.1%} {torque:>14.3%} {predicted:>10.2%} {wall:>9.0f}",
+        f"{label:<22} {cond:>8.1f} {scaled:>9.0f} {level:>8.4f} {rms:>14.2%} {worst:>11.1%} {torque:>14.3%} {predicted:>10.3%} {wall:>9.0f}",
         flush=True,
     )
     if seeds > 1:
