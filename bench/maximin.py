@@ -71,18 +71,26 @@ class Maximin:
 
     @property
     def objective(self):
+        """The parts' criterion record (A-optimality: not of the extreme singular values, so the
+        optimizer takes value and gradient as they are)."""
         return self.parts[0].objective
 
     def _smooth_max(self, values: list[float]) -> tuple[float, np.ndarray]:
+        """The smooth maximum of the log regrets f_m − f_m* and its weights (m,) (the softmax: its
+        gradient in the f_m)."""
         g = np.array(values) - np.array(self.optima)
         top = g.max()
         w = np.exp(SHARPNESS * (g - top))
         return float(top + np.log(w.sum()) / SHARPNESS), w / w.sum()
 
     def value(self, alpha: np.ndarray, from_gram: bool = False) -> float:
+        """The smooth maximum at α (n, 2N+1) [1, log regret]; ``from_gram`` as the parts take it
+        (:meth:`~excite_cli.design.criterion.Criterion.value`)."""
         return self._smooth_max([p.value(alpha, from_gram) for p in self.parts])[0]
 
     def value_and_gradient(self, alpha: np.ndarray) -> tuple[float, np.ndarray]:
+        """The smooth maximum at α (n, 2N+1) and its gradient (n, 2N+1): the softmax-weighted sum of
+        the parts' analytic gradients (Eqs. 45–49 each)."""
         both = [p.value_and_gradient(alpha) for p in self.parts]
         value, w = self._smooth_max([v for v, _ in both])
         return value, sum(wk * g for wk, (_, g) in zip(w, both))
@@ -100,6 +108,8 @@ class _MaximinExcitation(Excitation):
     maximin: Maximin | None = None
 
     def criterion(self, prior=None, objective=None, scaling=None, weighed=True):
+        """The maximin (its own C₀ per model, whatever ``prior`` says) where the optimizer asks for the
+        design's criterion; any other criterion as :meth:`Excitation.criterion` builds it."""
         if weighed and objective is None and scaling is None:
             return self.maximin
         return super().criterion(prior, objective, scaling, weighed)
