@@ -126,8 +126,9 @@ def design_noise(problem, design: str, relative: bool) -> None:
     (:func:`~excite_cli.design.noise.typical_torques`: random feasible motions, not the unseen one);
     ``maximin`` (``maximin:sequence``) or ``maximin:iteration``, the maximin-efficiency design over an
     absolute and a relative model, normalized by each model's own sequence or by each model's optimum
-    at each iteration (bench/maximin.py; it sets its models itself)."""
-    if design == "config" or design.startswith("maximin"):  # maximin: the models are bench/maximin.py's
+    at each iteration, or ``compound:W`` the weighted mean of the two models' log criteria, W the
+    absolute model's weight (bench/maximin.py; it sets its models itself)."""
+    if design == "config" or design.startswith(("maximin", "compound")):  # maximin: the models are bench/maximin.py's
         return
     if design == "default":
         problem.noise = None
@@ -156,9 +157,11 @@ def run(config: Path, objective: str, scaling: str, seed: int, truths: list[bool
     excitation = build_excitation(problem)
     begin = time.perf_counter()
     iterations = problem.sequence.iterations
-    if design.startswith("maximin"):
+    if design.startswith("compound"):
+        alphas = maximin_sequence(problem, seed, 1, design)
+    elif design.startswith("maximin"):
         workers = min(default_workers(), problem.optimizer.screened or problem.optimizer.restarts)
-        alphas = maximin_sequence(problem, seed, workers, (design.split(":") + ["sequence"])[1])
+        alphas = maximin_sequence(problem, seed, workers, design.partition(":")[2] or "sequence")
     elif objective == "random":
         prior = np.zeros((0, excitation.base.count))
         alphas = [excitation.random_start(RestartTask(k, 1, seed, prior).rng()) for k in range(1, iterations + 1)]
@@ -184,7 +187,7 @@ def main() -> None:
     parser.add_argument(
         "--design-noise",
         default="measured",
-        help="measured | config | default | equal | hedge:K | maximin[:iteration|:sequence]",
+        help="measured | config | default | equal | hedge:K | maximin[:iteration|:sequence] | compound:W",
     )
     args = parser.parse_args()
     truths = {"absolute": [False], "relative": [True], "both": [False, True]}[args.noise]
