@@ -64,7 +64,7 @@ def test_a_link_resting_on_its_fixed_base_turns_freely_as_on_its_bearing(tmp_pat
     robot = {"urdf": "pan.urdf", "active_joints": ["pan"]}
     problem = load_problem(write_config(tmp_path, {"robot": robot, "limits": {"acceleration": 5.0}}))
     robot = rehearsal_robot(problem.robot, problem.constraints, tmp_path / "pan.urdf", [], RehearsalConfig())
-    assert any("overlapping at home: arm-base" in note or "base-arm" in note for note in robot.notes)
+    assert any("overlapping at home: arm-base" in note for note in robot.notes)  # pairs are noted sorted
     t = np.arange(0.0, 4.0, 1e-3)
     q, qdd = 0.6 * (1 - np.cos(1.5 * t)), 1.35 * np.cos(1.5 * t)
     played = play(robot, Commands(q[:, None], (0.9 * np.sin(1.5 * t))[:, None], (0.05 * qdd)[:, None], None, 1000.0))
