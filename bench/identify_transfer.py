@@ -285,6 +285,7 @@ def main() -> None:
                     "limits": {"position_margin": 0.1, "acceleration": 4.0, "velocity": 2.0},
                     "optimizer": {"max_iterations": 60, "restarts": 3},
                     "sequence": {"iterations": 3},
+                    "noise": {"absolute": 0.1},  # every row the same, as these rows were measured (not the hedge)
                 }
             )
         )
