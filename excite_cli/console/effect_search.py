@@ -23,14 +23,14 @@ def search(report: Report, runners_up: int = 2) -> list[Table | str]:
         others = sorted(((v, m, t) for m, t, v in step.tried if (m, t) != (step.move, step.term)), key=lambda o: o[0])[
             :runners_up
         ]
-        unclear = not np.isnan(step.clear_of_zero)
+        by_estimate = not np.isnan(step.clear_of_zero)  # judged by the estimate, not the folds
         rows.append(
             (
                 str(k),
-                step.label(report.joints) + (f" (estimate {step.clear_of_zero:.1f} std from 0)" if unclear else ""),
+                step.label(report.joints) + (f" (estimate {step.clear_of_zero:.1f} std from 0)" if by_estimate else ""),
                 f"{step.gain:.1f}",
-                *(["—" if unclear else _folds(step)] if paired else []),
-                "—" if unclear else str(len(step.tried)),
+                *(["—" if by_estimate else _folds(step)] if paired else []),
+                "—" if by_estimate else str(len(step.tried)),
                 "; ".join(f"{MOVE_SIGNS[m]} {t.label(report.joints)} {step.gain_of(v):.1f}" for v, m, t in others),
             )
         )

@@ -21,8 +21,11 @@ on, or moves a Stribeck or held term along its velocity grid or a coupled term a
 
 Under the price every move lowers J; under the paired test no model is visited twice. Either way
 the search cannot cycle, and it stops when no move is allowed. Given the reported fit's estimates
-(on distinct recordings: :mod:`~excite_cli.identification.choice.selection`), it then
-removes the added terms whose estimate is not clear of zero, the least clear first, each a step
+(on distinct recordings: :mod:`~excite_cli.identification.choice.selection`), it then adds back the
+friction a real joint most likely has (:data:`LIKELY_FRICTION`) where the folds left it out but its
+estimate is clear of zero (a loaded joint's viscous friction under noise growing with the torque:
+the folds' spread hides what the estimate shows), the clearest first, and removes the added terms
+whose estimate is not clear of zero, the least clear first, each a step
 (:mod:`~excite_cli.identification.choice.estimates`).
 """
 
@@ -50,6 +53,10 @@ from excite_cli.identification.choice.estimates import CLEAR
 from excite_cli.identification.choice.search_record import Refused, Search, Step
 from excite_cli.identification.config import IdentificationConfig
 from excite_cli.identification.effects import Term
+
+#: The friction a real joint most likely has: the searches' starts (selection's ``STARTS``), and what a
+#: search's end gets back where its estimate is clear of zero (:meth:`StepwiseSearch._restore`).
+LIKELY_FRICTION = ("coulomb", "viscous")
 
 
 class StepwiseSearch:
@@ -234,13 +241,38 @@ class StepwiseSearch:
             terms, score = after, value
             visited.add(frozenset(terms))
             search.objective = self.objective(terms, score)
-        terms, score = self._clear_of_zero(search, terms, score)
+        terms, score = self._clear_of_zero(search, *self._restore(search, terms, score))
         search.terms, search.cv_error, search.folds = terms, score[0], score[1]
         return search
 
     def _removable(self, terms: list[Term]) -> list[Term]:
         """The terms of ``terms`` a removal may take: added, and no other term requires them."""
         return [m[1] for m in self.moves(terms) if m[0] == "remove"]
+
+    def _restore(self, search: Search, terms: list[Term], score: tuple) -> tuple[list[Term], tuple]:
+        """The end ``terms`` (scored ``score``) with the friction a real joint most likely has
+        (:data:`LIKELY_FRICTION`) added back where the search left it out and its estimate, added to the
+        end, is clear of zero (:data:`~excite_cli.identification.choice.estimates.CLEAR`), the clearest
+        first and the rest judged again with it, each addition a step of ``search``."""
+        restored = 0
+        likely = [c for c in self.candidates if c.effect in LIKELY_FRICTION and c.shape is None and c.coupling is None]
+        while self.clear is not None:
+            held = {t.family for t in terms}
+            ratios = {c: self.clear(terms + [c], [c])[c] for c in likely if c.family not in held}
+            term, ratio = max(ratios.items(), key=lambda item: item[1], default=(None, 0.0))
+            if ratio < CLEAR:
+                break
+            after = terms + [term]
+            value = self.score(after)
+            search.steps.append(Step("add", term, after, value[0], score[0], [], clear_of_zero=ratio))
+            terms, score, restored = after, value, restored + 1
+            search.objective = self.objective(terms, score)
+        if restored:
+            search.stop += (
+                f"; then {restored} friction term{'s' * (restored > 1)} the folds left out added back, whose "
+                f"estimate the report tells from zero ({CLEAR:g} standard deviations or more)"
+            )
+        return terms, score
 
     def _clear_of_zero(self, search: Search, terms: list[Term], score: tuple) -> tuple[list[Term], tuple]:
         """The end ``terms`` (scored ``score``) without the added terms whose estimate is not clear of

@@ -31,8 +31,8 @@ class Step:
             cut of the error [%]: the step was open because some move's gain exceeded its own (NaN
             below those folds, for a removal, which keeps the plain test, and under the price).
         clear_of_zero: a removal because the term's estimate was not clear of zero in the reported fit
-            (:mod:`~excite_cli.identification.choice.estimates`): its clearest coefficient's |value| in
-            standard deviations (NaN for every other step).
+            (:mod:`~excite_cli.identification.choice.estimates`), or a friction term added back because
+            it was: its clearest coefficient's |value| in standard deviations (NaN for every other step).
     """
 
     move: str

@@ -48,7 +48,7 @@ from excite_cli.identification.choice.admission import (
 )
 from excite_cli.identification.choice.crossval import CrossValidation
 from excite_cli.identification.choice.estimates import Estimates
-from excite_cli.identification.choice.search import StepwiseSearch
+from excite_cli.identification.choice.search import LIKELY_FRICTION, StepwiseSearch
 from excite_cli.identification.choice.search_record import Search, Step
 from excite_cli.identification.config import IdentificationConfig
 from excite_cli.identification.data_config import TransmissionConfig
@@ -62,7 +62,7 @@ from excite_cli.identification.fitting.normal import ABSORBED, NormalEquations, 
 STARTS = {
     "declared effects": (),
     "Coulomb on every joint": ("coulomb",),
-    "Coulomb and viscous on every joint": ("coulomb", "viscous"),
+    "Coulomb and viscous on every joint": LIKELY_FRICTION,
 }
 
 

@@ -166,15 +166,15 @@ def test_a_step_takes_a_shaped_term_over_a_plain_one_only_where_it_passes_the_te
 
 
 class _Clear:
-    """A stand-in of the reported fit's ratios: each term's from ``ratios`` (10 for any other), and the
-    terms it was asked about."""
+    """A stand-in of the reported fit's ratios: each term's from ``ratios`` (``other`` for any other),
+    and the terms it was asked about."""
 
-    def __init__(self, ratios: dict):
-        self.ratios, self.asked = ratios, []
+    def __init__(self, ratios: dict, other: float = 10.0):
+        self.ratios, self.other, self.asked = ratios, other, []
 
     def __call__(self, terms, asked):
         self.asked.append(list(asked))
-        return {t: self.ratios.get(t, 10.0) for t in asked}
+        return {t: self.ratios.get(t, self.other) for t in asked}
 
 
 def test_the_search_removes_the_admitted_terms_its_estimates_cannot_tell_from_zero_least_clear_first():
@@ -187,7 +187,7 @@ def test_the_search_removes_the_admitted_terms_its_estimates_cannot_tell_from_ze
     gains = {a: 0.1, b: 0.1}
     plain = StepwiseSearch(_Folds(8, gains, 0), candidates, declared, cfg, Admission.PAIRED).run("s", declared)
     assert {a, b} <= set(plain.terms)
-    clear = _Clear({a: 2.5, b: 1.5})
+    clear = _Clear({a: 2.5, b: 1.5}, other=0.0)
     search = StepwiseSearch(_Folds(8, gains, 0), candidates, declared, cfg, Admission.PAIRED, clear=clear).run(
         "s", declared
     )
@@ -196,5 +196,27 @@ def test_the_search_removes_the_admitted_terms_its_estimates_cannot_tell_from_ze
     assert a not in search.terms and b not in search.terms and search.terms == removals[-1].terms
     assert "2 added terms removed" in search.stop and f"under {CLEAR:g} standard deviations" in search.stop
     assert all(declared[0] not in asked for asked in clear.asked)
-    kept = StepwiseSearch(_Folds(8, gains, 0), candidates, declared, cfg, Admission.PAIRED, clear=_Clear({a: 3.5}))
+    kept = StepwiseSearch(
+        _Folds(8, gains, 0), candidates, declared, cfg, Admission.PAIRED, clear=_Clear({a: 3.5}, other=0.0)
+    )
     assert a in kept.run("s", declared).terms
+
+
+def test_a_search_end_gets_back_the_likely_friction_its_estimates_tell_from_zero_clearest_first():
+    """Eight folds where only Coulomb friction on joint 3 helps: the search leaves out viscous friction
+    on joints 5 and 6 (the folds cannot show it), whose estimates added to the end stand 5 and 4 std
+    from zero: both are added back after the search (5 first), each a step with its ratio, and judged
+    again; at 2.9 std, or a Stribeck term however clear (not the friction a joint most likely has), none."""
+    a, v5, v6, stribeck = Term("coulomb", 3), Term("viscous", 5), Term("viscous", 6), Term("stribeck", 7, 0.1)
+    candidates = [Term("coulomb", j) for j in range(20)] + [v5, v6, stribeck]
+    cfg = IdentificationConfig(candidates=["coulomb", "viscous", "stribeck"])
+
+    def run(ratios):
+        clear = _Clear({a: 50.0, **ratios}, other=0.0)
+        return StepwiseSearch(_Folds(8, {a: 0.1}, 0), candidates, [], cfg, Admission.PAIRED, clear=clear).run("s", [])
+
+    search = run({v5: 5.0, v6: 4.0, stribeck: 20.0})
+    back = [s for s in search.steps if s.move == "add" and not np.isnan(s.clear_of_zero)]
+    assert [(s.term, s.clear_of_zero) for s in back] == [(v5, 5.0), (v6, 4.0)]
+    assert set(search.terms) == {a, v5, v6} and "2 friction terms the folds left out added back" in search.stop
+    assert set(run({v5: 2.9, stribeck: 20.0}).terms) == {a}
