@@ -89,7 +89,7 @@ def write_search(g: h5py.Group, report: Report) -> None:
     units = "cv_error in %, gain in % of the CV error before the step, shape in rad/s"
     written = g.create_dataset("steps", data=np.array(steps, dtype=move))
     written.attrs["units"], written.attrs["admission"] = units, str(sel.admission)
-    written.attrs["clear_of_zero_std"] = [step.clear_of_zero for step in sel.steps]  # NaN but for the steps judged by the estimate
+    written.attrs["clear_of_zero_std"] = [step.clear_of_zero for step in sel.steps]  # NaN unless judged by the estimate
     if sel.admission is Admission.PAIRED:  # each step's mean gain over the folds and the margin it passed
         written.attrs["fold_gain_percent"] = [step.fold_gain for step in sel.steps]
         written.attrs["fold_margin_percent"] = [step.fold_margin for step in sel.steps]
