@@ -2,7 +2,8 @@
 config (excite's simulator, 10 s at 200 Hz each, 0.2 mrad encoder noise, torque noise 0.05 N·m + 1 %
 of the torque), truth ``friction``: Coulomb 0.6 N·m and viscous 0.4 N·m·s/rad on every joint;
 ``stribeck``: and Stribeck friction of 0.35 N·m (v_s 0.1 rad/s) on the middle joint; ``spring``: and
-a 100 N·m/rad spring on the middle joint. N recordings fitted with nothing declared (the default
+a 100 N·m/rad spring on the middle joint; ``coulomb``: Coulomb friction alone (no viscous friction
+anywhere, for the friction a search's end gets back). N recordings fitted with nothing declared (the default
 search, folds the recordings: the paired test) and one more for validation; beside it the truth's
 terms declared and fitted without a search on the same data (the true model's floor).
 
@@ -11,7 +12,7 @@ truth's Stribeck or spring term, the largest ratio of the validation error to th
 the mean identify time.
 
 Run: `.venv/bin/python bench/admission.py CONFIG [--recordings 4 6 8] [--seeds 0 1 ...] [--truth
-friction|stribeck|spring]`. Asserts nothing.
+friction|coulomb|stribeck|spring]`. Asserts nothing.
 """
 
 from __future__ import annotations
@@ -42,6 +43,8 @@ FRICTION = {"coulomb": {"*": 0.6}, "viscous": {"*": 0.4}}
 
 def truth_effects(truth: str, middle: str) -> dict:
     """The simulated effects of ``truth`` (module docstring), its extra term on joint ``middle``."""
+    if truth == "coulomb":  # no viscous friction anywhere
+        return {"coulomb": FRICTION["coulomb"]}
     extra = {
         "stribeck": {"stribeck": {middle: 0.35}},
         "spring": {"spring": {middle: 100.0}},
@@ -109,7 +112,9 @@ def one(config: Path, count: int, seed: int, truth: str) -> tuple[list[str], boo
     joints = report.joints
     truth_terms = {(e, j) for j, names in declared.items() for e in names}
     extra = [t.label(joints) for t in report.selection.terms if (t.effect, t.where(joints)) not in truth_terms]
-    found = truth == "friction" or any(t.effect == truth and t.where(joints) == middle for t in report.selection.terms)
+    found = truth in ("friction", "coulomb") or any(
+        t.effect == truth and t.where(joints) == middle for t in report.selection.terms
+    )
     return extra, found, report.mean(report.relative_after) / floor.mean(floor.relative_after), wall
 
 
@@ -118,7 +123,7 @@ def main() -> None:
     parser.add_argument("config", type=Path)
     parser.add_argument("--recordings", type=int, nargs="+", default=[4, 6, 8])
     parser.add_argument("--seeds", type=int, nargs="+", default=list(range(20)))
-    parser.add_argument("--truth", choices=["friction", "stribeck", "spring"], default="friction")
+    parser.add_argument("--truth", choices=["friction", "coulomb", "stribeck", "spring"], default="friction")
     args = parser.parse_args()
     for count in args.recordings:
         rows = []
