@@ -249,6 +249,16 @@ class StepwiseSearch:
         """The terms of ``terms`` a removal may take: added, and no other term requires them."""
         return [m[1] for m in self.moves(terms) if m[0] == "remove"]
 
+    def _by_estimate(
+        self, search: Search, move: str, term: Term, after: list[Term], before: tuple, ratio: float
+    ) -> tuple[list[Term], tuple]:
+        """``after`` and its score, the ``move`` of ``term`` from the model scored ``before`` a step of
+        ``search`` judged by the term's estimate (``ratio`` standard deviations from zero), not the folds."""
+        value = self.score(after)
+        search.steps.append(Step(move, term, after, value[0], before[0], [], clear_of_zero=ratio))
+        search.objective = self.objective(after, value)
+        return after, value
+
     def _restore(self, search: Search, terms: list[Term], score: tuple) -> tuple[list[Term], tuple]:
         """The end ``terms`` (scored ``score``) with the friction a real joint most likely has
         (:data:`LIKELY_FRICTION`) added back where the search left it out and its estimate, added to the
@@ -262,11 +272,8 @@ class StepwiseSearch:
             term, ratio = max(ratios.items(), key=lambda item: item[1], default=(None, 0.0))
             if ratio < CLEAR:
                 break
-            after = terms + [term]
-            value = self.score(after)
-            search.steps.append(Step("add", term, after, value[0], score[0], [], clear_of_zero=ratio))
-            terms, score, restored = after, value, restored + 1
-            search.objective = self.objective(terms, score)
+            terms, score = self._by_estimate(search, "add", term, terms + [term], score, ratio)
+            restored += 1
         if restored:
             search.stop += (
                 f"; then {restored} friction term{'s' * (restored > 1)} the folds left out added back, whose "
@@ -283,11 +290,8 @@ class StepwiseSearch:
             term, ratio = min(self.clear(terms, removable).items(), key=lambda item: item[1])
             if ratio >= CLEAR:
                 break
-            after = [t for t in terms if t != term]
-            value = self.score(after)
-            search.steps.append(Step("remove", term, after, value[0], score[0], [], clear_of_zero=ratio))
-            terms, score, removed = after, value, removed + 1
-            search.objective = self.objective(terms, score)
+            terms, score = self._by_estimate(search, "remove", term, [t for t in terms if t != term], score, ratio)
+            removed += 1
         if removed:
             search.stop += (
                 f"; then {removed} added term{'s' * (removed > 1)} removed whose estimate the report could not tell "
